@@ -1,0 +1,30 @@
+# SPDX-License-Identifier: Apache-2.0
+# The two commands of the README: `make render` and `make test`.
+BUILD ?= build
+JOBS ?= $(shell nproc)
+CAMBIUM = $(BUILD)/src/app/cambium
+DEFAULT = scenes/default
+
+.PHONY: setup build render test clean
+
+setup:
+	@bash scripts/setup.sh
+
+build: setup
+	@echo "build: configuring $(BUILD) (Release)"
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release > $(BUILD).configure.log 2>&1 || { cat $(BUILD).configure.log; exit 1; }
+	@echo "build: compiling with $(JOBS) jobs"
+	@cmake --build $(BUILD) --parallel $(JOBS)
+
+render: build
+	@mkdir -p out
+	@echo "render: $(DEFAULT) -> out/default.png, out/default.exr"
+	@cd $(DEFAULT) && $(CURDIR)/$(CAMBIUM) -M plant.mat -o $(CURDIR)/out/default.png \
+		-o $(CURDIR)/out/default.exr plant.l plant.v
+
+test: build
+	@echo "test: running the ctest suite"
+	@ctest --test-dir $(BUILD) --output-on-failure --parallel $(JOBS)
+
+clean:
+	rm -rf $(BUILD) $(BUILD).configure.log out

@@ -1,0 +1,204 @@
+// SPDX-License-Identifier: Apache-2.0
+// Reading cpfg's small text formats: bounded file reads, comment removal, value tokens.
+#include "geom/text_input.h"
+
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+
+namespace cambium::geom {
+
+namespace {
+std::uintmax_t checked_size(const std::filesystem::path& file, const char* what,
+                            std::uintmax_t max_bytes)
+{
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec))
+        throw Error(FileLoc{file.string()}, std::string("cannot open ") + what + ": no such file");
+    std::uintmax_t size = std::filesystem::file_size(file, ec);
+    if (ec)
+        throw Error(FileLoc{file.string()}, std::string("cannot read ") + what);
+    if (size > max_bytes)
+        throw Error(FileLoc{file.string()}, std::string(what) + " is too large (" +
+                                                std::to_string(size) + " bytes; the limit is " +
+                                                std::to_string(max_bytes) + ")");
+    return size;
+}
+}  // namespace
+
+std::string read_text_file(const std::filesystem::path& file, const char* what)
+{
+    checked_size(file, what, max_text_file_bytes);
+    std::ifstream in(file, std::ios::binary);
+    if (!in)
+        throw Error(FileLoc{file.string()}, std::string("cannot open ") + what);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+std::vector<unsigned char> read_binary_file(const std::filesystem::path& file, const char* what,
+                                            std::uintmax_t max_bytes)
+{
+    std::uintmax_t size = checked_size(file, what, max_bytes);
+    std::ifstream in(file, std::ios::binary);
+    if (!in)
+        throw Error(FileLoc{file.string()}, std::string("cannot open ") + what);
+    std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
+    in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(size));
+    if (!in)
+        throw Error(FileLoc{file.string()}, std::string("cannot read ") + what);
+    return bytes;
+}
+
+std::vector<SourceLine> split_lines_without_comments(std::string_view text)
+{
+    std::vector<SourceLine> lines;
+    std::string current;
+    int number = 1;
+    bool in_block = false;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        char c = text[i];
+        if (c == '\n') {
+            lines.push_back({number++, current});
+            current.clear();
+            continue;
+        }
+        if (in_block) {
+            if (c == '*' && i + 1 < text.size() && text[i + 1] == '/') {
+                in_block = false;
+                current += "  ";
+                ++i;
+            } else {
+                current += ' ';
+            }
+        } else if (c == '/' && i + 1 < text.size() && text[i + 1] == '*') {
+            in_block = true;
+            current += "  ";
+            ++i;
+        } else if (c == '/' && i + 1 < text.size() && text[i + 1] == '/') {
+            while (i + 1 < text.size() && text[i + 1] != '\n')
+                ++i;
+        } else {
+            current += c;
+        }
+    }
+    if (!current.empty())
+        lines.push_back({number, current});
+    return lines;
+}
+
+std::string normalize_command_name(std::string_view name)
+{
+    std::string out;
+    bool space = false;
+    for (char c : name) {
+        if (std::isspace(static_cast<unsigned char>(c))) {
+            space = !out.empty();
+            continue;
+        }
+        if (space)
+            out += ' ';
+        space = false;
+        out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    }
+    return out;
+}
+
+ValueReader::ValueReader(std::string_view line, std::size_t start, FileLoc line_loc)
+    : m_line(line), m_pos(start), m_loc(std::move(line_loc))
+{
+}
+
+void ValueReader::skip_separators()
+{
+    while (m_pos < m_line.size() &&
+           (std::isspace(static_cast<unsigned char>(m_line[m_pos])) || m_line[m_pos] == ','))
+        ++m_pos;
+}
+
+bool ValueReader::at_end()
+{
+    skip_separators();
+    return m_pos >= m_line.size();
+}
+
+FileLoc ValueReader::loc()
+{
+    skip_separators();
+    FileLoc l = m_loc;
+    l.column = static_cast<int>(m_pos) + 1;
+    return l;
+}
+
+Error ValueReader::error(const std::string& message) { return Error(loc(), message); }
+
+double ValueReader::number()
+{
+    if (at_end())
+        throw error("expected a number");
+    std::string token;
+    std::size_t end = m_pos;
+    while (end < m_line.size() && !std::isspace(static_cast<unsigned char>(m_line[end])) &&
+           m_line[end] != ',')
+        ++end;
+    token = std::string(m_line.substr(m_pos, end - m_pos));
+    char* stop = nullptr;
+    errno = 0;
+    double value = std::strtod(token.c_str(), &stop);
+    if (stop == token.c_str() || errno == ERANGE || !std::isfinite(value))
+        throw error("expected a number, found '" + token + "'");
+    // "0.5abc": consume only the numeric prefix and let the next read complain.
+    m_pos += static_cast<std::size_t>(stop - token.c_str());
+    return value;
+}
+
+int ValueReader::integer()
+{
+    FileLoc where = loc();
+    double value = number();
+    if (value != std::floor(value) || std::fabs(value) > 1e9)
+        throw Error(where, "expected an integer");
+    return static_cast<int>(value);
+}
+
+std::string ValueReader::word(const char* what)
+{
+    if (at_end())
+        throw error(std::string("expected ") + what);
+    std::string out;
+    while (m_pos < m_line.size()) {
+        char c = m_line[m_pos];
+        if (!std::isalnum(static_cast<unsigned char>(c)) && c != '.' && c != '_' && c != '-' &&
+            c != '%')
+            break;
+        out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        ++m_pos;
+    }
+    if (out.empty())
+        throw error(std::string("expected ") + what);
+    return out;
+}
+
+char ValueReader::subcommand(const char* what)
+{
+    if (at_end() || !std::isalpha(static_cast<unsigned char>(m_line[m_pos])))
+        throw error(std::string("expected ") + what);
+    char c = static_cast<char>(std::toupper(static_cast<unsigned char>(m_line[m_pos++])));
+    if (m_pos < m_line.size() && m_line[m_pos] == ':')
+        ++m_pos;
+    return c;
+}
+
+void ValueReader::expect_label(const std::string& label)
+{
+    FileLoc where = loc();
+    std::string found = at_end() ? std::string() : word(("'" + label + ":'").c_str());
+    if (found != label)
+        throw Error(where, "expected '" + label + ":'");
+    if (m_pos < m_line.size() && m_line[m_pos] == ':')
+        ++m_pos;
+}
+
+}  // namespace cambium::geom

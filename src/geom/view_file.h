@@ -1,0 +1,59 @@
+// SPDX-License-Identifier: Apache-2.0
+// The view file (.v, CPFG manual 5.2): every setting with cpfg's default.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "base/diagnostics.h"
+#include "geom/scene.h"
+
+namespace cambium::geom {
+
+/// How F and G are drawn (`line style:`, or the suffix of `initial line width:`).
+enum class LineStyle { pixel, polygon, cylinder };
+
+/// A view-file command that Cambium reads but does not use yet, kept with its
+/// location so later stages can find it.
+struct ViewCommand {
+    std::string name;   ///< lower-case, without the colon: "contour", "tropism"...
+    std::string value;  ///< the text after the colon, comments removed
+    FileLoc loc;
+};
+
+/// The parsed view file. Defaults are cpfg's.
+struct ViewFile {
+    std::filesystem::path path;  ///< where it was read from (files it names are relative to it)
+
+    // Turtle parameters (5.2.1)
+    double angle_increment_deg = 45;
+    double initial_line_width = 1;
+    double line_width_increment = 0;
+    LineStyle line_style = LineStyle::pixel;
+    int initial_color = 128;
+    int initial_back_color = 128;
+    int color_increment = 1;
+    int back_color_increment = 1;
+    double initial_scale = 1;
+    double scale_multiplier = 1;
+    bool tapered_lines = true;
+
+    // View (5.2.2) and lights (5.2.5, 5.2.6)
+    View view;
+    std::vector<Light> lights;     ///< `light:` commands, in order
+    std::optional<Vec3> light_direction;  ///< colormap mode `light direction:`
+
+    /// Recognised commands whose meaning is implemented later (surfaces, tropisms...).
+    std::vector<ViewCommand> deferred;
+};
+
+/// Reads a view file. Unknown commands are a warning naming file and line (as in
+/// cpfg); malformed values of known commands are an Error naming line and column.
+ViewFile read_view_file(const std::filesystem::path& file);
+
+/// The same from text (tests); `file_name` is used in messages.
+ViewFile parse_view_file(std::string_view text, const std::string& file_name);
+
+}  // namespace cambium::geom

@@ -1,0 +1,373 @@
+// SPDX-License-Identifier: Apache-2.0
+// Applies productions to a ModuleString step by step, as cpfg's generator does.
+#include "lsys/deriver.h"
+
+#include <algorithm>
+#include <array>
+
+namespace cambium::lsys {
+
+namespace {
+
+int symbol_or_none(const SymbolTable& symbols, std::string_view name)
+{
+    return symbols.find(name);
+}
+
+}  // namespace
+
+Deriver::Deriver(const Program& program, DeriveLimits limits)
+    : m_program(program), m_limits(limits)
+{
+    const SymbolTable& symbols = program.symbols;
+    m_bracket_open = symbol_or_none(symbols, "[");
+    m_bracket_close = symbol_or_none(symbols, "]");
+    m_cut = symbol_or_none(symbols, "%");
+    m_sub_start = symbol_or_none(symbols, "?");
+    m_sub_end = symbol_or_none(symbols, "$");
+    m_equals = symbol_or_none(symbols, "=");
+
+    // Ignore tables: consider: ignores everything not listed
+    for (const auto& ls : program.lsystems) {
+        std::vector<char> ignored(symbols.size(), ls.has_consider ? 1 : 0);
+        for (SymbolId s : ls.ignore)
+            ignored[s] = 1;
+        for (SymbolId s : ls.consider)
+            ignored[s] = 0;
+        m_ignored.push_back(std::move(ignored));
+    }
+    int frame = 0;
+    for (const auto& ls : program.lsystems)
+        for (const ProductionSet* set : {&ls.productions, &ls.decomposition})
+            for (const auto& p : set->productions)
+                frame = std::max(frame, p.frame_size);
+    m_frame.assign(static_cast<std::size_t>(frame) + 1, 0.0);
+
+    m_runtime.globals.assign(program.global_names.size(), 0.0);
+    for (const auto& a : program.arrays)
+        m_runtime.arrays.push_back(a.initial);
+    m_runtime.strings = &program.strings;
+
+    const LSystemDefinition& main = program.lsystems.front();
+    if (main.derivation_length)
+        m_runtime.derivation_length =
+            static_cast<int>(evaluate(*main.derivation_length, m_frame, m_runtime));
+    if (main.seed) {
+        m_stochastic_mode = true;
+        long seed = static_cast<long>(evaluate(*main.seed, m_frame, m_runtime));
+        // Only the production choice is seeded: ran() and friends keep their own
+        // state until the L-system calls srand(), as in cpfg
+        m_stochastic.seed(seed);
+    }
+    evaluate(program.start_block, m_frame, m_runtime);
+    for (const auto& m : main.axiom)
+        append_evaluated(m, m_string);
+    decompose();
+}
+
+int Deriver::lsystem_index(double id) const
+{
+    for (std::size_t i = 0; i < m_program.lsystems.size(); ++i)
+        if (m_program.lsystems[i].id == static_cast<int>(id))
+            return static_cast<int>(i);
+    return -1;
+}
+
+void Deriver::index(const ModuleString& s, Indexed& out) const
+{
+    out.string = &s;
+    out.offsets.resize(s.size() + 1);
+    out.partner.assign(s.size(), 0);
+    std::vector<std::uint32_t> open;
+    std::uint32_t offset = 0;
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        out.offsets[i] = offset;
+        offset += static_cast<std::uint32_t>(s.param_count(i));
+        int sym = s.symbol(i);
+        if (sym == m_bracket_open) {
+            open.push_back(static_cast<std::uint32_t>(i));
+        } else if (sym == m_bracket_close && !open.empty()) {
+            out.partner[i] = open.back();
+            out.partner[open.back()] = static_cast<std::uint32_t>(i);
+            open.pop_back();
+        }
+    }
+    out.offsets[s.size()] = offset;
+}
+
+void Deriver::step()
+{
+    evaluate(m_program.start_each_block, m_frame, m_runtime);
+    index(m_string, m_indexed);
+    m_next.clear();
+    m_next.reserve(m_string.size(), m_string.param_total());
+    rewrite(m_indexed, m_next, false);
+    std::swap(m_string, m_next);
+    decompose();
+    evaluate(m_program.end_each_block, m_frame, m_runtime);
+    ++m_steps;
+}
+
+void Deriver::finish() { evaluate(m_program.end_block, m_frame, m_runtime); }
+
+void Deriver::decompose()
+{
+    const ProductionSet& set = m_program.lsystems.front().decomposition;
+    if (set.productions.empty())
+        return;
+    int depth = set.max_depth ? static_cast<int>(evaluate(*set.max_depth, m_frame, m_runtime)) : 1;
+    for (int pass = 0; pass < depth; ++pass) {
+        index(m_string, m_indexed);
+        m_next.clear();
+        std::size_t applied = rewrite(m_indexed, m_next, true);
+        std::swap(m_string, m_next);
+        if (applied == 0)
+            break;
+    }
+}
+
+std::size_t Deriver::rewrite(const Indexed& src, ModuleString& dst, bool decomposition)
+{
+    const ModuleString& s = *src.string;
+    m_lsystem_stack.assign(1, 0);
+    std::size_t applied = 0;
+    for (std::size_t i = 0; i < s.size();) {
+        const LSystemDefinition& ls =
+            m_program.lsystems[static_cast<std::size_t>(m_lsystem_stack.back())];
+        const ProductionSet& set = decomposition ? ls.decomposition : ls.productions;
+        int sym = s.symbol(i);
+        std::size_t consumed = 1;
+        if (apply_first_match(set, ls, src, i, dst, consumed)) {
+            ++applied;
+        } else if (sym == m_cut && !decomposition) {
+            consumed = cut_end(src, i) - i;
+        } else {
+            dst.append(s.symbol(i), std::span<const float>(s.param_data() + src.offsets[i],
+                                                           s.param_count(i)));
+        }
+        // Sub-L-system switching: ?(id) enters, $ returns
+        if (sym == m_sub_start && s.param_count(i) > 0) {
+            int idx = lsystem_index(s.param_data()[src.offsets[i]]);
+            m_lsystem_stack.push_back(idx >= 0 ? idx : m_lsystem_stack.back());
+        } else if (sym == m_sub_end && m_lsystem_stack.size() > 1) {
+            m_lsystem_stack.pop_back();
+        }
+        i += consumed;
+        check_size(dst);
+    }
+    return applied;
+}
+
+std::size_t Deriver::cut_end(const Indexed& src, std::size_t i) const
+{
+    const ModuleString& s = *src.string;
+    for (std::size_t k = i + 1; k < s.size(); ++k) {
+        if (s.symbol(k) == m_bracket_open)
+            k = src.partner[k];
+        else if (s.symbol(k) == m_bracket_close)
+            return k;
+    }
+    return s.size();
+}
+
+void Deriver::check_size(const ModuleString& s) const
+{
+    if (s.size() > m_limits.max_modules)
+        throw Error(FileLoc{m_program.file_name, 0, 0},
+                    "the string grew past " + std::to_string(m_limits.max_modules) +
+                        " modules in step " + std::to_string(m_steps + 1) +
+                        "; reduce the derivation length or raise the limit");
+}
+
+bool Deriver::apply_first_match(const ProductionSet& set, const LSystemDefinition& ls,
+                                const Indexed& src, std::size_t i, ModuleString& dst,
+                                std::size_t& consumed)
+{
+    if (ls.seed && &set == &ls.productions)
+        return apply_stochastic(set, ls, src, i, dst, consumed);
+    const auto* candidates = set.candidates(src.string->symbol(i));
+    if (!candidates)
+        return false;
+    for (std::uint32_t index : *candidates) {
+        const Production& p = set.productions[index];
+        if (match(p, ls, src, i) && condition_holds(p)) {
+            run_post_block(p);
+            produce(p, dst);
+            consumed = p.predecessor.size();
+            return true;
+        }
+    }
+    return false;
+}
+
+bool Deriver::apply_stochastic(const ProductionSet& set, const LSystemDefinition& ls,
+                               const Indexed& src, std::size_t i, ModuleString& dst,
+                               std::size_t& consumed)
+{
+    // cpfg collects every applicable production with its probability, summed in
+    // single precision, then draws once per module, even where nothing applies
+    m_matches.clear();
+    m_match_frames.clear();
+    m_match_probs.clear();
+    float total = 0;
+    if (const auto* candidates = set.candidates(src.string->symbol(i))) {
+        for (std::uint32_t index : *candidates) {
+            const Production& p = set.productions[index];
+            if (!match(p, ls, src, i) || !condition_holds(p))
+                continue;
+            float prob = p.probability
+                             ? static_cast<float>(evaluate(*p.probability, m_frame, m_runtime))
+                             : 1.0f;
+            total += prob;
+            m_matches.push_back(index);
+            m_match_probs.push_back(prob);
+            // each cpfg production keeps its own variables: save this one's bindings
+            m_match_frames.insert(m_match_frames.end(), m_frame.begin(),
+                                  m_frame.begin() + p.frame_size);
+        }
+    }
+    auto scaled = static_cast<float>(total * m_stochastic.next_double());
+    std::size_t frame_offset = 0;
+    for (std::size_t k = 0; k < m_matches.size(); ++k) {
+        const Production& p = set.productions[m_matches[k]];
+        scaled -= m_match_probs[k];
+        if (scaled <= 0) {
+            std::copy_n(m_match_frames.begin() + static_cast<std::ptrdiff_t>(frame_offset),
+                        p.frame_size, m_frame.begin());
+            run_post_block(p);
+            produce(p, dst);
+            consumed = p.predecessor.size();
+            return true;
+        }
+        frame_offset += static_cast<std::size_t>(p.frame_size);
+    }
+    return false;
+}
+
+bool Deriver::bind(const FormalModule& f, const Indexed& src, std::size_t k)
+{
+    const ModuleString& s = *src.string;
+    if (s.symbol(k) != f.symbol || s.param_count(k) != f.param_slots.size())
+        return false;
+    const float* params = s.param_data() + src.offsets[k];
+    for (std::size_t j = 0; j < f.param_slots.size(); ++j)
+        m_frame[static_cast<std::size_t>(f.param_slots[j])] = params[j];
+    return true;
+}
+
+bool Deriver::match(const Production& p, const LSystemDefinition& ls, const Indexed& src,
+                    std::size_t i)
+{
+    const ModuleString& s = *src.string;
+    if (i + p.predecessor.size() > s.size())
+        return false;
+    std::fill(m_frame.begin(), m_frame.begin() + p.frame_size, 0.0);
+    for (std::size_t k = 0; k < p.predecessor.size(); ++k)
+        if (!bind(p.predecessor[k], src, i + k))
+            return false;
+    const auto& ignored = m_ignored[static_cast<std::size_t>(&ls - m_program.lsystems.data())];
+    return match_left(p, ignored, src, i) &&
+           match_right(p, ignored, src, i + p.predecessor.size());
+}
+
+bool Deriver::match_left(const Production& p, const std::vector<char>& ignored,
+                         const Indexed& src, std::size_t i)
+{
+    const ModuleString& s = *src.string;
+    std::size_t k = i;
+    for (auto f = p.left_context.rbegin(); f != p.left_context.rend(); ++f) {
+        for (;;) {
+            if (k == 0)
+                return false;
+            --k;
+            int sym = s.symbol(k);
+            if (sym == m_bracket_close)
+                k = src.partner[k];  // skip a whole branch to the left
+            else if (sym == m_bracket_open || (sym < static_cast<int>(ignored.size()) && ignored[static_cast<std::size_t>(sym)]))
+                continue;            // into the parent branch, or ignored
+            else
+                break;
+        }
+        if (!bind(*f, src, k))
+            return false;
+    }
+    return true;
+}
+
+bool Deriver::match_right(const Production& p, const std::vector<char>& ignored,
+                          const Indexed& src, std::size_t i)
+{
+    // cpfg's RconDiff: '=' jumps to the end of the current branch; every other context
+    // module matches literally after skipping ignored modules and, unless the context
+    // names '[', whole lateral branches. Ignoring comes first, so a '[' that consider:
+    // leaves out is stepped into rather than skipped.
+    const ModuleString& s = *src.string;
+    std::size_t k = i;
+    for (const FormalModule& f : p.right_context) {
+        if (f.symbol == m_equals) {
+            k = branch_end(src, k);
+            continue;
+        }
+        for (;;) {
+            if (k >= s.size())
+                return false;
+            int sym = s.symbol(k);
+            if (sym < static_cast<int>(ignored.size()) && ignored[static_cast<std::size_t>(sym)])
+                ++k;
+            else if (sym == m_bracket_open && f.symbol != m_bracket_open)
+                k = src.partner[k] > k ? src.partner[k] + 1 : s.size();
+            else
+                break;
+        }
+        if (!bind(f, src, k))
+            return false;
+        ++k;
+    }
+    return true;
+}
+
+std::size_t Deriver::branch_end(const Indexed& src, std::size_t k) const
+{
+    const ModuleString& s = *src.string;
+    for (; k < s.size(); ++k) {
+        int sym = s.symbol(k);
+        if (sym == m_bracket_close)
+            return k;
+        if (sym == m_bracket_open) {
+            if (src.partner[k] <= k)
+                return s.size();
+            k = src.partner[k];
+        }
+    }
+    return s.size();
+}
+
+bool Deriver::condition_holds(const Production& p)
+{
+    std::span<double> frame(m_frame);
+    if (!p.pre_block.empty())
+        evaluate(p.pre_block, frame, m_runtime);
+    return !p.condition || evaluate(*p.condition, frame, m_runtime) != 0;
+}
+
+void Deriver::run_post_block(const Production& p)
+{
+    if (!p.post_block.empty())
+        evaluate(p.post_block, std::span<double>(m_frame), m_runtime);
+}
+
+void Deriver::produce(const Production& p, ModuleString& dst)
+{
+    for (const auto& m : p.successor)
+        append_evaluated(m, dst);
+}
+
+void Deriver::append_evaluated(const ModuleTemplate& m, ModuleString& dst)
+{
+    std::array<float, ModuleString::max_params> values;
+    for (std::size_t j = 0; j < m.params.size(); ++j)
+        values[j] = static_cast<float>(evaluate(m.params[j], m_frame, m_runtime));
+    dst.append(m.symbol, std::span<const float>(values.data(), m.params.size()));
+}
+
+}  // namespace cambium::lsys

@@ -1,0 +1,81 @@
+// SPDX-License-Identifier: Apache-2.0
+// Applies productions to a ModuleString step by step, as cpfg's generator does.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "lsys/program.h"
+
+namespace cambium::lsys {
+
+struct DeriveLimits {
+    std::size_t max_modules = 100'000'000;  ///< string growth limit
+};
+
+/// One derivation run: global variables, random generators and the current string.
+/// A Deriver is created from a Program, runs the Start block and builds the axiom; each
+/// step() rewrites the string once (then decomposes it); finish() runs the End block.
+class Deriver {
+public:
+    Deriver(const Program& program, DeriveLimits limits = {});
+
+    const ModuleString& string() const { return m_string; }
+    int steps_done() const { return m_steps; }
+    int derivation_length() const { return m_runtime.derivation_length; }
+    bool stop_requested() const { return m_runtime.stop_requested; }
+    void step();
+    void finish();
+
+private:
+    /// A string with the lookup tables context matching needs.
+    struct Indexed {
+        const ModuleString* string = nullptr;
+        std::vector<std::uint32_t> offsets;   ///< first parameter of each module
+        std::vector<std::uint32_t> partner;   ///< matching bracket of each '[' / ']'
+    };
+    void index(const ModuleString& s, Indexed& out) const;
+    std::size_t rewrite(const Indexed& src, ModuleString& dst, bool decomposition);
+    bool apply_first_match(const ProductionSet& set, const LSystemDefinition& ls,
+                           const Indexed& src, std::size_t i, ModuleString& dst,
+                           std::size_t& consumed);
+    bool apply_stochastic(const ProductionSet& set, const LSystemDefinition& ls,
+                          const Indexed& src, std::size_t i, ModuleString& dst,
+                          std::size_t& consumed);
+    void run_post_block(const Production& p);
+    std::size_t branch_end(const Indexed& src, std::size_t k) const;
+    bool match(const Production& p, const LSystemDefinition& ls, const Indexed& src,
+               std::size_t i);
+    bool match_left(const Production& p, const std::vector<char>& ignored, const Indexed& src,
+                    std::size_t i);
+    bool match_right(const Production& p, const std::vector<char>& ignored, const Indexed& src,
+                     std::size_t i);
+    bool bind(const FormalModule& f, const Indexed& src, std::size_t k);
+    bool condition_holds(const Production& p);
+    void produce(const Production& p, ModuleString& dst);
+    void append_evaluated(const ModuleTemplate& m, ModuleString& dst);
+    std::size_t cut_end(const Indexed& src, std::size_t i) const;
+    void decompose();
+    void check_size(const ModuleString& s) const;
+    int lsystem_index(double id) const;
+
+    const Program& m_program;
+    DeriveLimits m_limits;
+    Runtime m_runtime;
+    Rand48 m_stochastic;
+    bool m_stochastic_mode = false;
+    ModuleString m_string, m_next;
+    Indexed m_indexed;
+    std::vector<double> m_frame;
+    std::vector<std::vector<char>> m_ignored;  ///< per L-system, by symbol
+    std::vector<int> m_lsystem_stack;
+    std::vector<std::uint32_t> m_matches;     ///< stochastic candidates
+    std::vector<float> m_match_probs;         ///< their probabilities
+    std::vector<double> m_match_frames;       ///< their bound variables, concatenated
+    int m_steps = 0;
+    int m_bracket_open = -1, m_bracket_close = -1, m_cut = -1, m_sub_start = -1, m_sub_end = -1;
+    int m_equals = -1;
+};
+
+}  // namespace cambium::lsys

@@ -1,0 +1,274 @@
+// SPDX-License-Identifier: Apache-2.0
+// Compiled expressions and statements: a small stack bytecode evaluated without allocation.
+#include "lsys/expression.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+namespace cambium::lsys {
+
+namespace {
+
+constexpr double to_radians = std::numbers::pi / 180.0;
+constexpr int max_stack_depth = 256;
+
+constexpr std::array<FunctionInfo, 28> functions = {{
+    {"sin", Function::Sin, 1},     {"cos", Function::Cos, 1},
+    {"tan", Function::Tan, 1},     {"asin", Function::Asin, 1},
+    {"acos", Function::Acos, 1},   {"atan", Function::Atan, 1},
+    {"atan2", Function::Atan2, 2}, {"exp", Function::Exp, 1},
+    {"log", Function::Log, 1},     {"sqrt", Function::Sqrt, 1},
+    {"fabs", Function::Fabs, 1},   {"floor", Function::Floor, 1},
+    {"ceil", Function::Ceil, 1},   {"trunc", Function::Trunc, 1},
+    {"sign", Function::Sign, 1},   {"ran", Function::Ran, 1},
+    {"nran", Function::Nran, 2},   {"bran", Function::Bran, 2},
+    {"biran", Function::Biran, 2}, {"srand", Function::Srand, 1},
+    {"stop", Function::Stop, 1},   {"GetDerivationLength", Function::GetDerivationLength, 1},
+    {"SetDerivationLength", Function::SetDerivationLength, 1},
+    {"func", Function::Func, 2},         {"curveX", Function::Func, -1},
+    {"curveY", Function::Func, -1},      {"curveZ", Function::Func, -1},
+    {"curveGAL", Function::Func, -1},
+}};
+
+/// nran: the polar (Marsaglia) method, which makes two normal deviates per pair of
+/// draws and caches the second one, as cpfg's nrand does. cpfg starts with a cached value
+/// of 0 that srand() clears, so the first nran before any srand returns the mean.
+double normal_random(Runtime& rt, double mean, double sqrt_variance)
+{
+    if (rt.normal_cached) {
+        rt.normal_cached = false;
+        return rt.normal_spare * sqrt_variance + mean;
+    }
+    double v1, v2, rsq;
+    do {
+        v1 = 2.0 * rt.function_random.next_double() - 1.0;
+        v2 = 2.0 * rt.function_random.next_double() - 1.0;
+        rsq = v1 * v1 + v2 * v2;
+    } while (rsq >= 1.0 || rsq == 0.0);
+    double fac = std::sqrt(-2.0 * std::log(rsq) / rsq);
+    rt.normal_spare = v1 * fac;
+    rt.normal_cached = true;
+    return v2 * fac * sqrt_variance + mean;
+}
+
+/// bran: Cheng's rejection algorithm for the beta distribution, as cpfg's brand.
+double beta_random(Rand48& r, double a, double b)
+{
+    double s = a + b;
+    double lambda = std::min(a, b) <= 1 ? std::min(a, b) : std::sqrt((2 * a * b - s) / (s - 2));
+    double u = a + lambda;
+    double u1, u2, v, ym;
+    do {
+        do
+            u1 = r.next_double();
+        while (u1 == 0);
+        do
+            u2 = r.next_double();
+        while (u2 == 0);
+        v = (1 / lambda) * std::log(u1 / (1 - u1));
+        ym = a * std::exp(v);
+    } while (s * std::log(s / (b + ym)) + u * v - std::log(4.0) < std::log(u1 * u1 * u2));
+    return ym / (b + ym);
+}
+
+double call(Function f, const double* a, Runtime& rt)
+{
+    switch (f) {
+    case Function::Sin: return std::sin(a[0] * to_radians);
+    case Function::Cos: return std::cos(a[0] * to_radians);
+    case Function::Tan: return std::tan(a[0] * to_radians);
+    case Function::Asin: return std::asin(a[0]) / to_radians;
+    case Function::Acos: return std::acos(a[0]) / to_radians;
+    case Function::Atan: return std::atan(a[0]) / to_radians;
+    // cpfg pops the arguments in reverse: its atan2(a, b) is C's atan2(b, a)
+    case Function::Atan2: return std::atan2(a[1], a[0]) / to_radians;
+    case Function::Exp: return std::exp(a[0]);
+    case Function::Log: return std::log(a[0]);
+    case Function::Sqrt: return std::sqrt(a[0]);
+    case Function::Fabs: return std::fabs(a[0]);
+    case Function::Floor: return std::floor(a[0]);
+    case Function::Ceil: return std::ceil(a[0]);
+    // cpfg's trunc rounds to the nearest integer (floor(x + 0.5)), unlike C's
+    case Function::Trunc: return std::floor(a[0] + 0.5);
+    case Function::Sign: return a[0] > 0 ? 1.0 : a[0] < 0 ? -1.0 : 0.0;
+    case Function::Ran: return a[0] * rt.function_random.next_double();
+    case Function::Nran: return normal_random(rt, a[0], a[1]);
+    case Function::Bran: return beta_random(rt.function_random, a[0], a[1]);
+    case Function::Biran: {
+        int n = static_cast<int>(a[0]);
+        int count = 0;
+        for (int i = 0; i < n; ++i)
+            count += rt.function_random.next_double() <= a[1] ? 1 : 0;
+        return count;
+    }
+    case Function::Srand:
+        rt.function_random.seed(static_cast<long>(a[0]));
+        rt.normal_cached = false;
+        return 0;
+    case Function::Stop: rt.stop_requested = true; return 0;
+    case Function::GetDerivationLength: return rt.derivation_length;
+    case Function::SetDerivationLength:
+        rt.derivation_length = static_cast<int>(a[0]);
+        return 0;
+    case Function::Func: return 0;  // function sets live in geom; not bound here
+    }
+    return 0;
+}
+
+/// printf with only %f/%g/%e-style conversions, each given one double.
+void print_formatted(const std::string& format, const double* args, int count)
+{
+    std::string out;
+    int used = 0;
+    for (std::size_t i = 0; i < format.size(); ++i) {
+        if (format[i] != '%' || i + 1 >= format.size()) {
+            out += format[i];
+            continue;
+        }
+        std::size_t j = i + 1;
+        while (j < format.size() && std::string_view("0123456789.-+ #l").find(format[j]) !=
+                                        std::string_view::npos)
+            ++j;
+        if (j >= format.size())
+            break;
+        std::string spec = format.substr(i, j - i + 1);
+        char buf[128];
+        if (format[j] == '%')
+            out += '%';
+        else if (std::string_view("dic").find(format[j]) != std::string_view::npos)
+            std::snprintf(buf, sizeof buf, (format.substr(i, j - i) + "d").c_str(),
+                          used < count ? static_cast<int>(args[used++]) : 0),
+                out += buf;
+        else
+            std::snprintf(buf, sizeof buf, spec.c_str(), used < count ? args[used++] : 0.0),
+                out += buf;
+        i = j;
+    }
+    std::fputs(out.c_str(), stdout);
+}
+
+double int_modulo(double a, double b)
+{
+    int divisor = static_cast<int>(b);
+    return divisor == 0 ? 0.0 : static_cast<double>(static_cast<int>(a) % divisor);
+}
+
+bool element_index(const ArrayValues& a, const double* idx, int n, std::size_t& flat)
+{
+    flat = 0;
+    for (int d = 0; d < n; ++d) {
+        int i = static_cast<int>(idx[d]);
+        int size = d < static_cast<int>(a.dims.size()) ? a.dims[static_cast<std::size_t>(d)] : 1;
+        if (i < 0 || i >= size)
+            return false;
+        flat = flat * static_cast<std::size_t>(size) + static_cast<std::size_t>(i);
+    }
+    return flat < a.values.size();
+}
+
+}  // namespace
+
+const FunctionInfo* find_function(std::string_view name)
+{
+    for (const auto& f : functions)
+        if (f.name == name)
+            return &f;
+    return nullptr;
+}
+
+double evaluate(const Code& code, std::span<double> frame, Runtime& rt)
+{
+    std::array<double, max_stack_depth> stack;
+    int sp = 0;
+    const Instr* instrs = code.instrs.data();
+    const std::size_t count = code.instrs.size();
+    for (std::size_t pc = 0; pc < count; ++pc) {
+        const Instr& in = instrs[pc];
+        switch (in.op) {
+        case Op::Const: stack[sp++] = in.value; break;
+        case Op::LoadLocal: stack[sp++] = frame[static_cast<std::size_t>(in.arg)]; break;
+        case Op::StoreLocal: frame[static_cast<std::size_t>(in.arg)] = stack[--sp]; break;
+        case Op::LoadGlobal: stack[sp++] = rt.globals[static_cast<std::size_t>(in.arg)]; break;
+        case Op::StoreGlobal: rt.globals[static_cast<std::size_t>(in.arg)] = stack[--sp]; break;
+        case Op::LoadElement: {
+            sp -= in.arg2;
+            std::size_t flat;
+            const auto& a = rt.arrays[static_cast<std::size_t>(in.arg)];
+            double v = element_index(a, &stack[sp], in.arg2, flat) ? a.values[flat] : 0.0;
+            stack[sp++] = v;
+            break;
+        }
+        case Op::StoreElement: {
+            double v = stack[--sp];
+            sp -= in.arg2;
+            std::size_t flat;
+            auto& a = rt.arrays[static_cast<std::size_t>(in.arg)];
+            if (element_index(a, &stack[sp], in.arg2, flat))
+                a.values[flat] = v;
+            break;
+        }
+        case Op::Neg: stack[sp - 1] = -stack[sp - 1]; break;
+        case Op::Not: stack[sp - 1] = stack[sp - 1] == 0 ? 1 : 0; break;
+        case Op::ToBool: stack[sp - 1] = stack[sp - 1] != 0 ? 1 : 0; break;
+#define CAMBIUM_BINARY(OPNAME, EXPR)          \
+    case Op::OPNAME: {                        \
+        double b = stack[--sp];               \
+        double a = stack[sp - 1];             \
+        stack[sp - 1] = (EXPR);               \
+        break;                                \
+    }
+        CAMBIUM_BINARY(Add, a + b)
+        CAMBIUM_BINARY(Sub, a - b)
+        CAMBIUM_BINARY(Mul, a * b)
+        // cpfg divides by 1 instead of 0 (with a warning) and takes % on ints
+        CAMBIUM_BINARY(Div, a / (b == 0.0 ? 1.0 : b))
+        CAMBIUM_BINARY(Mod, int_modulo(a, b))
+        CAMBIUM_BINARY(Pow, std::pow(a, b))
+        CAMBIUM_BINARY(Less, a < b ? 1.0 : 0.0)
+        CAMBIUM_BINARY(LessEqual, a <= b ? 1.0 : 0.0)
+        CAMBIUM_BINARY(Greater, a > b ? 1.0 : 0.0)
+        CAMBIUM_BINARY(GreaterEqual, a >= b ? 1.0 : 0.0)
+        CAMBIUM_BINARY(Equal, a == b ? 1.0 : 0.0)
+        CAMBIUM_BINARY(NotEqual, a != b ? 1.0 : 0.0)
+#undef CAMBIUM_BINARY
+        case Op::AndJump:
+            if (stack[sp - 1] == 0)
+                pc = static_cast<std::size_t>(in.arg) - 1;
+            else
+                --sp;
+            break;
+        case Op::OrJump:
+            if (stack[sp - 1] != 0) {
+                stack[sp - 1] = 1;
+                pc = static_cast<std::size_t>(in.arg) - 1;
+            } else {
+                --sp;
+            }
+            break;
+        case Op::Jump: pc = static_cast<std::size_t>(in.arg) - 1; break;
+        case Op::JumpIfFalse:
+            if (stack[--sp] == 0)
+                pc = static_cast<std::size_t>(in.arg) - 1;
+            break;
+        case Op::Pop: --sp; break;
+        case Op::Call:
+            sp -= in.arg2;
+            stack[sp] = call(static_cast<Function>(in.arg), &stack[sp], rt);
+            ++sp;
+            break;
+        case Op::Print:
+            sp -= in.arg2;
+            if (rt.strings)
+                print_formatted((*rt.strings)[static_cast<std::size_t>(in.arg)], &stack[sp],
+                                in.arg2);
+            stack[sp++] = 0;
+            break;
+        }
+    }
+    return sp > 0 ? stack[sp - 1] : 0.0;
+}
+
+}  // namespace cambium::lsys

@@ -1,0 +1,86 @@
+// SPDX-License-Identifier: Apache-2.0
+// Compiled expressions and statements: a small stack bytecode evaluated without allocation.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "lsys/random.h"
+
+namespace cambium::lsys {
+
+enum class Op : std::uint8_t {
+    Const,        ///< push value
+    LoadLocal,    ///< push frame[arg]
+    StoreLocal,   ///< frame[arg] = pop
+    LoadGlobal,   ///< push globals[arg]
+    StoreGlobal,  ///< globals[arg] = pop
+    LoadElement,  ///< pop arg2 indices, push array arg element
+    StoreElement, ///< pop value, pop arg2 indices, store into array arg
+    Neg, Not, Add, Sub, Mul, Div, Mod, Pow, Less, LessEqual, Greater, GreaterEqual, Equal,
+    NotEqual,
+    AndJump,      ///< if top is 0 jump to arg (keep it), else pop
+    OrJump,       ///< if top is not 0 jump to arg (keep 1), else pop
+    ToBool,
+    Jump,         ///< to arg
+    JumpIfFalse,  ///< pop; jump to arg when 0
+    Pop,
+    Call,         ///< function arg with arg2 arguments
+    Print,        ///< printf with format string arg and arg2 arguments; pushes 0
+};
+
+/// Predefined functions of cpfg section 5.1.5 (the ones evaluated here).
+enum class Function : std::uint8_t {
+    Sin, Cos, Tan, Asin, Acos, Atan, Atan2, Exp, Log, Sqrt, Fabs, Floor, Ceil, Trunc, Sign,
+    Ran, Nran, Bran, Biran, Srand, Stop, GetDerivationLength, SetDerivationLength, Func,
+};
+
+struct Instr {
+    Op op;
+    std::uint8_t arg2 = 0;
+    std::int32_t arg = 0;
+    double value = 0;
+};
+
+/// One compiled expression or statement list.
+struct Code {
+    std::vector<Instr> instrs;
+    int max_stack = 0;
+    bool empty() const { return instrs.empty(); }
+};
+
+/// A defined array (section 5.1.4): dimensions and row-major values.
+struct ArrayValues {
+    std::vector<int> dims;
+    std::vector<double> values;
+};
+
+/// Everything an evaluation may read or change besides the production's frame.
+struct Runtime {
+    std::vector<double> globals;
+    std::vector<ArrayValues> arrays;
+    const std::vector<std::string>* strings = nullptr;  ///< printf formats
+    /// ran/nran/bran/biran: cpfg's erand48 state, 0x330E until srand() sets it
+    Rand48 function_random = Rand48::from_state(0x330E);
+    double normal_spare = 0;     ///< nran's cached second deviate
+    bool normal_cached = true;   ///< cpfg starts "cached" with a spare of 0
+    int derivation_length = 0;
+    bool stop_requested = false;
+};
+
+/// Runs `code` with the given local frame. Returns the value left on top of the stack
+/// (0 for statement code).
+double evaluate(const Code& code, std::span<double> frame, Runtime& runtime);
+
+/// Function properties used by the compiler.
+struct FunctionInfo {
+    std::string_view name;
+    Function function;
+    int arity;  ///< -1: any
+};
+/// The function named `name`, or nullptr.
+const FunctionInfo* find_function(std::string_view name);
+
+}  // namespace cambium::lsys

@@ -1,0 +1,957 @@
+// SPDX-License-Identifier: Apache-2.0
+// Recursive-descent parser of preprocessed cpfg L-system text into a compiled Program.
+#include "lsys/parser.h"
+
+#include <cstdlib>
+#include <functional>
+
+#include "lsys/lexer.h"
+
+namespace cambium::lsys {
+
+namespace {
+
+constexpr int max_expression_nesting = 200;
+constexpr int max_stack = 250;
+
+/// Appends instructions to a Code and tracks the evaluation stack depth.
+class Emitter {
+public:
+    explicit Emitter(Code& code) : m_code(code) {}
+    std::size_t emit(Op op, int effect, std::int32_t arg = 0, std::uint8_t arg2 = 0,
+                     double value = 0)
+    {
+        m_code.instrs.push_back(Instr{op, arg2, arg, value});
+        m_depth += effect;
+        if (m_depth > m_code.max_stack)
+            m_code.max_stack = m_depth;
+        return m_code.instrs.size() - 1;
+    }
+    std::int32_t here() const { return static_cast<std::int32_t>(m_code.instrs.size()); }
+    void patch(std::size_t at, std::int32_t target) { m_code.instrs[at].arg = target; }
+    int depth() const { return m_depth; }
+    void set_depth(int d) { m_depth = d; }
+
+private:
+    Code& m_code;
+    int m_depth = 0;
+};
+
+/// Where a name lives: the production frame, the globals, or an array.
+struct VariableRef {
+    enum Kind { Local, Global, Array } kind;
+    int index;
+};
+
+/// Names visible while compiling one production or one global block.
+struct Scope {
+    bool global = false;
+    std::vector<std::pair<std::string, int>> locals;
+    int next_slot = 0;
+
+    int local_slot(const std::string& name)
+    {
+        for (const auto& [n, slot] : locals)
+            if (n == name)
+                return slot;
+        locals.emplace_back(name, next_slot);
+        return next_slot++;
+    }
+};
+
+Scope global_scope()
+{
+    Scope s;
+    s.global = true;
+    return s;
+}
+
+class Parser {
+public:
+    Parser(std::string_view text, const std::string& file_name, Program& program)
+        : m_lexer(text, file_name), m_program(program)
+    {
+    }
+    void parse_file();
+
+private:
+    // --- tokens ---
+    Token next(LexMode mode) { return m_lexer.next(mode); }
+    Token peek(LexMode mode) { return m_lexer.peek(mode); }
+    [[noreturn]] void fail(const Token& at, const std::string& expected);
+    Token expect(LexMode mode, TokenKind kind, const char* what);
+    void expect_operator(const char* op);
+    bool accept_operator(const char* op);
+    bool at_keyword(const char* keyword);
+    void expect_eol(const char* after);
+    void skip_blank_lines();
+
+    // --- L-system structure (Appendix A) ---
+    void parse_lsystem();
+    void parse_label(LSystemDefinition& ls);
+    bool parse_item(LSystemDefinition& ls);
+    void parse_characters(std::vector<SymbolId>& out);
+    void parse_define_block();
+    void parse_array_definition();
+    Code parse_global_block();
+    void parse_axiom(LSystemDefinition& ls);
+    void parse_decomposition(LSystemDefinition& ls);
+    void parse_homomorphism(LSystemDefinition& ls);
+    void parse_warning_flag(ProductionSet& set);
+    void parse_productions(ProductionSet& set);
+    void parse_production(ProductionSet& set);
+    void parse_predecessor(Production& p);
+    std::vector<FormalModule> parse_formal_modules(bool allow_star);
+    FormalModule parse_formal_module(const Token& symbol);
+    void parse_conditional(Production& p);
+    void parse_successor(Production& p);
+    std::vector<ModuleTemplate> parse_modules(bool stop_at_colon);
+    ModuleTemplate parse_module(const Token& symbol);
+
+    // --- statements ---
+    void parse_block(Emitter& e);
+    void parse_statement(Emitter& e);
+    void parse_if(Emitter& e);
+    void parse_while(Emitter& e);
+    void parse_do(Emitter& e);
+    void parse_assignment_or_expression(Emitter& e);
+
+    // --- expressions, by precedence ---
+    Code compile_expression();
+    void parse_expression(Emitter& e);
+    void parse_ternary(Emitter& e);
+    void parse_or(Emitter& e);
+    void parse_and(Emitter& e);
+    void parse_equality(Emitter& e);
+    void parse_relational(Emitter& e);
+    void parse_additive(Emitter& e);
+    void parse_multiplicative(Emitter& e);
+    void parse_power(Emitter& e);
+    void parse_unary(Emitter& e);
+    void parse_primary(Emitter& e);
+    void parse_call(Emitter& e, const Token& name);
+    int parse_indices(Emitter& e);
+    void emit_load(Emitter& e, const Token& name);
+    VariableRef resolve(const std::string& name);
+    double constant_expression();
+
+    Lexer m_lexer;
+    Program& m_program;
+    Scope* m_scope = nullptr;
+    int m_nesting = 0;
+};
+
+// ---------------------------------------------------------------- tokens
+
+std::string describe(const Token& t)
+{
+    switch (t.kind) {
+    case TokenKind::End: return "end of file";
+    case TokenKind::Eol: return "end of line";
+    default: return "'" + t.text + "'";
+    }
+}
+
+void Parser::fail(const Token& at, const std::string& expected)
+{
+    throw Error(at.loc, "expected " + expected + ", found " + describe(at));
+}
+
+Token Parser::expect(LexMode mode, TokenKind kind, const char* what)
+{
+    Token t = next(mode);
+    if (t.kind != kind)
+        fail(t, what);
+    return t;
+}
+
+void Parser::expect_operator(const char* op)
+{
+    Token t = next(LexMode::Expression);
+    if (t.text != op || t.kind == TokenKind::String)
+        fail(t, std::string("'") + op + "'");
+}
+
+bool Parser::accept_operator(const char* op)
+{
+    Token t = peek(LexMode::Expression);
+    if (t.kind != TokenKind::Operator || t.text != op)
+        return false;
+    next(LexMode::Expression);
+    return true;
+}
+
+bool Parser::at_keyword(const char* keyword)
+{
+    Token t = peek(LexMode::Module);
+    return t.kind == TokenKind::Keyword && t.text == keyword;
+}
+
+void Parser::expect_eol(const char* after)
+{
+    Token t = next(LexMode::Expression);
+    if (t.kind != TokenKind::Eol && t.kind != TokenKind::End)
+        fail(t, std::string("end of line after ") + after);
+}
+
+void Parser::skip_blank_lines()
+{
+    while (peek(LexMode::Module).kind == TokenKind::Eol)
+        next(LexMode::Module);
+}
+
+// ---------------------------------------------------------------- structure
+
+void Parser::parse_file()
+{
+    skip_blank_lines();
+    while (peek(LexMode::Module).kind != TokenKind::End) {
+        parse_lsystem();
+        skip_blank_lines();
+    }
+    if (m_program.lsystems.empty())
+        throw Error(FileLoc{m_program.file_name, 0, 0}, "no 'lsystem:' found");
+}
+
+void Parser::parse_lsystem()
+{
+    Token label = next(LexMode::Module);
+    if (label.kind != TokenKind::Keyword || label.text != "lsystem:")
+        fail(label, "'lsystem:'");
+    LSystemDefinition ls;
+    ls.loc = label.loc;
+    parse_label(ls);
+    while (parse_item(ls)) {
+    }
+    parse_axiom(ls);
+    parse_productions(ls.productions);
+    if (at_keyword("decomposition"))
+        parse_decomposition(ls);
+    if (at_keyword("homomorphism"))
+        parse_homomorphism(ls);
+    Token end = next(LexMode::Module);
+    if (end.kind != TokenKind::Keyword || end.text != "endlsystem")
+        fail(end, "a production or 'endlsystem'");
+    m_program.lsystems.push_back(std::move(ls));
+}
+
+void Parser::parse_label(LSystemDefinition& ls)
+{
+    std::string text = m_lexer.rest_of_line();
+    std::size_t first = text.find_first_not_of(" \t");
+    ls.label = first == std::string::npos ? "" : text.substr(first);
+    ls.id = std::atoi(ls.label.c_str());
+}
+
+bool Parser::parse_item(LSystemDefinition& ls)
+{
+    Token t = next(LexMode::Module);
+    if (t.kind == TokenKind::Eol)
+        return true;
+    if (t.kind != TokenKind::Keyword)
+        fail(t, "a header item or 'axiom:'");
+    if (t.text == "axiom:")
+        return false;
+    if (t.text == "seed:" || t.text == "derivation length:") {
+        Scope scope = global_scope();
+        m_scope = &scope;
+        (t.text == "seed:" ? ls.seed : ls.derivation_length) = compile_expression();
+        m_scope = nullptr;
+        expect_eol(t.text.c_str());
+    } else if (t.text == "ignore:") {
+        parse_characters(ls.ignore);
+    } else if (t.text == "consider:") {
+        ls.has_consider = true;
+        parse_characters(ls.consider);
+    } else if (t.text == "define:") {
+        parse_define_block();
+    } else if (t.text == "start:" || t.text == "end:" || t.text == "start each:" ||
+               t.text == "end each:") {
+        Code block = parse_global_block();
+        Code& target = t.text == "start:"        ? m_program.start_block
+                       : t.text == "end:"        ? m_program.end_block
+                       : t.text == "start each:" ? m_program.start_each_block
+                                                 : m_program.end_each_block;
+        target.instrs.insert(target.instrs.end(), block.instrs.begin(), block.instrs.end());
+        target.max_stack = std::max(target.max_stack, block.max_stack);
+    } else if (t.text == "ring lsystem") {
+        warn(t.loc, "ring L-systems are not supported; treated as an ordinary L-system");
+    } else {
+        fail(t, "a header item or 'axiom:'");
+    }
+    return true;
+}
+
+void Parser::parse_characters(std::vector<SymbolId>& out)
+{
+    for (Token t = next(LexMode::Module); t.kind != TokenKind::Eol && t.kind != TokenKind::End;
+         t = next(LexMode::Module))
+        out.push_back(m_program.symbols.intern(t.text));
+}
+
+Code Parser::parse_global_block()
+{
+    Scope scope = global_scope();
+    m_scope = &scope;
+    Code code;
+    Emitter e(code);
+    parse_block(e);
+    m_scope = nullptr;
+    expect_eol("a block");
+    return code;
+}
+
+void Parser::parse_define_block()
+{
+    expect_operator("{");
+    while (!accept_operator("}")) {
+        Token t = next(LexMode::Expression);
+        if (t.kind != TokenKind::Name || t.text != "array")
+            fail(t, "'array' or '}'");
+        do
+            parse_array_definition();
+        while (accept_operator(","));
+        expect_operator(";");
+    }
+    expect_eol("'define:'");
+}
+
+void Parser::parse_array_definition()
+{
+    Token name = expect(LexMode::Expression, TokenKind::Name, "an array name");
+    ArrayDefinition def;
+    def.name = name.text;
+    std::size_t total = 1;
+    while (accept_operator("[")) {
+        int dim = static_cast<int>(constant_expression());
+        if (dim <= 0 || dim > (1 << 24))
+            throw Error(name.loc, "array '" + name.text + "' has an invalid dimension");
+        def.initial.dims.push_back(dim);
+        total *= static_cast<std::size_t>(dim);
+        expect_operator("]");
+    }
+    if (total > (std::size_t{1} << 26))
+        throw Error(name.loc, "array '" + name.text + "' is too large");
+    def.initial.values.assign(total, 0.0);
+    if (accept_operator("=")) {
+        expect_operator("{");
+        std::size_t i = 0;
+        do {
+            double v = constant_expression();
+            if (i < total)
+                def.initial.values[i] = v;
+            ++i;
+        } while (accept_operator(","));
+        expect_operator("}");
+    }
+    m_program.arrays.push_back(std::move(def));
+}
+
+double Parser::constant_expression()
+{
+    Scope scope = global_scope();
+    Scope* saved = m_scope;
+    m_scope = &scope;
+    Code code = compile_expression();
+    m_scope = saved;
+    Runtime rt;
+    rt.globals.assign(m_program.global_names.size(), 0.0);
+    return evaluate(code, {}, rt);
+}
+
+void Parser::parse_axiom(LSystemDefinition& ls)
+{
+    Scope scope = global_scope();
+    m_scope = &scope;
+    ls.axiom = parse_modules(false);
+    m_scope = nullptr;
+}
+
+void Parser::parse_warning_flag(ProductionSet& set)
+{
+    if (peek(LexMode::Module).kind == TokenKind::Colon)
+        next(LexMode::Module);
+    Token t = peek(LexMode::Module);
+    if (t.kind == TokenKind::Keyword && (t.text == "warnings" || t.text == "no warnings")) {
+        set.warnings = t.text == "warnings";
+        next(LexMode::Module);
+    }
+    expect_eol("the section keyword");
+}
+
+void Parser::parse_decomposition(LSystemDefinition& ls)
+{
+    next(LexMode::Module);
+    parse_warning_flag(ls.decomposition);
+    skip_blank_lines();
+    if (at_keyword("maximum depth:")) {
+        next(LexMode::Module);
+        ls.decomposition.max_depth = compile_expression();
+        expect_eol("'maximum depth:'");
+    }
+    parse_productions(ls.decomposition);
+}
+
+void Parser::parse_homomorphism(LSystemDefinition& ls)
+{
+    next(LexMode::Module);
+    parse_warning_flag(ls.homomorphism);
+    for (;;) {
+        skip_blank_lines();
+        if (at_keyword("maximum depth:")) {
+            next(LexMode::Module);
+            ls.homomorphism.max_depth = compile_expression();
+            expect_eol("'maximum depth:'");
+        } else if (at_keyword("seed:")) {
+            next(LexMode::Module);
+            ls.homomorphism.seed = compile_expression();
+            expect_eol("'seed:'");
+        } else {
+            break;
+        }
+    }
+    parse_productions(ls.homomorphism);
+}
+
+void Parser::parse_productions(ProductionSet& set)
+{
+    for (;;) {
+        Token t = peek(LexMode::Module);
+        if (t.kind == TokenKind::Eol) {
+            next(LexMode::Module);
+            continue;
+        }
+        if (t.kind == TokenKind::Keyword || t.kind == TokenKind::End)
+            return;
+        parse_production(set);
+    }
+}
+
+void Parser::parse_production(ProductionSet& set)
+{
+    Production p;
+    Scope scope;
+    m_scope = &scope;
+    p.loc = peek(LexMode::Module).loc;
+    parse_predecessor(p);
+    Token t = next(LexMode::Module);
+    if (t.kind == TokenKind::Colon) {
+        parse_conditional(p);
+        t = next(LexMode::Module);
+    }
+    if (t.kind != TokenKind::Yields && t.kind != TokenKind::ObjectYields)
+        fail(t, "'-->'");
+    p.object_production = t.kind == TokenKind::ObjectYields;
+    parse_successor(p);
+    p.frame_size = scope.next_slot;
+    m_scope = nullptr;
+    set.productions.push_back(std::move(p));
+}
+
+void Parser::parse_predecessor(Production& p)
+{
+    std::vector<FormalModule> first = parse_formal_modules(true);
+    Token t = peek(LexMode::Module);
+    if (t.kind == TokenKind::LeftSep) {
+        next(LexMode::Module);
+        p.left_context = std::move(first);
+        p.predecessor = parse_formal_modules(false);
+        t = peek(LexMode::Module);
+    } else {
+        p.predecessor = std::move(first);
+    }
+    if (t.kind == TokenKind::RightSep) {
+        next(LexMode::Module);
+        p.right_context = parse_formal_modules(true);
+    }
+    if (p.predecessor.empty())
+        fail(peek(LexMode::Module), "a predecessor module");
+}
+
+std::vector<FormalModule> Parser::parse_formal_modules(bool allow_star)
+{
+    std::vector<FormalModule> modules;
+    for (;;) {
+        Token t = peek(LexMode::Module);
+        if (t.kind == TokenKind::Star && allow_star && modules.empty()) {
+            next(LexMode::Module);
+            return modules;
+        }
+        if (t.kind != TokenKind::Symbol)
+            return modules;
+        modules.push_back(parse_formal_module(next(LexMode::Module)));
+    }
+}
+
+FormalModule Parser::parse_formal_module(const Token& symbol)
+{
+    FormalModule m;
+    m.symbol = m_program.symbols.intern(symbol.text);
+    m.loc = symbol.loc;
+    if (peek(LexMode::Module).kind != TokenKind::LParen)
+        return m;
+    next(LexMode::Module);
+    do {
+        Token name = expect(LexMode::Expression, TokenKind::Name, "a formal parameter name");
+        m.param_slots.push_back(m_scope->local_slot(name.text));
+    } while (accept_operator(","));
+    expect(LexMode::Expression, TokenKind::RParen, "')' after formal parameters");
+    if (m.param_slots.size() > ModuleString::max_params)
+        throw Error(symbol.loc, "too many parameters");
+    return m;
+}
+
+void Parser::parse_conditional(Production& p)
+{
+    Token t = peek(LexMode::Expression);
+    if (t.kind == TokenKind::Operator && t.text == "{") {
+        Emitter e(p.pre_block);
+        parse_block(e);
+        t = peek(LexMode::Expression);
+    }
+    if (t.kind == TokenKind::Operator && t.text == "*")
+        next(LexMode::Expression);
+    else if (t.kind != TokenKind::Yields && t.kind != TokenKind::ObjectYields &&
+             !(t.kind == TokenKind::Operator && t.text == "{"))
+        p.condition = compile_expression();
+    t = peek(LexMode::Expression);
+    if (t.kind == TokenKind::Operator && t.text == "{") {
+        Emitter e(p.post_block);
+        parse_block(e);
+    }
+}
+
+void Parser::parse_successor(Production& p)
+{
+    Token t = peek(LexMode::Module);
+    if (t.kind == TokenKind::Star)
+        next(LexMode::Module);
+    else
+        p.successor = parse_modules(true);
+    if (peek(LexMode::Module).kind == TokenKind::Colon) {
+        next(LexMode::Module);
+        p.probability = compile_expression();
+    }
+    Token end = next(LexMode::Expression);
+    if (end.kind != TokenKind::Eol && end.kind != TokenKind::End)
+        fail(end, "a successor module or end of line");
+}
+
+std::vector<ModuleTemplate> Parser::parse_modules(bool stop_at_colon)
+{
+    std::vector<ModuleTemplate> modules;
+    for (;;) {
+        Token t = peek(LexMode::Module);
+        if (t.kind == TokenKind::Symbol) {
+            modules.push_back(parse_module(next(LexMode::Module)));
+        } else if (t.kind == TokenKind::RParen || (t.kind == TokenKind::Star && !stop_at_colon)) {
+            next(LexMode::Module);  // cpfg ignores these here
+        } else if (t.kind == TokenKind::Eol || t.kind == TokenKind::End ||
+                   (t.kind == TokenKind::Colon && stop_at_colon)) {
+            return modules;
+        } else {
+            fail(t, "a module");
+        }
+    }
+}
+
+ModuleTemplate Parser::parse_module(const Token& symbol)
+{
+    ModuleTemplate m;
+    m.symbol = m_program.symbols.intern(symbol.text);
+    if (peek(LexMode::Module).kind != TokenKind::LParen)
+        return m;
+    next(LexMode::Module);
+    if (peek(LexMode::Expression).kind == TokenKind::RParen) {
+        next(LexMode::Expression);
+        return m;
+    }
+    do
+        m.params.push_back(compile_expression());
+    while (accept_operator(","));
+    expect(LexMode::Expression, TokenKind::RParen, "',' or ')' after a module parameter");
+    if (m.params.size() > ModuleString::max_params)
+        throw Error(symbol.loc, "too many parameters");
+    return m;
+}
+
+// ---------------------------------------------------------------- statements
+
+void Parser::parse_block(Emitter& e)
+{
+    expect_operator("{");
+    while (!accept_operator("}"))
+        parse_statement(e);
+}
+
+void Parser::parse_statement(Emitter& e)
+{
+    Token t = peek(LexMode::Expression);
+    if (t.kind == TokenKind::Name && t.text == "if")
+        parse_if(e);
+    else if (t.kind == TokenKind::Name && t.text == "while")
+        parse_while(e);
+    else if (t.kind == TokenKind::Name && t.text == "do")
+        parse_do(e);
+    else if (t.kind == TokenKind::End)
+        fail(t, "'}'");
+    else
+        parse_assignment_or_expression(e);
+}
+
+void Parser::parse_if(Emitter& e)
+{
+    next(LexMode::Expression);
+    expect(LexMode::Expression, TokenKind::LParen, "'(' after 'if'");
+    parse_expression(e);
+    expect(LexMode::Expression, TokenKind::RParen, "')'");
+    std::size_t skip_then = e.emit(Op::JumpIfFalse, -1);
+    parse_block(e);
+    Token t = peek(LexMode::Expression);
+    if (t.kind == TokenKind::Name && t.text == "else") {
+        next(LexMode::Expression);
+        std::size_t skip_else = e.emit(Op::Jump, 0);
+        e.patch(skip_then, e.here());
+        parse_block(e);
+        e.patch(skip_else, e.here());
+    } else {
+        e.patch(skip_then, e.here());
+    }
+}
+
+void Parser::parse_while(Emitter& e)
+{
+    next(LexMode::Expression);
+    std::int32_t top = e.here();
+    expect(LexMode::Expression, TokenKind::LParen, "'(' after 'while'");
+    parse_expression(e);
+    expect(LexMode::Expression, TokenKind::RParen, "')'");
+    std::size_t exit = e.emit(Op::JumpIfFalse, -1);
+    parse_block(e);
+    e.emit(Op::Jump, 0, top);
+    e.patch(exit, e.here());
+}
+
+void Parser::parse_do(Emitter& e)
+{
+    next(LexMode::Expression);
+    std::int32_t top = e.here();
+    parse_block(e);
+    Token w = next(LexMode::Expression);
+    if (w.kind != TokenKind::Name || w.text != "while")
+        fail(w, "'while' after a 'do' block");
+    expect(LexMode::Expression, TokenKind::LParen, "'(' after 'while'");
+    parse_expression(e);
+    expect(LexMode::Expression, TokenKind::RParen, "')'");
+    e.emit(Op::Not, 0);
+    e.emit(Op::JumpIfFalse, -1, top);
+    expect_operator(";");
+}
+
+void Parser::parse_assignment_or_expression(Emitter& e)
+{
+    Token first = peek(LexMode::Expression);
+    if (first.kind == TokenKind::Name && !find_function(first.text) && first.text != "printf") {
+        next(LexMode::Expression);
+        Token after = peek(LexMode::Expression);
+        VariableRef ref = resolve(first.text);
+        if (after.text == "[" && ref.kind == VariableRef::Array) {
+            next(LexMode::Expression);
+            int n = 1;
+            parse_expression(e);
+            expect_operator("]");
+            while (accept_operator("[")) {
+                parse_expression(e);
+                expect_operator("]");
+                ++n;
+            }
+            expect_operator("=");
+            parse_expression(e);
+            e.emit(Op::StoreElement, -(n + 1), ref.index, static_cast<std::uint8_t>(n));
+            expect_operator(";");
+            return;
+        }
+        if (after.kind == TokenKind::Operator && after.text == "=") {
+            next(LexMode::Expression);
+            parse_expression(e);
+            if (ref.kind == VariableRef::Array)
+                throw Error(first.loc, "cannot assign to array '" + first.text + "' as a whole");
+            e.emit(ref.kind == VariableRef::Local ? Op::StoreLocal : Op::StoreGlobal, -1,
+                   ref.index);
+            expect_operator(";");
+            return;
+        }
+        fail(after, "'=' after '" + first.text + "'");
+    }
+    parse_expression(e);
+    e.emit(Op::Pop, -1);
+    expect_operator(";");
+}
+
+// ---------------------------------------------------------------- expressions
+
+Code Parser::compile_expression()
+{
+    Code code;
+    Emitter e(code);
+    parse_expression(e);
+    return code;
+}
+
+void Parser::parse_expression(Emitter& e)
+{
+    if (++m_nesting > max_expression_nesting)
+        throw Error(peek(LexMode::Expression).loc, "expression nested too deeply");
+    parse_ternary(e);
+    --m_nesting;
+    if (e.depth() > max_stack)
+        throw Error(peek(LexMode::Expression).loc, "expression too complex");
+}
+
+void Parser::parse_ternary(Emitter& e)
+{
+    parse_or(e);
+    if (!accept_operator("?"))
+        return;
+    std::size_t to_else = e.emit(Op::JumpIfFalse, -1);
+    parse_ternary(e);
+    std::size_t to_end = e.emit(Op::Jump, -1);
+    expect(LexMode::Expression, TokenKind::Colon, "':' in a conditional expression");
+    e.patch(to_else, e.here());
+    parse_ternary(e);
+    e.patch(to_end, e.here());
+}
+
+void Parser::parse_or(Emitter& e)
+{
+    parse_and(e);
+    while (accept_operator("||")) {
+        std::size_t jump = e.emit(Op::OrJump, -1);
+        parse_and(e);
+        e.emit(Op::ToBool, 0);
+        e.patch(jump, e.here());
+    }
+}
+
+void Parser::parse_and(Emitter& e)
+{
+    parse_equality(e);
+    while (accept_operator("&&")) {
+        std::size_t jump = e.emit(Op::AndJump, -1);
+        parse_equality(e);
+        e.emit(Op::ToBool, 0);
+        e.patch(jump, e.here());
+    }
+}
+
+void Parser::parse_equality(Emitter& e)
+{
+    parse_relational(e);
+    for (;;) {
+        if (accept_operator("==")) {
+            parse_relational(e);
+            e.emit(Op::Equal, -1);
+        } else if (accept_operator("!=")) {
+            parse_relational(e);
+            e.emit(Op::NotEqual, -1);
+        } else {
+            return;
+        }
+    }
+}
+
+void Parser::parse_relational(Emitter& e)
+{
+    parse_additive(e);
+    for (;;) {
+        Op op;
+        if (accept_operator("<"))
+            op = Op::Less;
+        else if (accept_operator("<="))
+            op = Op::LessEqual;
+        else if (accept_operator(">"))
+            op = Op::Greater;
+        else if (accept_operator(">="))
+            op = Op::GreaterEqual;
+        else
+            return;
+        parse_additive(e);
+        e.emit(op, -1);
+    }
+}
+
+void Parser::parse_additive(Emitter& e)
+{
+    parse_multiplicative(e);
+    for (;;) {
+        Token t = peek(LexMode::Expression);
+        if (t.kind != TokenKind::Operator || (t.text != "+" && t.text != "-"))
+            return;
+        next(LexMode::Expression);
+        parse_multiplicative(e);
+        e.emit(t.text == "+" ? Op::Add : Op::Sub, -1);
+    }
+}
+
+void Parser::parse_multiplicative(Emitter& e)
+{
+    parse_power(e);
+    for (;;) {
+        Token t = peek(LexMode::Expression);
+        if (t.kind != TokenKind::Operator || (t.text != "*" && t.text != "/" && t.text != "%"))
+            return;
+        next(LexMode::Expression);
+        parse_power(e);
+        e.emit(t.text == "*" ? Op::Mul : t.text == "/" ? Op::Div : Op::Mod, -1);
+    }
+}
+
+void Parser::parse_power(Emitter& e)
+{
+    // cpfg's grammar makes '^' left-associative and binds unary minus tighter
+    parse_unary(e);
+    while (accept_operator("^")) {
+        parse_unary(e);
+        e.emit(Op::Pow, -1);
+    }
+}
+
+void Parser::parse_unary(Emitter& e)
+{
+    if (++m_nesting > max_expression_nesting)
+        throw Error(peek(LexMode::Expression).loc, "expression nested too deeply");
+    if (accept_operator("-")) {
+        parse_unary(e);
+        e.emit(Op::Neg, 0);
+    } else if (accept_operator("!")) {
+        parse_unary(e);
+        e.emit(Op::Not, 0);
+    } else if (accept_operator("+")) {
+        parse_unary(e);
+    } else {
+        parse_primary(e);
+    }
+    --m_nesting;
+}
+
+void Parser::parse_primary(Emitter& e)
+{
+    Token t = next(LexMode::Expression);
+    switch (t.kind) {
+    case TokenKind::Number: e.emit(Op::Const, 1, 0, 0, t.number); return;
+    case TokenKind::LParen:
+        parse_expression(e);
+        expect(LexMode::Expression, TokenKind::RParen, "')'");
+        return;
+    case TokenKind::Name:
+        if (peek(LexMode::Expression).kind == TokenKind::LParen)
+            parse_call(e, t);
+        else
+            emit_load(e, t);
+        return;
+    case TokenKind::String:
+        m_program.strings.push_back(t.text);
+        e.emit(Op::Const, 1, 0, 0, static_cast<double>(m_program.strings.size() - 1));
+        return;
+    default: fail(t, "an expression");
+    }
+}
+
+void Parser::parse_call(Emitter& e, const Token& name)
+{
+    next(LexMode::Expression);  // '('
+    if (name.text == "printf") {
+        Token format = expect(LexMode::Expression, TokenKind::String, "a format string");
+        m_program.strings.push_back(format.text);
+        int n = 0;
+        while (accept_operator(",")) {
+            parse_expression(e);
+            ++n;
+        }
+        expect(LexMode::Expression, TokenKind::RParen, "')'");
+        e.emit(Op::Print, 1 - n, static_cast<std::int32_t>(m_program.strings.size() - 1),
+               static_cast<std::uint8_t>(n));
+        return;
+    }
+    const FunctionInfo* f = find_function(name.text);
+    if (!f)
+        throw Error(name.loc, "unknown function '" + name.text + "'");
+    int n = 0;
+    if (peek(LexMode::Expression).kind != TokenKind::RParen) {
+        do {
+            parse_expression(e);
+            ++n;
+        } while (accept_operator(","));
+    }
+    expect(LexMode::Expression, TokenKind::RParen, "')'");
+    if (f->arity >= 0 && n != f->arity && !(f->arity == 1 && n == 0))
+        throw Error(name.loc, "'" + name.text + "' takes " + std::to_string(f->arity) +
+                                  " argument(s), " + std::to_string(n) + " given");
+    if (f->function == Function::Func)
+        warn(name.loc, "'" + name.text + "' needs the view file's function set; it evaluates to 0");
+    e.emit(Op::Call, 1 - n, static_cast<std::int32_t>(f->function), static_cast<std::uint8_t>(n));
+}
+
+int Parser::parse_indices(Emitter& e)
+{
+    int n = 0;
+    while (accept_operator("[")) {
+        parse_expression(e);
+        expect_operator("]");
+        ++n;
+    }
+    return n;
+}
+
+void Parser::emit_load(Emitter& e, const Token& name)
+{
+    VariableRef ref = resolve(name.text);
+    if (ref.kind == VariableRef::Array) {
+        int n = parse_indices(e);
+        e.emit(Op::LoadElement, 1 - n, ref.index, static_cast<std::uint8_t>(n));
+    } else {
+        e.emit(ref.kind == VariableRef::Local ? Op::LoadLocal : Op::LoadGlobal, 1, ref.index);
+    }
+}
+
+VariableRef Parser::resolve(const std::string& name)
+{
+    for (std::size_t i = 0; i < m_program.arrays.size(); ++i)
+        if (m_program.arrays[i].name == name)
+            return {VariableRef::Array, static_cast<int>(i)};
+    if (m_scope && !m_scope->global)
+        for (const auto& [n, slot] : m_scope->locals)
+            if (n == name)
+                return {VariableRef::Local, slot};
+    for (std::size_t i = 0; i < m_program.global_names.size(); ++i)
+        if (m_program.global_names[i] == name)
+            return {VariableRef::Global, static_cast<int>(i)};
+    if (m_scope && !m_scope->global)
+        return {VariableRef::Local, m_scope->local_slot(name)};
+    m_program.global_names.push_back(name);
+    return {VariableRef::Global, static_cast<int>(m_program.global_names.size() - 1)};
+}
+
+}  // namespace
+
+void ProductionSet::index(std::size_t symbol_count)
+{
+    by_symbol.assign(symbol_count, {});
+    for (std::size_t i = 0; i < productions.size(); ++i)
+        by_symbol[productions[i].predecessor.front().symbol].push_back(
+            static_cast<std::uint32_t>(i));
+}
+
+void parse_program(std::string_view preprocessed, const std::string& file_name, Program& program)
+{
+    program.file_name = file_name;
+    Parser parser(preprocessed, file_name, program);
+    parser.parse_file();
+    for (auto& ls : program.lsystems) {
+        ls.productions.index(program.symbols.size());
+        ls.decomposition.index(program.symbols.size());
+        ls.homomorphism.index(program.symbols.size());
+    }
+}
+
+}  // namespace cambium::lsys

@@ -1,0 +1,95 @@
+// SPDX-License-Identifier: Apache-2.0
+// A parsed and compiled L-system file: L-systems, productions, global blocks, arrays.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "base/diagnostics.h"
+#include "lsys/expression.h"
+#include "lsys/module_string.h"
+
+namespace cambium::lsys {
+
+/// A module of a predecessor or context: its symbol and the frame slots its formal
+/// parameters bind to.
+struct FormalModule {
+    SymbolId symbol = 0;
+    std::vector<int> param_slots;
+    FileLoc loc;
+};
+
+/// A module of a successor or axiom: its symbol and one compiled expression per parameter.
+struct ModuleTemplate {
+    SymbolId symbol = 0;
+    std::vector<Code> params;
+};
+
+/// lc < pred > rc : {pre} condition {post} --> successor : probability
+struct Production {
+    std::vector<FormalModule> left_context;   ///< in reading order
+    std::vector<FormalModule> predecessor;    ///< the strict predecessor
+    std::vector<FormalModule> right_context;
+    Code pre_block;                           ///< {alpha}
+    std::optional<Code> condition;            ///< none: '*' or absent
+    Code post_block;                          ///< {beta}
+    std::vector<ModuleTemplate> successor;
+    std::optional<Code> probability;          ///< stochastic productions only
+    bool object_production = false;           ///< '-o>'
+    int frame_size = 0;                       ///< formal parameters + local variables
+    FileLoc loc;
+};
+
+/// Productions of one section with their lookup by first predecessor symbol.
+struct ProductionSet {
+    std::vector<Production> productions;
+    std::vector<std::vector<std::uint32_t>> by_symbol;  ///< indexed by SymbolId
+    std::optional<Code> max_depth;
+    std::optional<Code> seed;
+    bool warnings = false;
+
+    /// Rebuilds by_symbol for `symbol_count` symbols.
+    void index(std::size_t symbol_count);
+    const std::vector<std::uint32_t>* candidates(SymbolId symbol) const
+    {
+        return symbol < by_symbol.size() && !by_symbol[symbol].empty() ? &by_symbol[symbol]
+                                                                      : nullptr;
+    }
+};
+
+/// One `lsystem: N ... endlsystem` block.
+struct LSystemDefinition {
+    int id = 0;
+    std::string label;
+    FileLoc loc;
+    std::optional<Code> seed;
+    std::optional<Code> derivation_length;
+    std::vector<SymbolId> ignore;
+    std::vector<SymbolId> consider;
+    bool has_consider = false;
+    std::vector<ModuleTemplate> axiom;
+    ProductionSet productions;
+    ProductionSet decomposition;
+    ProductionSet homomorphism;
+};
+
+/// A declared array and its initial values.
+struct ArrayDefinition {
+    std::string name;
+    ArrayValues initial;
+};
+
+/// The whole compiled file.
+struct Program {
+    SymbolTable symbols;
+    std::vector<LSystemDefinition> lsystems;  ///< the first is the main L-system
+    Code start_block, end_block, start_each_block, end_each_block;
+    std::vector<std::string> global_names;
+    std::vector<ArrayDefinition> arrays;
+    std::vector<std::string> strings;
+    std::string file_name;
+};
+
+}  // namespace cambium::lsys

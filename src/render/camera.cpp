@@ -1,0 +1,186 @@
+// SPDX-License-Identifier: Apache-2.0
+// The camera that frames a Scene as cpfg's window does: parallel auto-fit or perspective.
+//
+// cpfg framing, checked against the corpus oracle (cpfg's own window grabs and its
+// rayshade export, see tests/render/camera_test.cpp):
+// - Both projections look along (reference point - viewpoint), up = +y made
+//   perpendicular to that direction, then rotated by `twist` about it.
+// - Parallel: the box (`box:` or the geometry's bounds) is projected onto the view
+//   plane; its centre goes to the window centre and the scale is
+//   scale_factor * min(width / box_width, height / box_height) pixels per unit, so the
+//   limiting dimension of the box fills scale_factor of the window.
+// - Perspective: no auto-fit. The eye sits at reference + (viewpoint - reference) /
+//   scale_factor, looking at the reference point, with `viewing angle` as the vertical
+//   field of view (rayshade's export: eyep = lookp + (vp - lookp)/sf, horizontal fov =
+//   2 atan(aspect tan(angle/2))).
+#include "render/camera.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+namespace cambium::render {
+
+using geom::Vec3;
+
+namespace {
+
+constexpr double deg_to_rad = std::numbers::pi / 180.0;
+
+/// Rotates v about the unit axis k by angle (Rodrigues).
+Vec3 rotate(const Vec3& v, const Vec3& k, double angle)
+{
+    double c = std::cos(angle), s = std::sin(angle);
+    return v * c + geom::cross(k, v) * s + k * (geom::dot(k, v) * (1 - c));
+}
+
+struct Frame {
+    Vec3 forward, right, up;
+};
+
+/// The viewing frame: forward from viewpoint to reference, up = +y (twisted).
+Frame view_frame(const geom::View& view)
+{
+    Vec3 forward = geom::normalize(view.reference_point - view.viewpoint);
+    // cpfg: a viewpoint on the reference point becomes viewpoint (0,0,-1), vrp 0.
+    if (geom::length(forward) == 0)
+        forward = {0, 0, 1};
+    Vec3 up_hint{0, 1, 0};
+    if (std::abs(geom::dot(forward, up_hint)) > 1 - 1e-12)
+        // cpfg (SetView): v = n x Y is zero, so v = (-1,0,0) and up = v x n: looking
+        // straight down the far side (-z) is up, looking straight up +z is up.
+        up_hint = forward.y < 0 ? Vec3{0, 0, -1} : Vec3{0, 0, 1};
+    Vec3 right = geom::normalize(geom::cross(forward, up_hint));
+    Vec3 up = geom::cross(right, forward);
+    // Positive twist turns the up vector counter-clockwise as the viewer sees it
+    // (right-handed about the view normal n = -forward), so the image turns clockwise
+    // (cpfg's rot_by_quat, read from the source; no corpus model uses a twist).
+    double twist = view.twist_deg * deg_to_rad;
+    if (twist != 0) {
+        up = rotate(up, -forward, twist);
+        right = geom::cross(forward, up);
+    }
+    return {forward, right, up};
+}
+
+/// The eight corners of a box.
+std::array<Vec3, 8> corners(const geom::Bounds3& b)
+{
+    std::array<Vec3, 8> c;
+    for (int i = 0; i < 8; ++i)
+        c[i] = {(i & 1) ? b.hi.x : b.lo.x, (i & 2) ? b.hi.y : b.lo.y, (i & 4) ? b.hi.z : b.lo.z};
+    return c;
+}
+
+Camera make_parallel(const geom::View& view, const Frame& f, const geom::Bounds3& fit,
+                     const geom::Bounds3& geometry, int width, int height)
+{
+    // Extent of the box projected onto the view plane.
+    double lo_x = 1e300, hi_x = -1e300, lo_y = 1e300, hi_y = -1e300;
+    for (const Vec3& p : corners(fit)) {
+        lo_x = std::min(lo_x, geom::dot(p, f.right));
+        hi_x = std::max(hi_x, geom::dot(p, f.right));
+        lo_y = std::min(lo_y, geom::dot(p, f.up));
+        hi_y = std::max(hi_y, geom::dot(p, f.up));
+    }
+    double ex = hi_x - lo_x, ey = hi_y - lo_y;
+    // cpfg's CalculateWindow: span = max(ex/2, (ey/2) W/H) / scale, k = W / (2 span) pixels
+    // per unit, i.e. k = scale * min(W/ex, H/ey). A point-like box gets span 1 unscaled.
+    double sf = view.scale_factor > 0 ? view.scale_factor : 1.0;
+    double span = std::max(ex / 2, ey / 2 * width / height) / sf;
+    if (span <= 0)
+        span = 1;
+    double pixel_size = 2 * span / width;
+
+    // Rays start behind everything: the geometry and the fitted box.
+    geom::Bounds3 all = fit;
+    all.extend(geometry);
+    Vec3 centre = fit.center();
+    double back_off = geom::length(all.extent()) + geom::length(all.center() - centre) + 1.0;
+    return Camera::parallel(centre, f.forward, f.up, pixel_size, back_off, width, height);
+}
+
+}  // namespace
+
+Camera Camera::parallel(const Vec3& focus, const Vec3& forward, const Vec3& up,
+                        double pixel_size, double back_off, int width, int height)
+{
+    Camera c;
+    c.m_projection = Projection::parallel;
+    c.m_origin = focus;
+    c.m_forward = forward;
+    c.m_up = up;
+    c.m_right = geom::cross(forward, up);
+    c.m_pixel_size = pixel_size;
+    c.m_back_off = back_off;
+    c.m_width = width;
+    c.m_height = height;
+    return c;
+}
+
+Camera Camera::perspective(const Vec3& eye, const Vec3& focus, const Vec3& up, double fov_deg,
+                           int width, int height)
+{
+    Camera c;
+    c.m_projection = Projection::perspective;
+    c.m_origin = eye;
+    c.m_forward = geom::normalize(focus - eye);
+    c.m_right = geom::normalize(geom::cross(c.m_forward, up));
+    c.m_up = geom::cross(c.m_right, c.m_forward);
+    c.m_focus_distance = geom::length(focus - eye);
+    double fov = std::clamp(fov_deg, 1e-3, 179.0) * deg_to_rad;
+    c.m_pixel_size = 2 * c.m_focus_distance * std::tan(fov / 2) / height;
+    c.m_width = width;
+    c.m_height = height;
+    return c;
+}
+
+PixelPoint Camera::project(const Vec3& p) const
+{
+    Vec3 rel = p - m_origin;
+    double x = geom::dot(rel, m_right), y = geom::dot(rel, m_up);
+    if (m_projection == Projection::perspective) {
+        double scale = m_focus_distance / geom::dot(rel, m_forward);
+        x *= scale;
+        y *= scale;
+    }
+    return {m_width * 0.5 + x / m_pixel_size, m_height * 0.5 - y / m_pixel_size};
+}
+
+CameraRay Camera::generate_ray(double x, double y) const
+{
+    double sx = (x - m_width * 0.5) * m_pixel_size;
+    double sy = (m_height * 0.5 - y) * m_pixel_size;
+    if (m_projection == Projection::parallel)
+        return {m_origin + m_right * sx + m_up * sy - m_forward * m_back_off, m_forward};
+    return {m_origin,
+            geom::normalize(m_forward * m_focus_distance + m_right * sx + m_up * sy)};
+}
+
+double Camera::pixel_size_at(const Vec3& p) const
+{
+    if (m_projection == Projection::parallel)
+        return m_pixel_size;
+    double depth = geom::dot(p - m_origin, m_forward);
+    return m_pixel_size * std::max(depth, 0.0) / m_focus_distance;
+}
+
+Camera make_camera(const geom::View& view, const geom::Bounds3& bounds, int width, int height)
+{
+    Frame f = view_frame(view);
+    if (view.perspective) {
+        double sf = view.scale_factor > 0 ? view.scale_factor : 1.0;
+        Vec3 eye = view.reference_point + (view.viewpoint - view.reference_point) / sf;
+        if (geom::length(eye - view.reference_point) == 0)
+            eye = view.reference_point - f.forward;
+        return Camera::perspective(eye, view.reference_point, f.up, view.viewing_angle_deg,
+                                   width, height);
+    }
+    geom::Bounds3 fit = view.box ? *view.box : bounds;
+    if (fit.empty())
+        fit.extend(Vec3{0, 0, 0});
+    return make_parallel(view, f, fit, bounds, width, height);
+}
+
+}  // namespace cambium::render

@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: Apache-2.0
+// The cambium command as a user runs it: exit status, messages, output files.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+    int status;
+    std::string output;  // stdout and stderr
+};
+
+Result run(const std::string& args)
+{
+    std::string command = std::string(CAMBIUM_EXE) + " " + args + " 2>&1";
+    Result r{0, {}};
+    FILE* pipe = popen(command.c_str(), "r");
+    std::array<char, 512> buffer{};
+    while (fgets(buffer.data(), buffer.size(), pipe))
+        r.output += buffer.data();
+    r.status = pclose(pipe);
+    return r;
+}
+
+fs::path scratch(const std::string& name)
+{
+    fs::path dir = fs::temp_directory_path() / ("cambium_cmd_" + name);
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+void write(const fs::path& file, const std::string& text) { std::ofstream(file) << text; }
+
+}  // namespace
+
+TEST(Command, RendersAPlantToPngAndExr)
+{
+    fs::path dir = scratch("ok");
+    write(dir / "p.l", "lsystem: 1\nderivation length: 1\naxiom: F\nF --> F[+F]F\nendlsystem\n");
+    write(dir / "p.v", "line style: cylinder\ninitial line width: 0.2\n");
+    Result r = run("-q -w 32 24 --spp 2 -o " + (dir / "p.png").string() + " -o " +
+                   (dir / "p.exr").string() + " " + (dir / "p.l").string() + " " +
+                   (dir / "p.v").string());
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_GT(fs::file_size(dir / "p.png"), 0u);
+    EXPECT_GT(fs::file_size(dir / "p.exr"), 0u);
+}
+
+TEST(Command, SyntaxErrorNamesFileLineAndColumnAndWritesNothing)
+{
+    fs::path dir = scratch("bad");
+    write(dir / "bad.l", "lsystem: 1\nderivation length: 1\naxiom: F\nF -> F\nendlsystem\n");
+    write(dir / "p.v", "line style: cylinder\n");
+    Result r = run("-o " + (dir / "out.png").string() + " " + (dir / "bad.l").string() + " " +
+                   (dir / "p.v").string());
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("bad.l:4:"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("error"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "out.png"));
+}
+
+TEST(Command, MissingViewFileIsAClearError)
+{
+    fs::path dir = scratch("missing");
+    write(dir / "p.l", "lsystem: 1\nderivation length: 0\naxiom: F\nendlsystem\n");
+    Result r = run((dir / "p.l").string() + " " + (dir / "nope.v").string());
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("nope.v"), std::string::npos) << r.output;
+}
+
+TEST(Command, UnknownOutputFormatFailsBeforeRendering)
+{
+    fs::path dir = scratch("format");
+    write(dir / "p.l", "lsystem: 1\nderivation length: 0\naxiom: F\nendlsystem\n");
+    write(dir / "p.v", "\n");
+    Result r = run("-o " + (dir / "p.xyz").string() + " " + (dir / "p.l").string() + " " +
+                   (dir / "p.v").string());
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("p.xyz"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("rendered"), std::string::npos) << r.output;
+}

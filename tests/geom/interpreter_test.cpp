@@ -1,0 +1,158 @@
+// SPDX-License-Identifier: Apache-2.0
+// Tests of string interpretation: segments, joints, branches, widths, colours, bounds.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "geom/interpreter.h"
+
+using namespace cambium;
+using namespace cambium::geom;
+
+namespace {
+
+/// Builds a string from single-character modules, `F(2)` style parameters allowed.
+lsys::ModuleString make_string(lsys::SymbolTable& symbols, const std::string& text)
+{
+    lsys::ModuleString s;
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        lsys::SymbolId id = symbols.intern(std::string(1, text[i]));
+        std::vector<float> params;
+        if (i + 1 < text.size() && text[i + 1] == '(') {
+            std::size_t close = text.find(')', i);
+            params.push_back(std::stof(text.substr(i + 2, close - i - 2)));
+            i = close;
+        }
+        s.append(id, params);
+    }
+    return s;
+}
+
+Scene run(const std::string& text, const std::string& view_text)
+{
+    lsys::SymbolTable symbols;
+    lsys::ModuleString s = make_string(symbols, text);
+    return interpret(s, symbols, parse_view_file(view_text, "t.v"));
+}
+
+std::array<float, 4> key_of(const Scene& scene, std::size_t segment, int end)
+{
+    return scene.lines.keys[scene.lines.segments[segment] + static_cast<std::uint32_t>(end)];
+}
+
+}  // namespace
+
+TEST(Interpreter, ConnectedSegmentsShareKeysAndNeighbourFlags)
+{
+    Scene scene = run("F+F(2)", "angle increment: 90\n");
+    ASSERT_EQ(scene.lines.segment_count(), 2u);
+    EXPECT_EQ(scene.lines.keys.size(), 3u);
+    EXPECT_EQ(scene.lines.flags[0], LinearCurves::neighbour_right);
+    EXPECT_EQ(scene.lines.flags[1], LinearCurves::neighbour_left);
+    auto end = key_of(scene, 1, 1);  // up 1, then left 2: (-2, 1, 0)
+    EXPECT_NEAR(end[0], -2, 1e-6);
+    EXPECT_NEAR(end[1], 1, 1e-6);
+}
+
+TEST(Interpreter, BranchReturnsToItsStartAndBreaksThePolyline)
+{
+    Scene scene = run("F[+F]F", "angle increment: 90\n");
+    ASSERT_EQ(scene.lines.segment_count(), 3u);
+    // The branch continues the trunk's polyline; the segment after ']' starts anew.
+    EXPECT_EQ(scene.lines.flags[1] & LinearCurves::neighbour_left, LinearCurves::neighbour_left);
+    EXPECT_EQ(scene.lines.flags[2], 0);
+    auto start = key_of(scene, 2, 0);
+    auto end = key_of(scene, 2, 1);
+    EXPECT_NEAR(start[1], 1, 1e-6);
+    EXPECT_NEAR(end[1], 2, 1e-6);
+    EXPECT_NEAR(end[0], 0, 1e-6);
+}
+
+TEST(Interpreter, MoveWithoutDrawingLeavesAGap)
+{
+    Scene scene = run("FfF", "");
+    ASSERT_EQ(scene.lines.segment_count(), 2u);
+    EXPECT_NEAR(key_of(scene, 1, 0)[1], 2, 1e-6);
+    EXPECT_EQ(scene.lines.flags[1], 0);
+}
+
+TEST(Interpreter, WidthIsTwiceTheRadiusAndFollowsHashAndBang)
+{
+    Scene scene = run("F#F!(0.5)F", "initial line width: 2\nline width increment: 1\n");
+    ASSERT_EQ(scene.lines.segment_count(), 3u);
+    EXPECT_FLOAT_EQ(key_of(scene, 0, 0)[3], 1.0f);
+    EXPECT_FLOAT_EQ(key_of(scene, 0, 1)[3], 1.5f);  // tapered: the top takes the new width
+    EXPECT_FLOAT_EQ(key_of(scene, 1, 0)[3], 1.5f);
+    EXPECT_FLOAT_EQ(key_of(scene, 2, 0)[3], 0.25f);
+    EXPECT_FALSE(scene.line_radius_in_pixels);
+    EXPECT_TRUE(run("F", "initial line width: 3 pixels\n").line_radius_in_pixels);
+}
+
+TEST(Interpreter, UntaperedLinesKeepTheirWidthAndBreakTheJoint)
+{
+    Scene scene = run("F#F", "initial line width: 2\nline width increment: 1\ntapered lines: off\n");
+    ASSERT_EQ(scene.lines.segment_count(), 2u);
+    EXPECT_FLOAT_EQ(key_of(scene, 0, 1)[3], 1.0f);
+    EXPECT_FLOAT_EQ(key_of(scene, 1, 0)[3], 1.5f);
+    EXPECT_EQ(scene.lines.flags[1], 0);
+}
+
+TEST(Interpreter, WidthChangeInsideABranchDoesNotTaperTheTrunk)
+{
+    Scene scene = run("F[!(1)F]", "initial line width: 2\n");
+    ASSERT_EQ(scene.lines.segment_count(), 2u);
+    EXPECT_FLOAT_EQ(key_of(scene, 0, 1)[3], 1.0f);
+    EXPECT_FLOAT_EQ(key_of(scene, 1, 0)[3], 0.5f);
+}
+
+TEST(Interpreter, ColourWrapsOnceAroundTheTable)
+{
+    Scene scene = run(";(255);F,(0),F", "color increment: 1\n");
+    EXPECT_EQ(scene.lines.material[0], 0);
+    EXPECT_EQ(scene.lines.material[1], 255);
+}
+
+TEST(Interpreter, ColourIndexSelectsTheMaterialOfEachSegment)
+{
+    Scene scene = run("F;F;(7)F,F", "initial color: 2\ncolor increment: 3\n");
+    ASSERT_EQ(scene.lines.segment_count(), 4u);
+    EXPECT_EQ(scene.lines.material[0], 2);
+    EXPECT_EQ(scene.lines.material[1], 5);
+    EXPECT_EQ(scene.lines.material[2], 7);
+    EXPECT_EQ(scene.lines.material[3], 4);
+}
+
+TEST(Interpreter, BoundsEncloseTheDrawnPoints)
+{
+    Scene scene = run("-(90)F(3)+(90)F(2)", "");
+    EXPECT_NEAR(scene.bounds.lo.x, 0, 1e-9);
+    EXPECT_NEAR(scene.bounds.hi.x, 3, 1e-9);
+    EXPECT_NEAR(scene.bounds.hi.y, 2, 1e-9);
+}
+
+TEST(Interpreter, BoundsHoldTheOriginAndMovesWithoutDrawing)
+{
+    Scene scene = run("f(5)F", "");
+    EXPECT_NEAR(scene.bounds.lo.y, 0, 1e-9);
+    EXPECT_NEAR(scene.bounds.hi.y, 6, 1e-9);
+}
+
+TEST(Interpreter, DefaultLightIsCpfgsDirectionalLight)
+{
+    Scene scene = run("F", "");
+    ASSERT_EQ(scene.lights.size(), 1u);
+    EXPECT_EQ(scene.lights[0].kind, Light::Kind::directional);
+    EXPECT_NEAR(scene.lights[0].direction.x, 1, 1e-12);
+    scene = run("F", "light direction: 0,3,4\n");
+    EXPECT_NEAR(scene.lights[0].direction.y, 0.6, 1e-12);
+    scene = run("F", "light: V: 1 0 0\nlight: O: 0 5 0\n");
+    EXPECT_EQ(scene.lights.size(), 2u);
+}
+
+TEST(Interpreter, UnbalancedPopIsIgnored)
+{
+    set_warnings_enabled(false);
+    Scene scene = run("F]F", "");
+    set_warnings_enabled(true);
+    EXPECT_EQ(scene.lines.segment_count(), 2u);
+}

@@ -1,0 +1,243 @@
+// SPDX-License-Identifier: Apache-2.0
+// Golden derivations of small inline L-systems, worked out by hand.
+#include "test_util.h"
+
+namespace cambium::lsys {
+namespace {
+
+using testing::derive_text;
+
+const char* koch = R"(lsystem: 1
+derivation length: 2
+axiom: F
+F --> F+F-F-FF+F+F-F
+endlsystem
+)";
+
+TEST(Derive, KochOneStep)
+{
+    EXPECT_EQ(derive_text(koch, 1), "F+F-F-FF+F+F-F");
+}
+
+TEST(Derive, KochTwoStepsIsDerivationLength)
+{
+    EXPECT_EQ(derive_text(koch),
+              "F+F-F-FF+F+F-F+F+F-F-FF+F+F-F-F+F-F-FF+F+F-F-F+F-F-FF+F+F-FF+F-F-FF+F+F-F+F+F-"
+              "F-FF+F+F-F+F+F-F-FF+F+F-F-F+F-F-FF+F+F-F");
+}
+
+TEST(Derive, ZeroStepsGivesAxiom)
+{
+    EXPECT_EQ(derive_text(koch, 0), "F");
+}
+
+TEST(Derive, ParametricHalving)
+{
+    const char* src = R"(Lsystem: 1
+derivation length: 2
+Axiom: F(1)
+F(x) --> F(x*0.5)+F(x*0.5)
+endLsystem
+)";
+    EXPECT_EQ(derive_text(src, 1), "F(0.5)+F(0.5)");
+    EXPECT_EQ(derive_text(src), "F(0.25)+F(0.25)+F(0.25)+F(0.25)");
+}
+
+TEST(Derive, FirstMatchingProductionWinsAndConditionsSelect)
+{
+    const char* src = R"(lsystem: 1
+derivation length: 3
+axiom: A(0)
+A(n) : n < 2 --> B A(n+1)
+A(n) : n >= 2 --> C(n*10)
+A(n) --> X
+endlsystem
+)";
+    EXPECT_EQ(derive_text(src), "BBC(20)");
+}
+
+TEST(Derive, ExpressionOperatorsAndFunctions)
+{
+    const char* src = R"(lsystem: 1
+derivation length: 1
+axiom: A(2,3)
+A(x,y) --> B(x^y, -x^2, 7%3, x<y && y<4, !(x==2) || 0, sin(90), sqrt(16), floor(-1.5), sign(-3), atan2(1,1), x>1 ? 5 : 6)
+endlsystem
+)";
+    EXPECT_EQ(derive_text(src), "B(8,4,1,1,0,1,4,-2,-1,45,5)");
+}
+
+TEST(Derive, ParametersAreStoredAsFloat)
+{
+    const char* src = R"(lsystem: 1
+derivation length: 1
+axiom: A(0.1)
+A(x) --> B(x*3)
+endlsystem
+)";
+    LSystem ls = LSystem::from_source(src);
+    ModuleString s = ls.derive();
+    float expected = static_cast<float>(static_cast<double>(0.1f) * 3.0);
+    ASSERT_EQ(s.size(), 1u);
+    EXPECT_EQ((*s.begin()).params[0], expected);
+}
+
+TEST(Derive, UnmatchedModulesAreCopiedWithParameters)
+{
+    const char* src = R"(lsystem: 1
+derivation length: 1
+axiom: +(30)[F(2)]A
+A --> B
+endlsystem
+)";
+    EXPECT_EQ(derive_text(src), "+(30)[F(2)]B");
+}
+
+TEST(Derive, EmptySuccessorDeletes)
+{
+    const char* src = "lsystem: 1\nderivation length: 1\naxiom: ABA\nA --> *\nendlsystem\n";
+    EXPECT_EQ(derive_text(src), "B");
+}
+
+TEST(Derive, MultiModulePredecessorConsumesAll)
+{
+    const char* src = "lsystem: 1\nderivation length: 1\naxiom: ABAC\nAB --> X\nendlsystem\n";
+    EXPECT_EQ(derive_text(src), "XAC");
+}
+
+TEST(Derive, GrowthLimitIsAClearError)
+{
+    LoadOptions options;
+    options.max_modules = 1000;
+    LSystem ls = LSystem::from_source(
+        "lsystem: 1\nderivation length: 20\naxiom: F\nF --> FF\nendlsystem\n", "grow.l", options);
+    try {
+        ls.derive();
+        FAIL() << "expected an error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("grew past 1000 modules"), std::string::npos)
+            << e.what();
+    }
+}
+
+TEST(DeriveContext, LeftContextSkipsBranchesAndIgnored)
+{
+    // B's left neighbour, skipping the branch [C] and the ignored '+', is A.
+    const char* src = R"(lsystem: 1
+derivation length: 1
+ignore: +
+axiom: A(7)[C]+B
+A(x) < B --> D(x)
+endlsystem
+)";
+    EXPECT_EQ(derive_text(src), "A(7)[C]+D(7)");
+}
+
+TEST(DeriveContext, LeftContextCrossesIntoParentBranch)
+{
+    const char* src = "lsystem: 1\nderivation length: 1\naxiom: A[B]\nA < B --> X\nendlsystem\n";
+    EXPECT_EQ(derive_text(src), "A[X]");
+}
+
+TEST(DeriveContext, RightContextSkipsLateralBranchesButNotBranchEnd)
+{
+    const char* src = R"(lsystem: 1
+derivation length: 1
+axiom: A[B]C[A]
+A > C --> X
+endlsystem
+)";
+    EXPECT_EQ(derive_text(src), "X[B]C[A]");
+}
+
+TEST(DeriveContext, SignalPropagatesOneModulePerStep)
+{
+    const char* src = R"(lsystem: 1
+derivation length: 2
+axiom: S A A A
+S < A --> S
+endlsystem
+)";
+    EXPECT_EQ(derive_text(src), "SSSA");
+}
+
+TEST(DeriveBlocks, PreAndPostConditionBlocks)
+{
+    const char* src = R"(lsystem: 1
+derivation length: 1
+axiom: A(4) A(1)
+A(y) : {x = y/2; s = x*x;} s < 5 {z = sqrt(y);} --> B(z) C(z+1)
+endlsystem
+)";
+    // A(4): x=2, s=4 < 5, z=2; A(1): x=0.5, s=0.25, z=1
+    EXPECT_EQ(derive_text(src), "B(2)C(3)B(1)C(2)");
+}
+
+TEST(DeriveBlocks, GlobalBlocksAndStatements)
+{
+    const char* src = R"(lsystem: 1
+derivation length: 3
+Start: {age = 0; total = 0;}
+StartEach: {age = age + 1;}
+EndEach: {i = 0; while (i < 2) {total = total + 1; i = i + 1;} if (age == 2) {total = total + 100;} else {do {total = total + 0;} while (0);}}
+axiom: A
+A --> B(age, total) A
+endlsystem
+)";
+    EXPECT_EQ(derive_text(src), "B(1,0)B(2,2)B(3,104)A");
+}
+
+TEST(DeriveBlocks, DefinedArrays)
+{
+    const char* src = R"(lsystem: 1
+define: { array rate[2][2] = {1, 2, 3, 4}, v[3]; }
+derivation length: 1
+axiom: A(1)
+A(i) : {v[2] = rate[i][0] + rate[i][1];} 1 --> B(v[2], rate[0][1])
+endlsystem
+)";
+    EXPECT_EQ(derive_text(src), "B(7,2)");
+}
+
+TEST(DeriveDecomposition, AppliedAfterEachStepToMaximumDepth)
+{
+    const char* src = R"(lsystem: 1
+derivation length: 1
+axiom: A
+A --> M
+decomposition
+maximum depth: 2
+M --> N N
+N --> x
+homomorphism
+x --> F
+endlsystem
+)";
+    EXPECT_EQ(derive_text(src), "xx");
+}
+
+TEST(DeriveCut, PercentRemovesRestOfBranch)
+{
+    const char* src = "lsystem: 1\nderivation length: 1\naxiom: A[B%CD[E]F]G\nendlsystem\n";
+    EXPECT_EQ(derive_text(src), "A[B]G");
+}
+
+TEST(DeriveStochastic, SameSeedSameString)
+{
+    const char* src = R"(lsystem: 1
+seed: 7
+derivation length: 6
+axiom: A
+A --> AB : 1
+A --> AC : 1
+endlsystem
+)";
+    std::string a = derive_text(src);
+    EXPECT_EQ(a, derive_text(src));
+    EXPECT_EQ(a.size(), 7u);
+    EXPECT_NE(a.find('B'), std::string::npos);
+    EXPECT_NE(a.find('C'), std::string::npos);
+}
+
+}  // namespace
+}  // namespace cambium::lsys

@@ -1,0 +1,134 @@
+// SPDX-License-Identifier: Apache-2.0
+// Parser and lexer behaviour: module names, sections, and located error messages.
+#include "lsys/program.h"
+#include "test_util.h"
+
+namespace cambium::lsys {
+namespace {
+
+using testing::derive_text;
+using testing::load_error;
+
+TEST(LsysParser, ReportsColumnOfMissingArrow)
+{
+    std::string e = load_error("lsystem: 1\naxiom: A\nA(x) B\nendlsystem\n");
+    EXPECT_NE(e.find("test.l:3:7: error: expected '-->', found end of line"), std::string::npos)
+        << e;
+}
+
+TEST(LsysParser, ReportsLineOfBadExpression)
+{
+    std::string e = load_error("lsystem: 1\n\naxiom: A(1)\nA(x) --> B(x*)\nendlsystem\n");
+    EXPECT_NE(e.find("test.l:4:14: error: expected an expression, found ')'"),
+              std::string::npos)
+        << e;
+}
+
+TEST(LsysParser, ReportsMissingEndlsystem)
+{
+    std::string e = load_error("lsystem: 1\naxiom: A\nA --> B\n");
+    EXPECT_NE(e.find("test.l:4:1: error: expected a production or 'endlsystem', found end of file"),
+              std::string::npos)
+        << e;
+}
+
+TEST(LsysParser, ReportsUnknownFunction)
+{
+    std::string e = load_error("lsystem: 1\naxiom: A(frob(2))\nendlsystem\n");
+    EXPECT_NE(e.find("test.l:2:10: error: unknown function 'frob'"), std::string::npos) << e;
+}
+
+TEST(LsysParser, LineNumbersSurviveMacrosAndComments)
+{
+    std::string e = load_error(
+        "#define X 3\n/* a\n comment */\nlsystem: 1\naxiom: A(X)\nA --> B(\nendlsystem\n");
+    EXPECT_NE(e.find("test.l:6:"), std::string::npos) << e;
+}
+
+TEST(LsysParser, RejectsDeepExpressionNesting)
+{
+    std::string deep(500, '(');
+    std::string src = "lsystem: 1\naxiom: A(" + deep + "1" + std::string(500, ')') +
+                      ")\nendlsystem\n";
+    EXPECT_NE(load_error(src).find("nested too deeply"), std::string::npos);
+}
+
+TEST(LsysParser, AtCommandsTildeAndQueryModulesAreSingleModules)
+{
+    LSystem ls = LSystem::from_source(
+        "lsystem: 1\naxiom: @Gs@GcF(1)@O(2)~l(3)?P(0,0)@v@oZG\nendlsystem\n");
+    ModuleString s = ls.axiom();
+    std::vector<std::string> names;
+    s.for_each([&](ModuleRef m) { names.emplace_back(ls.symbols().name(m.symbol)); });
+    EXPECT_EQ(names, (std::vector<std::string>{"@Gs", "@Gc", "F", "@O", "~l", "?P", "@v", "@o",
+                                               "Z", "G"}));
+}
+
+TEST(LsysParser, KeywordSpellingsOfTheCorpus)
+{
+    const char* src = "Lsystem: 1\nDerivation Length: 1\nAxiom: A\nA --> B\nendLsystem\n";
+    EXPECT_EQ(derive_text(src), "B");
+}
+
+TEST(LsysParser, StarContextsAndConditions)
+{
+    const char* src = "lsystem: 1\nderivation length: 1\naxiom: A\n* < A > * : * --> B\nendlsystem\n";
+    EXPECT_EQ(derive_text(src), "B");
+}
+
+TEST(LsysParser, TabContinuesProductionOnNextLine)
+{
+    const char* src = "lsystem: 1\nderivation length: 1\naxiom: A\nA --> B\n\tC\n\tD\nendlsystem\n";
+    EXPECT_EQ(derive_text(src), "BCD");
+}
+
+TEST(LsysParser, LineWithoutTabEndsProduction)
+{
+    std::string e = load_error("lsystem: 1\naxiom: A\nA --> B\n C\nendlsystem\n");
+    EXPECT_NE(e.find("test.l:4:3: error: expected '-->'"), std::string::npos) << e;
+}
+
+TEST(LsysParser, ParsesMultipleLsystemsAndSections)
+{
+    LSystem ls = LSystem::from_source(R"(lsystem: 1
+axiom: A
+A --> B
+homomorphism: no warnings
+maximum depth: 3
+B --> F
+endlsystem
+lsystem: 2
+axiom: C
+endlsystem
+)");
+    const Program& p = ls.program();
+    ASSERT_EQ(p.lsystems.size(), 2u);
+    EXPECT_EQ(p.lsystems[1].id, 2);
+    EXPECT_EQ(p.lsystems[0].homomorphism.productions.size(), 1u);
+    EXPECT_TRUE(p.lsystems[0].homomorphism.max_depth.has_value());
+}
+
+TEST(LsysParser, StochasticProbabilityParsed)
+{
+    LSystem ls = LSystem::from_source("lsystem: 1\nseed: 3\naxiom: A\nA --> B : 0.3\nA --> C : 0.7\nendlsystem\n");
+    ASSERT_EQ(ls.program().lsystems[0].productions.productions.size(), 2u);
+    EXPECT_TRUE(ls.program().lsystems[0].productions.productions[1].probability.has_value());
+}
+
+TEST(LsysParser, SubLsystemSwitchesProductionSets)
+{
+    const char* src = R"(lsystem: 1
+derivation length: 1
+axiom: A?(2)A$A
+A --> X
+endlsystem
+lsystem: 2
+axiom: A
+A --> Y
+endlsystem
+)";
+    EXPECT_EQ(derive_text(src), "X?(2)Y$X");
+}
+
+}  // namespace
+}  // namespace cambium::lsys

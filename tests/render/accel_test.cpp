@@ -1,0 +1,136 @@
+// SPDX-License-Identifier: Apache-2.0
+// EmbreeScene: hits on round linear curves, pixel radii, empty scenes, spawn offsets.
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <utility>
+
+#include "base/diagnostics.h"
+#include "render/accel.h"
+#include "render/material.h"
+#include "render/sampler.h"
+#include "test_scenes.h"
+
+namespace cambium::render {
+namespace {
+
+using testing::add_segment;
+using testing::empty_scene;
+
+constexpr float inf = std::numeric_limits<float>::infinity();
+
+Camera unit_camera(const geom::Scene& s)
+{
+    return make_camera(s.view, s.bounds, 200, 100);
+}
+
+TEST(EmbreeScene, EmptySceneHitsNothing)
+{
+    geom::Scene s = empty_scene({0, 0, 0}, {0, 0, 0});
+    EmbreeScene accel(s, unit_camera(s));
+    EXPECT_EQ(accel.segment_count(), 0u);
+    EXPECT_FALSE(accel.intersect({0, 0, 5}, {0, 0, -1}, 0, inf));
+    EXPECT_FALSE(accel.occluded({0, 0, 5}, {0, 0, -1}, 0, inf));
+}
+
+TEST(EmbreeScene, HitsRoundSegmentWithMaterialAndRadius)
+{
+    geom::Scene s = empty_scene({-10, -1, 0}, {10, 1, 0});
+    add_segment(s, {-10, 0, 0}, {10, 0, 0}, 1.0f, 7);
+    EmbreeScene accel(s, unit_camera(s));
+    auto hit = accel.intersect({2, 0, 10}, {0, 0, -1}, 0, inf);
+    ASSERT_TRUE(hit);
+    EXPECT_NEAR(hit->t, 9.0f, 1e-4f);
+    EXPECT_NEAR(hit->normal.z, 1.0f, 1e-4f);
+    EXPECT_EQ(hit->material, 7);
+    EXPECT_EQ(hit->prim_id, 0u);
+    EXPECT_NEAR(hit->radius, 1.0f, 1e-6f);
+    // The normal faces the ray also when hit from below.
+    auto below = accel.intersect({2, 0, -10}, {0, 0, 1}, 0, inf);
+    ASSERT_TRUE(below);
+    EXPECT_NEAR(below->normal.z, -1.0f, 1e-4f);
+    EXPECT_TRUE(accel.occluded({2, 0, 10}, {0, 0, -1}, 0, 20));
+    EXPECT_FALSE(accel.occluded({2, 0, 10}, {0, 0, -1}, 0, 8.5f));
+    EXPECT_FALSE(accel.intersect({2, 1.5f, 10}, {0, 0, -1}, 0, inf));
+}
+
+// Radii in pixels become pixel_size * radius world units: here k = min(200/20, 100/10) = 10
+// px per unit, so 5 px is 0.5 units.
+TEST(EmbreeScene, ConvertsPixelRadiiThroughCamera)
+{
+    geom::Scene s = empty_scene({-10, -5, 0}, {10, 5, 0});
+    s.line_radius_in_pixels = true;
+    add_segment(s, {-10, 0, 0}, {10, 0, 0}, 5.0f);
+    Camera camera = unit_camera(s);
+    ASSERT_NEAR(camera.pixel_size(), 0.1, 1e-12);
+    EmbreeScene accel(s, camera);
+    auto hit = accel.intersect({0, 0, 10}, {0, 0, -1}, 0, inf);
+    ASSERT_TRUE(hit);
+    EXPECT_NEAR(hit->t, 9.5f, 1e-4f);
+    EXPECT_NEAR(hit->radius, 0.5f, 1e-6f);
+    EXPECT_FALSE(accel.intersect({0, 0.6f, 10}, {0, 0, -1}, 0, inf));
+}
+
+/// Diffuse rays spawned from camera hits on the scene's curves: how many hit a curve
+/// again, of how many spawned. The scenes below are convex tubes, so every hit is spurious.
+std::pair<int, int> count_rehits(const geom::Scene& s, float half_width)
+{
+    EmbreeScene accel(s, unit_camera(s));
+    int rehits = 0, n = 0;
+    for (std::uint32_t i = 0; i < 4000; ++i) {
+        Sampler sm(i, 0, 0, 1);
+        float ox = sm.next() * 10 - 5, oy = (sm.next() * 2 - 1) * half_width * 0.9f;
+        auto hit = accel.intersect({ox, oy, 1}, {0, 0, -1}, 0, inf);
+        if (!hit)
+            continue;
+        ++n;
+        Vec3f org = hit->position + hit->normal * hit->spawn_offset;
+        BsdfSample bs = bsdf_sample(Lambertian{Vec3f(1)}, hit->normal, sm.next(), sm.next());
+        rehits += accel.intersect(org, bs.wi, 0, inf, hit->prim()) ? 1 : 0;
+    }
+    return {rehits, n};
+}
+
+// FACTS.md: without protection about half the diffuse rays leaving a curve hit it again.
+TEST(EmbreeScene, SpawnedRaysDoNotHitTheirOwnSegment)
+{
+    geom::Scene s = empty_scene({-10, -1, -1}, {10, 1, 1});
+    add_segment(s, {-10, 0, 0}, {10, 0, 0}, 0.01f);
+    auto [rehits, n] = count_rehits(s, 0.01f);
+    ASSERT_GT(n, 3000);
+    EXPECT_LE(rehits, n / 1000) << rehits << " of " << n;
+}
+
+// A straight polyline of short joined segments (neighbour flags) is one convex tube: rays
+// leaving one segment must not hit its neighbours at the joints either.
+TEST(EmbreeScene, SpawnedRaysDoNotHitJoinedNeighbours)
+{
+    geom::Scene s = empty_scene({-10, -1, -1}, {10, 1, 1});
+    const int count = 40;
+    for (int i = 0; i <= count; ++i)
+        s.lines.keys.push_back({-10.0f + 20.0f * i / count, 0, 0, 0.05f});
+    for (int i = 0; i < count; ++i) {
+        s.lines.segments.push_back(static_cast<std::uint32_t>(i));
+        std::uint8_t f = 0;
+        if (i > 0)
+            f |= geom::LinearCurves::neighbour_left;
+        if (i + 1 < count)
+            f |= geom::LinearCurves::neighbour_right;
+        s.lines.flags.push_back(f);
+        s.lines.material.push_back(1);
+    }
+    auto [rehits, n] = count_rehits(s, 0.05f);
+    ASSERT_GT(n, 3000);
+    EXPECT_LE(rehits, n / 500) << rehits << " of " << n;
+}
+
+TEST(EmbreeScene, RejectsSegmentPastTheKeys)
+{
+    geom::Scene s = empty_scene({0, 0, 0}, {1, 1, 1});
+    s.lines.keys.push_back({0, 0, 0, 1});
+    s.lines.segments.push_back(0);
+    EXPECT_THROW(EmbreeScene(s, unit_camera(s)), Error);
+}
+
+}  // namespace
+}  // namespace cambium::render

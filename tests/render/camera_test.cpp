@@ -1,0 +1,133 @@
+// SPDX-License-Identifier: Apache-2.0
+// Camera framing against hand-computed values from cpfg's rule (CalculateWindow, SetView).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "render/camera.h"
+
+namespace cambium::render {
+namespace {
+
+geom::Bounds3 box(const geom::Vec3& lo, const geom::Vec3& hi)
+{
+    geom::Bounds3 b;
+    b.extend(lo);
+    b.extend(hi);
+    return b;
+}
+
+// Oracle 03-snowflake: box 0..81 x 0..23.3827, scale 0.9, 640x480. The width limits:
+// 0.9 * 640 / 81 = 7.1111 px per unit, centred; cpfg's window shows x 32..607, y 157..323.
+TEST(Camera, ParallelFitsSnowflakeAsCpfg)
+{
+    geom::View view;
+    view.scale_factor = 0.9;
+    Camera c = make_camera(view, box({0, -8.88178e-16, 0}, {81, 23.3827, 0}), 640, 480);
+    EXPECT_NEAR(c.project({0, 0, 0}).x, 32.0, 1e-9);
+    EXPECT_NEAR(c.project({81, 0, 0}).x, 608.0, 1e-9);
+    double k = 0.9 * 640 / 81;
+    EXPECT_NEAR(c.project({0, 0, 0}).y, 240 + (23.3827 / 2) * k, 1e-4);  // 323.14
+    EXPECT_NEAR(c.project({0, 23.3827, 0}).y, 240 - (23.3827 / 2) * k, 1e-4);  // 156.86
+    EXPECT_NEAR(c.pixel_size(), 1 / k, 1e-12);
+}
+
+// Oracle DragonCurve: box -10..5 x -5..18, scale 0.9. The height limits:
+// k = 0.9 * 480 / 23 = 18.783; x = -10 lands at 320 - 7.5 k = 179.1 (image: 178..461).
+TEST(Camera, ParallelHeightLimitedFit)
+{
+    geom::View view;
+    view.scale_factor = 0.9;
+    Camera c = make_camera(view, box({-10, -5, 0}, {5, 18, 0}), 640, 480);
+    double k = 0.9 * 480 / 23;
+    EXPECT_NEAR(c.project({-10, 6.5, 0}).x, 320 - 7.5 * k, 1e-9);
+    EXPECT_NEAR(c.project({5, 6.5, 0}).x, 320 + 7.5 * k, 1e-9);
+    EXPECT_NEAR(c.project({0, 18, 0}).y, 240 - 0.9 * 240, 1e-9);
+    EXPECT_NEAR(c.project({0, -5, 0}).y, 240 + 0.9 * 240, 1e-9);
+}
+
+// Looking from +x at the origin: screen right is -z, up is +y. Box 0..1 x 0..2 x 0..4:
+// projected extent 4 (z) x 2 (y), k = min(640/4, 480/2) = 160, so z = 4 -> 0, z = 0 -> 640.
+TEST(Camera, ParallelFitsTheProjectedBox)
+{
+    geom::View view;
+    view.viewpoint = {1, 0, 0};
+    Camera c = make_camera(view, box({0, 0, 0}, {1, 2, 4}), 640, 480);
+    EXPECT_NEAR(c.project({0.5, 1, 4}).x, 0.0, 1e-9);
+    EXPECT_NEAR(c.project({0.5, 1, 0}).x, 640.0, 1e-9);
+    EXPECT_NEAR(c.project({0.5, 2, 2}).y, 240 - 160, 1e-9);
+    // Depth along the view does not move a point in a parallel view.
+    EXPECT_NEAR(c.project({-7, 2, 2}).x, c.project({3, 2, 2}).x, 1e-9);
+}
+
+TEST(Camera, BoxOverridesBounds)
+{
+    geom::View view;
+    view.box = box({-4, -2, -4}, {4, 7, 4});
+    Camera c = make_camera(view, box({-1, -1, -1}, {1, 1, 1}), 640, 480);
+    // k = min(640/8, 480/9) = 53.33; centre (0, 2.5).
+    EXPECT_NEAR(c.project({0, 2.5, 0}).y, 240, 1e-9);
+    EXPECT_NEAR(c.project({4, 2.5, 0}).x, 320 + 4 * 480.0 / 9, 1e-9);
+}
+
+TEST(Camera, PointBoxGetsUnitSpan)
+{
+    geom::View view;
+    view.scale_factor = 0.5;  // cpfg ignores the scale when the box is a point
+    Camera c = make_camera(view, box({0, 0, 0}, {0, 0, 0}), 640, 480);
+    EXPECT_NEAR(c.project({1, 0, 0}).x, 640.0, 1e-9);
+}
+
+// Twist 90 degrees: the up vector turns counter-clockwise as the viewer sees it (+y -> -x),
+// so a point above the centre moves to the right of the image.
+TEST(Camera, TwistRotatesImageClockwise)
+{
+    geom::View view;
+    view.twist_deg = 90;
+    Camera c = make_camera(view, box({-1, -1, 0}, {1, 1, 0}), 480, 480);
+    PixelPoint p = c.project({0, 1, 0});
+    EXPECT_NEAR(p.y, 240, 1e-9);
+    EXPECT_GT(p.x, 240 + 100);
+}
+
+// Perspective: eye = vrp + (vp - vrp) / scale = (0,0,80); fovy 20: a point 10 above the
+// reference point is 10 / (80 tan 10deg) of the half height above the centre.
+TEST(Camera, PerspectiveEyeMovesWithScaleFactor)
+{
+    geom::View view;
+    view.perspective = true;
+    view.viewpoint = {0, 0, 40};
+    view.viewing_angle_deg = 20;
+    view.scale_factor = 0.5;
+    Camera c = make_camera(view, box({-1, -1, -1}, {1, 1, 1}), 640, 480);
+    double t = std::tan(10 * std::numbers::pi / 180);
+    EXPECT_NEAR(c.project({0, 0, 0}).x, 320, 1e-9);
+    EXPECT_NEAR(c.project({0, 10, 0}).y, 240 - 10 / (80 * t) * 240, 1e-6);
+    EXPECT_NEAR(c.project({10, 0, 0}).x, 320 + 10 / (80 * t) * 240, 1e-6);
+    // Twice as far from the eye, half the offset.
+    EXPECT_NEAR(c.project({0, 10, -80}).y, 240 - 5 / (80 * t) * 240, 1e-6);
+    EXPECT_NEAR(c.pixel_size_at({0, 0, -80}), 2 * c.pixel_size(), 1e-12);
+}
+
+TEST(Camera, GeneratedRayPassesThroughProjectedPoint)
+{
+    for (bool perspective : {false, true}) {
+        geom::View view;
+        view.perspective = perspective;
+        view.viewpoint = {3, 2, 10};
+        view.reference_point = {0.5, 1, 0};
+        view.twist_deg = 30;
+        Camera c = make_camera(view, box({-2, -1, -3}, {2, 4, 1}), 320, 200);
+        geom::Vec3 p{1.2, 2.5, -0.7};
+        PixelPoint q = c.project(p);
+        CameraRay r = c.generate_ray(q.x, q.y);
+        geom::Vec3 to = p - r.org;
+        double miss = geom::length(to - r.dir * geom::dot(to, r.dir));
+        EXPECT_LT(miss, 1e-9) << (perspective ? "perspective" : "parallel");
+        EXPECT_GT(geom::dot(to, r.dir), 0);
+    }
+}
+
+}  // namespace
+}  // namespace cambium::render

@@ -1,0 +1,231 @@
+// SPDX-License-Identifier: Apache-2.0
+// Whole renders of tiny scenes: silhouettes, lighting, symmetry, furnace, determinism.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+
+#include "base/diagnostics.h"
+#include "render/color.h"
+#include "render/render.h"
+#include "test_scenes.h"
+
+namespace cambium::render {
+namespace {
+
+using testing::add_segment;
+using testing::empty_scene;
+
+RenderSettings small(int w, int h, int spp, int depth = 1)
+{
+    RenderSettings s;
+    s.width = w;
+    s.height = h;
+    s.samples_per_pixel = spp;
+    s.max_depth = depth;
+    s.threads = 2;
+    s.ambient = {0, 0, 0};
+    return s;
+}
+
+geom::Light directional(const geom::Vec3& toward_light)
+{
+    geom::Light l;
+    l.kind = geom::Light::Kind::directional;
+    l.direction = toward_light;
+    return l;
+}
+
+// Bounds x -20..20, y -5..5 at 200x100: k = min(200/40, 100/10) = 5 px per unit, centre
+// (100, 50). A segment x -10..10 of radius 2 covers rows 40..60 and (with its round caps)
+// columns 40..160.
+TEST(Render, SegmentSilhouetteWhereCameraPutsIt)
+{
+    geom::Scene s = empty_scene({-20, -5, 0}, {20, 5, 0});
+    add_segment(s, {-10, 0, 0}, {10, 0, 0}, 2.0f);
+    Image img = render(s, small(200, 100, 4));
+    for (int y = 41; y <= 58; ++y)
+        EXPECT_EQ(img.at(100, y, 3), 1.0f) << "row " << y;
+    for (int y : {0, 20, 38, 61, 80, 99})
+        EXPECT_EQ(img.at(100, y, 3), 0.0f) << "row " << y;
+    EXPECT_EQ(img.at(45, 50, 3), 1.0f);
+    EXPECT_EQ(img.at(155, 50, 3), 1.0f);
+    EXPECT_EQ(img.at(38, 50, 3), 0.0f);
+    EXPECT_EQ(img.at(161, 50, 3), 0.0f);
+    // Edge rows are partly covered.
+    EXPECT_GT(img.at(100, 40, 3) + img.at(100, 59, 3), 0.0f);
+}
+
+// Camera rays that miss see the background: the PNG must hold cpfg's exact bytes.
+TEST(Render, MissedPixelsAreTheDecodedBackground)
+{
+    geom::Scene s = empty_scene({-1, -1, 0}, {1, 1, 0});
+    s.background = {161 / 255.0f, 229 / 255.0f, 7 / 255.0f};
+    Image img = render(s, small(8, 8, 2));
+    Vec3f bg = decode_display(s.background);
+    EXPECT_FLOAT_EQ(img.at(3, 3, 0), bg.x);
+    EXPECT_FLOAT_EQ(img.at(3, 3, 1), bg.y);
+    EXPECT_FLOAT_EQ(img.at(3, 3, 2), bg.z);
+    EXPECT_EQ(img.at(3, 3, 3), 0.0f);
+}
+
+// Light from +y, camera from +z: the upper half of the cylinder is lit, the lower half
+// (normals toward -y) receives nothing.
+TEST(Render, LitSideIsBrighterThanUnlitSide)
+{
+    geom::Scene s = empty_scene({-20, -5, 0}, {20, 5, 0});
+    add_segment(s, {-10, 0, 0}, {10, 0, 0}, 2.0f);
+    s.materials[1].diffuse = {0.8f, 0.8f, 0.8f};
+    s.lights.push_back(directional({0, 1, 0}));
+    Image img = render(s, small(200, 100, 4));
+    float lit = img.at(100, 45, 1), unlit = img.at(100, 55, 1);
+    EXPECT_GT(lit, 0.05f);
+    EXPECT_LT(unlit, 0.5f * lit);
+    // Normal incidence on the top of the cylinder: irradiance pi * 1, radiance = albedo.
+    // Near row 41 the normal is ~ (0, 0.9, 0.44): expect albedo * cos within tolerance.
+    float albedo = srgb_to_linear(0.8f);
+    EXPECT_LE(img.at(100, 41, 1), albedo * 1.001f);
+}
+
+// A white light straight onto a white-ish Lambertian surface gives exactly its albedo
+// (cpfg/OpenGL convention, light.h) where the normal faces the light.
+TEST(Render, LightIntensityConventionMatchesAlbedoAtNormalIncidence)
+{
+    geom::Scene s = empty_scene({-20, -5, 0}, {20, 5, 0});
+    add_segment(s, {-10, 0, 0}, {10, 0, 0}, 2.0f);
+    s.materials[1].diffuse = {0.6f, 0.6f, 0.6f};
+    s.lights.push_back(directional({0, 0, 1}));  // toward the camera side
+    RenderSettings set = small(200, 100, 1);
+    Image img = render(s, set);
+    // Pixel row 50 is the cylinder's axis: normal ~ +z, cos ~ 1.
+    float albedo = srgb_to_linear(0.6f);
+    EXPECT_NEAR(img.at(100, 50, 0), albedo, 0.01f * albedo);
+}
+
+// Seen from +y with the light straight above (+z): the lower cylinder's upper half is lit,
+// unless a second, wider cylinder above it casts its shadow.
+TEST(Render, ShadowRaysAreBlocked)
+{
+    geom::Scene s = empty_scene({-20, -2, -2}, {20, 2, 2});
+    s.view.viewpoint = {0, 1, 0};  // looking straight down -y: screen up is -z
+    add_segment(s, {-10, 0, 0}, {10, 0, 0}, 2.0f);
+    s.lights.push_back(directional({0, 0, 1}));
+    Camera c = make_camera(s.view, s.bounds, 100, 100);
+    // The +z side of the cylinder is below the centre on screen.
+    PixelPoint p = c.project({0, 2, 1});
+    int px = static_cast<int>(p.x), py = static_cast<int>(p.y);
+    ASSERT_GT(py, 50);
+
+    Image open = render(s, small(100, 100, 1));
+    EXPECT_EQ(open.at(px, py, 3), 1.0f);
+    EXPECT_GT(open.at(px, py, 0), 0.1f);
+
+    add_segment(s, {-10, 0, 10}, {10, 0, 10}, 4.0f);  // above it, off screen
+    Image shadowed = render(s, small(100, 100, 1));
+    EXPECT_EQ(shadowed.at(px, py, 3), 1.0f);
+    EXPECT_EQ(shadowed.at(px, py, 0), 0.0f);
+}
+
+// Two segments mirrored about x = 0, a point light on the axis: the image is mirror
+// symmetric up to sampling noise.
+TEST(Render, MirrorSymmetricSceneRendersSymmetric)
+{
+    geom::Scene s = empty_scene({-10, -6, -1}, {10, 6, 1});
+    add_segment(s, {2, -5, 0}, {8, 5, 0}, 0.8f);
+    add_segment(s, {-2, -5, 0}, {-8, 5, 0}, 0.8f);
+    s.materials[1].diffuse = {0.7f, 0.7f, 0.7f};
+    geom::Light l;
+    l.position = {0, 3, 4};
+    l.attenuation_quadratic = 0.02f;
+    s.lights.push_back(l);
+    RenderSettings set = small(64, 48, 16, 4);
+    set.ambient = {0.1f, 0.1f, 0.1f};
+    Image img = render(s, set);
+    double total = 0, diff = 0;
+    for (int y = 0; y < 48; ++y)
+        for (int x = 0; x < 32; x += 4) {
+            // Compare 4-pixel blocks to average the per-pixel noise.
+            double a = 0, b = 0;
+            for (int i = 0; i < 4; ++i) {
+                a += img.at(x + i, y, 1);
+                b += img.at(63 - x - i, y, 1);
+            }
+            total += a + b;
+            diff += std::abs(a - b);
+        }
+    ASSERT_GT(total, 1.0);
+    EXPECT_LT(diff / total, 0.05);
+    // An asymmetric light breaks it: the check has teeth.
+    s.lights[0].position = {6, 3, 4};
+    Image shifted = render(s, set);
+    double d2 = 0, t2 = 0;
+    for (int y = 0; y < 48; ++y)
+        for (int x = 0; x < 32; ++x) {
+            t2 += shifted.at(x, y, 1) + shifted.at(63 - x, y, 1);
+            d2 += std::abs(shifted.at(x, y, 1) - shifted.at(63 - x, y, 1));
+        }
+    EXPECT_GT(d2 / t2, 0.2);
+}
+
+// White furnace: albedo 1, environment = background = E, no lights. Every path carries E
+// exactly (cosine sampling: weight = albedo), so every pixel is E whatever it hits.
+TEST(Render, WhiteFurnaceConservesEnergy)
+{
+    geom::Scene s = empty_scene({-10, -6, -1}, {10, 6, 1});
+    add_segment(s, {-5, -4, 0}, {5, 4, 0}, 2.0f);
+    add_segment(s, {-5, 4, 0.5}, {5, -4, 0.5}, 2.0f);
+    s.materials[1].diffuse = {1, 1, 1};
+    float e = 0.5f;
+    s.background = {linear_to_srgb(e), linear_to_srgb(e), linear_to_srgb(e)};
+    RenderSettings set = small(32, 24, 8, 64);
+    set.roulette_depth = 1000;
+    float bg = decode_display(s.background).x;
+    set.ambient = {bg, bg, bg};
+    Image img = render(s, set);
+    int covered = 0;
+    for (int y = 0; y < 24; ++y)
+        for (int x = 0; x < 32; ++x) {
+            EXPECT_NEAR(img.at(x, y, 0), bg, 1e-5f) << x << "," << y;
+            covered += img.at(x, y, 3) > 0 ? 1 : 0;
+        }
+    EXPECT_GT(covered, 100);
+
+    // Albedo 0.5 on a lone convex cylinder: one bounce then escape -> exactly 0.5 E.
+    geom::Scene one = empty_scene({-10, -6, -1}, {10, 6, 1});
+    add_segment(one, {-8, 0, 0}, {8, 0, 0}, 3.0f);
+    one.materials[1].diffuse = {linear_to_srgb(0.5f), linear_to_srgb(0.5f), linear_to_srgb(0.5f)};
+    Image half = render(one, set);
+    EXPECT_NEAR(half.at(16, 12, 0), 0.5f * bg, 2e-3f * bg);
+}
+
+TEST(Render, BitIdenticalForAnyThreadCount)
+{
+    geom::Scene s = empty_scene({-10, -6, -1}, {10, 6, 1});
+    add_segment(s, {-5, -4, 0}, {5, 4, 0}, 1.0f);
+    add_segment(s, {-5, 4, 1}, {5, -4, 1}, 1.0f);
+    s.lights.push_back(directional({1, 1, 1}));
+    RenderSettings set = small(48, 40, 4, 6);
+    set.ambient = {0.2f, 0.2f, 0.2f};
+    set.threads = 1;
+    Image one = render(s, set);
+    set.threads = 2;
+    Image two = render(s, set);
+    ASSERT_EQ(one.rgba.size(), two.rgba.size());
+    EXPECT_EQ(std::memcmp(one.rgba.data(), two.rgba.data(), one.rgba.size() * sizeof(float)), 0);
+    set.seed = 1;
+    Image other = render(s, set);
+    EXPECT_NE(std::memcmp(one.rgba.data(), other.rgba.data(), one.rgba.size() * sizeof(float)),
+              0);
+}
+
+TEST(Render, RejectsInvalidSettings)
+{
+    geom::Scene s = empty_scene({0, 0, 0}, {1, 1, 1});
+    RenderSettings set = small(0, 10, 1);
+    EXPECT_THROW(render(s, set), Error);
+    set = small(10, 10, 0);
+    EXPECT_THROW(render(s, set), Error);
+}
+
+}  // namespace
+}  // namespace cambium::render

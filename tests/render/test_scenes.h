@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: Apache-2.0
+// Small hand-built Scenes shared by the render tests.
+#pragma once
+
+#include <array>
+
+#include "geom/scene.h"
+
+namespace cambium::render::testing {
+
+/// Appends one round linear segment a-b of radius r with material m.
+inline void add_segment(geom::Scene& s, const geom::Vec3& a, const geom::Vec3& b, float r,
+                        std::uint16_t m = 1)
+{
+    auto first = static_cast<std::uint32_t>(s.lines.keys.size());
+    s.lines.keys.push_back({float(a.x), float(a.y), float(a.z), r});
+    s.lines.keys.push_back({float(b.x), float(b.y), float(b.z), r});
+    s.lines.segments.push_back(first);
+    s.lines.flags.push_back(0);
+    s.lines.material.push_back(m);
+}
+
+/// A scene with no lights, a black background and the given fit box.
+inline geom::Scene empty_scene(const geom::Vec3& lo, const geom::Vec3& hi)
+{
+    geom::Scene s;
+    s.bounds.extend(lo);
+    s.bounds.extend(hi);
+    return s;
+}
+
+}  // namespace cambium::render::testing
