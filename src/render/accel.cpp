@@ -92,6 +92,7 @@ struct EmbreeScene::Impl {
     const geom::LinearCurves* lines = nullptr;
     /// Keys with world-unit radii when the Scene's are in pixels (else empty: shared).
     std::vector<Key> world_keys;
+    bool lines_unlit = false;  ///< pixel-style lines: flat colour, no shading
     const Key* keys = nullptr;
     std::uint32_t lines_geom_id = RTC_INVALID_GEOMETRY_ID;
 
@@ -136,6 +137,7 @@ void EmbreeScene::Impl::add_lines(const geom::Scene& s, const Camera& camera)
         if (first + 1 >= l.keys.size())
             throw Error("scene: curve segment starts at key " + std::to_string(first) +
                         " of " + std::to_string(l.keys.size()));
+    lines_unlit = s.line_radius_in_pixels;
     if (s.line_radius_in_pixels) {
         world_keys = keys_in_world_units(l, camera);
         keys = world_keys.data();
@@ -218,6 +220,7 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     // One geometry so far: the linear curves.
     const geom::LinearCurves& l = *m.lines;
     h.material = h.prim_id < l.material.size() ? l.material[h.prim_id] : 0;
+    h.unlit = m.lines_unlit;
     const Key& k0 = m.keys[l.segments[h.prim_id]];
     const Key& k1 = m.keys[l.segments[h.prim_id] + 1];
     h.radius = k0[3] + (k1[3] - k0[3]) * rh.hit.u;

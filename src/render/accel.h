@@ -31,6 +31,9 @@ struct SurfaceHit {
     /// Distance to move a spawned ray's origin along `normal`: Embree's round curves have
     /// no self-intersection protection (FACTS.md), so this scales with the radius.
     float spawn_offset = 0;
+    /// Drawn in its flat colour, not shaded: cpfg's `line style: pixel` lines are
+    /// unlit GL lines, and this keeps their look (docs/deviations.md).
+    bool unlit = false;
 
     PrimId prim() const { return {geom_id, prim_id}; }
 };

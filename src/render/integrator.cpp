@@ -55,6 +55,10 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         if (depth == 0)
             result.hit = true;
         const SurfaceMaterial& material = material_of(ctx, *hit);
+        if (hit->unlit) {
+            result.radiance += beta * flat_colour(material);
+            break;
+        }
         result.radiance += beta * material.emission;
         // Spawned rays leave from just outside the curve (FACTS.md: no self-hit guard).
         Vec3f origin = hit->position + hit->normal * hit->spawn_offset;

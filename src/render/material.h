@@ -25,6 +25,13 @@ struct SurfaceMaterial {
     Vec3f emission;
 };
 
+/// The colour a surface shows unlit (cpfg's flat colour): its diffuse albedo plus emission.
+inline Vec3f flat_colour(const SurfaceMaterial& m)
+{
+    Vec3f albedo = std::visit([](const auto& b) { return b.albedo; }, m.bsdf);
+    return albedo + m.emission;
+}
+
 /// A direction sampled from a BSDF: `weight` = f cos / pdf.
 struct BsdfSample {
     Vec3f wi;

@@ -151,3 +151,25 @@ TEST(Pipeline, LitPlantIsNotBlackAndFacesItsLight)
     EXPECT_GT(right, 0.1);
     EXPECT_GT(right, 3 * left);
 }
+
+// cpfg draws `line style: pixel` lines unlit in their colour: the centre of a 5-pixel
+// line shows exactly the material's colour, whatever the lights.
+TEST(Pipeline, PixelLinesShowTheirFlatColour)
+{
+    lsys::LSystem l = lsys::LSystem::from_source(
+        "lsystem: 1\nderivation length: 0\naxiom: -(90)F(10)\nendlsystem\n", "e2e.l");
+    geom::Scene scene = geom::interpret(
+        l.derive(), l.symbols(),
+        geom::parse_view_file("initial line width: 5 pixels\ninitial color: 3\n"
+                              "light: V: 0 1 0\nscale factor: 0.5\n", "e2e.v"));
+    scene.materials[3].diffuse = {1.0f, 0.5f, 0.25f};
+    render::RenderSettings settings;
+    settings.width = 40;
+    settings.height = 40;
+    settings.samples_per_pixel = 8;
+    render::Image im = render::render(scene, settings);
+    // sRGB 0.5 decodes to 0.2140 linear, 0.25 to 0.0508.
+    EXPECT_NEAR(channel(im, 20, 20, 0), 1.0, 1e-3);
+    EXPECT_NEAR(channel(im, 20, 20, 1), 0.2140, 1e-3);
+    EXPECT_NEAR(channel(im, 20, 20, 2), 0.0508, 1e-3);
+}
