@@ -1,8 +1,9 @@
 # SPDX-License-Identifier: Apache-2.0
-# The two commands of the README: `make render` and `make test`.
+# Build, render the default scene, run the tests (build.sh installs packages first).
 BUILD ?= build
 JOBS ?= $(shell nproc)
 CAMBIUM = $(BUILD)/src/app/cambium
+MAKEFLAGS += --no-print-directory
 DEFAULT = scenes/default
 
 .PHONY: setup build render test clean
@@ -10,7 +11,7 @@ DEFAULT = scenes/default
 setup:
 	@bash scripts/setup.sh
 
-build: setup
+build:
 	@echo "build: configuring $(BUILD) (Release)"
 	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release > $(BUILD).configure.log 2>&1 || { cat $(BUILD).configure.log; exit 1; }
 	@echo "build: compiling with $(JOBS) jobs"
