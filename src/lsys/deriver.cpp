@@ -9,6 +9,16 @@ namespace cambium::lsys {
 
 namespace {
 
+std::size_t predicted(std::size_t size, double growth)
+{
+    return static_cast<std::size_t>(static_cast<double>(size) * growth * 1.01) + 64;
+}
+
+double growth(std::size_t before, std::size_t after)
+{
+    return before == 0 ? 1.0 : static_cast<double>(after) / static_cast<double>(before);
+}
+
 int symbol_or_none(const SymbolTable& symbols, std::string_view name)
 {
     return symbols.find(name);
@@ -26,6 +36,10 @@ Deriver::Deriver(const Program& program, DeriveLimits limits)
     m_sub_start = symbol_or_none(symbols, "?");
     m_sub_end = symbol_or_none(symbols, "$");
     m_equals = symbol_or_none(symbols, "=");
+    for (const auto& ls : program.lsystems)
+        for (const ProductionSet* set : {&ls.productions, &ls.decomposition})
+            for (const auto& p : set->productions)
+                m_needs_index |= !p.left_context.empty() || !p.right_context.empty();
 
     // Ignore tables: consider: ignores everything not listed
     for (const auto& ls : program.lsystems) {
@@ -52,13 +66,10 @@ Deriver::Deriver(const Program& program, DeriveLimits limits)
     if (main.derivation_length)
         m_runtime.derivation_length =
             static_cast<int>(evaluate(*main.derivation_length, m_frame, m_runtime));
-    if (main.seed) {
-        m_stochastic_mode = true;
-        long seed = static_cast<long>(evaluate(*main.seed, m_frame, m_runtime));
-        // Only the production choice is seeded: ran() and friends keep their own
-        // state until the L-system calls srand(), as in cpfg
-        m_stochastic.seed(seed);
-    }
+    // seed: makes the L-system stochastic. The production choice draws from erand48 on
+    // a state that starts at 0 and that cpfg (the build the corpus oracle comes from)
+    // never seeds: RandomMoss (seed: 2454) matches cpfg only this way.
+    m_stochastic.set_state(0);
     evaluate(program.start_block, m_frame, m_runtime);
     for (const auto& m : main.axiom)
         append_evaluated(m, m_string);
@@ -76,6 +87,13 @@ int Deriver::lsystem_index(double id) const
 void Deriver::index(const ModuleString& s, Indexed& out) const
 {
     out.string = &s;
+    // Only context matching needs random access to parameters and bracket partners;
+    // without context productions the arrays (8 bytes a module) are not built
+    if (!m_needs_index) {
+        out.offsets.clear();
+        out.partner.clear();
+        return;
+    }
     out.offsets.resize(s.size() + 1);
     out.partner.assign(s.size(), 0);
     std::vector<std::uint32_t> open;
@@ -100,12 +118,24 @@ void Deriver::step()
     evaluate(m_program.start_each_block, m_frame, m_runtime);
     index(m_string, m_indexed);
     m_next.clear();
-    m_next.reserve(m_string.size(), m_string.param_total());
+    // Reserve what the last step's growth predicts, so the new string is not
+    // reallocated (and briefly held twice) while it is built
+    m_next.reserve(predicted(m_string.size(), m_module_growth),
+                   predicted(m_string.param_total(), m_param_growth));
+    std::size_t modules = m_string.size(), params = m_string.param_total();
     rewrite(m_indexed, m_next, false);
+    m_module_growth = growth(modules, m_next.size());
+    m_param_growth = growth(params, m_next.param_total());
     std::swap(m_string, m_next);
     decompose();
     evaluate(m_program.end_each_block, m_frame, m_runtime);
     ++m_steps;
+}
+
+ModuleString Deriver::take_string()
+{
+    m_next = ModuleString();
+    return std::move(m_string);
 }
 
 void Deriver::finish() { evaluate(m_program.end_block, m_frame, m_runtime); }
@@ -131,40 +161,69 @@ std::size_t Deriver::rewrite(const Indexed& src, ModuleString& dst, bool decompo
     const ModuleString& s = *src.string;
     m_lsystem_stack.assign(1, 0);
     std::size_t applied = 0;
+    std::size_t offset = 0;  // first parameter of module i
     for (std::size_t i = 0; i < s.size();) {
         const LSystemDefinition& ls =
             m_program.lsystems[static_cast<std::size_t>(m_lsystem_stack.back())];
         const ProductionSet& set = decomposition ? ls.decomposition : ls.productions;
+        bool stochastic = ls.seed && !decomposition;
+        // Copy a run of modules that nothing can rewrite in one go
+        std::size_t run = i;
+        std::size_t run_params = 0;
+        while (run < s.size() && is_plain(set, s.symbol(run), decomposition)) {
+            run_params += s.param_count(run);
+            ++run;
+        }
+        if (run > i) {
+            if (stochastic)
+                for (std::size_t k = i; k < run; ++k)
+                    m_stochastic.next_double();  // cpfg draws for every module
+            dst.append_range(s, i, run, offset);
+            offset += run_params;
+            i = run;
+            check_size(dst);
+            continue;
+        }
         int sym = s.symbol(i);
         std::size_t consumed = 1;
-        if (apply_first_match(set, ls, src, i, dst, consumed)) {
+        if (apply_first_match(set, ls, src, i, offset, dst, consumed)) {
             ++applied;
         } else if (sym == m_cut && !decomposition) {
-            consumed = cut_end(src, i) - i;
+            consumed = cut_end(s, i) - i;
         } else {
-            dst.append(s.symbol(i), std::span<const float>(s.param_data() + src.offsets[i],
-                                                           s.param_count(i)));
+            dst.append(s.symbol(i),
+                       std::span<const float>(s.param_data() + offset, s.param_count(i)));
         }
         // Sub-L-system switching: ?(id) enters, $ returns
         if (sym == m_sub_start && s.param_count(i) > 0) {
-            int idx = lsystem_index(s.param_data()[src.offsets[i]]);
+            int idx = lsystem_index(s.param_data()[offset]);
             m_lsystem_stack.push_back(idx >= 0 ? idx : m_lsystem_stack.back());
         } else if (sym == m_sub_end && m_lsystem_stack.size() > 1) {
             m_lsystem_stack.pop_back();
         }
+        for (std::size_t k = 0; k < consumed; ++k)
+            offset += s.param_count(i + k);
         i += consumed;
         check_size(dst);
     }
     return applied;
 }
 
-std::size_t Deriver::cut_end(const Indexed& src, std::size_t i) const
+bool Deriver::is_plain(const ProductionSet& set, int sym, bool decomposition) const
 {
-    const ModuleString& s = *src.string;
+    return !set.candidates(static_cast<SymbolId>(sym)) && sym != m_sub_start &&
+           sym != m_sub_end && (decomposition || sym != m_cut);
+}
+
+std::size_t Deriver::cut_end(const ModuleString& s, std::size_t i) const
+{
+    // the end of the current branch: the ']' that closes it, or the end of the string
+    int depth = 0;
     for (std::size_t k = i + 1; k < s.size(); ++k) {
-        if (s.symbol(k) == m_bracket_open)
-            k = src.partner[k];
-        else if (s.symbol(k) == m_bracket_close)
+        int sym = s.symbol(k);
+        if (sym == m_bracket_open)
+            ++depth;
+        else if (sym == m_bracket_close && depth-- == 0)
             return k;
     }
     return s.size();
@@ -180,17 +239,17 @@ void Deriver::check_size(const ModuleString& s) const
 }
 
 bool Deriver::apply_first_match(const ProductionSet& set, const LSystemDefinition& ls,
-                                const Indexed& src, std::size_t i, ModuleString& dst,
-                                std::size_t& consumed)
+                                const Indexed& src, std::size_t i, std::size_t offset,
+                                ModuleString& dst, std::size_t& consumed)
 {
     if (ls.seed && &set == &ls.productions)
-        return apply_stochastic(set, ls, src, i, dst, consumed);
+        return apply_stochastic(set, ls, src, i, offset, dst, consumed);
     const auto* candidates = set.candidates(src.string->symbol(i));
     if (!candidates)
         return false;
     for (std::uint32_t index : *candidates) {
         const Production& p = set.productions[index];
-        if (match(p, ls, src, i) && condition_holds(p)) {
+        if (match(p, ls, src, i, offset) && condition_holds(p)) {
             run_post_block(p);
             produce(p, dst);
             consumed = p.predecessor.size();
@@ -201,8 +260,8 @@ bool Deriver::apply_first_match(const ProductionSet& set, const LSystemDefinitio
 }
 
 bool Deriver::apply_stochastic(const ProductionSet& set, const LSystemDefinition& ls,
-                               const Indexed& src, std::size_t i, ModuleString& dst,
-                               std::size_t& consumed)
+                               const Indexed& src, std::size_t i, std::size_t offset,
+                               ModuleString& dst, std::size_t& consumed)
 {
     // cpfg collects every applicable production with its probability, summed in
     // single precision, then draws once per module, even where nothing applies
@@ -213,7 +272,7 @@ bool Deriver::apply_stochastic(const ProductionSet& set, const LSystemDefinition
     if (const auto* candidates = set.candidates(src.string->symbol(i))) {
         for (std::uint32_t index : *candidates) {
             const Production& p = set.productions[index];
-            if (!match(p, ls, src, i) || !condition_holds(p))
+            if (!match(p, ls, src, i, offset) || !condition_holds(p))
                 continue;
             float prob = p.probability
                              ? static_cast<float>(evaluate(*p.probability, m_frame, m_runtime))
@@ -244,27 +303,31 @@ bool Deriver::apply_stochastic(const ProductionSet& set, const LSystemDefinition
     return false;
 }
 
-bool Deriver::bind(const FormalModule& f, const Indexed& src, std::size_t k)
+bool Deriver::bind(const FormalModule& f, const ModuleString& s, std::size_t k,
+                  std::size_t offset)
 {
-    const ModuleString& s = *src.string;
     if (s.symbol(k) != f.symbol || s.param_count(k) != f.param_slots.size())
         return false;
-    const float* params = s.param_data() + src.offsets[k];
+    const float* params = s.param_data() + offset;
     for (std::size_t j = 0; j < f.param_slots.size(); ++j)
         m_frame[static_cast<std::size_t>(f.param_slots[j])] = params[j];
     return true;
 }
 
 bool Deriver::match(const Production& p, const LSystemDefinition& ls, const Indexed& src,
-                    std::size_t i)
+                    std::size_t i, std::size_t offset)
 {
     const ModuleString& s = *src.string;
     if (i + p.predecessor.size() > s.size())
         return false;
     std::fill(m_frame.begin(), m_frame.begin() + p.frame_size, 0.0);
-    for (std::size_t k = 0; k < p.predecessor.size(); ++k)
-        if (!bind(p.predecessor[k], src, i + k))
+    for (std::size_t k = 0; k < p.predecessor.size(); ++k) {
+        if (!bind(p.predecessor[k], s, i + k, offset))
             return false;
+        offset += s.param_count(i + k);
+    }
+    if (p.left_context.empty() && p.right_context.empty())
+        return true;
     const auto& ignored = m_ignored[static_cast<std::size_t>(&ls - m_program.lsystems.data())];
     return match_left(p, ignored, src, i) &&
            match_right(p, ignored, src, i + p.predecessor.size());
@@ -288,7 +351,7 @@ bool Deriver::match_left(const Production& p, const std::vector<char>& ignored,
             else
                 break;
         }
-        if (!bind(*f, src, k))
+        if (!bind(*f, s, k, src.offsets[k]))
             return false;
     }
     return true;
@@ -319,7 +382,7 @@ bool Deriver::match_right(const Production& p, const std::vector<char>& ignored,
             else
                 break;
         }
-        if (!bind(f, src, k))
+        if (!bind(f, s, k, src.offsets[k]))
             return false;
         ++k;
     }
@@ -358,6 +421,10 @@ void Deriver::run_post_block(const Production& p)
 
 void Deriver::produce(const Production& p, ModuleString& dst)
 {
+    if (p.constant_successor) {
+        dst.append(*p.constant_successor);
+        return;
+    }
     for (const auto& m : p.successor)
         append_evaluated(m, dst);
 }

@@ -27,6 +27,8 @@ public:
     bool stop_requested() const { return m_runtime.stop_requested; }
     void step();
     void finish();
+    /// Moves the current string out (the Deriver is spent afterwards).
+    ModuleString take_string();
 
 private:
     /// A string with the lookup tables context matching needs.
@@ -38,24 +40,25 @@ private:
     void index(const ModuleString& s, Indexed& out) const;
     std::size_t rewrite(const Indexed& src, ModuleString& dst, bool decomposition);
     bool apply_first_match(const ProductionSet& set, const LSystemDefinition& ls,
-                           const Indexed& src, std::size_t i, ModuleString& dst,
-                           std::size_t& consumed);
+                           const Indexed& src, std::size_t i, std::size_t offset,
+                           ModuleString& dst, std::size_t& consumed);
+    bool is_plain(const ProductionSet& set, int sym, bool decomposition) const;
     bool apply_stochastic(const ProductionSet& set, const LSystemDefinition& ls,
-                          const Indexed& src, std::size_t i, ModuleString& dst,
-                          std::size_t& consumed);
+                          const Indexed& src, std::size_t i, std::size_t offset,
+                          ModuleString& dst, std::size_t& consumed);
     void run_post_block(const Production& p);
     std::size_t branch_end(const Indexed& src, std::size_t k) const;
     bool match(const Production& p, const LSystemDefinition& ls, const Indexed& src,
-               std::size_t i);
+               std::size_t i, std::size_t offset);
     bool match_left(const Production& p, const std::vector<char>& ignored, const Indexed& src,
                     std::size_t i);
     bool match_right(const Production& p, const std::vector<char>& ignored, const Indexed& src,
                      std::size_t i);
-    bool bind(const FormalModule& f, const Indexed& src, std::size_t k);
+    bool bind(const FormalModule& f, const ModuleString& s, std::size_t k, std::size_t offset);
     bool condition_holds(const Production& p);
     void produce(const Production& p, ModuleString& dst);
     void append_evaluated(const ModuleTemplate& m, ModuleString& dst);
-    std::size_t cut_end(const Indexed& src, std::size_t i) const;
+    std::size_t cut_end(const ModuleString& s, std::size_t i) const;
     void decompose();
     void check_size(const ModuleString& s) const;
     int lsystem_index(double id) const;
@@ -64,7 +67,6 @@ private:
     DeriveLimits m_limits;
     Runtime m_runtime;
     Rand48 m_stochastic;
-    bool m_stochastic_mode = false;
     ModuleString m_string, m_next;
     Indexed m_indexed;
     std::vector<double> m_frame;
@@ -74,6 +76,8 @@ private:
     std::vector<float> m_match_probs;         ///< their probabilities
     std::vector<double> m_match_frames;       ///< their bound variables, concatenated
     int m_steps = 0;
+    bool m_needs_index = false;          ///< some production has a context
+    double m_module_growth = 1.0, m_param_growth = 1.0;  ///< last step's, for reserve()
     int m_bracket_open = -1, m_bracket_close = -1, m_cut = -1, m_sub_start = -1, m_sub_end = -1;
     int m_equals = -1;
 };

@@ -186,8 +186,20 @@ Token Lexer::lex_symbol()
     FileLoc where = loc();
     char c = at();
     std::size_t len = 1;
-    if (c == '@' && at(1) != '\0')
-        len = continues_at_command(at(1), at(2)) ? 3 : 2;
+    if (c == '@') {
+        // cpfg reads modules one character at a time and skips blanks, so "@ Tx" is
+        // the command @Tx: drop the blanks after '@'
+        std::size_t gap = 1;
+        while (at(gap) == ' ' || at(gap) == '\t')
+            ++gap;
+        if (at(gap) != '\0' && at(gap) != '\n') {
+            std::size_t name_len = continues_at_command(at(gap), at(gap + 1)) ? 2 : 1;
+            std::string name(1, '@');
+            name.append(m_text.substr(m_state.pos + gap, name_len));
+            advance(gap + name_len);
+            return make(TokenKind::Symbol, std::move(name), where);
+        }
+    }
     else if (c == '~' && at(1) != '\0' && at(1) != '\n')
         len = 2;
     else if (c == '?' && std::string_view("PHLUE").find(at(1)) != std::string_view::npos &&

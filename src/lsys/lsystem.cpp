@@ -94,7 +94,7 @@ ModuleString LSystem::derive(std::optional<int> steps) const
     for (int i = 0; i < n; ++i)
         deriver.step();
     deriver.finish();
-    return deriver.string();
+    return deriver.take_string();
 }
 
 }  // namespace cambium::lsys

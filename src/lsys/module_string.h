@@ -2,6 +2,7 @@
 // The L-system string: interned module symbols and a compact structure-of-arrays store.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -37,9 +38,10 @@ struct ModuleRef {
 
 /// A string of modules. Parameters are 32-bit floats, as cpfg stores them.
 ///
-/// Storage is three flat arrays (symbol, parameter count, parameter values): three
-/// bytes per module plus four per parameter, no per-module heap object. Walk it with
-/// a Cursor, which tracks the parameter offset in both directions.
+/// Storage is three flat arrays (symbol, parameter count, parameter values): two bytes
+/// per module plus four per parameter while every symbol id fits in a byte (the array
+/// widens to 16 bits the first time one does not), no per-module heap object. Walk it
+/// with a Cursor, which tracks the parameter offset in both directions.
 class ModuleString {
 public:
     static constexpr std::size_t max_params = 255;
@@ -49,11 +51,14 @@ public:
     /// Appends one module. Throws cambium::Error with more than max_params parameters.
     void append(SymbolId symbol, std::span<const float> params = {});
     void append(const ModuleString& other);
+    /// Appends modules [first, last) of `other`, whose parameters start at `param_offset`.
+    void append_range(const ModuleString& other, std::size_t first, std::size_t last,
+                      std::size_t param_offset);
 
-    std::size_t size() const { return m_symbols.size(); }
-    bool empty() const { return m_symbols.empty(); }
+    std::size_t size() const { return m_counts.size(); }
+    bool empty() const { return m_counts.empty(); }
     std::size_t param_total() const { return m_params.size(); }
-    SymbolId symbol(std::size_t i) const { return m_symbols[i]; }
+    SymbolId symbol(std::size_t i) const { return m_wide ? m_symbols16[i] : m_symbols8[i]; }
     /// All parameter values, module after module (index with a prefix sum of counts).
     const float* param_data() const { return m_params.data(); }
     std::size_t param_count(std::size_t i) const { return m_counts[i]; }
@@ -87,15 +92,27 @@ public:
     void for_each(F&& f) const
     {
         std::size_t offset = 0;
-        for (std::size_t i = 0; i < m_symbols.size(); ++i) {
+        for (std::size_t i = 0; i < m_counts.size(); ++i) {
             std::size_t n = m_counts[i];
-            f(ModuleRef{m_symbols[i], std::span<const float>(m_params.data() + offset, n)});
+            f(ModuleRef{symbol(i), std::span<const float>(m_params.data() + offset, n)});
             offset += n;
         }
     }
 
 private:
-    std::vector<SymbolId> m_symbols;
+    void widen();
+    /// Grows `v` by a quarter instead of doubling, so that a string near the memory
+    /// budget does not briefly need twice its size.
+    template <class T>
+    static void make_room(std::vector<T>& v, std::size_t extra)
+    {
+        if (v.size() + extra > v.capacity())
+            v.reserve(std::max(v.size() + extra, v.capacity() + v.capacity() / 4 + 64));
+    }
+
+    bool m_wide = false;                   ///< symbols stored in m_symbols16
+    std::vector<std::uint8_t> m_symbols8;  ///< while every id is below 256
+    std::vector<SymbolId> m_symbols16;
     std::vector<std::uint8_t> m_counts;
     std::vector<float> m_params;
 };

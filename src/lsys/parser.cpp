@@ -105,6 +105,7 @@ private:
     FormalModule parse_formal_module(const Token& symbol);
     void parse_conditional(Production& p);
     void parse_successor(Production& p);
+    void build_constant_successor(Production& p);
     std::vector<ModuleTemplate> parse_modules(bool stop_at_colon);
     ModuleTemplate parse_module(const Token& symbol);
 
@@ -443,9 +444,22 @@ void Parser::parse_production(ProductionSet& set)
         fail(t, "'-->'");
     p.object_production = t.kind == TokenKind::ObjectYields;
     parse_successor(p);
+    build_constant_successor(p);
     p.frame_size = scope.next_slot;
     m_scope = nullptr;
     set.productions.push_back(std::move(p));
+}
+
+void Parser::build_constant_successor(Production& p)
+{
+    // A successor without parameters is the same every time: keep it ready to copy
+    for (const auto& m : p.successor)
+        if (!m.params.empty())
+            return;
+    ModuleString constant;
+    for (const auto& m : p.successor)
+        constant.append(m.symbol);
+    p.constant_successor = std::move(constant);
 }
 
 void Parser::parse_predecessor(Production& p)

@@ -36,6 +36,7 @@ struct Production {
     std::optional<Code> condition;            ///< none: '*' or absent
     Code post_block;                          ///< {beta}
     std::vector<ModuleTemplate> successor;
+    std::optional<ModuleString> constant_successor;  ///< when no successor module has parameters
     std::optional<Code> probability;          ///< stochastic productions only
     bool object_production = false;           ///< '-o>'
     int frame_size = 0;                       ///< formal parameters + local variables
