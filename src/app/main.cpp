@@ -65,7 +65,7 @@ int run(const Options& options)
     geom::Scene scene = geom::interpret(string, lsystem.symbols(), view);
     scene.materials = palette.entries(options.colour_block);
     scene.background = palette.background(options.colour_block);
-    say("interpreted " + std::to_string(scene.lines.segment_count()) + " segments");
+    say("interpreted " + std::to_string(scene.geometry.lines.segment_count()) + " segments");
 
     render::RenderSettings settings;
     settings.width = options.width;

@@ -127,7 +127,7 @@ private:
             return;
         m_turtle.line_width = width;
         if (m_taper_open && tapers())
-            m_scene.lines.keys.back()[3] = radius();  // the open segment's top
+            m_scene.geometry.lines.keys.back()[3] = radius();  // the open segment's top
         else
             m_chain_open = false;  // the joint key cannot carry two widths
     }
@@ -161,7 +161,7 @@ private:
         end_node();
         Vec3 start = m_turtle.position;
         m_turtle.position += m_turtle.heading * distance;
-        LinearCurves& lines = m_scene.lines;
+        LinearCurves& lines = m_scene.geometry.lines;
         bool joined = m_chain_open;
         if (!joined)
             lines.keys.push_back(key(start, radius()));

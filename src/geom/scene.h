@@ -1,32 +1,139 @@
 // SPDX-License-Identifier: Apache-2.0
 // The Scene: renderer-independent plain data produced by the turtle, consumed by render.
+//
+// Every primitive array is in the layout Embree takes directly (keys as float4, indices
+// as uint32), but nothing here depends on Embree. Per-primitive attributes are parallel
+// vectors: material[i] belongs to primitive i. The optional attributes `v` and `texture`
+// may be left empty, meaning v = 0 and no_texture everywhere.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <filesystem>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "geom/vec.h"
 
 namespace cambium::geom {
 
-/// Round linear curve segments (cylinders drawn by F and G), in the layout Embree
-/// takes directly: a key buffer (x, y, z, radius) and one first-key index per segment;
-/// segment i spans keys[segments[i]] .. keys[segments[i] + 1].
-struct LinearCurves {
-    /// Embree's RTC_CURVE_FLAG_NEIGHBOR_LEFT / _RIGHT values: the segment continues a
-    /// previous segment at its start / is continued by the next one at its end, so the
-    /// joint is closed without a cap or a bulge.
+using Float4 = std::array<float, 4>;
+using Float3 = std::array<float, 3>;
+using Float2 = std::array<float, 2>;
+
+/// Material index meaning "the instance's material" inside a prototype.
+inline constexpr std::uint16_t inherit_material = 0xffff;
+/// Texture index meaning "no texture".
+inline constexpr std::int16_t no_texture = -1;
+
+/// Embree's RTC_CURVE_FLAG_NEIGHBOR_LEFT / _RIGHT values: the segment continues a
+/// previous segment at its start / is continued by the next one at its end, so the
+/// joint is closed without a cap or a bulge.
+struct CurveFlags {
     static constexpr std::uint8_t neighbour_left = 1;
     static constexpr std::uint8_t neighbour_right = 2;
+};
 
-    std::vector<std::array<float, 4>> keys;
+/// Round linear curve segments (cylinders drawn by F and G): keys (x, y, z, radius) and
+/// one first-key index per segment; segment i spans keys[segments[i]] .. keys[segments[i]+1].
+struct LinearCurves {
+    static constexpr std::uint8_t neighbour_left = CurveFlags::neighbour_left;
+    static constexpr std::uint8_t neighbour_right = CurveFlags::neighbour_right;
+
+    std::vector<Float4> keys;
+    std::vector<float> v;                  ///< per key: texture v along the axis (report 4.2)
     std::vector<std::uint32_t> segments;
     std::vector<std::uint8_t> flags;       ///< per segment, neighbour_* bits
     std::vector<std::uint16_t> material;   ///< per segment, index into Scene::materials
+    std::vector<std::int16_t> texture;     ///< per segment, index into Scene::textures or no_texture
 
     std::size_t segment_count() const { return segments.size(); }
+};
+
+/// Round cubic Hermite segments: generalized cylinders with the circular contour.
+/// Segment i spans points[segments[i]] .. points[segments[i]+1] with the tangents at
+/// the same indices; the fourth component is the radius (points) and its derivative
+/// (tangents), so `@Gr` radius profiles survive (Embree's ROUND_HERMITE_CURVE layout).
+struct HermiteCurves {
+    std::vector<Float4> points;
+    std::vector<Float4> tangents;
+    std::vector<float> v;                  ///< per point: texture v along the axis
+    std::vector<std::uint32_t> segments;
+    std::vector<std::uint8_t> flags;       ///< per segment, CurveFlags bits
+    std::vector<std::uint16_t> material;
+    std::vector<std::int16_t> texture;
+
+    std::size_t segment_count() const { return segments.size(); }
+};
+
+/// Spheres (`@O`): centre and radius.
+struct Spheres {
+    std::vector<Float4> centres;           ///< x, y, z, radius
+    std::vector<std::uint16_t> material;
+    std::vector<std::int16_t> texture;
+
+    std::size_t size() const { return centres.size(); }
+};
+
+/// Oriented discs (`@o`, `@c`): centre, radius and the unit normal of the front face.
+struct Discs {
+    std::vector<Float4> centres;           ///< x, y, z, radius
+    std::vector<Float3> normals;           ///< unit, the front side
+    std::vector<std::uint16_t> material;       ///< front
+    std::vector<std::uint16_t> back_material;  ///< back
+
+    std::size_t size() const { return centres.size(); }
+};
+
+/// Triangles: polygons, patches, surfaces, non-circular contours, tsurfaces, background.
+/// normals and uvs are per vertex and always as long as positions (flat faces carry their
+/// face normal; untextured ones carry zeros as uv). The front of a triangle is the side
+/// its vertex normals point to (or, for a flat face, the side its winding a,b,c makes
+/// counter-clockwise).
+struct TriangleMesh {
+    std::vector<Float3> positions;
+    std::vector<Float3> normals;
+    std::vector<Float2> uvs;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    std::vector<std::uint16_t> material;       ///< per triangle, front
+    std::vector<std::uint16_t> back_material;  ///< per triangle, back
+    std::vector<std::int16_t> texture;         ///< per triangle
+
+    std::size_t size() const { return triangles.size(); }
+};
+
+/// A set of primitives of every kind: the scene's own, or a prototype's.
+struct Geometry {
+    LinearCurves lines;
+    HermiteCurves curves;
+    Spheres spheres;
+    Discs discs;
+    TriangleMesh mesh;
+
+    bool empty() const
+    {
+        return lines.segment_count() == 0 && curves.segment_count() == 0 && spheres.size() == 0 &&
+               discs.size() == 0 && mesh.size() == 0;
+    }
+};
+
+/// Geometry drawn many times (a predefined surface `~x`, an `-o>` object): built once in
+/// its own frame, placed by instances. Its material indices may be inherit_material.
+struct Prototype {
+    std::string name;
+    Geometry geometry;
+};
+
+/// One placement of a prototype: x' = transform * (x, 1), a 3x4 matrix stored column-major
+/// (columns: images of the x, y, z axes, then the translation), as Embree's
+/// RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR. The materials replace inherit_material.
+struct Instance {
+    std::uint32_t prototype = 0;
+    std::array<float, 12> transform{1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    std::uint16_t material = 0;
+    std::uint16_t back_material = 0;
+    std::int16_t texture = no_texture;
 };
 
 /// A cpfg material (manual 5.4.2) or colormap entry (5.4.1, as diffuse), with the
@@ -38,6 +145,18 @@ struct Material {
     Rgb specular{0, 0, 0};
     float shininess = 0;     ///< 0..128
     float transparency = 0;  ///< 0 opaque .. 1 fully transparent
+    /// Cambium extension (view file `translucency:`, docs/materials.md): the fraction of
+    /// the diffuse albedo transmitted through the surface instead of reflected.
+    float translucency = 0;
+};
+
+/// A `texture:` of the view file (manual 5.2.7), in order: `@Tx(i)` and surfaces name
+/// them by index.
+struct TextureDef {
+    std::filesystem::path file;  ///< absolute or relative to the view file's folder
+    bool decal = false;          ///< E: decal; otherwise modulate
+    bool linear_filter = true;   ///< H: / L: filters (mag / min): false = nearest
+    bool mipmap = true;
 };
 
 /// A view-file light (manual 5.2.6).
@@ -67,14 +186,26 @@ struct View {
     std::optional<double> front_distance, back_distance;
 };
 
+/// `@L` text, kept for tools; the renderer ignores it.
+struct Label {
+    std::string text;
+    Vec3 position;
+    std::uint16_t material = 0;
+};
+
 /// Everything render needs to draw one frame of a plant.
 struct Scene {
-    LinearCurves lines;
+    Geometry geometry;
+    std::vector<Prototype> prototypes;
+    std::vector<Instance> instances;
+    std::vector<Label> labels;
+
     /// true when line radii are in pixels (`line style: pixel`): render converts
     /// them with its camera's pixel footprint.
     bool line_radius_in_pixels = false;
 
     std::vector<Material> materials = std::vector<Material>(256);  ///< by colour index
+    std::vector<TextureDef> textures;
     Rgb background{0, 0, 0};  ///< display values: colormap entry 0 or material 0's emission
     std::vector<Light> lights;
     View view;

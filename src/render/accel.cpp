@@ -129,7 +129,7 @@ std::vector<Key> keys_in_world_units(const geom::LinearCurves& lines, const Came
 
 void EmbreeScene::Impl::add_lines(const geom::Scene& s, const Camera& camera)
 {
-    const geom::LinearCurves& l = s.lines;
+    const geom::LinearCurves& l = s.geometry.lines;
     lines = &l;
     if (l.segments.empty())
         return;

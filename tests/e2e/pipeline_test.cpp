@@ -118,7 +118,7 @@ TEST(Pipeline, MirrorSymmetricModelGivesMirrorSymmetricImage)
         "lsystem: 1\nderivation length: 3\naxiom: A(8)\n"
         "A(x) --> F(x)[+(40)A(x*0.6)][-(40)A(x*0.6)]\nendlsystem\n",
         "line style: cylinder\ninitial line width: 0.6\nlight: V: 0 0 1\n", 64, 64, 64);
-    ASSERT_GT(r.scene.lines.segment_count(), 5u);
+    ASSERT_GT(r.scene.geometry.lines.segment_count(), 5u);
     const auto& im = r.image;
     double diff = 0, total = 0;
     for (int y = 0; y < im.height; ++y)

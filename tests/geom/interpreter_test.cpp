@@ -37,7 +37,7 @@ Scene run(const std::string& text, const std::string& view_text)
 
 std::array<float, 4> key_of(const Scene& scene, std::size_t segment, int end)
 {
-    return scene.lines.keys[scene.lines.segments[segment] + static_cast<std::uint32_t>(end)];
+    return scene.geometry.lines.keys[scene.geometry.lines.segments[segment] + static_cast<std::uint32_t>(end)];
 }
 
 }  // namespace
@@ -45,10 +45,10 @@ std::array<float, 4> key_of(const Scene& scene, std::size_t segment, int end)
 TEST(Interpreter, ConnectedSegmentsShareKeysAndNeighbourFlags)
 {
     Scene scene = run("F+F(2)", "angle increment: 90\n");
-    ASSERT_EQ(scene.lines.segment_count(), 2u);
-    EXPECT_EQ(scene.lines.keys.size(), 3u);
-    EXPECT_EQ(scene.lines.flags[0], LinearCurves::neighbour_right);
-    EXPECT_EQ(scene.lines.flags[1], LinearCurves::neighbour_left);
+    ASSERT_EQ(scene.geometry.lines.segment_count(), 2u);
+    EXPECT_EQ(scene.geometry.lines.keys.size(), 3u);
+    EXPECT_EQ(scene.geometry.lines.flags[0], LinearCurves::neighbour_right);
+    EXPECT_EQ(scene.geometry.lines.flags[1], LinearCurves::neighbour_left);
     auto end = key_of(scene, 1, 1);  // up 1, then left 2: (-2, 1, 0)
     EXPECT_NEAR(end[0], -2, 1e-6);
     EXPECT_NEAR(end[1], 1, 1e-6);
@@ -57,10 +57,10 @@ TEST(Interpreter, ConnectedSegmentsShareKeysAndNeighbourFlags)
 TEST(Interpreter, BranchReturnsToItsStartAndBreaksThePolyline)
 {
     Scene scene = run("F[+F]F", "angle increment: 90\n");
-    ASSERT_EQ(scene.lines.segment_count(), 3u);
+    ASSERT_EQ(scene.geometry.lines.segment_count(), 3u);
     // The branch continues the trunk's polyline; the segment after ']' starts anew.
-    EXPECT_EQ(scene.lines.flags[1] & LinearCurves::neighbour_left, LinearCurves::neighbour_left);
-    EXPECT_EQ(scene.lines.flags[2], 0);
+    EXPECT_EQ(scene.geometry.lines.flags[1] & LinearCurves::neighbour_left, LinearCurves::neighbour_left);
+    EXPECT_EQ(scene.geometry.lines.flags[2], 0);
     auto start = key_of(scene, 2, 0);
     auto end = key_of(scene, 2, 1);
     EXPECT_NEAR(start[1], 1, 1e-6);
@@ -71,15 +71,15 @@ TEST(Interpreter, BranchReturnsToItsStartAndBreaksThePolyline)
 TEST(Interpreter, MoveWithoutDrawingLeavesAGap)
 {
     Scene scene = run("FfF", "");
-    ASSERT_EQ(scene.lines.segment_count(), 2u);
+    ASSERT_EQ(scene.geometry.lines.segment_count(), 2u);
     EXPECT_NEAR(key_of(scene, 1, 0)[1], 2, 1e-6);
-    EXPECT_EQ(scene.lines.flags[1], 0);
+    EXPECT_EQ(scene.geometry.lines.flags[1], 0);
 }
 
 TEST(Interpreter, WidthIsTwiceTheRadiusAndFollowsHashAndBang)
 {
     Scene scene = run("F#F!(0.5)F", "initial line width: 2\nline width increment: 1\n");
-    ASSERT_EQ(scene.lines.segment_count(), 3u);
+    ASSERT_EQ(scene.geometry.lines.segment_count(), 3u);
     EXPECT_FLOAT_EQ(key_of(scene, 0, 0)[3], 1.0f);
     EXPECT_FLOAT_EQ(key_of(scene, 0, 1)[3], 1.5f);  // tapered: the top takes the new width
     EXPECT_FLOAT_EQ(key_of(scene, 1, 0)[3], 1.5f);
@@ -91,16 +91,16 @@ TEST(Interpreter, WidthIsTwiceTheRadiusAndFollowsHashAndBang)
 TEST(Interpreter, UntaperedLinesKeepTheirWidthAndBreakTheJoint)
 {
     Scene scene = run("F#F", "initial line width: 2\nline width increment: 1\ntapered lines: off\n");
-    ASSERT_EQ(scene.lines.segment_count(), 2u);
+    ASSERT_EQ(scene.geometry.lines.segment_count(), 2u);
     EXPECT_FLOAT_EQ(key_of(scene, 0, 1)[3], 1.0f);
     EXPECT_FLOAT_EQ(key_of(scene, 1, 0)[3], 1.5f);
-    EXPECT_EQ(scene.lines.flags[1], 0);
+    EXPECT_EQ(scene.geometry.lines.flags[1], 0);
 }
 
 TEST(Interpreter, WidthChangeInsideABranchDoesNotTaperTheTrunk)
 {
     Scene scene = run("F[!(1)F]", "initial line width: 2\n");
-    ASSERT_EQ(scene.lines.segment_count(), 2u);
+    ASSERT_EQ(scene.geometry.lines.segment_count(), 2u);
     EXPECT_FLOAT_EQ(key_of(scene, 0, 1)[3], 1.0f);
     EXPECT_FLOAT_EQ(key_of(scene, 1, 0)[3], 0.5f);
 }
@@ -108,18 +108,18 @@ TEST(Interpreter, WidthChangeInsideABranchDoesNotTaperTheTrunk)
 TEST(Interpreter, ColourWrapsOnceAroundTheTable)
 {
     Scene scene = run(";(255);F,(0),F", "color increment: 1\n");
-    EXPECT_EQ(scene.lines.material[0], 0);
-    EXPECT_EQ(scene.lines.material[1], 255);
+    EXPECT_EQ(scene.geometry.lines.material[0], 0);
+    EXPECT_EQ(scene.geometry.lines.material[1], 255);
 }
 
 TEST(Interpreter, ColourIndexSelectsTheMaterialOfEachSegment)
 {
     Scene scene = run("F;F;(7)F,F", "initial color: 2\ncolor increment: 3\n");
-    ASSERT_EQ(scene.lines.segment_count(), 4u);
-    EXPECT_EQ(scene.lines.material[0], 2);
-    EXPECT_EQ(scene.lines.material[1], 5);
-    EXPECT_EQ(scene.lines.material[2], 7);
-    EXPECT_EQ(scene.lines.material[3], 4);
+    ASSERT_EQ(scene.geometry.lines.segment_count(), 4u);
+    EXPECT_EQ(scene.geometry.lines.material[0], 2);
+    EXPECT_EQ(scene.geometry.lines.material[1], 5);
+    EXPECT_EQ(scene.geometry.lines.material[2], 7);
+    EXPECT_EQ(scene.geometry.lines.material[3], 4);
 }
 
 TEST(Interpreter, BoundsEncloseTheDrawnPoints)
@@ -154,5 +154,5 @@ TEST(Interpreter, UnbalancedPopIsIgnored)
     set_warnings_enabled(false);
     Scene scene = run("F]F", "");
     set_warnings_enabled(true);
-    EXPECT_EQ(scene.lines.segment_count(), 2u);
+    EXPECT_EQ(scene.geometry.lines.segment_count(), 2u);
 }

@@ -108,16 +108,16 @@ TEST(EmbreeScene, SpawnedRaysDoNotHitJoinedNeighbours)
     geom::Scene s = empty_scene({-10, -1, -1}, {10, 1, 1});
     const int count = 40;
     for (int i = 0; i <= count; ++i)
-        s.lines.keys.push_back({-10.0f + 20.0f * i / count, 0, 0, 0.05f});
+        s.geometry.lines.keys.push_back({-10.0f + 20.0f * i / count, 0, 0, 0.05f});
     for (int i = 0; i < count; ++i) {
-        s.lines.segments.push_back(static_cast<std::uint32_t>(i));
+        s.geometry.lines.segments.push_back(static_cast<std::uint32_t>(i));
         std::uint8_t f = 0;
         if (i > 0)
             f |= geom::LinearCurves::neighbour_left;
         if (i + 1 < count)
             f |= geom::LinearCurves::neighbour_right;
-        s.lines.flags.push_back(f);
-        s.lines.material.push_back(1);
+        s.geometry.lines.flags.push_back(f);
+        s.geometry.lines.material.push_back(1);
     }
     auto [rehits, n] = count_rehits(s, 0.05f);
     ASSERT_GT(n, 3000);
@@ -127,8 +127,8 @@ TEST(EmbreeScene, SpawnedRaysDoNotHitJoinedNeighbours)
 TEST(EmbreeScene, RejectsSegmentPastTheKeys)
 {
     geom::Scene s = empty_scene({0, 0, 0}, {1, 1, 1});
-    s.lines.keys.push_back({0, 0, 0, 1});
-    s.lines.segments.push_back(0);
+    s.geometry.lines.keys.push_back({0, 0, 0, 1});
+    s.geometry.lines.segments.push_back(0);
     EXPECT_THROW(EmbreeScene(s, unit_camera(s)), Error);
 }
 

@@ -12,12 +12,12 @@ namespace cambium::render::testing {
 inline void add_segment(geom::Scene& s, const geom::Vec3& a, const geom::Vec3& b, float r,
                         std::uint16_t m = 1)
 {
-    auto first = static_cast<std::uint32_t>(s.lines.keys.size());
-    s.lines.keys.push_back({float(a.x), float(a.y), float(a.z), r});
-    s.lines.keys.push_back({float(b.x), float(b.y), float(b.z), r});
-    s.lines.segments.push_back(first);
-    s.lines.flags.push_back(0);
-    s.lines.material.push_back(m);
+    auto first = static_cast<std::uint32_t>(s.geometry.lines.keys.size());
+    s.geometry.lines.keys.push_back({float(a.x), float(a.y), float(a.z), r});
+    s.geometry.lines.keys.push_back({float(b.x), float(b.y), float(b.z), r});
+    s.geometry.lines.segments.push_back(first);
+    s.geometry.lines.flags.push_back(0);
+    s.geometry.lines.material.push_back(m);
 }
 
 /// A scene with no lights, a black background and the given fit box.
