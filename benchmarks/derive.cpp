@@ -13,10 +13,13 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <ostream>
+#include <streambuf>
 #include <string>
 #include <vector>
 
 #include "lsys/lsystem.h"
+#include "lsys/string_io.h"
 
 namespace fs = std::filesystem;
 
@@ -45,6 +48,13 @@ double peak_rss_mb()
     return static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss is in KiB
 }
 
+/// A stream buffer that counts and drops what is written: string output without disk I/O.
+class NullBuffer : public std::streambuf {
+protected:
+    std::streamsize xsputn(const char*, std::streamsize n) override { return n; }
+    int_type overflow(int_type c) override { return traits_type::not_eof(c); }
+};
+
 /// Loads, derives and reports one model (runs in the child process).
 int run_one(const std::string& model)
 {
@@ -60,13 +70,22 @@ int run_one(const std::string& model)
         auto t1 = clock::now();
         cambium::lsys::ModuleString s = ls.derive();
         auto t2 = clock::now();
+        double peak = peak_rss_mb();
+        // cpfg's -str text output of the same string, written to a sink (no disk)
+        NullBuffer sink;
+        std::ostream null_stream(&sink);
+        auto t3 = clock::now();
+        cambium::lsys::write_string_text(s, ls.symbols(), null_stream);
+        auto t4 = clock::now();
         double load_s = std::chrono::duration<double>(t1 - t0).count();
         double derive_s = std::chrono::duration<double>(t2 - t1).count();
+        double str_s = std::chrono::duration<double>(t4 - t3).count();
         double wall_s = load_s + derive_s;
         std::printf("{\"model\":\"%s\",\"modules\":%zu,\"wall_s\":%.3f,\"load_s\":%.3f,"
-                    "\"derive_s\":%.3f,\"modules_per_s\":%.0f,\"peak_rss_mb\":%.1f}\n",
+                    "\"derive_s\":%.3f,\"modules_per_s\":%.0f,\"peak_rss_mb\":%.1f,"
+                    "\"str_text_s\":%.3f}\n",
                     model.c_str(), s.size(), wall_s, load_s, derive_s,
-                    static_cast<double>(s.size()) / derive_s, peak_rss_mb());
+                    static_cast<double>(s.size()) / derive_s, peak, str_s);
     } catch (const std::exception& e) {
         std::printf("{\"model\":\"%s\",\"error\":\"%s\"}\n", model.c_str(), e.what());
         return 1;

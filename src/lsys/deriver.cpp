@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <array>
 
+#include "base/diagnostics.h"
+
 namespace cambium::lsys {
 
 namespace {
@@ -52,7 +54,7 @@ Deriver::Deriver(const Program& program, DeriveLimits limits)
     }
     int frame = 0;
     for (const auto& ls : program.lsystems)
-        for (const ProductionSet* set : {&ls.productions, &ls.decomposition})
+        for (const ProductionSet* set : {&ls.productions, &ls.decomposition, &ls.homomorphism})
             for (const auto& p : set->productions)
                 frame = std::max(frame, p.frame_size);
     m_frame.assign(static_cast<std::size_t>(frame) + 1, 0.0);
@@ -61,6 +63,9 @@ Deriver::Deriver(const Program& program, DeriveLimits limits)
     for (const auto& a : program.arrays)
         m_runtime.arrays.push_back(a.initial);
     m_runtime.strings = &program.strings;
+    m_runtime.function = &m_limits.function;
+    m_runtime.curve = &m_limits.curve;
+    m_runtime.file_name = &program.file_name;
 
     const LSystemDefinition& main = program.lsystems.front();
     if (main.derivation_length)
@@ -70,6 +75,8 @@ Deriver::Deriver(const Program& program, DeriveLimits limits)
     // a state that starts at 0 and that cpfg (the build the corpus oracle comes from)
     // never seeds: RandomMoss (seed: 2454) matches cpfg only this way.
     m_stochastic.set_state(0);
+    if (!m_limits.start)
+        return;
     evaluate(program.start_block, m_frame, m_runtime);
     for (const auto& m : main.axiom)
         append_evaluated(m, m_string);
@@ -84,12 +91,21 @@ int Deriver::lsystem_index(double id) const
     return -1;
 }
 
-void Deriver::index(const ModuleString& s, Indexed& out) const
+void Deriver::set_runtime(const Runtime& runtime)
+{
+    m_runtime = runtime;
+    m_runtime.function = &m_limits.function;
+    m_runtime.curve = &m_limits.curve;
+    m_runtime.file_name = &m_program.file_name;
+    m_runtime.strings = &m_program.strings;
+}
+
+void Deriver::index(const ModuleString& s, Indexed& out, bool force) const
 {
     out.string = &s;
     // Only context matching needs random access to parameters and bracket partners;
     // without context productions the arrays (8 bytes a module) are not built
-    if (!m_needs_index) {
+    if (!m_needs_index && !force) {
         out.offsets.clear();
         out.partner.clear();
         return;
@@ -146,13 +162,27 @@ void Deriver::decompose()
     if (set.productions.empty())
         return;
     int depth = set.max_depth ? static_cast<int>(evaluate(*set.max_depth, m_frame, m_runtime)) : 1;
+    std::size_t applied = 0;
     for (int pass = 0; pass < depth; ++pass) {
         index(m_string, m_indexed);
         m_next.clear();
-        std::size_t applied = rewrite(m_indexed, m_next, true);
+        applied = rewrite(m_indexed, m_next, true);
         std::swap(m_string, m_next);
         if (applied == 0)
             break;
+    }
+    // `warnings` after the section keyword: say when the depth cut decomposition short
+    if (applied > 0 && set.warnings && depth > 0) {
+        index(m_string, m_indexed);
+        m_next.clear();
+        ModuleString probe;
+        Runtime saved = m_runtime;  // probing must not run blocks for real
+        Rand48 saved_random = m_stochastic;
+        if (rewrite(m_indexed, probe, true) > 0)
+            warn(set.productions.front().loc,
+                 "maximum depth (" + std::to_string(depth) + ") of the decomposition reached");
+        m_runtime = saved;
+        m_stochastic = saved_random;
     }
 }
 
@@ -435,6 +465,185 @@ void Deriver::append_evaluated(const ModuleTemplate& m, ModuleString& dst)
     for (std::size_t j = 0; j < m.params.size(); ++j)
         values[j] = static_cast<float>(evaluate(m.params[j], m_frame, m_runtime));
     dst.append(m.symbol, std::span<const float>(values.data(), m.params.size()));
+}
+
+
+// ---------------------------------------------------------------- homomorphism
+
+namespace {
+
+constexpr int max_homomorphism_depth = 1000;
+
+}  // namespace
+
+void Deriver::apply_homomorphism(const ModuleString& in, ModuleString& out)
+{
+    out.clear();
+    bool any = false, contexts = false;
+    for (const auto& ls : m_program.lsystems) {
+        any |= !ls.homomorphism.productions.empty();
+        for (const auto& p : ls.homomorphism.productions)
+            contexts |= !p.left_context.empty() || !p.right_context.empty();
+    }
+    if (!any) {
+        out.append(in);
+        return;
+    }
+    Indexed ctx;
+    index(in, ctx, contexts);
+    // Each pass starts the homomorphism's own random stream afresh from its seed:
+    const ProductionSet& main_set = m_program.lsystems.front().homomorphism;
+    m_homomorphism_random.seed(
+        main_set.seed ? static_cast<long>(evaluate(*main_set.seed, m_frame, m_runtime)) : 0);
+    std::vector<int> depth_of(m_program.lsystems.size(), 1);
+    for (std::size_t l = 0; l < m_program.lsystems.size(); ++l) {
+        const ProductionSet& set = m_program.lsystems[l].homomorphism;
+        if (set.max_depth)
+            depth_of[l] = static_cast<int>(evaluate(*set.max_depth, m_frame, m_runtime));
+        if (depth_of[l] > max_homomorphism_depth) {
+            warn(set.productions.empty() ? FileLoc{m_program.file_name, 0, 0}
+                                         : set.productions.front().loc,
+                 "homomorphism maximum depth " + std::to_string(depth_of[l]) +
+                     " is more than " + std::to_string(max_homomorphism_depth) +
+                     "; using " + std::to_string(max_homomorphism_depth));
+            depth_of[l] = max_homomorphism_depth;
+        }
+    }
+    m_homomorphism_stack.resize(static_cast<std::size_t>(
+        *std::max_element(depth_of.begin(), depth_of.end()) + 1));
+    m_lsystem_stack.assign(1, 0);
+    std::size_t offset = 0;
+    for (std::size_t i = 0; i < in.size();) {
+        std::size_t l = static_cast<std::size_t>(m_lsystem_stack.back());
+        const LSystemDefinition& ls = m_program.lsystems[l];
+        int sym = in.symbol(i);
+        std::size_t first = i, first_offset = offset;
+        if (ls.homomorphism.candidates(static_cast<SymbolId>(sym)) && depth_of[l] > 0) {
+            homomorphism_module(ls.homomorphism, ls, in, i, offset, ctx, i, i + 1, 0,
+                                depth_of[l], out);
+        } else {
+            out.append(static_cast<SymbolId>(sym),
+                       std::span<const float>(in.param_data() + offset, in.param_count(i)));
+            offset += in.param_count(i);
+            ++i;
+        }
+        check_size(out);
+        // sub-L-system switching follows the original string, as in derivation
+        for (std::size_t k = first, o = first_offset; k < i; o += in.param_count(k), ++k) {
+            int s = in.symbol(k);
+            if (s == m_sub_start && in.param_count(k) > 0) {
+                int idx = lsystem_index(in.param_data()[o]);
+                m_lsystem_stack.push_back(idx >= 0 ? idx : m_lsystem_stack.back());
+            } else if (s == m_sub_end && m_lsystem_stack.size() > 1) {
+                m_lsystem_stack.pop_back();
+            }
+        }
+    }
+}
+
+bool Deriver::match_at(const Production& p, const LSystemDefinition& ls, const ModuleString& s,
+                       std::size_t k, std::size_t offset, const Indexed& ctx, std::size_t left,
+                       std::size_t right)
+{
+    if (k + p.predecessor.size() > s.size())
+        return false;
+    std::fill(m_frame.begin(), m_frame.begin() + p.frame_size, 0.0);
+    for (std::size_t j = 0; j < p.predecessor.size(); ++j) {
+        if (!bind(p.predecessor[j], s, k + j, offset))
+            return false;
+        offset += s.param_count(k + j);
+    }
+    if (p.left_context.empty() && p.right_context.empty())
+        return true;
+    if (ctx.offsets.empty())
+        return false;  // no original string to take context from (an object expansion)
+    const auto& ignored = m_ignored[static_cast<std::size_t>(&ls - m_program.lsystems.data())];
+    return match_left(p, ignored, ctx, left) && match_right(p, ignored, ctx, right);
+}
+
+const Production* Deriver::find_homomorphism(const ProductionSet& set,
+                                             const LSystemDefinition& ls,
+                                             const ModuleString& s, std::size_t k,
+                                             std::size_t offset, const Indexed& ctx,
+                                             std::size_t left, std::size_t right)
+{
+    const auto* candidates = set.candidates(s.symbol(k));
+    if (!candidates)
+        return nullptr;
+    if (!set.seed) {
+        for (std::uint32_t index : *candidates) {
+            const Production& p = set.productions[index];
+            if (match_at(p, ls, s, k, offset, ctx, left, right) && condition_holds(p))
+                return &p;
+        }
+        return nullptr;
+    }
+    // seed: makes the homomorphism stochastic: choose among the applicable productions
+    // by their probabilities, drawing from the homomorphism's own generator
+    std::vector<const Production*> applicable;
+    std::vector<float> probs;
+    std::vector<double> frames;
+    float total = 0;
+    for (std::uint32_t index : *candidates) {
+        const Production& p = set.productions[index];
+        if (!match_at(p, ls, s, k, offset, ctx, left, right) || !condition_holds(p))
+            continue;
+        float prob = p.probability ? static_cast<float>(evaluate(*p.probability, m_frame, m_runtime))
+                                   : 1.0f;
+        total += prob;
+        applicable.push_back(&p);
+        probs.push_back(prob);
+        frames.insert(frames.end(), m_frame.begin(), m_frame.begin() + p.frame_size);
+    }
+    auto scaled = static_cast<float>(total * m_homomorphism_random.next_double());
+    std::size_t frame_offset = 0;
+    for (std::size_t j = 0; j < applicable.size(); ++j) {
+        scaled -= probs[j];
+        if (scaled <= 0) {
+            std::copy_n(frames.begin() + static_cast<std::ptrdiff_t>(frame_offset),
+                        applicable[j]->frame_size, m_frame.begin());
+            return applicable[j];
+        }
+        frame_offset += static_cast<std::size_t>(applicable[j]->frame_size);
+    }
+    return nullptr;
+}
+
+void Deriver::homomorphism_module(const ProductionSet& set, const LSystemDefinition& ls,
+                                  const ModuleString& s, std::size_t& k, std::size_t& offset,
+                                  const Indexed& ctx, std::size_t left, std::size_t right,
+                                  int depth, int max_depth, ModuleString& out)
+{
+    auto copy_one = [&] {
+        out.append(s.symbol(k), std::span<const float>(s.param_data() + offset, s.param_count(k)));
+        offset += s.param_count(k);
+        ++k;
+    };
+    const Production* p = find_homomorphism(set, ls, s, k, offset, ctx, left, right);
+    if (!p) {
+        copy_one();
+        return;
+    }
+    if (depth >= max_depth) {
+        if (set.warnings)
+            warn(p->loc, "maximum depth of the homomorphism reached for module '" +
+                             std::string(m_program.symbols.name(s.symbol(k))) + "'");
+        copy_one();
+        return;
+    }
+    run_post_block(*p);
+    ModuleString& successor = m_homomorphism_stack[static_cast<std::size_t>(depth)];
+    successor.clear();
+    produce(*p, successor);
+    for (std::size_t j = 0; j < p->predecessor.size(); ++j)
+        offset += s.param_count(k + j);
+    k += p->predecessor.size();
+    std::size_t sk = 0, soffset = 0;
+    while (sk < successor.size()) {
+        homomorphism_module(set, ls, successor, sk, soffset, ctx, left, right, depth + 1,
+                            max_depth, out);
+        check_size(out);
+    }
 }
 
 }  // namespace cambium::lsys

@@ -5,8 +5,14 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cctype>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <numbers>
+
+#include "base/diagnostics.h"
 
 namespace cambium::lsys {
 
@@ -15,7 +21,7 @@ namespace {
 constexpr double to_radians = std::numbers::pi / 180.0;
 constexpr int max_stack_depth = 256;
 
-constexpr std::array<FunctionInfo, 28> functions = {{
+constexpr std::array<FunctionInfo, 31> functions = {{
     {"sin", Function::Sin, 1},     {"cos", Function::Cos, 1},
     {"tan", Function::Tan, 1},     {"asin", Function::Asin, 1},
     {"acos", Function::Acos, 1},   {"atan", Function::Atan, 1},
@@ -28,9 +34,10 @@ constexpr std::array<FunctionInfo, 28> functions = {{
     {"biran", Function::Biran, 2}, {"srand", Function::Srand, 1},
     {"stop", Function::Stop, 1},   {"GetDerivationLength", Function::GetDerivationLength, 1},
     {"SetDerivationLength", Function::SetDerivationLength, 1},
-    {"func", Function::Func, 2},         {"curveX", Function::Func, -1},
-    {"curveY", Function::Func, -1},      {"curveZ", Function::Func, -1},
-    {"curveGAL", Function::Func, -1},
+    {"func", Function::Func, 2},         {"curveX", Function::CurveX, 2},
+    {"curveY", Function::CurveY, 2},     {"curveZ", Function::CurveZ, 2},
+    {"curveGAL", Function::CurveLength, 1},   {"fopen", Function::Fopen, 2},
+    {"fclose", Function::Fclose, 1},     {"fflush", Function::Fflush, 1},
 }};
 
 /// nran: the polar (Marsaglia) method, which makes two normal deviates per pair of
@@ -74,6 +81,20 @@ double beta_random(Rand48& r, double a, double b)
     return ym / (b + ym);
 }
 
+/// func() and the curve functions without the view file's data: 0, said once.
+void warn_unbound(Runtime& rt, const std::string& what)
+{
+    if (rt.function_warned)
+        return;
+    rt.function_warned = true;
+    std::string message = what + " needs the view file's functions or curves, which are "
+                                 "not loaded; it evaluates to 0";
+    if (rt.file_name)
+        warn(FileLoc{*rt.file_name, 0, 0}, message);
+    else
+        warn(message);
+}
+
 double call(Function f, const double* a, Runtime& rt)
 {
     switch (f) {
@@ -113,13 +134,48 @@ double call(Function f, const double* a, Runtime& rt)
     case Function::SetDerivationLength:
         rt.derivation_length = static_cast<int>(a[0]);
         return 0;
-    case Function::Func: return 0;  // function sets live in geom; not bound here
+    case Function::Fopen: {
+        std::string l_file = rt.file_name ? *rt.file_name : std::string();
+        auto text = [&](double index) -> std::string {
+            auto i = static_cast<std::size_t>(index);
+            if (!rt.strings || index < 0 || i >= rt.strings->size())
+                throw Error(FileLoc{l_file, 0, 0}, "fopen needs a file name and a mode in quotes");
+            return (*rt.strings)[i];
+        };
+        std::string base = std::filesystem::path(l_file).parent_path().string();
+        return rt.files->open(base, text(a[0]), text(a[1]), l_file);
+    }
+    case Function::Fclose:
+        rt.files->close(a[0], rt.file_name ? *rt.file_name : std::string());
+        return 0;
+    case Function::Fflush:
+        std::fflush(rt.files->get(a[0], rt.file_name ? *rt.file_name : std::string()));
+        return 0;
+    case Function::Func:
+        // function sets live in the view file (geom); the caller binds them
+        if (rt.function && *rt.function)
+            return (*rt.function)(static_cast<int>(a[0]), a[1]);
+        warn_unbound(rt, "func()");
+        return 0;
+    case Function::CurveX:
+    case Function::CurveY:
+    case Function::CurveZ:
+    case Function::CurveLength: {
+        char which = f == Function::CurveX   ? 'x'
+                     : f == Function::CurveY ? 'y'
+                     : f == Function::CurveZ ? 'z'
+                                             : 'l';
+        if (rt.curve && *rt.curve)
+            return (*rt.curve)(which, static_cast<int>(a[0]), which == 'l' ? 0.0 : a[1]);
+        warn_unbound(rt, "curveX/curveY/curveZ/curveGAL()");
+        return 0;
+    }
     }
     return 0;
 }
 
 /// printf with only %f/%g/%e-style conversions, each given one double.
-void print_formatted(const std::string& format, const double* args, int count)
+std::string format_values(const std::string& format, const double* args, int count)
 {
     std::string out;
     int used = 0;
@@ -147,7 +203,61 @@ void print_formatted(const std::string& format, const double* args, int count)
                 out += buf;
         i = j;
     }
-    std::fputs(out.c_str(), stdout);
+    return out;
+}
+
+/// fscanf with only number conversions (%f %g %e %lf %d ...): each reads one number
+/// into the next value; blanks in the format skip blanks, other characters must match.
+/// Returns how many values were read.
+int scan_values(std::FILE* file, const std::string& format, double* values, int count)
+{
+    int read = 0;
+    auto skip_blanks = [&] {
+        int c;
+        while ((c = std::fgetc(file)) != EOF && std::isspace(c)) {
+        }
+        if (c != EOF)
+            std::ungetc(c, file);
+    };
+    for (std::size_t i = 0; i < format.size(); ++i) {
+        char f = format[i];
+        if (std::isspace(static_cast<unsigned char>(f))) {
+            skip_blanks();
+            continue;
+        }
+        if (f != '%' || i + 1 >= format.size()) {
+            int c = std::fgetc(file);
+            if (c != f) {
+                if (c != EOF)
+                    std::ungetc(c, file);
+                return read;
+            }
+            continue;
+        }
+        std::size_t j = i + 1;
+        while (j < format.size() && (format[j] == 'l' || std::isdigit(static_cast<unsigned char>(format[j]))))
+            ++j;
+        if (j >= format.size() || read >= count)
+            return read;
+        i = j;
+        skip_blanks();
+        std::string number;
+        int c;
+        while (number.size() < 64 && (c = std::fgetc(file)) != EOF) {
+            if (std::isdigit(c) || std::strchr("+-.eE", c)) {
+                number += static_cast<char>(c);
+            } else {
+                std::ungetc(c, file);
+                break;
+            }
+        }
+        char* end = nullptr;
+        double v = std::strtod(number.c_str(), &end);
+        if (number.empty() || end == number.c_str())
+            return read;
+        values[read++] = v;
+    }
+    return read;
 }
 
 double int_modulo(double a, double b)
@@ -170,6 +280,56 @@ bool element_index(const ArrayValues& a, const double* idx, int n, std::size_t& 
 }
 
 }  // namespace
+
+OpenFiles::~OpenFiles()
+{
+    for (std::FILE* f : m_files)
+        if (f)
+            std::fclose(f);
+}
+
+int OpenFiles::open(const std::string& base_dir, const std::string& name,
+                    const std::string& mode, const std::string& l_file)
+{
+    if (mode != "r" && mode != "w" && mode != "a")
+        throw Error(FileLoc{l_file, 0, 0}, "fopen(\"" + name + "\", \"" + mode +
+                                               "\"): the mode must be \"r\", \"w\" or \"a\"");
+    std::size_t slot = 0;
+    while (slot < m_files.size() && m_files[slot])
+        ++slot;
+    if (slot >= static_cast<std::size_t>(max_open))
+        throw Error(FileLoc{l_file, 0, 0}, "fopen(\"" + name + "\"): more than " +
+                                               std::to_string(max_open) + " files open at once");
+    std::filesystem::path path(name);
+    if (path.is_relative() && !base_dir.empty())
+        path = std::filesystem::path(base_dir) / path;
+    std::FILE* f = std::fopen(path.string().c_str(), mode.c_str());
+    if (!f)
+        throw Error(FileLoc{l_file, 0, 0}, "fopen: cannot open '" + path.string() + "' for " +
+                                               (mode == "r" ? "reading" : "writing") + ": " +
+                                               std::strerror(errno));
+    if (slot == m_files.size())
+        m_files.push_back(f);
+    else
+        m_files[slot] = f;
+    return static_cast<int>(slot);
+}
+
+std::FILE* OpenFiles::get(double index, const std::string& l_file) const
+{
+    auto i = static_cast<long long>(index);
+    if (index < 0 || i >= static_cast<long long>(m_files.size()) || !m_files[static_cast<std::size_t>(i)])
+        throw Error(FileLoc{l_file, 0, 0},
+                    "file index " + std::to_string(i) + " does not name a file opened with fopen");
+    return m_files[static_cast<std::size_t>(i)];
+}
+
+void OpenFiles::close(double index, const std::string& l_file)
+{
+    std::FILE* f = get(index, l_file);
+    std::fclose(f);
+    m_files[static_cast<std::size_t>(index)] = nullptr;
+}
 
 const FunctionInfo* find_function(std::string_view name)
 {
@@ -262,10 +422,39 @@ double evaluate(const Code& code, std::span<double> frame, Runtime& rt)
         case Op::Print:
             sp -= in.arg2;
             if (rt.strings)
-                print_formatted((*rt.strings)[static_cast<std::size_t>(in.arg)], &stack[sp],
-                                in.arg2);
+                std::fputs(format_values((*rt.strings)[static_cast<std::size_t>(in.arg)],
+                                         &stack[sp], in.arg2)
+                               .c_str(),
+                           stdout);
             stack[sp++] = 0;
             break;
+        case Op::FilePrint: {
+            sp -= in.arg2;
+            std::FILE* f = rt.files->get(stack[sp - 1], rt.file_name ? *rt.file_name : "");
+            if (rt.strings)
+                std::fputs(format_values((*rt.strings)[static_cast<std::size_t>(in.arg)],
+                                         &stack[sp], in.arg2)
+                               .c_str(),
+                           f);
+            stack[sp - 1] = 0;
+            break;
+        }
+        case Op::FileScan: {
+            // stack: file, old values; becomes: count, values
+            int n = in.arg2;
+            sp -= n;
+            double* values = &stack[sp];
+            std::FILE* f = rt.files->get(stack[sp - 1], rt.file_name ? *rt.file_name : "");
+            std::array<double, max_stack_depth> read_values;
+            int count = rt.strings ? scan_values(f, (*rt.strings)[static_cast<std::size_t>(in.arg)],
+                                                 read_values.data(), n)
+                                   : 0;
+            for (int k = 0; k < count; ++k)
+                values[k] = read_values[static_cast<std::size_t>(k)];
+            stack[sp - 1] = count;
+            sp += n;
+            break;
+        }
         }
     }
     return sp > 0 ? stack[sp - 1] : 0.0;

@@ -3,6 +3,9 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
+#include <functional>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -29,12 +32,16 @@ enum class Op : std::uint8_t {
     Pop,
     Call,         ///< function arg with arg2 arguments
     Print,        ///< printf with format string arg and arg2 arguments; pushes 0
+    FilePrint,    ///< fprintf: pop arg2 arguments and the file index; pushes 0
+    FileScan,     ///< fscanf: pop arg2 old values and the file index; push the count
+                  ///< read, then arg2 values (new where read, else the old ones)
 };
 
 /// Predefined functions of cpfg section 5.1.5 (the ones evaluated here).
 enum class Function : std::uint8_t {
     Sin, Cos, Tan, Asin, Acos, Atan, Atan2, Exp, Log, Sqrt, Fabs, Floor, Ceil, Trunc, Sign,
     Ran, Nran, Bran, Biran, Srand, Stop, GetDerivationLength, SetDerivationLength, Func,
+    CurveX, CurveY, CurveZ, CurveLength, Fopen, Fclose, Fflush,
 };
 
 struct Instr {
@@ -57,6 +64,26 @@ struct ArrayValues {
     std::vector<double> values;
 };
 
+/// Files the L-system opened with fopen (manual 5.1.5), by index; closed with the last
+/// Runtime that shares them.
+class OpenFiles {
+public:
+    static constexpr int max_open = 32;
+    OpenFiles() = default;
+    OpenFiles(const OpenFiles&) = delete;
+    OpenFiles& operator=(const OpenFiles&) = delete;
+    ~OpenFiles();
+    /// Opens `name` (relative to `base_dir`) with mode "r", "w" or "a"; returns its index.
+    int open(const std::string& base_dir, const std::string& name, const std::string& mode,
+             const std::string& l_file);
+    /// The open file with `index`, or throws naming `l_file`.
+    std::FILE* get(double index, const std::string& l_file) const;
+    void close(double index, const std::string& l_file);
+
+private:
+    std::vector<std::FILE*> m_files;
+};
+
 /// Everything an evaluation may read or change besides the production's frame.
 struct Runtime {
     std::vector<double> globals;
@@ -68,6 +95,14 @@ struct Runtime {
     bool normal_cached = true;   ///< cpfg starts "cached" with a spare of 0
     int derivation_length = 0;
     bool stop_requested = false;
+    /// func(id, x): the view file's functions, provided by the caller (may be empty)
+    const std::function<double(int, double)>* function = nullptr;
+    /// curveX/Y/Z(id, t) and curveGAL(id): the view file's curves (may be empty)
+    const std::function<double(char, int, double)>* curve = nullptr;
+    /// named in the warning that an unprovided func() evaluates to 0
+    const std::string* file_name = nullptr;
+    bool function_warned = false;
+    std::shared_ptr<OpenFiles> files = std::make_shared<OpenFiles>();
 };
 
 /// Runs `code` with the given local frame. Returns the value left on top of the stack

@@ -36,7 +36,8 @@ std::string canonical(std::string_view keyword)
     return std::string(keyword);
 }
 
-/// Characters after '@' that continue a two-letter turtle command (@Gs, @Tx, @PS, @Dd...).
+}  // namespace
+
 bool continues_at_command(char first, char second)
 {
     std::string_view set;
@@ -49,8 +50,6 @@ bool continues_at_command(char first, char second)
     }
     return second != '\0' && set.find(second) != std::string_view::npos;
 }
-
-}  // namespace
 
 Lexer::Lexer(std::string_view text, std::string file_name) : m_text(text)
 {

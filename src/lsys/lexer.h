@@ -35,6 +35,10 @@ struct Token {
     FileLoc loc;
 };
 
+/// Whether `second` continues a two-letter turtle command after "@" and `first`
+/// (@Gs, @Tx, @PS, @Dd...): cpfg's lexer and string reader group these characters.
+bool continues_at_command(char first, char second);
+
 /// Whether the lexer reads module names or expression tokens, as cpfg's lexer states do.
 enum class LexMode { Module, Expression };
 

@@ -2,6 +2,7 @@
 // The public face of src/lsys: load a cpfg .l file, read its axiom, derive strings.
 #include "lsys/lsystem.h"
 
+#include <algorithm>
 #include <fstream>
 #include <sstream>
 
@@ -42,11 +43,40 @@ std::unique_ptr<Program> compile(std::string_view source, const std::string& fil
     return program;
 }
 
+bool uses_symbol(const Program& program, int symbol)
+{
+    if (symbol < 0)
+        return false;
+    auto in = [&](const std::vector<ModuleTemplate>& modules) {
+        for (const auto& m : modules)
+            if (m.symbol == symbol)
+                return true;
+        return false;
+    };
+    for (const auto& ls : program.lsystems) {
+        if (in(ls.axiom))
+            return true;
+        for (const ProductionSet* set : {&ls.productions, &ls.decomposition, &ls.homomorphism})
+            for (const auto& p : set->productions)
+                if (in(p.successor))
+                    return true;
+    }
+    return false;
+}
+
 }  // namespace
 
 LSystem::LSystem(std::unique_ptr<Program> program, LoadOptions options)
     : m_program(std::move(program)), m_options(std::move(options))
 {
+    const SymbolTable& symbols = m_program->symbols;
+    for (const char* name : {"?P", "?H", "?L", "?U"})
+        m_has_queries |= uses_symbol(*m_program, symbols.find(name));
+    // cpfg's ?E talks to an environmental program (out of scope): say so once
+    if (uses_symbol(*m_program, symbols.find("?E")))
+        warn(FileLoc{m_program->file_name, 0, 0},
+             "the L-system uses ?E communication modules, but no environment is connected; "
+             "they stay in the string with their parameters unchanged");
 }
 LSystem::LSystem(LSystem&&) noexcept = default;
 LSystem& LSystem::operator=(LSystem&&) noexcept = default;
@@ -75,26 +105,132 @@ const SymbolTable& LSystem::symbols() const { return m_program->symbols; }
 SymbolTable& LSystem::symbols() { return m_program->symbols; }
 const Program& LSystem::program() const { return *m_program; }
 
+namespace {
+
+DeriveLimits limits_of(const LoadOptions& options)
+{
+    DeriveLimits limits;
+    limits.max_modules = options.max_modules;
+    limits.function = options.function;
+    limits.curve = options.curve;
+    return limits;
+}
+
+}  // namespace
+
 int LSystem::derivation_length() const
 {
-    Deriver deriver(*m_program, DeriveLimits{m_options.max_modules});
+    Deriver deriver(*m_program, limits_of(m_options));
     return deriver.derivation_length();
 }
 
 ModuleString LSystem::axiom() const
 {
-    Deriver deriver(*m_program, DeriveLimits{m_options.max_modules});
+    Deriver deriver(*m_program, limits_of(m_options));
     return deriver.string();
 }
 
+bool LSystem::has_queries() const { return m_has_queries; }
+
 ModuleString LSystem::derive(std::optional<int> steps) const
 {
-    Deriver deriver(*m_program, DeriveLimits{m_options.max_modules});
+    Deriver deriver(*m_program, limits_of(m_options));
+    auto between_steps = [&] {
+        if (m_has_queries && m_options.query)
+            run_query(deriver.mutable_string());
+        if (m_options.on_step)
+            m_options.on_step(deriver.steps_done(), deriver.string());
+    };
+    between_steps();
     int n = steps.value_or(deriver.derivation_length());
-    for (int i = 0; i < n; ++i)
+    for (int i = 0; i < n; ++i) {
         deriver.step();
+        between_steps();
+    }
     deriver.finish();
+    m_last_runtime = std::make_shared<Runtime>(deriver.runtime());
     return deriver.take_string();
+}
+
+void LSystem::run_query(ModuleString& s) const
+{
+    if (m_program->split_commands.empty()) {
+        m_options.query(s);
+        return;
+    }
+    // '@' has no parameters, so the joined string holds the same values in the same order
+    ModuleString joined = join_at_commands(s);
+    m_options.query(joined);
+    if (joined.param_total() != s.param_total())
+        throw Error(FileLoc{m_program->file_name, 0, 0},
+                    "internal: the query pass changed the number of parameters");
+    std::copy_n(joined.param_data(), joined.param_total(), s.mutable_params().data());
+}
+
+ModuleString LSystem::join_at_commands(const ModuleString& s) const
+{
+    const auto& commands = m_program->split_commands;
+    if (commands.empty())
+        return s;
+    SymbolId at = commands.front().parts.front();
+    ModuleString out;
+    out.reserve(s.size(), s.param_total());
+    std::size_t offset = 0;
+    for (std::size_t i = 0; i < s.size();) {
+        const SplitCommand* best = nullptr;
+        if (s.symbol(i) == at && s.param_count(i) == 0) {
+            for (const auto& c : commands) {
+                std::size_t n = c.parts.size();
+                if (i + n > s.size() || (best && best->parts.size() >= n))
+                    continue;
+                bool ok = true;
+                for (std::size_t k = 1; k < n && ok; ++k)
+                    ok = s.symbol(i + k) == c.parts[k] && (k + 1 == n || s.param_count(i + k) == 0);
+                if (ok)
+                    best = &c;
+            }
+        }
+        if (best) {
+            std::size_t last = i + best->parts.size() - 1;
+            out.append(best->joined,
+                       std::span<const float>(s.param_data() + offset, s.param_count(last)));
+            offset += s.param_count(last);
+            i = last + 1;
+        } else {
+            out.append(s.symbol(i), std::span<const float>(s.param_data() + offset, s.param_count(i)));
+            offset += s.param_count(i);
+            ++i;
+        }
+    }
+    return out;
+}
+
+ModuleString LSystem::interpretation_string(const ModuleString& derived) const
+{
+    DeriveLimits limits = limits_of(m_options);
+    limits.start = m_last_runtime == nullptr;  // else the Start block gives the globals
+    Deriver deriver(*m_program, limits);
+    if (m_last_runtime)
+        deriver.set_runtime(*m_last_runtime);
+    ModuleString out;
+    deriver.apply_homomorphism(derived, out);
+    return join_at_commands(out);
+}
+
+bool LSystem::is_object_symbol(int symbol) const
+{
+    for (const auto& ls : m_program->lsystems)
+        for (const auto& p : ls.homomorphism.productions)
+            if (p.object_production && !p.predecessor.empty() && p.predecessor.front().symbol == symbol)
+                return true;
+    return false;
+}
+
+ModuleString LSystem::expand_object(ModuleRef module) const
+{
+    ModuleString one;
+    one.append(module.symbol, module.params);
+    return interpretation_string(one);
 }
 
 }  // namespace cambium::lsys

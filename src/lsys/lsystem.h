@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -14,11 +15,28 @@
 namespace cambium::lsys {
 
 struct Program;
+struct Runtime;
 
 struct LoadOptions {
     std::vector<std::string> defines;      ///< extra -D NAME[=VALUE] for the preprocessor
     std::string preprocessor = "cpp";      ///< the system C preprocessor
     std::size_t max_modules = 100'000'000; ///< derivation fails past this string length
+    /// func(id, x): the view file's function set (geom's FunctionSet::evaluate, which
+    /// owns the clamping). Unset: func() evaluates to 0 with one warning.
+    std::function<double(int id, double x)> function;
+    /// curveX(id, t), curveY, curveZ and curveGAL(id) on the view file's curves (geom):
+    /// `which` is 'x', 'y', 'z', or 'l' for the curve's length (t is then 0).
+    /// Unset: they evaluate to 0 with one warning.
+    std::function<double(char which, int id, double t)> curve;
+    /// The interpretation pass that fills the parameters of ?P ?H ?L ?U from the turtle
+    /// (geom). Called, when the program has query modules, on the axiom and after every
+    /// derivation step (so before each next step and after the last one), as cpfg
+    /// interprets the string between steps. It gets the string with @-commands joined
+    /// (as interpretation_string() would join them) and may change parameter values
+    /// only, not modules or parameter counts. Homomorphism is not applied to it.
+    std::function<void(ModuleString&)> query;
+    /// Called with the axiom (step 0) and after every step (cpfg's -V output).
+    std::function<void(int step, const ModuleString&)> on_step;
 };
 
 /// A parsed and compiled .l file.
@@ -48,10 +66,33 @@ public:
     /// The compiled program (productions, decomposition, homomorphism, globals).
     const Program& program() const;
 
+    /// Whether an axiom or successor holds ?P ?H ?L or ?U (then LoadOptions::query runs).
+    bool has_queries() const;
+    /// The string the turtle interprets: `derived` with the homomorphism applied
+    /// (recursively to each set's `maximum depth:`, default 1; its `seed:` makes it
+    /// stochastic; `warnings` reports reaching the depth), object productions (-o>)
+    /// expanded inline, and @-commands that derivation kept as one-character modules
+    /// (see docs: cpfg's one-character string) joined back into their turtle names.
+    /// Global variables are those the last derive() left (else after the Start block).
+    /// Not thread-safe with derive() on the same LSystem.
+    ModuleString interpretation_string(const ModuleString& derived) const;
+    /// Whether `symbol` is the predecessor of an object production (-o>) in a
+    /// homomorphism: geom may instance its expansion instead of repeating it.
+    bool is_object_symbol(int symbol) const;
+    /// The homomorphism successor of one module (context-free, recursively to the
+    /// maximum depth), @-commands joined: the geometry of one instance of an object.
+    ModuleString expand_object(ModuleRef module) const;
+
 private:
     explicit LSystem(std::unique_ptr<Program> program, LoadOptions options);
+    void run_query(ModuleString& s) const;
+    ModuleString join_at_commands(const ModuleString& s) const;
+
     std::unique_ptr<Program> m_program;
     LoadOptions m_options;
+    /// Globals and arrays after the last derive(), for interpretation_string()
+    mutable std::shared_ptr<Runtime> m_last_runtime;
+    bool m_has_queries = false;
 };
 
 }  // namespace cambium::lsys

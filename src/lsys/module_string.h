@@ -61,6 +61,8 @@ public:
     SymbolId symbol(std::size_t i) const { return m_wide ? m_symbols16[i] : m_symbols8[i]; }
     /// All parameter values, module after module (index with a prefix sum of counts).
     const float* param_data() const { return m_params.data(); }
+    /// The same, writable (a query pass fills ?P ?H ?L ?U values in place).
+    std::span<float> mutable_params() { return m_params; }
     std::size_t param_count(std::size_t i) const { return m_counts[i]; }
     /// Bytes held by the string's arrays (for memory reports).
     std::size_t memory_bytes() const;
@@ -70,6 +72,8 @@ public:
     public:
         Cursor() = default;
         std::size_t index() const { return m_index; }
+        /// Index of the module's first parameter in param_data() / mutable_params().
+        std::size_t param_offset() const { return m_offset; }
         bool at_end() const { return m_index >= m_string->size(); }
         ModuleRef operator*() const;
         void next();

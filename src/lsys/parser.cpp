@@ -131,6 +131,7 @@ private:
     void parse_unary(Emitter& e);
     void parse_primary(Emitter& e);
     void parse_call(Emitter& e, const Token& name);
+    void parse_file_call(Emitter& e, const Token& name);
     int parse_indices(Emitter& e);
     void emit_load(Emitter& e, const Token& name);
     VariableRef resolve(const std::string& name);
@@ -665,7 +666,9 @@ void Parser::parse_do(Emitter& e)
 void Parser::parse_assignment_or_expression(Emitter& e)
 {
     Token first = peek(LexMode::Expression);
-    if (first.kind == TokenKind::Name && !find_function(first.text) && first.text != "printf") {
+    if (first.kind == TokenKind::Name && !find_function(first.text) && first.text != "printf" &&
+        first.text != "fprintf" && first.text != "fscanf") {
+        Lexer before_name = m_lexer;  // an expression statement starts the same way
         next(LexMode::Expression);
         Token after = peek(LexMode::Expression);
         VariableRef ref = resolve(first.text);
@@ -695,7 +698,9 @@ void Parser::parse_assignment_or_expression(Emitter& e)
             expect_operator(";");
             return;
         }
-        fail(after, "'=' after '" + first.text + "'");
+        // Not an assignment: cpfg evaluates the expression and drops its value
+        // (04-paintbrush has `roll - roll/L0;`).
+        m_lexer = before_name;
     }
     parse_expression(e);
     e.emit(Op::Pop, -1);
@@ -887,6 +892,10 @@ void Parser::parse_call(Emitter& e, const Token& name)
                static_cast<std::uint8_t>(n));
         return;
     }
+    if (name.text == "fprintf" || name.text == "fscanf") {
+        parse_file_call(e, name);
+        return;
+    }
     const FunctionInfo* f = find_function(name.text);
     if (!f)
         throw Error(name.loc, "unknown function '" + name.text + "'");
@@ -901,9 +910,45 @@ void Parser::parse_call(Emitter& e, const Token& name)
     if (f->arity >= 0 && n != f->arity && !(f->arity == 1 && n == 0))
         throw Error(name.loc, "'" + name.text + "' takes " + std::to_string(f->arity) +
                                   " argument(s), " + std::to_string(n) + " given");
-    if (f->function == Function::Func)
-        warn(name.loc, "'" + name.text + "' needs the view file's function set; it evaluates to 0");
     e.emit(Op::Call, 1 - n, static_cast<std::int32_t>(f->function), static_cast<std::uint8_t>(n));
+}
+
+void Parser::parse_file_call(Emitter& e, const Token& name)
+{
+    // fprintf(file, "format", values...) and fscanf(file, "format", &var...) (5.1.5)
+    parse_expression(e);
+    expect_operator(",");
+    Token format = expect(LexMode::Expression, TokenKind::String, "a format string");
+    m_program.strings.push_back(format.text);
+    auto format_index = static_cast<std::int32_t>(m_program.strings.size() - 1);
+    if (name.text == "fprintf") {
+        int n = 0;
+        while (accept_operator(",")) {
+            parse_expression(e);
+            ++n;
+        }
+        expect(LexMode::Expression, TokenKind::RParen, "')'");
+        if (n > max_stack)
+            throw Error(name.loc, "too many arguments");
+        e.emit(Op::FilePrint, -n, format_index, static_cast<std::uint8_t>(n));
+        return;
+    }
+    std::vector<VariableRef> targets;
+    while (accept_operator(",")) {
+        accept_operator("&");
+        Token var = expect(LexMode::Expression, TokenKind::Name, "a variable to read into");
+        VariableRef ref = resolve(var.text);
+        if (ref.kind == VariableRef::Array)
+            throw Error(var.loc, "fscanf reads into variables, not arrays ('" + var.text + "')");
+        e.emit(ref.kind == VariableRef::Local ? Op::LoadLocal : Op::LoadGlobal, 1, ref.index);
+        targets.push_back(ref);
+        if (targets.size() > 200)
+            throw Error(var.loc, "too many variables");
+    }
+    expect(LexMode::Expression, TokenKind::RParen, "')'");
+    e.emit(Op::FileScan, 0, format_index, static_cast<std::uint8_t>(targets.size()));
+    for (auto it = targets.rbegin(); it != targets.rend(); ++it)
+        e.emit(it->kind == VariableRef::Local ? Op::StoreLocal : Op::StoreGlobal, -1, it->index);
 }
 
 int Parser::parse_indices(Emitter& e)
@@ -956,11 +1001,133 @@ void ProductionSet::index(std::size_t symbol_count)
             static_cast<std::uint32_t>(i));
 }
 
+namespace {
+
+std::vector<ProductionSet*> production_sets(LSystemDefinition& ls)
+{
+    return {&ls.productions, &ls.decomposition, &ls.homomorphism};
+}
+
+/// The @-commands whose letters some production names as a predecessor or context
+/// module (see SplitCommand).
+void find_split_commands(Program& program)
+{
+    std::vector<char> rewritten(256, 0);
+    auto note = [&](const std::vector<FormalModule>& modules) {
+        for (const auto& f : modules) {
+            std::string_view name = program.symbols.name(f.symbol);
+            if (name.size() == 1)
+                rewritten[static_cast<unsigned char>(name[0])] = 1;
+        }
+    };
+    for (auto& ls : program.lsystems)
+        for (ProductionSet* set : production_sets(ls))
+            for (const auto& p : set->productions) {
+                note(p.predecessor);
+                note(p.left_context);
+                note(p.right_context);
+            }
+    std::size_t n = program.symbols.size();
+    for (std::size_t id = 0; id < n; ++id) {
+        std::string name(program.symbols.name(static_cast<SymbolId>(id)));
+        if (name.size() < 2 || name[0] != '@')
+            continue;
+        bool split = false;
+        for (std::size_t i = 1; i < name.size(); ++i)
+            split |= rewritten[static_cast<unsigned char>(name[i])] != 0;
+        if (!split)
+            continue;
+        SplitCommand command;
+        command.joined = static_cast<SymbolId>(id);
+        for (char c : name)
+            command.parts.push_back(program.symbols.intern(std::string(1, c)));
+        program.split_commands.push_back(std::move(command));
+    }
+}
+
+const SplitCommand* split_of(const Program& program, SymbolId symbol)
+{
+    for (const auto& c : program.split_commands)
+        if (c.joined == symbol)
+            return &c;
+    return nullptr;
+}
+
+void split_templates(const Program& program, std::vector<ModuleTemplate>& modules)
+{
+    std::vector<ModuleTemplate> out;
+    for (auto& m : modules) {
+        const SplitCommand* c = split_of(program, m.symbol);
+        if (!c) {
+            out.push_back(std::move(m));
+            continue;
+        }
+        for (std::size_t i = 0; i + 1 < c->parts.size(); ++i)
+            out.push_back(ModuleTemplate{c->parts[i], {}});
+        out.push_back(ModuleTemplate{c->parts.back(), std::move(m.params)});
+    }
+    modules = std::move(out);
+}
+
+void split_formals(const Program& program, std::vector<FormalModule>& modules)
+{
+    std::vector<FormalModule> out;
+    for (auto& m : modules) {
+        const SplitCommand* c = split_of(program, m.symbol);
+        if (!c) {
+            out.push_back(std::move(m));
+            continue;
+        }
+        for (std::size_t i = 0; i + 1 < c->parts.size(); ++i)
+            out.push_back(FormalModule{c->parts[i], {}, m.loc});
+        out.push_back(FormalModule{c->parts.back(), std::move(m.param_slots), m.loc});
+    }
+    modules = std::move(out);
+}
+
+void split_symbols(const Program& program, std::vector<SymbolId>& symbols)
+{
+    std::vector<SymbolId> extra;
+    for (SymbolId s : symbols)
+        if (const SplitCommand* c = split_of(program, s))
+            extra.insert(extra.end(), c->parts.begin(), c->parts.end());
+    symbols.insert(symbols.end(), extra.begin(), extra.end());
+}
+
+/// Rewrites every axiom, production and ignore list in terms of the split commands.
+void split_at_commands(Program& program)
+{
+    find_split_commands(program);
+    if (program.split_commands.empty())
+        return;
+    for (auto& ls : program.lsystems) {
+        split_templates(program, ls.axiom);
+        split_symbols(program, ls.ignore);
+        split_symbols(program, ls.consider);
+        for (ProductionSet* set : production_sets(ls))
+            for (auto& p : set->productions) {
+                split_formals(program, p.predecessor);
+                split_formals(program, p.left_context);
+                split_formals(program, p.right_context);
+                split_templates(program, p.successor);
+                if (p.constant_successor) {
+                    ModuleString constant;
+                    for (const auto& m : p.successor)
+                        constant.append(m.symbol);
+                    p.constant_successor = std::move(constant);
+                }
+            }
+    }
+}
+
+}  // namespace
+
 void parse_program(std::string_view preprocessed, const std::string& file_name, Program& program)
 {
     program.file_name = file_name;
     Parser parser(preprocessed, file_name, program);
     parser.parse_file();
+    split_at_commands(program);
     for (auto& ls : program.lsystems) {
         ls.productions.index(program.symbols.size());
         ls.decomposition.index(program.symbols.size());

@@ -82,6 +82,15 @@ struct ArrayDefinition {
     ArrayValues initial;
 };
 
+/// An @-command ("@o", "@Gs") that cpfg's productions rewrite letter by letter: cpfg
+/// stores its string one character per module, so `o(r) --> o(r+1)` rewrites the 'o' of
+/// "@o(0.2)". Such commands are derived as '@' plus one module per letter (the
+/// parameters on the last) and joined back for interpretation.
+struct SplitCommand {
+    SymbolId joined = 0;
+    std::vector<SymbolId> parts;  ///< '@' first
+};
+
 /// The whole compiled file.
 struct Program {
     SymbolTable symbols;
@@ -91,6 +100,7 @@ struct Program {
     std::vector<ArrayDefinition> arrays;
     std::vector<std::string> strings;
     std::string file_name;
+    std::vector<SplitCommand> split_commands;
 };
 
 }  // namespace cambium::lsys

@@ -132,3 +132,26 @@ endlsystem
 
 }  // namespace
 }  // namespace cambium::lsys
+
+namespace cambium::lsys {
+namespace {
+
+TEST(LsysParser, ExpressionStatementStartingWithAVariableIsEvaluatedAndDropped)
+{
+    // cpfg accepts `x - 1;` as a statement (04-paintbrush writes `roll - roll/L0;`):
+    // the value is dropped and x is unchanged.
+    std::string text = testing::derive_text(
+        "lsystem: 1\nderivation length: 1\naxiom: A(4)\n"
+        "A(x) : { y = x; y - 1; y + x * 2; } --> B(y)\nendlsystem\n");
+    EXPECT_EQ(text, "B(4)");
+}
+
+TEST(LsysParser, StatementOfAVariableAloneStillNeedsASemicolon)
+{
+    std::string e = load_error(
+        "lsystem: 1\naxiom: A(4)\nA(x) : { y = x; y } --> B(y)\nendlsystem\n");
+    EXPECT_NE(e.find("test.l:3:"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace cambium::lsys
