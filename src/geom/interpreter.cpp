@@ -3,8 +3,17 @@
 #include "geom/interpreter.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
 #include <vector>
 
+#include "geom/patch.h"
+#include "geom/polygon.h"
+#include "geom/query.h"
+#include "geom/surface.h"
+#include "geom/tropism.h"
 #include "geom/turtle.h"
 
 namespace cambium::geom {
@@ -32,29 +41,167 @@ std::vector<TurtleOp> symbol_ops(const lsys::SymbolTable& symbols)
 /// (`tapered lines: on`, cpfg's default). Consecutive segments share their joint key,
 /// which carries that width, and get Embree's neighbour flags.
 class Interpreter {
+    /// A polygon vertex: the turtle's position and the frame its texture axes use.
+    struct PolygonCorner {
+        Vec3 position, heading, left;
+        int color, back_color, texture;
+    };
+
 public:
-    explicit Interpreter(const ViewFile& view) : m_view(view)
+    Interpreter(const ViewFile& view, const InterpretOptions& options)
+        : m_view(view), m_options(options),
+          m_cylinders(cylinder_settings(view), m_scene.geometry, m_scene.bounds)
     {
+        m_turtle.cylinder.sides = m_cylinders.settings().sides;
         m_turtle.line_width = view.initial_line_width;
         m_turtle.color = view.initial_color;
         m_turtle.back_color = view.initial_back_color;
         m_turtle.scale = view.initial_scale;
+        m_sub_scales.push_back(view.initial_scale);
+        m_movements = std::span<const Movement>(view.movements.data(),
+                                                std::min(view.movements.size(), Turtle::max_movements));
+        if (view.movements.size() > Turtle::max_movements)
+            warn("only the first " + std::to_string(Turtle::max_movements) +
+                 " tropisms and torques are used");
+        for (std::size_t i = 0; i < m_movements.size(); ++i)
+            m_turtle.elasticity[i] = m_movements[i].initial_elasticity;
+        m_turtle.legacy_elasticity = view.legacy_elasticity;
+        m_scene.textures = view.textures;
         m_scene.line_radius_in_pixels = view.line_style == LineStyle::pixel;
         m_scene.view = view.view;
         m_scene.lights = effective_lights(view);
         m_scene.bounds.extend(Vec3{0, 0, 0});  // cpfg's box always holds the origin
+        load_surfaces();
     }
 
     void run(const lsys::ModuleString& string, const lsys::SymbolTable& symbols)
     {
         std::vector<TurtleOp> ops = symbol_ops(symbols);
-        string.for_each([&](lsys::ModuleRef m) { apply(ops[m.symbol], m.params); });
+        std::vector<int> surfaces = surface_slots(symbols);
+        string.for_each([&](lsys::ModuleRef m) {
+            if (int slot = surfaces[m.symbol]; slot != not_a_surface)
+                draw_surface(slot, symbols.name(m.symbol)[1], m.params);
+            else
+                apply(ops[m.symbol], m.params);
+            ++m_module_index;
+        });
         end_node();
+        if (!m_polygons.empty())
+            warn(std::to_string(m_polygons.size()) +
+                 " polygon(s) left open at the end of the string are not drawn");
     }
+
+    /// Records the answers of query modules (?P ?H ?L ?U) while interpreting.
+    void collect_queries(std::vector<QueryAnswer>* answers) { m_answers = answers; }
 
     Scene take() { return std::move(m_scene); }
 
 private:
+    static constexpr int not_a_surface = -1;
+    static constexpr int undefined_surface = -2;
+
+    /// The view file's `surface:` and `tsurface:` files, each a prototype of the scene.
+    void load_surfaces()
+    {
+        m_surfaces = load_view_surfaces(m_view);
+        for (SurfaceDef& def : m_surfaces) {
+            m_surface_prototypes.push_back({static_cast<std::uint32_t>(m_scene.prototypes.size()), -1});
+            m_scene.prototypes.push_back(std::move(def.prototype));
+            def.prototype = Prototype{};
+        }
+    }
+
+    /// The prototype of surface `slot` for a texture: textures with `S:` use a copy
+    /// whose uvs span the whole surface, made the first time one is needed.
+    std::uint32_t surface_prototype(int slot, std::int16_t texture)
+    {
+        auto s = static_cast<std::size_t>(slot);
+        SurfacePrototypes& p = m_surface_prototypes[s];
+        const std::vector<bool>& flags = m_view.texture_per_surface;
+        auto t = static_cast<std::size_t>(texture);
+        bool per_surface = texture >= 0 && t < flags.size() && flags[t];
+        if (!per_surface)
+            return p.per_patch;
+        if (p.per_surface < 0) {
+            Prototype copy = m_scene.prototypes[p.per_patch];
+            if (copy.geometry.mesh.uvs.size() == m_surfaces[s].uvs_per_surface.size())
+                copy.geometry.mesh.uvs = m_surfaces[s].uvs_per_surface;
+            p.per_surface = static_cast<int>(m_scene.prototypes.size());
+            m_scene.prototypes.push_back(std::move(copy));
+        }
+        return static_cast<std::uint32_t>(p.per_surface);
+    }
+
+    /// Per symbol: the index into m_surfaces of a `~x` module, undefined_surface for a
+    /// `~x` whose letter no surface defines, not_a_surface otherwise.
+    std::vector<int> surface_slots(const lsys::SymbolTable& symbols) const
+    {
+        std::vector<int> slots(symbols.size(), not_a_surface);
+        for (std::size_t id = 0; id < symbols.size(); ++id) {
+            std::string_view name = symbols.name(static_cast<lsys::SymbolId>(id));
+            if (name.size() != 2 || name[0] != '~')
+                continue;
+            auto it = std::find_if(m_surfaces.begin(), m_surfaces.end(),
+                                   [&](const SurfaceDef& d) { return d.letter == name[1]; });
+            slots[id] = it == m_surfaces.end() ? undefined_surface
+                                               : static_cast<int>(it - m_surfaces.begin());
+        }
+        return slots;
+    }
+
+    /// `~x`, `~x(s)`, `~x(sx, sy, sz)`: an instance of the surface at the turtle, then
+    /// the turtle moves to its end point (cpfg ends the node first). cpfg's view volume
+    /// takes the placed control points (vertices of a tsurface), unless a scale is 0.
+    void draw_surface(int slot, char letter, std::span<const float> p)
+    {
+        end_node();
+        if (slot == undefined_surface) {
+            if (m_warned_surface_letters.find(letter) == std::string::npos) {
+                warn(std::string("surface '~") + letter + "' is not defined in the view file; not drawn");
+                m_warned_surface_letters += letter;
+            }
+            return;
+        }
+        const SurfaceDef& def = m_surfaces[static_cast<std::size_t>(slot)];
+        const Turtle& t = m_turtle;
+        Vec3 s = surface_scale(p, t.scale);
+        if (s.x != 0 && s.y != 0 && s.z != 0) {
+            std::int16_t texture = def.texture ? *def.texture : static_cast<std::int16_t>(t.texture);
+            m_scene.instances.push_back(Instance{
+                surface_prototype(slot, texture),
+                surface_instance_transform(def, t.position, t.heading, t.left, t.up, s),
+                material(t.color), material(t.back_color), texture});
+            for (const Vec3& q : def.hull_points)
+                m_scene.bounds.extend(t.position + t.left * (s.x * q.x) + t.heading * (s.y * q.y) +
+                                      t.up * (s.z * q.z));
+        }
+        m_turtle.position = surface_end_position(def, t.position, t.heading, t.left, t.up, s.x);
+        m_chain_open = false;
+    }
+
+    /// `@PS(i [, basis])`, `@PC(i, row, column)`, `@PD(i [, s, t])`: L-system patches.
+    /// cpfg's view volume ignores them (the turtle has visited the control points).
+    void patch_command(TurtleOp op, std::span<const float> p)
+    {
+        std::size_t needed = op == TurtleOp::PatchControl ? 3 : 1;
+        if (p.size() < needed || !std::isfinite(p[0])) {
+            warn_once(m_warned_patch, "@PS/@PC/@PD without a finite patch number are ignored");
+            return;
+        }
+        // not finite: -1, which every use rejects or replaces with its default
+        auto whole = [](float v) {
+            return std::isfinite(v) ? static_cast<int>(std::clamp(v, -1e6f, 1e6f)) : -1;
+        };
+        if (op == TurtleOp::PatchStart)
+            m_patches.start(p[0], p.size() >= 2 ? whole(p[1]) : 0);
+        else if (op == TurtleOp::PatchControl)
+            m_patches.set_control_point(p[0], whole(p[1]), whole(p[2]), m_turtle.position, FileLoc{});
+        else
+            m_patches.draw(p[0], p.size() >= 3 ? whole(p[1]) : 0, p.size() >= 3 ? whole(p[2]) : 0,
+                           material(m_turtle.color), material(m_turtle.back_color),
+                           static_cast<std::int16_t>(m_turtle.texture), m_scene.geometry.mesh, FileLoc{});
+    }
+
     double angle(std::span<const float> p) const
     {
         return p.empty() ? m_view.angle_increment_deg : static_cast<double>(p[0]);
@@ -69,10 +216,10 @@ private:
     {
         switch (op) {
         case TurtleOp::None: break;
-        case TurtleOp::Forward:
-        case TurtleOp::ForwardG: draw_forward(length(p)); break;
-        case TurtleOp::ForwardNoDraw:
-        case TurtleOp::ForwardGNoDraw: move_forward(length(p)); break;
+        case TurtleOp::Forward: draw_forward(length(p), true); break;
+        case TurtleOp::ForwardG: draw_forward(length(p), false); break;
+        case TurtleOp::ForwardNoDraw: move_forward(length(p), true); break;
+        case TurtleOp::ForwardGNoDraw: move_forward(length(p), false); break;
         case TurtleOp::TurnLeft: m_turtle.turn(angle(p)); break;
         case TurtleOp::TurnRight: m_turtle.turn(-angle(p)); break;
         case TurtleOp::PitchDown: m_turtle.pitch(angle(p)); break;
@@ -86,7 +233,357 @@ private:
         case TurtleOp::WidthDown: change_width(p, -1); break;
         case TurtleOp::ColorUp: change_color(p, +1); break;
         case TurtleOp::ColorDown: change_color(p, -1); break;
+        case TurtleOp::BackColorUp: at_command(); change_back_color(p, +1); break;
+        case TurtleOp::BackColorDown: at_command(); change_back_color(p, -1); break;
+        case TurtleOp::MoveTo: at_command(); move_to(p); break;
+        case TurtleOp::RollVertical: at_command(); m_turtle.roll_to_vertical(); break;
+        case TurtleOp::SetHeading: at_command(); set_heading(p); break;
+        case TurtleOp::Texture: at_command(); set_texture(p); break;
+        case TurtleOp::ScaleSet:
+        case TurtleOp::ScaleMultiply:
+        case TurtleOp::ScaleDivide: at_command(); change_scale(op, p); break;
+        case TurtleOp::Sphere: at_command(); draw_sphere(p); break;
+        case TurtleOp::ScreenCircle: at_command(); draw_disc(p, true); break;
+        case TurtleOp::Circle: at_command(); draw_disc(p, false); break;
+        case TurtleOp::PolygonStart:
+            end_node();  // cpfg ends the node at every `{`, with or without a type
+            if (p.empty() || p[0] == 0)
+                start_polygon();
+            else
+                m_cylinders.open_curve(m_turtle, p);  // {(type): a generalized cylinder
+            break;
+        case TurtleOp::PolygonEnd:
+            if (p.empty() || p[0] == 0)
+                end_polygon();
+            else
+                m_cylinders.close_curve(m_turtle);
+            break;
+        case TurtleOp::PolygonVertex:
+            if (!m_polygons.empty())
+                add_polygon_vertex();
+            else if (m_turtle.cylinder.mode != CylinderMode::none)
+                m_cylinders.control_point(m_turtle, p);  // cpfg: `.` outside polygons is @Gc
+            break;
+        case TurtleOp::ElasticitySet:
+        case TurtleOp::ElasticityUp:
+        case TurtleOp::ElasticityDown: at_command(); change_elasticity(op, p); break;
+        case TurtleOp::PreventTwist: at_command(); m_turtle.adjust_up_and_left(); break;
+        case TurtleOp::ForceTwist: at_command(); m_turtle.remember_frame(); break;
+        case TurtleOp::SubLsystem: enter_sub_lsystem(p); break;
+        case TurtleOp::SubLsystemEnd: leave_sub_lsystem(); break;
+        case TurtleOp::Label: at_command(); add_label(p); break;
+        case TurtleOp::SystemCall:
+            at_command();
+            warn_once(m_warned_system, "@S system calls are not run; use --allow-system-calls");
+            break;
+        case TurtleOp::IncludeObject:
+            at_command();
+            warn_once(m_warned_include, "@I (rayshade object inclusion) is ignored");
+            break;
+        case TurtleOp::NewGrid:
+            at_command();
+            warn_once(m_warned_grid, "@J (rayshade grid) is ignored");
+            break;
+        case TurtleOp::QueryPosition: answer_query(p, m_turtle.position); break;
+        case TurtleOp::QueryHeading: answer_query(p, m_turtle.heading); break;
+        case TurtleOp::QueryLeft: answer_query(p, m_turtle.left); break;
+        case TurtleOp::QueryUp: answer_query(p, m_turtle.up); break;
+        case TurtleOp::CylinderStart: at_command(); m_cylinders.start(m_turtle); break;
+        case TurtleOp::CylinderPoint: at_command(); m_cylinders.control_point(m_turtle, p); break;
+        case TurtleOp::CylinderEnd: at_command(); m_cylinders.end(m_turtle, p); break;
+        case TurtleOp::CylinderTangents: at_command(); CylinderBuilder::set_tangent_parameters(m_turtle, p); break;
+        case TurtleOp::CylinderRadius: at_command(); CylinderBuilder::set_radius_tangents(m_turtle, p); break;
+        case TurtleOp::CylinderContour: at_command(); m_cylinders.set_contour(m_turtle, p); break;
+        case TurtleOp::CylinderSides: at_command(); m_cylinders.set_sides(m_turtle, p); break;
+        case TurtleOp::PatchStart:
+        case TurtleOp::PatchControl:
+        case TurtleOp::PatchDraw: at_command(); patch_command(op, p); break;
         }
+    }
+
+    void warn_once(bool& warned, const std::string& message)
+    {
+        if (!warned)
+            warn(message);
+        warned = true;
+    }
+
+    /// Every `@` module ends the current node first (cpfg's interpret.c).
+    void at_command() { end_node(); }
+
+    /// `@M(x, y, z)`: cpfg's view volume records the new position.
+    void move_to(std::span<const float> p)
+    {
+        if (p.size() < 2)
+            return;
+        m_turtle.position = Vec3{p[0], p[1], p.size() >= 3 ? p[2] : 0.0};
+        m_scene.bounds.extend(m_turtle.position);
+        m_chain_open = false;
+    }
+
+    void set_heading(std::span<const float> p)
+    {
+        if (p.size() < 2)
+            return;
+        Vec3 h{p[0], p[1], p.size() >= 3 ? p[2] : 0.0};
+        if (p.size() >= 6)
+            m_turtle.set_heading_and_up(h, Vec3{p[3], p[4], p[5]});
+        else
+            m_turtle.set_heading(h);
+    }
+
+    /// `@Tx(i)`: texture i-1 of the view file; 0, none or an unknown index: none.
+    void set_texture(std::span<const float> p)
+    {
+        int index = p.empty() ? -1 : static_cast<int>(p[0]) - 1;
+        bool known = index >= 0 && static_cast<std::size_t>(index) < m_view.textures.size();
+        m_turtle.texture = known ? index : -1;
+    }
+
+    /// `@D(s)`, `@Di(f)`, `@Dd(f)`: set, multiply or divide the turtle scale.
+    void change_scale(TurtleOp op, std::span<const float> p)
+    {
+        if (op == TurtleOp::ScaleSet) {
+            if (p.empty())
+                warn_once(m_warned_scale, "@D without its parameter is ignored");
+            else
+                m_turtle.scale = p[0];
+            return;
+        }
+        double factor = p.empty() ? m_view.scale_multiplier : static_cast<double>(p[0]);
+        if (factor == 0) {
+            warn_once(m_warned_scale, "@Di/@Dd with factor 0 is ignored");
+            return;
+        }
+        m_turtle.scale = op == TurtleOp::ScaleMultiply ? m_turtle.scale * factor : m_turtle.scale / factor;
+    }
+
+    /// The diameter of `@O`, `@o`, `@c`: the parameter times the scale, or the line width.
+    double diameter(std::span<const float> p) const
+    {
+        return p.empty() ? m_turtle.line_width : static_cast<double>(p[0]) * m_turtle.scale;
+    }
+
+    std::uint16_t material(int color) const { return static_cast<std::uint16_t>(std::clamp(color, 0, 255)); }
+
+    /// `@O(d)`: a sphere; cpfg's view volume takes the 8 corners of its cube.
+    void draw_sphere(std::span<const float> p)
+    {
+        double r = std::abs(0.5 * diameter(p));  // cpfg draws -d as d
+        Spheres& spheres = m_scene.geometry.spheres;
+        spheres.centres.push_back(key(m_turtle.position, static_cast<float>(r)));
+        spheres.material.push_back(material(m_turtle.color));
+        spheres.texture.push_back(no_texture);  // cpfg maps no texture on spheres
+        for (int x = -1; x <= 1; x += 2)
+            for (int y = -1; y <= 1; y += 2)
+                for (int z = -1; z <= 1; z += 2)
+                    m_scene.bounds.extend(m_turtle.position + Vec3{x * r, y * r, z * r});
+    }
+
+    /// `@o(d)`: a disc facing the viewer; `@c(d)`: a disc in the HL plane, its front
+    /// toward U. cpfg's view volume takes four corners in x and y, at z = 0 for `@o`
+    /// and at the turtle's z for `@c`.
+    void draw_disc(std::span<const float> p, bool facing_viewer)
+    {
+        double r = std::abs(0.5 * diameter(p));
+        Vec3 normal = facing_viewer ? normalize(m_view.view.viewpoint - m_view.view.reference_point)
+                                    : normalize(m_turtle.up);
+        if (dot(normal, normal) == 0)
+            normal = Vec3{0, 0, 1};
+        Discs& discs = m_scene.geometry.discs;
+        discs.centres.push_back(key(m_turtle.position, static_cast<float>(r)));
+        discs.normals.push_back({static_cast<float>(normal.x), static_cast<float>(normal.y),
+                                 static_cast<float>(normal.z)});
+        discs.material.push_back(material(m_turtle.color));
+        discs.back_material.push_back(material(m_turtle.back_color));
+        double z = facing_viewer ? 0.0 : m_turtle.position.z;
+        for (int x = -1; x <= 1; x += 2)
+            for (int y = -1; y <= 1; y += 2)
+                m_scene.bounds.extend(Vec3{m_turtle.position.x + x * r, m_turtle.position.y + y * r, z});
+    }
+
+    /// `{`: a new polygon on the polygon stack (independent of the turtle stack, so a
+    /// polygon may collect vertices across branches).
+    void start_polygon()
+    {
+        end_node();
+        if (m_polygons.size() >= max_open_polygons)
+            throw Error("more than " + std::to_string(max_open_polygons) + " nested polygons");
+        m_polygons.emplace_back();
+    }
+
+    void add_polygon_vertex()
+    {
+        if (m_polygons.back().size() >= max_polygon_vertices)
+            throw Error("a polygon with more than " + std::to_string(max_polygon_vertices) +
+                                       " vertices");
+        m_polygons.back().push_back({m_turtle.position, m_turtle.heading, m_turtle.left,
+                                     m_turtle.color, m_turtle.back_color, m_turtle.texture});
+    }
+
+    /// `}`: triangulates the innermost polygon.
+    void end_polygon()
+    {
+        if (m_polygons.empty()) {
+            warn_once(m_warned_unmatched_polygon, "unmatched '}' in the string ignored");
+            return;
+        }
+        end_node();
+        emit_polygon(m_polygons.back());
+        m_polygons.pop_back();
+    }
+
+    /// Materials and texture are the first vertex's (as cpfg's rayshade output
+    /// takes them); texture coordinates come from its frame (report 5.3): u along
+    /// R = -L, v along H, each scaled to [0, 1] over the polygon.
+    void emit_polygon(const std::vector<PolygonCorner>& corners)
+    {
+        std::vector<Vec3> outline;
+        outline.reserve(corners.size());
+        for (const PolygonCorner& c : corners)
+            outline.push_back(c.position);
+        auto triangles = triangulate_polygon(outline);
+        if (triangles.empty())
+            return;
+        Vec3 n = polygon_normal(outline);
+        Vec3 s_axis = -corners[0].left, t_axis = corners[0].heading;
+        double s_lo = 1e300, s_hi = -1e300, t_lo = 1e300, t_hi = -1e300;
+        for (const Vec3& q : outline) {
+            s_lo = std::min(s_lo, dot(q, s_axis));
+            s_hi = std::max(s_hi, dot(q, s_axis));
+            t_lo = std::min(t_lo, dot(q, t_axis));
+            t_hi = std::max(t_hi, dot(q, t_axis));
+        }
+        auto unit = [](double x, double lo, double hi) {
+            return hi > lo ? static_cast<float>((x - lo) / (hi - lo)) : 0.f;
+        };
+        auto f3 = [](const Vec3& v) {
+            return Float3{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
+        };
+        TriangleMesh& mesh = m_scene.geometry.mesh;
+        auto base = static_cast<std::uint32_t>(mesh.positions.size());
+        for (const Vec3& q : outline) {
+            mesh.positions.push_back(f3(q));
+            mesh.normals.push_back(f3(n));
+            mesh.uvs.push_back({unit(dot(q, s_axis), s_lo, s_hi), unit(dot(q, t_axis), t_lo, t_hi)});
+        }
+        for (const auto& t : triangles) {
+            mesh.triangles.push_back({base + t[0], base + t[1], base + t[2]});
+            mesh.material.push_back(material(corners[0].color));
+            mesh.back_material.push_back(material(corners[0].back_color));
+            mesh.texture.push_back(static_cast<std::int16_t>(corners[0].texture));
+        }
+    }
+
+    /// `@Ts(i, e)`, `@Ti(i [, d])`, `@Td(i [, d])`: tropism i (from 1; 0 parameters:
+    /// the first). `@Ts(i)` sets 0; `@Ti`/`@Td` without d use the tropism's S: step.
+    void change_elasticity(TurtleOp op, std::span<const float> p)
+    {
+        int index = p.empty() ? 0 : static_cast<int>(p[0]) - 1;
+        if (index < 0 || static_cast<std::size_t>(index) >= m_movements.size()) {
+            warn_once(m_warned_movement, "tropism index out of range in @Ts/@Ti/@Td ignored");
+            return;
+        }
+        double& e = m_turtle.elasticity[static_cast<std::size_t>(index)];
+        double step = p.size() >= 2 ? static_cast<double>(p[1])
+                                    : m_movements[static_cast<std::size_t>(index)].elasticity_step;
+        if (op == TurtleOp::ElasticitySet)
+            e = p.size() >= 2 ? static_cast<double>(p[1]) : 0.0;
+        else if (op == TurtleOp::ElasticityUp)
+            e += step;
+        else
+            e -= step;
+    }
+
+    /// `?(id, s)`: the scale is multiplied by s (kept on its own stack), the line
+    /// width follows; `$` restores both (cpfg's UpdateCurrentLsystem).
+    void enter_sub_lsystem(std::span<const float> p)
+    {
+        if (p.empty())
+            return;
+        if (m_sub_scales.size() >= max_sub_lsystem_depth)
+            throw Error("sub-L-systems nested deeper than " + std::to_string(max_sub_lsystem_depth));
+        double old_scale = m_sub_scales.back();
+        double new_scale = p.size() >= 2 ? old_scale * p[1] : old_scale;
+        m_sub_scales.push_back(new_scale);
+        rescale(old_scale, new_scale);
+    }
+
+    void leave_sub_lsystem()
+    {
+        if (m_sub_scales.size() <= 1) {
+            warn_once(m_warned_unmatched_sub, "unmatched '$' in the string ignored");
+            return;
+        }
+        double old_scale = m_sub_scales.back();
+        m_sub_scales.pop_back();
+        rescale(old_scale, m_sub_scales.back());
+    }
+
+    void rescale(double old_scale, double new_scale)
+    {
+        m_turtle.scale = new_scale;
+        if (old_scale != 0)
+            m_turtle.line_width = m_turtle.line_width * new_scale / old_scale;
+    }
+
+    /// `@L(text [, values...])`: a label; the text's printf conversions take the values.
+    void add_label(std::span<const float> p)
+    {
+        Label label;
+        label.position = m_turtle.position;
+        label.material = material(m_turtle.color);
+        if (!p.empty() && p[0] >= 0 && static_cast<std::size_t>(p[0]) < m_options.strings.size())
+            label.text = format_label(m_options.strings[static_cast<std::size_t>(p[0])], p.subspan(1));
+        else if (!m_options.strings.empty() || !p.empty())
+            warn_once(m_warned_label, "@L without a known string: label text left empty");
+        m_scene.labels.push_back(std::move(label));
+    }
+
+    /// Replaces each printf conversion (%g %f %d %e...) with the next value.
+    static std::string format_label(const std::string& format, std::span<const float> values)
+    {
+        std::string out;
+        std::size_t next = 0;
+        for (std::size_t i = 0; i < format.size(); ++i) {
+            if (format[i] != '%' || i + 1 >= format.size()) {
+                out += format[i];
+                continue;
+            }
+            if (format[i + 1] == '%') {
+                out += '%';
+                ++i;
+                continue;
+            }
+            // only flags, width and precision may stand between '%' and the conversion
+            std::size_t end = format.find_first_not_of("-+ #0123456789.", i + 1);
+            if (end == std::string::npos || end - i > 12 ||
+                std::string_view("diouxXeEfFgG").find(format[end]) == std::string_view::npos) {
+                out += format[i];
+                continue;
+            }
+            std::string spec = format.substr(i, end - i + 1);
+            double value = next < values.size() ? static_cast<double>(values[next++]) : 0.0;
+            char buffer[128];
+            char conversion = format[end];
+            if (std::string_view("diouxX").find(conversion) != std::string_view::npos)
+                std::snprintf(buffer, sizeof buffer, (spec.substr(0, spec.size() - 1) + "lld").c_str(),
+                              static_cast<long long>(value));
+            else
+                std::snprintf(buffer, sizeof buffer, spec.c_str(), value);
+            out += buffer;
+            i = end;
+        }
+        return out;
+    }
+
+    /// `?P` `?H` `?L` `?U`: the first two or three parameters get the vector.
+    void answer_query(std::span<const float> p, const Vec3& v)
+    {
+        if (!m_answers || p.empty())
+            return;
+        m_answers->push_back({m_module_index, {static_cast<float>(v.x), static_cast<float>(v.y),
+                                               static_cast<float>(v.z)}});
     }
 
     /// Ends the current node: the last segment's top width is now fixed, and the
@@ -132,6 +629,18 @@ private:
             m_chain_open = false;  // the joint key cannot carry two widths
     }
 
+    /// `@;` and `@,`: the back colour, by the second colour increment or set.
+    void change_back_color(std::span<const float> p, int sign)
+    {
+        int color = p.empty() ? m_turtle.back_color + sign * m_view.back_color_increment
+                              : static_cast<int>(p[0]);
+        if (color > 255)
+            color -= 256;
+        if (color < 0)
+            color += 256;
+        m_turtle.back_color = color;
+    }
+
     /// `;` and `,`: by the increment (wrapping once around the 256 entries) or set.
     void change_color(std::span<const float> p, int sign)
     {
@@ -147,31 +656,81 @@ private:
 
     float radius() const { return static_cast<float>(0.5 * m_turtle.line_width); }
 
-    void move_forward(double distance)
+    /// f and g. The order is cpfg's: tropisms turn the heading, the node ends, the
+    /// turtle moves, the legacy tropism bends it, texture v advances, and f records a
+    /// polygon vertex.
+    void move_forward(double distance, bool polygon_vertex)
     {
+        apply_movements(m_turtle, m_movements);
         end_node();
         m_turtle.position += m_turtle.heading * distance;
+        after_move(distance, polygon_vertex);
         m_chain_open = false;
+    }
+
+    void after_move(double distance, bool polygon_vertex)
+    {
+        legacy_bend();
+        m_turtle.texture_v += texture_advance(distance);
+        if (polygon_vertex && !m_polygons.empty())
+            add_polygon_vertex();
+        if (polygon_vertex)
+            m_cylinders.moved(m_turtle);  // F and f are control points after {(type)
+    }
+
+    /// cpfg's bend(): the pre-3.0 tropism turns H toward U, then toward L, by the
+    /// angles whose sines are e T.U and e T.L (clamped to [-1, 1]).
+    void legacy_bend()
+    {
+        double e = m_turtle.legacy_elasticity;
+        if (e == 0)
+            return;
+        const Vec3& t = m_view.legacy_tropism_direction;
+        double s = std::clamp(e * dot(t, m_turtle.up), -1.0, 1.0);
+        m_turtle.pitch(std::asin(s) * 180.0 / std::numbers::pi);
+        s = std::clamp(e * dot(t, m_turtle.left), -1.0, 1.0);
+        m_turtle.turn(std::asin(s) * 180.0 / std::numbers::pi);
+    }
+
+    /// Texture v gained over a step (report 5.2, cpfg's update_segment_texture):
+    /// length / (pi width R) while a texture is selected. The image's width/height
+    /// factor is left to the renderer (it knows the image).
+    double texture_advance(double distance) const
+    {
+        if (m_turtle.texture < 0 || m_turtle.line_width == 0)
+            return 0;
+        double ratio = static_cast<std::size_t>(m_turtle.texture) < m_view.texture_aspect_ratios.size()
+                           ? m_view.texture_aspect_ratios[static_cast<std::size_t>(m_turtle.texture)]
+                           : 1.0;
+        return distance / (std::numbers::pi * m_turtle.line_width) / ratio;
     }
 
     /// Draws one cylinder segment, continuing the current polyline when the turtle
     /// has drawn without interruption, so Embree closes the joint.
-    void draw_forward(double distance)
+    void draw_forward(double distance, bool polygon_vertex)
     {
+        apply_movements(m_turtle, m_movements);
         end_node();
         Vec3 start = m_turtle.position;
+        double start_v = m_turtle.texture_v;
         m_turtle.position += m_turtle.heading * distance;
+        after_move(distance, polygon_vertex);
         LinearCurves& lines = m_scene.geometry.lines;
         bool joined = m_chain_open;
-        if (!joined)
+        if (!joined) {
             lines.keys.push_back(key(start, radius()));
+            lines.v.push_back(static_cast<float>(start_v));
+        }
         auto first = static_cast<std::uint32_t>(lines.keys.size() - 1);
         lines.keys.push_back(key(m_turtle.position, radius()));
+        lines.v.push_back(static_cast<float>(m_turtle.texture_v));
         if (joined)
             lines.flags.back() |= LinearCurves::neighbour_right;
         lines.segments.push_back(first);
         lines.flags.push_back(joined ? LinearCurves::neighbour_left : 0);
-        lines.material.push_back(static_cast<std::uint16_t>(std::clamp(m_turtle.color, 0, 255)));
+        lines.material.push_back(material(m_turtle.color));
+        lines.texture.push_back(static_cast<std::int16_t>(m_turtle.texture));
+        m_turtle.remember_frame();  // F and G: the reference for twist-free adjustments
         m_chain_open = true;
         m_taper_open = true;
     }
@@ -181,10 +740,33 @@ private:
         return {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z), radius};
     }
 
+    static constexpr std::size_t max_open_polygons = 100'000;
+    static constexpr std::size_t max_polygon_vertices = 10'000'000;
+    static constexpr std::size_t max_sub_lsystem_depth = 100'000;
+
     const ViewFile& m_view;
+    InterpretOptions m_options;
     Scene m_scene;
     Turtle m_turtle;
+    CylinderBuilder m_cylinders;  ///< generalized cylinders, into m_scene
     std::vector<Turtle> m_stack;
+    std::span<const Movement> m_movements;
+    std::vector<std::vector<PolygonCorner>> m_polygons;  ///< cpfg's polygon stack
+    std::vector<double> m_sub_scales;                    ///< cpfg's sub-L-system scale stack
+    std::vector<QueryAnswer>* m_answers = nullptr;
+    std::vector<SurfaceDef> m_surfaces;                  ///< their prototypes moved out
+    struct SurfacePrototypes {
+        std::uint32_t per_patch;  ///< uvs per patch (cpfg's default)
+        int per_surface;          ///< uvs over the surface, for `S:` textures; -1: not made
+    };
+    std::vector<SurfacePrototypes> m_surface_prototypes;  ///< per surface
+    LsystemPatches m_patches;
+    std::size_t m_module_index = 0;
+    bool m_warned_system = false, m_warned_include = false, m_warned_grid = false;
+    bool m_warned_scale = false, m_warned_unmatched_polygon = false, m_warned_movement = false;
+    bool m_warned_unmatched_sub = false, m_warned_label = false;
+    bool m_warned_patch = false;
+    std::string m_warned_surface_letters;  ///< undefined `~x` letters already reported
     bool m_chain_open = false;  ///< the last key is at the turtle and may be shared
     bool m_taper_open = false;  ///< the last segment's top width may still change
     bool m_warned_unbalanced = false;
@@ -206,9 +788,26 @@ std::vector<Light> effective_lights(const ViewFile& view)
 Scene interpret(const lsys::ModuleString& string, const lsys::SymbolTable& symbols,
                 const ViewFile& view)
 {
-    Interpreter interpreter(view);
+    return interpret(string, symbols, view, InterpretOptions{});
+}
+
+Scene interpret(const lsys::ModuleString& string, const lsys::SymbolTable& symbols,
+                const ViewFile& view, const InterpretOptions& options)
+{
+    Interpreter interpreter(view, options);
     interpreter.run(string, symbols);
     return interpreter.take();
+}
+
+std::vector<QueryAnswer> collect_query_answers(const lsys::ModuleString& string,
+                                               const lsys::SymbolTable& symbols,
+                                               const ViewFile& view)
+{
+    std::vector<QueryAnswer> answers;
+    Interpreter interpreter(view, InterpretOptions{});
+    interpreter.collect_queries(&answers);
+    interpreter.run(string, symbols);
+    return answers;
 }
 
 }  // namespace cambium::geom

@@ -2,6 +2,9 @@
 // Interprets an L-system string with the turtle and builds the renderer-independent Scene.
 #pragma once
 
+#include <span>
+#include <string>
+
 #include "geom/scene.h"
 #include "geom/view_file.h"
 #include "lsys/module_string.h"
@@ -13,6 +16,16 @@ namespace cambium::geom {
 /// come from the command line's colormap or material files).
 Scene interpret(const lsys::ModuleString& string, const lsys::SymbolTable& symbols,
                 const ViewFile& view);
+
+/// What interpretation needs beyond the string, the symbols and the view file.
+struct InterpretOptions {
+    /// The L-system's string constants (lsys::Program::strings): `@L("text")` holds
+    /// the index of its text there as its first parameter. Empty: labels get no text.
+    std::span<const std::string> strings;
+};
+
+Scene interpret(const lsys::ModuleString& string, const lsys::SymbolTable& symbols,
+                const ViewFile& view, const InterpretOptions& options);
 
 /// The lights render should use: the view file's `light:` commands, or cpfg's
 /// default light when there are none.

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -22,8 +23,7 @@ constexpr std::array deferred_commands = {
     "antialiasing", "min zoom", "max zoom", "polygonization level", "contour",
     "contour sides", "surface", "line", "tsurface", "twist of cylinders",
     "background scene", "ambient light", "diffuse reflection", "surface ambient",
-    "surface diffuse", "background color", "texture", "tropism direction",
-    "initial elasticity", "elasticity increment", "tropism", "torque", "function",
+    "surface diffuse", "background color", "function",
     "function set", "concave polygons", "shadow map", "curve", "corner"};
 
 bool parse_flag(ValueReader& in)
@@ -129,6 +129,147 @@ Light parse_light(ValueReader& in)
     return light;
 }
 
+/// `tropism: T: x y z [A: angle] [I: intensity] [E: elasticity] [S: step]`, and
+/// `torque:` with the same subcommands (A: ignored). The direction is normalised and
+/// scaled by clamp(I / |T|, -1, 1), as cpfg's read_movement does.
+Movement parse_movement(ValueReader& in, Movement::Kind kind)
+{
+    Movement m;
+    m.kind = kind;
+    bool has_direction = false;
+    double intensity = 1;
+    while (!in.at_end()) {
+        FileLoc where = in.loc();
+        char sub = in.subcommand("a tropism subcommand (T: A: I: E: S:)");
+        switch (sub) {
+        case 'T':
+            m.direction = parse_vec3(in);
+            has_direction = true;
+            if (dot(m.direction, m.direction) == 0)
+                throw Error(where, "the tropism vector must not be zero");
+            break;
+        case 'A': m.angle_deg = in.number(); break;
+        case 'I':
+            intensity = in.number();
+            if (intensity == 0)
+                throw Error(where, "the tropism intensity must not be zero");
+            break;
+        case 'E': m.initial_elasticity = in.number(); break;
+        case 'S': m.elasticity_step = in.number(); break;
+        default: throw Error(where, std::string("unknown tropism subcommand '") + sub + ":'");
+        }
+    }
+    if (!has_direction)
+        throw in.error("a tropism needs its vector 'T: x y z'");
+    double scale = std::clamp(intensity / length(m.direction), -1.0, 1.0);
+    m.direction = m.direction * scale;
+    if (kind == Movement::Kind::torque)
+        m.angle_deg = 0;
+    return m;
+}
+
+/// The whitespace-separated words of a command's text, case kept (file names).
+std::vector<std::pair<std::string, int>> raw_words(std::string_view text, std::size_t start)
+{
+    std::vector<std::pair<std::string, int>> words;
+    std::size_t i = start;
+    while (i < text.size()) {
+        while (i < text.size() && (text[i] == ' ' || text[i] == '\t' || text[i] == '\r'))
+            ++i;
+        std::size_t begin = i;
+        while (i < text.size() && text[i] != ' ' && text[i] != '\t' && text[i] != '\r')
+            ++i;
+        if (i > begin)
+            words.emplace_back(std::string(text.substr(begin, i - begin)), static_cast<int>(begin) + 1);
+    }
+    return words;
+}
+
+/// `texture: F: file [H: l|n] [L: l|n|m...] [E: m|d|b] [S:] [R: ratio]` (5.2.6).
+void parse_texture(ViewFile& v, std::string_view line, std::size_t start, const FileLoc& line_loc)
+{
+    TextureDef t;
+    t.linear_filter = false;  // cpfg's defaults: nearest, no mipmaps
+    t.mipmap = false;
+    double ratio = 1;
+    bool has_file = false;
+    bool per_surface = false;
+    auto words = raw_words(line, start);
+    auto loc_of = [&](std::size_t k) {
+        return FileLoc{line_loc.file, line_loc.line, k < words.size() ? words[k].second : 0};
+    };
+    for (std::size_t k = 0; k < words.size(); ++k) {
+        std::string word = words[k].first;
+        if (word.empty() || !std::isalpha(static_cast<unsigned char>(word[0])))
+            throw Error(loc_of(k), "expected a texture subcommand (F: H: L: E: S: R:), found '" + word + "'");
+        char sub = static_cast<char>(std::toupper(static_cast<unsigned char>(word[0])));
+        std::string value = word.size() > 2 ? word.substr(2) : "";  // "F:name" glued
+        if (word.size() > 1 && word[1] != ':')
+            throw Error(loc_of(k), "expected a texture subcommand (F: H: L: E: S: R:), found '" + word + "'");
+        if (sub == 'S') {
+            per_surface = true;  // takes no value
+            continue;
+        }
+        if (value.empty()) {
+            if (++k >= words.size())
+                throw Error(loc_of(k - 1), std::string("texture subcommand '") + sub + ":' needs a value");
+            value = words[k].first;
+        }
+        char first = static_cast<char>(std::tolower(static_cast<unsigned char>(value[0])));
+        switch (sub) {
+        case 'F':
+            t.file = value;
+            has_file = true;
+            break;
+        case 'H': t.linear_filter = first == 'l'; break;
+        case 'L': t.mipmap = first == 'm'; break;
+        case 'E': t.decal = first == 'd'; break;
+        case 'R': {
+            char* end = nullptr;
+            ratio = std::strtod(value.c_str(), &end);
+            if (end == value.c_str() || *end != '\0' || ratio <= 0)
+                throw Error(loc_of(k), "texture ratio must be a positive number, found '" + value + "'");
+            break;
+        }
+        default: throw Error(loc_of(k), std::string("unknown texture subcommand '") + sub + ":'");
+        }
+    }
+    if (!has_file)
+        throw Error(FileLoc{line_loc.file, line_loc.line, static_cast<int>(start) + 1},
+                    "a texture needs its image 'F: file'");
+    v.textures.push_back(t);
+    v.texture_aspect_ratios.push_back(ratio);
+    v.texture_per_surface.push_back(per_surface);
+}
+
+/// `translucency: FIRST [LAST] AMOUNT` (Cambium extension).
+TranslucencySetting parse_translucency(ValueReader& in)
+{
+    TranslucencySetting t;
+    t.loc = in.loc();
+    std::vector<std::pair<double, FileLoc>> values;
+    while (!in.at_end() && values.size() < 4) {
+        FileLoc where = in.loc();
+        values.emplace_back(in.number(), where);
+    }
+    if (values.size() < 2 || values.size() > 3)
+        throw Error(t.loc, "expected 'translucency: FIRST [LAST] AMOUNT'");
+    auto index = [](const std::pair<double, FileLoc>& v) {
+        if (v.first != std::floor(v.first) || v.first < 0 || v.first > 255)
+            throw Error(v.second, "colour index must be an integer in 0..255");
+        return static_cast<int>(v.first);
+    };
+    t.first = index(values[0]);
+    t.last = values.size() == 3 ? index(values[1]) : t.first;
+    if (t.last < t.first)
+        throw Error(values[1].second, "LAST must not be below FIRST");
+    const auto& amount = values.back();
+    if (!(amount.first >= 0 && amount.first <= 1))
+        throw Error(amount.second, "translucency must be in 0..1");
+    t.amount = static_cast<float>(amount.first);
+    return t;
+}
+
 /// Applies one `name: value` command to the view file.
 void apply_command(ViewFile& v, const std::string& name, ValueReader& in)
 {
@@ -182,11 +323,52 @@ void apply_command(ViewFile& v, const std::string& name, ValueReader& in)
         v.lights.push_back(parse_light(in));
     } else if (name == "light direction") {
         v.light_direction = parse_vec3(in);
+    } else if (name == "tropism") {
+        v.movements.push_back(parse_movement(in, Movement::Kind::tropism));
+    } else if (name == "torque") {
+        v.movements.push_back(parse_movement(in, Movement::Kind::torque));
+    } else if (name == "tropism direction") {
+        Vec3 d = parse_vec3(in);
+        if (dot(d, d) == 0)
+            throw in.error("the tropism direction must not be zero");
+        v.legacy_tropism_direction = normalize(d);
+    } else if (name == "initial elasticity") {
+        v.legacy_elasticity = in.number();
+    } else if (name == "elasticity increment") {
+        v.legacy_elasticity_increment = in.number();
+    } else if (name == "translucency") {
+        v.translucency.push_back(parse_translucency(in));
     } else {
         return;  // handled by the caller
     }
     if (!in.at_end())
         warn(in.loc(), "extra text after '" + name + ":' ignored");
+}
+
+/// Commands whose value starts with one number. cpfg reads them with sscanf and keeps
+/// the default, with a message, when the value is no number at all ("angle increment: ?").
+bool keeps_default_without_number(const std::string& name)
+{
+    static const std::array lenient = {
+        "angle factor", "angle increment", "initial color", "color increment",
+        "initial line width", "line width increment", "initial scale", "scale multiplier",
+        "twist", "viewing angle", "front distance", "back distance", "scale factor",
+        "initial elasticity", "elasticity increment"};
+    return std::find(lenient.begin(), lenient.end(), name) != lenient.end();
+}
+
+/// Whether the text from `start` begins (after blanks) with something strtod reads.
+/// An empty value is not covered: it stays an error.
+bool starts_without_number(std::string_view line, std::size_t start, int& column)
+{
+    std::size_t first = line.find_first_not_of(" \t\r", start);
+    if (first == std::string_view::npos)
+        return false;
+    column = static_cast<int>(first) + 1;
+    std::string token(line.substr(first, std::min<std::size_t>(64, line.size() - first)));
+    char* stop = nullptr;
+    std::strtod(token.c_str(), &stop);
+    return stop == token.c_str();
 }
 
 bool is_applied(const std::string& name)
@@ -196,7 +378,8 @@ bool is_applied(const std::string& name)
         "initial line width", "line width increment", "initial scale", "scale multiplier",
         "line style", "tapered lines", "tappered lines", "viewpoint", "view reference point",
         "twist", "projection", "viewing angle", "front distance", "back distance",
-        "scale factor", "box", "light", "light direction"};
+        "scale factor", "box", "light", "light direction", "tropism", "torque",
+        "tropism direction", "initial elasticity", "elasticity increment", "translucency"};
     return std::find(applied.begin(), applied.end(), name) != applied.end();
 }
 
@@ -219,7 +402,15 @@ ViewFile parse_view_file(std::string_view text, const std::string& file_name)
         }
         std::string name = normalize_command_name(body.substr(0, colon));
         ValueReader in(body, colon + 1, FileLoc{file_name, line.number, 0});
-        if (is_applied(name)) {
+        if (name == "texture") {
+            parse_texture(v, body, colon + 1, FileLoc{file_name, line.number, 0});
+        } else if (is_applied(name)) {
+            int column = 0;
+            if (keeps_default_without_number(name) && starts_without_number(body, colon + 1, column)) {
+                warn(FileLoc{file_name, line.number, column},
+                     "'" + name + ":' needs a number; the default is kept");
+                continue;
+            }
             apply_command(v, name, in);
         } else if (std::find(deferred_commands.begin(), deferred_commands.end(), name) !=
                    deferred_commands.end()) {
@@ -235,6 +426,12 @@ ViewFile read_view_file(const std::filesystem::path& file)
 {
     ViewFile v = parse_view_file(read_text_file(file, "view file"), file.string());
     v.path = file;
+    // Texture images are relative to the view file's folder; made absolute so that the
+    // renderer finds them from any working directory.
+    std::filesystem::path folder = std::filesystem::absolute(file).parent_path();
+    for (TextureDef& t : v.textures)
+        if (!t.file.empty() && t.file.is_relative())
+            t.file = (folder / t.file).lexically_normal();
     return v;
 }
 

@@ -9,6 +9,7 @@
 
 #include "base/diagnostics.h"
 #include "geom/scene.h"
+#include "geom/tropism.h"
 
 namespace cambium::geom {
 
@@ -20,6 +21,15 @@ enum class LineStyle { pixel, polygon, cylinder };
 struct ViewCommand {
     std::string name;   ///< lower-case, without the colon: "contour", "tropism"...
     std::string value;  ///< the text after the colon, comments removed
+    FileLoc loc;
+};
+
+/// Cambium extension `translucency: FIRST [LAST] AMOUNT`: colour indices FIRST..LAST
+/// (inclusive, 0..255) get Material::translucency = AMOUNT (0..1).
+struct TranslucencySetting {
+    int first = 0;
+    int last = 0;
+    float amount = 0;
     FileLoc loc;
 };
 
@@ -39,6 +49,25 @@ struct ViewFile {
     double initial_scale = 1;
     double scale_multiplier = 1;
     bool tapered_lines = true;
+
+    // Tropisms (5.2.7): `tropism:` and `torque:` in order (@Ts/@Ti/@Td index them from 1)
+    std::vector<Movement> movements;
+    // The pre-3.0 tropism (`tropism direction:`, `initial elasticity:`), bent after
+    // every move as cpfg's bend() does: normalised direction and elasticity.
+    Vec3 legacy_tropism_direction{0, 1, 0};
+    double legacy_elasticity = 0;
+    double legacy_elasticity_increment = 0;
+
+    // Textures (5.2.6): `texture:` in order; @Tx(i) selects textures[i-1].
+    std::vector<TextureDef> textures;
+    /// Per texture, `R:` (default 1): v along cylinders advances length / (pi width R).
+    std::vector<double> texture_aspect_ratios;
+    /// Per texture, `S:`: predefined surfaces map it once over the whole surface (its
+    /// x, y extent) instead of once per patch (cpfg's default).
+    std::vector<bool> texture_per_surface;
+
+    /// Cambium's `translucency:` commands, in order (the caller applies them).
+    std::vector<TranslucencySetting> translucency;
 
     // View (5.2.2) and lights (5.2.5, 5.2.6)
     View view;

@@ -101,3 +101,91 @@ TEST(ViewFile, DeferredCommandsAreKept)
     EXPECT_EQ(v.deferred[0].name, "contour");
     EXPECT_EQ(v.deferred[0].loc.line, 1);
 }
+
+TEST(ViewFile, TropismsAndTorquesInOrder)
+{
+    ViewFile v = parse_view_file("tropism: T: 0 4 0 I: 0.5 A: 30 E: 0.2 S: 0.05\n"
+                                 "torque: T: 3,0,4 E: 1 A: 60\n"
+                                 "tropism: T 0 -2 0 I: 9\n",
+                                 "t.v");
+    ASSERT_EQ(v.movements.size(), 3u);
+    const Movement& a = v.movements[0];
+    EXPECT_EQ(a.kind, Movement::Kind::tropism);
+    EXPECT_NEAR(a.direction.y, 0.5, 1e-12);  // unit vector times the intensity
+    EXPECT_DOUBLE_EQ(a.angle_deg, 30);
+    EXPECT_DOUBLE_EQ(a.initial_elasticity, 0.2);
+    EXPECT_DOUBLE_EQ(a.elasticity_step, 0.05);
+    const Movement& b = v.movements[1];
+    EXPECT_EQ(b.kind, Movement::Kind::torque);
+    EXPECT_NEAR(b.direction.x, 0.6, 1e-12);
+    EXPECT_NEAR(b.direction.z, 0.8, 1e-12);
+    EXPECT_DOUBLE_EQ(b.angle_deg, 0);  // A: is ignored for torques
+    // cpfg clamps I/|T| (not I) to [-1, 1]: T = (0,-2,0) with I = 9 keeps its length 2
+    EXPECT_NEAR(v.movements[2].direction.y, -2, 1e-12);
+}
+
+TEST(ViewFile, TropismErrorsNameTheColumn)
+{
+    try {
+        parse_view_file("tropism: E: 1\n", "t.v");
+        FAIL() << "no error";
+    } catch (const cambium::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("t.v:1:"), std::string::npos) << e.what();
+    }
+    try {
+        parse_view_file("tropism: T: 0 0 0\n", "t.v");
+        FAIL() << "no error";
+    } catch (const cambium::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("t.v:1:10"), std::string::npos) << e.what();
+    }
+}
+
+TEST(ViewFile, LegacyTropism)
+{
+    ViewFile v = parse_view_file("tropism direction: 0.0,2.0,0.0\ninitial elasticity: 0.02\n"
+                                 "elasticity increment: -0.02\n",
+                                 "t.v");
+    EXPECT_NEAR(v.legacy_tropism_direction.y, 1, 1e-12);
+    EXPECT_DOUBLE_EQ(v.legacy_elasticity, 0.02);
+    EXPECT_DOUBLE_EQ(v.legacy_elasticity_increment, -0.02);
+}
+
+TEST(ViewFile, TexturesKeepTheFileNameCase)
+{
+    ViewFile v = parse_view_file("texture: F: Bark.RGB H: linear L: mll E: decal R: 2.5\n"
+                                 "texture: F:leaf.tga\n",
+                                 "t.v");
+    ASSERT_EQ(v.textures.size(), 2u);
+    EXPECT_EQ(v.textures[0].file, "Bark.RGB");
+    EXPECT_TRUE(v.textures[0].linear_filter);
+    EXPECT_TRUE(v.textures[0].mipmap);
+    EXPECT_TRUE(v.textures[0].decal);
+    EXPECT_DOUBLE_EQ(v.texture_aspect_ratios[0], 2.5);
+    EXPECT_EQ(v.textures[1].file, "leaf.tga");
+    EXPECT_FALSE(v.textures[1].linear_filter);  // cpfg's default: nearest
+    EXPECT_FALSE(v.textures[1].decal);
+    EXPECT_DOUBLE_EQ(v.texture_aspect_ratios[1], 1);
+    EXPECT_THROW(parse_view_file("texture: H: l\n", "t.v"), cambium::Error);
+}
+
+TEST(ViewFile, TranslucencyRanges)
+{
+    ViewFile v = parse_view_file("translucency: 5 0.3\ntranslucency: 10 20 0.5\n", "t.v");
+    ASSERT_EQ(v.translucency.size(), 2u);
+    EXPECT_EQ(v.translucency[0].first, 5);
+    EXPECT_EQ(v.translucency[0].last, 5);
+    EXPECT_FLOAT_EQ(v.translucency[0].amount, 0.3f);
+    EXPECT_EQ(v.translucency[1].first, 10);
+    EXPECT_EQ(v.translucency[1].last, 20);
+    EXPECT_EQ(v.translucency[1].loc.line, 2);
+    try {
+        parse_view_file("\ntranslucency: 1 2 1.5\n", "t.v");
+        FAIL() << "no error";
+    } catch (const cambium::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("t.v:2:19"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(parse_view_file("translucency: 256 0.5\n", "t.v"), cambium::Error);
+    EXPECT_THROW(parse_view_file("translucency: 7 3 0.5\n", "t.v"), cambium::Error);
+    EXPECT_THROW(parse_view_file("translucency: 0.5\n", "t.v"), cambium::Error);
+    EXPECT_THROW(parse_view_file("translucency: 1.5 0.5\n", "t.v"), cambium::Error);
+}

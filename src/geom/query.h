@@ -1,0 +1,33 @@
+// SPDX-License-Identifier: Apache-2.0
+// Query modules ?P ?H ?L ?U (manual 5.1.9): the turtle's state written back into the string.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <vector>
+
+#include "geom/view_file.h"
+#include "lsys/module_string.h"
+
+namespace cambium::geom {
+
+/// Interprets `string` with the same turtle as `interpret` and sets the parameters of
+/// every `?P` `?H` `?L` `?U` module to the turtle's position, heading, left or up
+/// vector there (the first two or three, as many as the module has), as cpfg's
+/// interpretation step after each derivation step does. Other modules are unchanged.
+void answer_queries(lsys::ModuleString& string, const lsys::SymbolTable& symbols,
+                    const ViewFile& view);
+
+/// One query's answer: the module's index in the string and the vector's x, y, z.
+struct QueryAnswer {
+    std::size_t module;
+    std::array<float, 3> values;
+};
+
+/// The answers of every query module, in string order (defined in interpreter.cpp,
+/// which owns the turtle walk).
+std::vector<QueryAnswer> collect_query_answers(const lsys::ModuleString& string,
+                                               const lsys::SymbolTable& symbols,
+                                               const ViewFile& view);
+
+}  // namespace cambium::geom

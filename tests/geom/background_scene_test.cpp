@@ -1,0 +1,195 @@
+// SPDX-License-Identifier: Apache-2.0
+// Tests of the background scene reader: the manual's example, transformations and primitives.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdlib>
+
+#include "geom/background_scene.h"
+
+using namespace cambium;
+using namespace cambium::geom;
+
+namespace {
+
+Vec3 v3(const Float3& f) { return {f[0], f[1], f[2]}; }
+
+void expect_near(const Vec3& a, const Vec3& b, double eps)
+{
+    EXPECT_NEAR(a.x, b.x, eps);
+    EXPECT_NEAR(a.y, b.y, eps);
+    EXPECT_NEAR(a.z, b.z, eps);
+}
+
+BackgroundScene build(const std::string& text, const Material& initial = Material{})
+{
+    return build_background_scene(parse_background_text(text, "bg.dat"), initial);
+}
+
+// The example of CPFG manual 5.4.10.
+const char* manual_example = R"(
+material 0.1 0.1 0.1 1 /* subsequent surfaces are grey */
+          0.16 0.21 0.27 1 /* with no specular reflections */
+          0 0 0 1 /* and no emissive color */
+          0 0 0 1
+          0
+
+pushmatrix
+translate 3 -20 -3
+scale 1 0.7 0.7
+sphere 15 /* ellipsoid */
+popmatrix
+
+pushmatrix
+translate -14 -55.0 8
+cone 15 2 14 /* cone */
+popmatrix
+
+translate -10 -65 0
+box 30 5 30 /* box */
+)";
+
+}  // namespace
+
+TEST(BackgroundScene, ManualExample)
+{
+    BackgroundScene s = build(manual_example);
+    ASSERT_EQ(s.materials.size(), 1u);
+    EXPECT_EQ(s.materials[0].diffuse, (Rgb{0.16f, 0.21f, 0.27f}));
+    EXPECT_EQ(s.materials[0].ambient, (Rgb{0.1f, 0.1f, 0.1f}));
+    EXPECT_FLOAT_EQ(s.materials[0].transparency, 0);
+
+    // cpfg draws the sphere at the transformed origin, unscaled.
+    ASSERT_EQ(s.geometry.spheres.size(), 1u);
+    EXPECT_EQ(s.geometry.spheres.centres[0], (Float4{3, -20, -3, 15}));
+
+    // The cone: a segment from (-14,-55,8) radius 15 to (-14,-41,8) radius 2, two discs.
+    ASSERT_EQ(s.geometry.lines.segment_count(), 1u);
+    EXPECT_EQ(s.geometry.lines.keys[0], (Float4{-14, -55, 8, 15}));
+    EXPECT_EQ(s.geometry.lines.keys[1], (Float4{-14, -41, 8, 2}));
+    ASSERT_EQ(s.geometry.discs.size(), 2u);
+    expect_near(v3(s.geometry.discs.normals[0]), {0, -1, 0}, 1e-6);
+    expect_near(v3(s.geometry.discs.normals[1]), {0, 1, 0}, 1e-6);
+
+    // The box: 6 faces, 12 triangles over [-10,20] x [-65,-60] x [0,30].
+    const TriangleMesh& m = s.geometry.mesh;
+    ASSERT_EQ(m.size(), 12u);
+    Vec3 lo{1e9, 1e9, 1e9}, hi{-1e9, -1e9, -1e9};
+    for (const Float3& p : m.positions) {
+        lo = {std::min(lo.x, double(p[0])), std::min(lo.y, double(p[1])), std::min(lo.z, double(p[2]))};
+        hi = {std::max(hi.x, double(p[0])), std::max(hi.y, double(p[1])), std::max(hi.z, double(p[2]))};
+    }
+    expect_near(lo, {-10, -65, 0}, 1e-5);
+    expect_near(hi, {20, -60, 30}, 1e-5);
+    EXPECT_TRUE(std::all_of(m.material.begin(), m.material.end(), [](auto k) { return k == 0; }));
+}
+
+TEST(BackgroundScene, RotationFollowsOpenGL)
+{
+    // Rotating 90 degrees about z takes +x to +y; the square's normal stays +z.
+    BackgroundScene s = build("rotate 90 0 0 1\npolygon 0 0 0  1 0 0  1 1 0  0 1 0\n");
+    const TriangleMesh& m = s.geometry.mesh;
+    ASSERT_EQ(m.size(), 2u);
+    expect_near(v3(m.positions[1]), {0, 1, 0}, 1e-6);
+    expect_near(v3(m.positions[2]), {-1, 1, 0}, 1e-6);
+    for (const Float3& n : m.normals)
+        expect_near(v3(n), {0, 0, 1}, 1e-6);
+}
+
+TEST(BackgroundScene, MatrixOrderIsRightMultiplied)
+{
+    // translate then scale: p' = T (S p); (1,0,0) -> (2,0,0) + (5,0,0).
+    BackgroundScene s = build("translate 5 0 0 scale 2 2 2 polygon 1 0 0 1 1 0 0 1 0\n");
+    expect_near(v3(s.geometry.mesh.positions[0]), {7, 0, 0}, 1e-6);
+    // loadmatrix is column-major; loadidentity resets.
+    s = build("loadmatrix 1 0 0 0  0 1 0 0  0 0 1 0  4 5 6 1\nsphere 1\nloadidentity\nsphere 2\n");
+    EXPECT_EQ(s.geometry.spheres.centres[0], (Float4{4, 5, 6, 1}));
+    EXPECT_EQ(s.geometry.spheres.centres[1], (Float4{0, 0, 0, 2}));
+}
+
+TEST(BackgroundScene, MeshRectanglesAndInitialMaterial)
+{
+    Material initial;
+    initial.diffuse = {1, 0, 0};
+    BackgroundScene s = build("mesh 0 0 0  0 1 0  1 0 0  1 1 0  2 0 0  2 1 0\n", initial);
+    EXPECT_EQ(s.geometry.mesh.size(), 4u);
+    ASSERT_EQ(s.materials.size(), 1u);
+    EXPECT_EQ(s.materials[0].diffuse, initial.diffuse);
+    // Partial material: only ambient and diffuse change; the diffuse alpha sets transparency.
+    s = build("material 0 0 1 1  0 1 0 0.25\nrectangle 2 3\n", initial);
+    ASSERT_EQ(s.materials.size(), 1u);
+    EXPECT_EQ(s.materials[0].diffuse, (Rgb{0, 1, 0}));
+    EXPECT_FLOAT_EQ(s.materials[0].transparency, 0.75f);
+    EXPECT_EQ(s.geometry.mesh.material[0], 0);
+    expect_near(v3(s.geometry.mesh.positions[2]), {2, 3, 0}, 1e-6);
+}
+
+TEST(BackgroundScene, RectangleEmissionFactorAppliesToItOnly)
+{
+    Material initial;
+    initial.emission = {0.5f, 0.5f, 0.5f};
+    BackgroundScene s = build("rectangle 1 1 0 0 2\nrectangle 1 1\n", initial);
+    ASSERT_EQ(s.geometry.mesh.size(), 4u);
+    const auto& mat = s.geometry.mesh.material;
+    EXPECT_EQ(s.materials[mat[0]].emission, (Rgb{1, 1, 1}));
+    EXPECT_EQ(s.materials[mat[2]].emission, (Rgb{0.5f, 0.5f, 0.5f}));
+}
+
+TEST(BackgroundScene, BadStatementsWarnAndAreSkipped)
+{
+    set_warnings_enabled(false);
+    BackgroundScene s = build("# 1 \"file\"\nteapot 3 4\npopmatrix\npolygon 0 0 0 1 1 1\nsphere 1\n");
+    set_warnings_enabled(true);
+    EXPECT_EQ(s.geometry.mesh.size(), 0u);
+    EXPECT_EQ(s.geometry.spheres.size(), 1u);
+}
+
+TEST(BackgroundScene, TruncatedTextNeverCrashes)
+{
+    set_warnings_enabled(false);
+    std::string text = manual_example;
+    for (std::size_t n = 0; n <= text.size(); n += 2) {
+        try {
+            build(text.substr(0, n));
+        } catch (const Error&) {
+        }
+    }
+    set_warnings_enabled(true);
+}
+
+TEST(BackgroundScene, AppendAndOffset)
+{
+    BackgroundScene a = build("cylinder 1 2\nbox 1 1 1\n");
+    BackgroundScene b = build("material 1 1 1 1\ncylinder 1 3\nsphere 1\n");
+    offset_materials(b.geometry, 5);
+    append_geometry(a.geometry, b.geometry);
+    EXPECT_EQ(a.geometry.lines.segment_count(), 2u);
+    EXPECT_EQ(a.geometry.lines.segments[1], 2u);  // shifted past a's two keys
+    EXPECT_EQ(a.geometry.lines.material[1], 5);
+    EXPECT_EQ(a.geometry.lines.v.size(), a.geometry.lines.keys.size());
+    EXPECT_EQ(a.geometry.spheres.material[0], 5);
+    EXPECT_EQ(a.geometry.discs.size(), 4u);
+}
+
+TEST(BackgroundSceneConformance, CorpusBackgroundsRead)
+{
+    const char* env = std::getenv("CAMBIUM_CORPUS");
+    std::filesystem::path root = std::filesystem::path(env ? env : CAMBIUM_CORPUS_DEFAULT) / "cpfg";
+    std::filesystem::path plant = root / "10-manuals/11-CPFG/BackgroundScene";
+    if (!std::filesystem::exists(plant / "background.dat"))
+        GTEST_SKIP() << "corpus not found";
+    // background.dat uses `#define TR1 0.5` for the material's alphas: cpp must run.
+    BackgroundScene s = read_background_scene("background.dat", plant, Material{}, FileLoc{"plant.v", 14, 1});
+    ASSERT_FALSE(s.materials.empty());
+    EXPECT_FLOAT_EQ(s.materials[0].transparency, 0.5f);
+    EXPECT_EQ(s.materials[0].diffuse, (Rgb{0.5f, 0.2f, 0.2f}));
+    // The first sphere: translate 2 2 0, then rotate and scale leave the origin there.
+    ASSERT_GE(s.geometry.spheres.size(), 1u);
+    EXPECT_EQ(s.geometry.spheres.centres[0], (Float4{2, 2, 0, 0.5f}));
+    EXPECT_GE(s.geometry.lines.segment_count(), 2u);
+    EXPECT_GE(s.geometry.mesh.size(), 2u);
+
+    std::filesystem::path knot = root / "10-manuals/20-EnviroPgms/CPFG-CelticKnot/background.dat";
+    BackgroundScene k = read_background_scene(knot.string(), "/", Material{}, FileLoc{"viewfile.v", 1, 1});
+    EXPECT_GT(k.geometry.lines.segment_count(), 0u);
+}
