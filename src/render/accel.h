@@ -12,46 +12,72 @@
 
 namespace cambium::render {
 
-/// A primitive: Embree geometry id and primitive id.
+class TextureSet;
+
+/// A primitive: instance (none for the scene's own geometry), Embree geometry id in its
+/// scene, primitive id.
 struct PrimId {
     static constexpr std::uint32_t none = 0xffffffffu;
     std::uint32_t geom = none;
     std::uint32_t prim = none;
+    std::uint32_t inst = none;
 };
 
-/// A ray's first hit, ready for shading.
+/// The kind of primitive hit: closed ones (curves, spheres) enclose a volume, flat ones
+/// (discs, triangles) have two sides with their own materials.
+enum class Shape : std::uint8_t { line, curve, sphere, disc, triangle };
+
+/// A ray's first hit, ready for shading. Everything is in world space.
 struct SurfaceHit {
     float t = 0;
     Vec3f position;
     Vec3f normal;              ///< unit shading normal, facing the incoming ray
+    Vec3f geometric_normal;    ///< unit true surface normal, facing the incoming ray
     std::uint32_t geom_id = 0;
     std::uint32_t prim_id = 0;
-    std::uint16_t material = 0;  ///< index into Scene::materials
-    float radius = 0;          ///< curve radius at the hit (world units)
-    /// Distance to move a spawned ray's origin along `normal`: Embree's round curves have
-    /// no self-intersection protection (FACTS.md), so this scales with the radius.
+    std::uint32_t inst_id = PrimId::none;  ///< the Instance's index + its geometry id
+    std::uint16_t material = 0;  ///< index into Scene::materials (side and instance resolved)
+    std::int16_t texture = geom::no_texture;  ///< index into Scene::textures
+    float u = 0, v = 0;        ///< texture coordinates (OpenGL's s, t)
+    Shape shape = Shape::line;
+    bool back = false;         ///< the ray hit the back side of a disc or triangle
+    bool inside = false;       ///< the ray hit a closed primitive from within
+    float radius = 0;          ///< curve or sphere radius at the hit (world units)
+    /// Distance to move a spawned ray's origin along `geometric_normal`: Embree's round
+    /// curves have no self-intersection protection (FACTS.md), so this scales with the radius.
     float spawn_offset = 0;
     /// Drawn in its flat colour, not shaded: cpfg's `line style: pixel` lines are
     /// unlit GL lines, and this keeps their look (docs/deviations.md).
     bool unlit = false;
 
-    PrimId prim() const { return {geom_id, prim_id}; }
+    PrimId prim() const { return {geom_id, prim_id, inst_id}; }
+    /// Whether the primitive encloses a volume (a ray leaving inward meets it again).
+    bool closed() const { return shape != Shape::disc && shape != Shape::triangle; }
+    /// Whether a ray leaving toward wi goes into the primitive's volume (never, if flat).
+    bool enters(const Vec3f& wi) const
+    {
+        return closed() && ((dot(geometric_normal, wi) < 0) != inside);
+    }
 };
 
-/// The acceleration structure of one frame. Shares the Scene's index and flag buffers
-/// (and its keys when radii are already in world units): the Scene must outlive it.
+/// The acceleration structure of one frame: every Geometry part natively in Embree
+/// (round linear and Hermite curves, sphere points, oriented discs, triangles), each
+/// prototype in its own Embree scene placed by one instance per Scene::Instance.
+/// Shares the Scene's buffers: the Scene (and `textures`) must outlive it.
 /// Thread-safe for concurrent intersect()/occluded() after construction.
 class EmbreeScene {
 public:
-    /// Builds the scene; `camera` converts pixel-width line radii to world units.
-    /// Throws cambium::Error if Embree fails; Embree warnings go to cambium::warn.
-    EmbreeScene(const geom::Scene& scene, const Camera& camera);
+    /// Builds the scene; `camera` converts pixel-width line radii to world units. With
+    /// `textures`, hits on textured meshes and curves where the texture's alpha < 0.5 are
+    /// ignored (cut-outs). Throws cambium::Error if Embree fails or an index is out of range.
+    EmbreeScene(const geom::Scene& scene, const Camera& camera,
+                const TextureSet* textures = nullptr);
     ~EmbreeScene();
     EmbreeScene(const EmbreeScene&) = delete;
     EmbreeScene& operator=(const EmbreeScene&) = delete;
 
     /// First hit along org + t dir, t in [tnear, tfar], ignoring the primitive `skip`
-    /// (the convex curve segment a spawned ray leaves cannot truly be hit again; Embree
+    /// (the convex primitive a spawned ray leaves cannot truly be hit again; Embree
     /// would report spurious hits on it). `coherent` for camera rays.
     std::optional<SurfaceHit> intersect(const Vec3f& org, const Vec3f& dir, float tnear,
                                         float tfar, PrimId skip = {},
@@ -60,7 +86,7 @@ public:
     bool occluded(const Vec3f& org, const Vec3f& dir, float tnear, float tfar,
                   PrimId skip = {}) const;
 
-    /// Number of curve segments given to Embree.
+    /// Number of curve segments (linear and Hermite) of the scene's own geometry.
     std::size_t segment_count() const;
 
 private:

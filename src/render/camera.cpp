@@ -18,7 +18,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
+#include <utility>
 
 namespace cambium::render {
 
@@ -38,6 +40,24 @@ Vec3 rotate(const Vec3& v, const Vec3& k, double angle)
 struct Frame {
     Vec3 forward, right, up;
 };
+
+/// Shirley and Chiu's concentric map from the unit square to the unit disk: uniform in
+/// area, and neighbouring samples stay neighbours.
+std::pair<double, double> concentric_disk(double u, double v)
+{
+    double a = 2 * u - 1, b = 2 * v - 1;
+    if (a == 0 && b == 0)
+        return {0, 0};
+    double r, phi;
+    if (std::abs(a) > std::abs(b)) {
+        r = a;
+        phi = std::numbers::pi / 4 * (b / a);
+    } else {
+        r = b;
+        phi = std::numbers::pi / 2 - std::numbers::pi / 4 * (a / b);
+    }
+    return {r * std::cos(phi), r * std::sin(phi)};
+}
 
 /// The viewing frame: forward from viewpoint to reference, up = +y (twisted).
 Frame view_frame(const geom::View& view)
@@ -129,6 +149,7 @@ Camera Camera::perspective(const Vec3& eye, const Vec3& focus, const Vec3& up, d
     c.m_right = geom::normalize(geom::cross(c.m_forward, up));
     c.m_up = geom::cross(c.m_right, c.m_forward);
     c.m_focus_distance = geom::length(focus - eye);
+    c.m_lens_focus = c.m_focus_distance;
     double fov = std::clamp(fov_deg, 1e-3, 179.0) * deg_to_rad;
     c.m_pixel_size = 2 * c.m_focus_distance * std::tan(fov / 2) / height;
     c.m_width = width;
@@ -152,10 +173,61 @@ CameraRay Camera::generate_ray(double x, double y) const
 {
     double sx = (x - m_width * 0.5) * m_pixel_size;
     double sy = (m_height * 0.5 - y) * m_pixel_size;
+    CameraRay ray;
     if (m_projection == Projection::parallel)
-        return {m_origin + m_right * sx + m_up * sy - m_forward * m_back_off, m_forward};
-    return {m_origin,
-            geom::normalize(m_forward * m_focus_distance + m_right * sx + m_up * sy)};
+        ray = {m_origin + m_right * sx + m_up * sy - m_forward * m_back_off, m_forward};
+    else
+        ray = {m_origin, geom::normalize(m_forward * m_focus_distance + m_right * sx + m_up * sy)};
+    clip(ray);
+    return ray;
+}
+
+CameraRay Camera::generate_ray(double x, double y, double lens_u, double lens_v) const
+{
+    if (m_aperture_radius <= 0 || m_projection == Projection::parallel)
+        return generate_ray(x, y);
+    double sx = (x - m_width * 0.5) * m_pixel_size;
+    double sy = (m_height * 0.5 - y) * m_pixel_size;
+    // The pinhole ray meets the plane in focus here; every lens point aims at it.
+    Vec3 through = m_forward * m_focus_distance + m_right * sx + m_up * sy;
+    Vec3 target = m_origin + through * (m_lens_focus / m_focus_distance);
+    auto [lx, ly] = concentric_disk(lens_u, lens_v);
+    Vec3 lens = m_origin + m_right * (lx * m_aperture_radius) + m_up * (ly * m_aperture_radius);
+    CameraRay ray{lens, geom::normalize(target - lens)};
+    clip(ray);
+    return ray;
+}
+
+void Camera::clip(CameraRay& ray) const
+{
+    if (std::isinf(m_clip_near) && std::isinf(m_clip_far))
+        return;
+    // Depth along forward of the ray origin, and depth gained per unit of t.
+    double origin_depth = geom::dot(ray.org - m_origin, m_forward);
+    double rate = geom::dot(ray.dir, m_forward);
+    if (rate <= 0) {
+        ray.tnear = 0;
+        ray.tfar = 0;
+        return;
+    }
+    ray.tnear = std::max(0.0, (m_clip_near - origin_depth) / rate);
+    ray.tfar = std::max(0.0, (m_clip_far - origin_depth) / rate);
+}
+
+Camera Camera::with_lens(double aperture_radius, double focus_distance) const
+{
+    Camera c = *this;
+    c.m_aperture_radius = std::max(0.0, aperture_radius);
+    c.m_lens_focus = focus_distance > 0 ? focus_distance : m_focus_distance;
+    return c;
+}
+
+Camera Camera::with_clipping(double near, double far) const
+{
+    Camera c = *this;
+    c.m_clip_near = near;
+    c.m_clip_far = far;
+    return c;
 }
 
 double Camera::pixel_size_at(const Vec3& p) const
@@ -166,6 +238,28 @@ double Camera::pixel_size_at(const Vec3& p) const
     return m_pixel_size * std::max(depth, 0.0) / m_focus_distance;
 }
 
+namespace {
+
+/// cpfg's clipping planes: from the eye in perspective; in parallel projection positions
+/// relative to the viewpoint along the view direction, in either order (glOrtho accepts
+/// near > far, and corpus views use both orders), converted to depths from origin().
+Camera apply_clipping(const Camera& camera, const geom::View& view)
+{
+    if (!view.front_distance && !view.back_distance)
+        return camera;
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    double front = view.front_distance.value_or(-inf);
+    double back = view.back_distance.value_or(inf);
+    if (camera.projection() == Camera::Projection::perspective)
+        return camera.with_clipping(front, back);
+    double viewpoint_depth = geom::dot(view.viewpoint - camera.origin(), camera.forward());
+    if (view.front_distance && view.back_distance && front > back)
+        std::swap(front, back);
+    return camera.with_clipping(viewpoint_depth + front, viewpoint_depth + back);
+}
+
+}  // namespace
+
 Camera make_camera(const geom::View& view, const geom::Bounds3& bounds, int width, int height)
 {
     Frame f = view_frame(view);
@@ -174,13 +268,14 @@ Camera make_camera(const geom::View& view, const geom::Bounds3& bounds, int widt
         Vec3 eye = view.reference_point + (view.viewpoint - view.reference_point) / sf;
         if (geom::length(eye - view.reference_point) == 0)
             eye = view.reference_point - f.forward;
-        return Camera::perspective(eye, view.reference_point, f.up, view.viewing_angle_deg,
-                                   width, height);
+        return apply_clipping(Camera::perspective(eye, view.reference_point, f.up,
+                                                  view.viewing_angle_deg, width, height),
+                              view);
     }
     geom::Bounds3 fit = view.box ? *view.box : bounds;
     if (fit.empty())
         fit.extend(Vec3{0, 0, 0});
-    return make_parallel(view, f, fit, bounds, width, height);
+    return apply_clipping(make_parallel(view, f, fit, bounds, width, height), view);
 }
 
 }  // namespace cambium::render

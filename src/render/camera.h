@@ -2,6 +2,8 @@
 // The camera that frames a Scene as cpfg's window does: parallel auto-fit or perspective.
 #pragma once
 
+#include <limits>
+
 #include "geom/scene.h"
 #include "geom/vec.h"
 
@@ -13,9 +15,12 @@ struct PixelPoint {
     double x = 0, y = 0;
 };
 
-/// A world-space ray; dir is unit length.
+/// A world-space ray; dir is unit length. Only t in [tnear, tfar] is seen: the view
+/// file's front and back clipping planes (tnear = 0, tfar = infinity without them).
 struct CameraRay {
     geom::Vec3 org, dir;
+    double tnear = 0;
+    double tfar = std::numeric_limits<double>::infinity();
 };
 
 /// A pinhole or orthographic camera in world units. Immutable after make_camera().
@@ -34,8 +39,28 @@ public:
 
     /// Where the world point p lands on the image (perspective: p must be in front).
     PixelPoint project(const geom::Vec3& p) const;
-    /// The ray through the image point (x, y) (continuous pixel coordinates).
+    /// The ray through the image point (x, y) (continuous pixel coordinates), from the
+    /// centre of the lens.
     CameraRay generate_ray(double x, double y) const;
+    /// The same through the lens point given by two uniforms in [0, 1) (a thin lens:
+    /// every ray through (x, y) meets the others on the plane in focus). Equals
+    /// generate_ray(x, y) for a pinhole camera.
+    CameraRay generate_ray(double x, double y, double lens_u, double lens_v) const;
+
+    /// This camera with a thin lens of radius `aperture_radius` (world units; 0 = pinhole)
+    /// focused on the plane `focus_distance` in front of the eye (<= 0: the plane through
+    /// the view's reference point, where the pinhole camera looks). Parallel cameras
+    /// ignore the lens: an orthographic view has no eye to focus.
+    Camera with_lens(double aperture_radius, double focus_distance = 0) const;
+    /// This camera seeing only depths in [near, far] along forward(), measured from the
+    /// eye (perspective) or from origin() (parallel): cpfg's front and back clipping
+    /// planes (glFrustum / glOrtho near and far).
+    Camera with_clipping(double near, double far) const;
+    double aperture_radius() const { return m_aperture_radius; }
+    /// Distance from the eye to the plane in focus (perspective).
+    double focus_distance() const { return m_lens_focus; }
+    double clip_near() const { return m_clip_near; }
+    double clip_far() const { return m_clip_far; }
     /// World size of one pixel on the plane through the focus, perpendicular to the view.
     double pixel_size() const { return m_pixel_size; }
     /// World size of one pixel at the depth of p (parallel: pixel_size()).
@@ -52,6 +77,8 @@ public:
 
 private:
     Camera() = default;
+    /// Sets the ray's [tnear, tfar] from the clipping planes.
+    void clip(CameraRay& ray) const;
 
     Projection m_projection = Projection::parallel;
     geom::Vec3 m_origin;                // eye, or the point imaged at the window centre
@@ -60,10 +87,17 @@ private:
     double m_focus_distance = 1;        // perspective: eye to focus plane
     double m_back_off = 0;              // parallel: ray origins this far behind the focus
     int m_width = 1, m_height = 1;
+    double m_aperture_radius = 0;       // thin lens radius; 0 = pinhole
+    double m_lens_focus = 1;            // eye to the plane in focus
+    double m_clip_near = -std::numeric_limits<double>::infinity();  // depth along forward
+    double m_clip_far = std::numeric_limits<double>::infinity();
 };
 
 /// The camera that frames the scene as cpfg does (docs: render/camera.cpp, "cpfg framing").
 /// `bounds` are the geometry's bounds (the view's `box:` overrides them for the fit).
+/// The view's `front distance:` / `back distance:` become clipping planes: from the eye
+/// in perspective, from the view file's viewpoint along the view direction in parallel
+/// projection (manual 5.2.2).
 Camera make_camera(const geom::View& view, const geom::Bounds3& bounds, int width, int height);
 
 }  // namespace cambium::render

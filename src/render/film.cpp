@@ -8,8 +8,10 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <system_error>
+#include <utility>
 
 #include <unistd.h>
 
@@ -43,54 +45,113 @@ Format format_of(const std::filesystem::path& file)
 std::filesystem::path temporary_name(const std::filesystem::path& file)
 {
     static std::atomic<unsigned> counter{0};
-    std::string name = "." + file.stem().string() + ".tmp" + std::to_string(::getpid()) + "-" +
-                       std::to_string(counter++) + file.extension().string();
+    // Appended piece by piece: GCC 12 reports a false -Wrestrict on "." + std::string.
+    std::string name(1, '.');
+    name += file.stem().string();
+    name += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+    name += file.extension().string();
     return file.parent_path() / name;
 }
 
-/// Display-referred pixels: sRGB-encoded, quantised to `Int` with `channels` channels.
+/// Display-referred pixels: exposure, straight (unassociated) colour for transparent
+/// images, sRGB-encoded, quantised to `Int` with `channels` channels (3: RGB, 4: RGBA).
 template <class Int>
-std::vector<Int> encode_srgb(const Image& image, int channels)
+std::vector<Int> encode_srgb(const Image& image, int channels, float exposure)
 {
     constexpr float max = static_cast<float>(std::numeric_limits<Int>::max());
+    float gain = std::exp2(exposure);
+    // A transparent image's colour is premultiplied; files with alpha want it straight.
+    bool unpremultiply = image.transparent && channels == 4;
     std::size_t n = std::size_t(image.width) * image.height;
     std::vector<Int> out(n * channels);
-    for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t i = 0; i < n; ++i) {
+        float alpha = image.rgba[i * 4 + 3];
+        float scale = unpremultiply && alpha > 0 ? gain / alpha : gain;
         for (int c = 0; c < channels; ++c) {
             float v = image.rgba[i * 4 + c];
-            float e = c < 3 ? linear_to_srgb(v) : std::clamp(v, 0.0f, 1.0f);
+            float e = c < 3 ? linear_to_srgb(v * scale) : std::clamp(v, 0.0f, 1.0f);
             out[i * channels + c] = static_cast<Int>(std::lround(e * max));
         }
+    }
     return out;
 }
 
+bool has_layer(const Image& image, const std::vector<float>& layer, int per_pixel)
+{
+    return layer.size() == std::size_t(image.width) * image.height * per_pixel;
+}
+
+/// The EXR's channels interleaved: RGBA, then each AOV layer the image holds.
+void write_exr(OIIO::ImageOutput& out, const Image& image, const std::filesystem::path& temp,
+               bool& ok)
+{
+    std::vector<std::string> names{"R", "G", "B", "A"};
+    std::vector<std::pair<const std::vector<float>*, int>> layers;
+    if (has_layer(image, image.albedo, 3)) {
+        names.insert(names.end(), {"albedo.R", "albedo.G", "albedo.B"});
+        layers.emplace_back(&image.albedo, 3);
+    }
+    if (has_layer(image, image.normal, 3)) {
+        names.insert(names.end(), {"normal.X", "normal.Y", "normal.Z"});
+        layers.emplace_back(&image.normal, 3);
+    }
+    bool depth = has_layer(image, image.depth, 1);
+    if (depth) {
+        names.emplace_back("Z");
+        layers.emplace_back(&image.depth, 1);
+    }
+    int channels = static_cast<int>(names.size());
+    OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::HALF);
+    spec.channelnames = names;
+    spec.alpha_channel = 3;
+    if (depth) {
+        // Distances need more than half's 11 bits.
+        spec.channelformats.assign(std::size_t(channels), OIIO::TypeDesc::HALF);
+        spec.channelformats.back() = OIIO::TypeDesc::FLOAT;
+        spec.z_channel = channels - 1;
+    }
+    spec.attribute("oiio:ColorSpace", "Linear");
+    spec.attribute("compression", "zip");
+    std::size_t n = std::size_t(image.width) * image.height;
+    std::vector<float> pixels(n * std::size_t(channels));
+    for (std::size_t i = 0; i < n; ++i) {
+        float* p = &pixels[i * channels];
+        for (int c = 0; c < 4; ++c)
+            *p++ = image.rgba[i * 4 + c];
+        for (const auto& [layer, count] : layers)
+            for (int c = 0; c < count; ++c)
+                *p++ = (*layer)[i * count + c];
+    }
+    ok = out.open(temp.string(), spec) && out.write_image(OIIO::TypeDesc::FLOAT, pixels.data());
+}
+
 void write_with_oiio(const Image& image, const std::filesystem::path& temp, Format format,
-                     const std::filesystem::path& file)
+                     const std::filesystem::path& file, const WriteOptions& options)
 {
     auto out = OIIO::ImageOutput::create(temp.string());
     if (!out)
         throw Error(file.string() + ": cannot write this format: " + OIIO::geterror());
     bool ok = false;
     if (format == Format::exr) {
-        OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::HALF);
-        spec.attribute("oiio:ColorSpace", "Linear");
-        spec.attribute("compression", "zip");
-        ok = out->open(temp.string(), spec) &&
-             out->write_image(OIIO::TypeDesc::FLOAT, image.rgba.data());
+        write_exr(*out, image, temp, ok);
     } else if (format == Format::tiff) {
         OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::UINT16);
         spec.attribute("oiio:ColorSpace", "sRGB");
-        // Colour is composited over the background; alpha is a coverage matte.
+        // Colour is composited over the background (or made straight when transparent);
+        // alpha is a coverage matte.
         spec.attribute("oiio:UnassociatedAlpha", 1);
-        auto pixels = encode_srgb<std::uint16_t>(image, 4);
+        auto pixels = encode_srgb<std::uint16_t>(image, 4, options.exposure);
         ok = out->open(temp.string(), spec) &&
              out->write_image(OIIO::TypeDesc::UINT16, pixels.data());
     } else {
-        OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+        int channels = format == Format::png && image.transparent ? 4 : 3;
+        OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::UINT8);
         spec.attribute("oiio:ColorSpace", "sRGB");
+        if (channels == 4)
+            spec.attribute("oiio:UnassociatedAlpha", 1);
         if (format == Format::jpeg)
             spec.attribute("Compression", "jpeg:95");
-        auto pixels = encode_srgb<std::uint8_t>(image, 3);
+        auto pixels = encode_srgb<std::uint8_t>(image, channels, options.exposure);
         ok = out->open(temp.string(), spec) &&
              out->write_image(OIIO::TypeDesc::UINT8, pixels.data());
     }
@@ -110,7 +171,8 @@ void check_output_format(const std::filesystem::path& file)
         throw Error(file.string() + ": the folder " + folder.string() + " does not exist");
 }
 
-void write_image(const Image& image, const std::filesystem::path& file)
+void write_image(const Image& image, const std::filesystem::path& file,
+                 const WriteOptions& options)
 {
     if (image.width <= 0 || image.height <= 0 ||
         image.rgba.size() != std::size_t(image.width) * image.height * 4)
@@ -118,7 +180,7 @@ void write_image(const Image& image, const std::filesystem::path& file)
     Format format = format_of(file);
     std::filesystem::path temp = temporary_name(file);
     try {
-        write_with_oiio(image, temp, format, file);
+        write_with_oiio(image, temp, format, file, options);
         std::error_code ec;
         std::filesystem::rename(temp, file, ec);
         if (ec)

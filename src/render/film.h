@@ -7,22 +7,42 @@
 
 namespace cambium::render {
 
-/// A rendered frame: rows top to bottom, 4 floats per pixel. RGB is linear and already
-/// composited over the background (what cpfg's window shows); A is the coverage, the
-/// fraction of the pixel's samples whose camera ray hit geometry.
+/// A rendered frame: rows top to bottom, 4 floats per pixel. RGB is linear; A is the
+/// coverage, the fraction of the pixel's samples whose camera ray hit geometry.
+/// Normally RGB is already composited over the background (what cpfg's window shows);
+/// when `transparent`, camera rays that missed contributed nothing, so RGB is
+/// premultiplied by A (associated alpha, as EXR expects).
 struct Image {
     int width = 0, height = 0;
     std::vector<float> rgba;
+    bool transparent = false;
+    /// Auxiliary layers from the camera rays, empty when not computed: the first hit's
+    /// diffuse colour (3 floats per pixel) and shading normal (3, facing the camera),
+    /// both averaged over the pixel's samples with misses counting as zero, and the
+    /// nearest hit distance along the camera ray (1; infinity where every sample missed;
+    /// perspective: from the eye, parallel: from the plane the rays start on).
+    std::vector<float> albedo{}, normal{}, depth{};
 
     float& at(int x, int y, int c) { return rgba[(std::size_t(y) * width + x) * 4 + c]; }
     float at(int x, int y, int c) const { return rgba[(std::size_t(y) * width + x) * 4 + c]; }
 };
 
-/// Writes by extension: .png (8-bit sRGB RGB), .jpg/.jpeg (8-bit sRGB RGB), .tif/.tiff
-/// (16-bit sRGB RGBA), .exr (linear half-float RGBA, A = coverage). The image is written to
-/// a temporary name in the same folder and renamed, so a failure never leaves a partial
-/// file. Throws cambium::Error naming the file on failure.
-void write_image(const Image& image, const std::filesystem::path& file);
+/// How write_image turns linear radiance into a file.
+struct WriteOptions {
+    /// Display formats (PNG, JPEG, TIFF) scale RGB by 2^exposure before encoding; EXR
+    /// keeps the scene-referred values.
+    float exposure = 0;
+};
+
+/// Writes by extension: .png (8-bit sRGB; RGB, or RGBA with straight alpha when the
+/// image is transparent), .jpg/.jpeg (8-bit sRGB RGB; a transparent image comes out over
+/// black), .tif/.tiff (16-bit sRGB RGBA, straight alpha), .exr (half-float linear RGBA
+/// with A = coverage, plus layers albedo.{R,G,B}, normal.{X,Y,Z} and a float Z for the
+/// depth when the image has them). The image is written to a temporary name in the same
+/// folder and renamed, so a failure never leaves a partial file. Throws cambium::Error
+/// naming the file on failure.
+void write_image(const Image& image, const std::filesystem::path& file,
+                 const WriteOptions& options = {});
 
 /// Throws cambium::Error when `file` could not be written by write_image: an unknown
 /// extension or a missing folder. Lets the command fail before rendering, not after.

@@ -2,8 +2,6 @@
 // Surface materials: cpfg materials mapped to a small physically-based model.
 #pragma once
 
-#include <numbers>
-#include <variant>
 #include <vector>
 
 #include "geom/scene.h"
@@ -11,47 +9,55 @@
 
 namespace cambium::render {
 
-/// An ideal diffuse reflector. Later lobes (glossy from specular/shininess, diffuse
-/// transmission for leaves, opacity) become further alternatives of Bsdf.
-struct Lambertian {
-    Vec3f albedo;
+/// The scattering at one surface point (docs/materials.md): three lobes summed,
+///  - Lambertian reflection with albedo `reflect`,
+///  - Lambertian transmission to the other side with albedo `transmit` (leaves),
+///  - an energy-conserving normalized Phong lobe (Lafortune & Willems 1994)
+///    f = glossy (exponent + 2) / (2 pi) cos^exponent(alpha) about the mirror direction.
+/// reflect + transmit + glossy <= 1 per channel keeps every lobe's sum energy-conserving.
+struct Bsdf {
+    Vec3f reflect;
+    Vec3f transmit;
+    Vec3f glossy;
+    float exponent = 0;
 };
 
-using Bsdf = std::variant<Lambertian>;
+/// An ideal diffuse reflector.
+inline Bsdf lambertian(const Vec3f& albedo) { return Bsdf{albedo, Vec3f(), Vec3f(), 0}; }
 
-/// A surface's scattering and its own emitted radiance (linear RGB).
+/// A surface's parameters in linear RGB, before any texture: `diffuse` is the albedo the
+/// texture modulates or replaces, split into reflection and transmission by translucency.
 struct SurfaceMaterial {
-    Bsdf bsdf = Lambertian{Vec3f(0.5f)};
-    Vec3f emission;
+    Vec3f diffuse{0.5f};
+    float translucency = 0;  ///< fraction of the diffuse albedo transmitted
+    Vec3f specular;          ///< glossy lobe albedo at normal incidence
+    float exponent = 0;      ///< Phong exponent (cpfg shininess / 4)
+    Vec3f emission;          ///< emitted radiance
+    float opacity = 1;       ///< 1 - transparency: probability a ray stops here
 };
+
+/// The BSDF of `m` with the (possibly textured) diffuse albedo `diffuse`. The glossy
+/// lobe takes its share first: the diffuse lobes keep (1 - max specular) of theirs.
+Bsdf make_bsdf(const SurfaceMaterial& m, const Vec3f& diffuse);
+inline Bsdf make_bsdf(const SurfaceMaterial& m) { return make_bsdf(m, m.diffuse); }
 
 /// The colour a surface shows unlit (cpfg's flat colour): its diffuse albedo plus emission.
-inline Vec3f flat_colour(const SurfaceMaterial& m)
-{
-    Vec3f albedo = std::visit([](const auto& b) { return b.albedo; }, m.bsdf);
-    return albedo + m.emission;
-}
+inline Vec3f flat_colour(const SurfaceMaterial& m) { return m.diffuse + m.emission; }
 
-/// A direction sampled from a BSDF: `weight` = f cos / pdf.
+/// A direction sampled from a BSDF: `weight` = f |cos| / pdf, `pdf` per steradian (the
+/// whole mixture's, for multiple importance sampling). pdf = 0: no direction.
 struct BsdfSample {
     Vec3f wi;
     Vec3f weight;
+    float pdf = 0;
 };
 
-/// f(wo, wi) for a normal n facing wo.
-inline Vec3f bsdf_eval(const Bsdf& bsdf, const Vec3f& n, const Vec3f& wi)
-{
-    return std::visit(
-        [&](const auto& b) -> Vec3f {
-            using T = std::decay_t<decltype(b)>;
-            if constexpr (std::is_same_v<T, Lambertian>)
-                return dot(n, wi) > 0 ? b.albedo * std::numbers::inv_pi_v<float> : Vec3f();
-        },
-        bsdf);
-}
-
-/// Samples wi given the shading normal n (facing the incoming ray) and two uniforms.
-BsdfSample bsdf_sample(const Bsdf& bsdf, const Vec3f& n, float u1, float u2);
+/// f(wo, wi); n is the shading normal on wo's side, all vectors unit.
+Vec3f bsdf_eval(const Bsdf& bsdf, const Vec3f& n, const Vec3f& wo, const Vec3f& wi);
+/// The solid-angle density bsdf_sample() draws wi with.
+float bsdf_pdf(const Bsdf& bsdf, const Vec3f& n, const Vec3f& wo, const Vec3f& wi);
+/// Draws wi from two uniforms: a lobe in proportion to its albedo, then a direction.
+BsdfSample bsdf_sample(const Bsdf& bsdf, const Vec3f& n, const Vec3f& wo, float u1, float u2);
 
 /// The cpfg materials decoded to linear RGB (display values decoded as sRGB).
 std::vector<SurfaceMaterial> make_materials(const std::vector<geom::Material>& materials);

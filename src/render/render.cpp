@@ -1,29 +1,53 @@
 // SPDX-License-Identifier: Apache-2.0
 // The render layer's entry points: render a Scene to an Image, write it to a file.
+//
+// Every pixel keeps its own running sums; a pass adds samples i = n .. target-1 to each
+// pixel still sampled, in order, so the image is a pure function of (scene, settings,
+// seed) whatever the thread count, tile order or number of passes. Adaptive sampling
+// decides between passes from the pixels' own sums, which keeps it deterministic too.
 #include "render/render.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <limits>
+#include <mutex>
+#include <numbers>
 #include <string>
+#include <vector>
 
 #include "base/diagnostics.h"
 #include "render/accel.h"
 #include "render/color.h"
 #include "render/integrator.h"
+#include "render/texture.h"
 
 namespace cambium::render {
 
 namespace {
 
+using Clock = std::chrono::steady_clock;
+
 constexpr int tile_size = 16;
+constexpr int first_pass_samples = 8;    // automatic passes: 8, 16, 32, ... spp
+constexpr int min_adaptive_samples = 16;  // fewer give no useful variance estimate
+constexpr float infinity = std::numeric_limits<float>::infinity();
 
 void check_settings(const RenderSettings& s)
 {
     if (s.width <= 0 || s.height <= 0)
         throw Error("render: image size " + std::to_string(s.width) + "x" +
                     std::to_string(s.height) + " is empty");
+    if (std::int64_t(s.width) * s.height > (std::int64_t{1} << 26))
+        throw Error("render: image size " + std::to_string(s.width) + "x" +
+                    std::to_string(s.height) + " is larger than 2^26 pixels");
     if (s.samples_per_pixel <= 0)
         throw Error("render: samples per pixel must be positive, not " +
                     std::to_string(s.samples_per_pixel));
@@ -32,79 +56,448 @@ void check_settings(const RenderSettings& s)
                     std::to_string(s.max_depth));
     if (s.threads < 0)
         throw Error("render: thread count must not be negative");
+    if (s.passes < 0)
+        throw Error("render: the number of passes must not be negative, not " +
+                    std::to_string(s.passes));
+    if (!(s.noise_target >= 0) || !(s.time_budget_s >= 0))
+        throw Error("render: the noise target and the time budget must not be negative");
+    if (!(s.filter_radius >= 0) || s.filter_radius > 16)
+        throw Error("render: the filter radius must be between 0 and 16 pixels");
+    if (!(s.aperture_radius >= 0) || !(s.focus_distance >= 0))
+        throw Error("render: the aperture and the focus distance must not be negative");
 }
 
-/// One pixel: jittered samples over its area (a box filter), averaged.
-void render_pixel(const PathContext& ctx, const Camera& camera, const RenderSettings& s, int x,
-                  int y, Image& image)
-{
-    Vec3f sum;
-    int hits = 0;
-    for (int i = 0; i < s.samples_per_pixel; ++i) {
-        Sampler sampler(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
-                        static_cast<std::uint32_t>(i), s.seed);
-        float jx = sampler.next(), jy = sampler.next();
-        CameraRay ray = camera.generate_ray(x + jx, y + jy);
-        PathResult r = trace_path(ctx, Vec3f(ray.org), Vec3f(ray.dir), sampler);
-        sum += r.radiance;
-        hits += r.hit ? 1 : 0;
+/// Draws a pixel-space offset from a separable filter profile: a 1D table over
+/// [-radius, radius], piecewise constant, inverted by binary search.
+class FilterTable {
+public:
+    FilterTable(PixelFilter filter, float radius)
+    {
+        if (filter == PixelFilter::box)
+            return;
+        m_radius = radius > 0 ? radius : (filter == PixelFilter::gaussian ? 1.5f : 1.0f);
+        constexpr int bins = 128;
+        m_cdf.resize(bins + 1);
+        double sigma = m_radius / 3.0;
+        double edge = std::exp(-m_radius * m_radius / (2 * sigma * sigma));
+        for (int i = 0; i < bins; ++i) {
+            double x = -m_radius + (i + 0.5) * 2 * m_radius / bins;
+            double f;
+            if (filter == PixelFilter::gaussian) {
+                f = std::max(0.0, std::exp(-x * x / (2 * sigma * sigma)) - edge);
+            } else {
+                double t = 2 * std::numbers::pi * (x + m_radius) / (2 * m_radius);
+                f = 0.35875 - 0.48829 * std::cos(t) + 0.14128 * std::cos(2 * t) -
+                    0.01168 * std::cos(3 * t);
+            }
+            m_cdf[i + 1] = m_cdf[i] + std::max(f, 0.0);
+        }
+        for (double& c : m_cdf)
+            c /= m_cdf.back();
     }
-    float inv = 1.0f / static_cast<float>(s.samples_per_pixel);
-    image.at(x, y, 0) = sum.x * inv;
-    image.at(x, y, 1) = sum.y * inv;
-    image.at(x, y, 2) = sum.z * inv;
-    image.at(x, y, 3) = static_cast<float>(hits) * inv;
+
+    bool box() const { return m_cdf.empty(); }
+
+    /// The offset from the pixel centre for the uniform u.
+    double offset(float u) const
+    {
+        auto it = std::upper_bound(m_cdf.begin(), m_cdf.end(), double(u));
+        std::size_t bin = std::min<std::size_t>(
+            std::size_t(std::max<std::ptrdiff_t>(it - m_cdf.begin() - 1, 0)), m_cdf.size() - 2);
+        double width = m_cdf[bin + 1] - m_cdf[bin];
+        double t = width > 0 ? std::clamp((u - m_cdf[bin]) / width, 0.0, 1.0) : 0.5;
+        double bins = double(m_cdf.size() - 1);
+        return -m_radius + (double(bin) + t) * 2 * m_radius / bins;
+    }
+
+private:
+    double m_radius = 0.5;
+    std::vector<double> m_cdf;
+};
+
+/// A pixel's running sums.
+struct PixelState {
+    Vec3f radiance, albedo, normal;
+    double luminance = 0, luminance_sq = 0;  // for the adaptive error estimate
+    float depth = infinity;
+    std::uint32_t samples = 0, hits = 0;
+    bool done = false;  // adaptive sampling: converged
+};
+
+float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+/// Everything one sample needs, shared read-only by all threads.
+struct Frame {
+    const PathContext& ctx;
+    const EmbreeScene& accel;
+    const Camera& camera;
+    const RenderSettings& settings;
+    FilterTable filter;
+    bool lens = false;
+    bool primary = false;  // intersect the camera ray here too (AOVs, clipping)
+};
+
+const SurfaceMaterial& material_of(const PathContext& ctx, std::uint16_t m)
+{
+    static const SurfaceMaterial fallback;
+    return m < ctx.materials.size() ? ctx.materials[m] : fallback;
 }
 
-void render_tile(const PathContext& ctx, const Camera& camera, const RenderSettings& s, int tile,
-                 Image& image)
+/// The albedo layer's colour: the (textured) diffuse albedo, or the flat colour of an
+/// unlit line.
+Vec3f first_hit_albedo(const PathContext& ctx, const SurfaceHit& hit)
 {
-    int tiles_x = (s.width + tile_size - 1) / tile_size;
-    int x0 = (tile % tiles_x) * tile_size, y0 = (tile / tiles_x) * tile_size;
-    for (int y = y0; y < std::min(y0 + tile_size, s.height); ++y)
-        for (int x = x0; x < std::min(x0 + tile_size, s.width); ++x)
-            render_pixel(ctx, camera, s, x, y, image);
+    const SurfaceMaterial& m = material_of(ctx, hit.material);
+    if (hit.unlit)
+        return flat_colour(m);
+    if (ctx.textures && ctx.textures->valid(hit.texture))
+        return ctx.textures->apply(hit.texture, m.diffuse, hit.u, hit.v);
+    return m.diffuse;
+}
+
+/// Sample i of pixel (x, y), added to its sums.
+void take_sample(const Frame& f, int x, int y, std::uint32_t i, PixelState& st)
+{
+    const RenderSettings& s = f.settings;
+    Sampler sampler(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), i, s.seed);
+    float jx = sampler.next(), jy = sampler.next();
+    double px, py;
+    if (f.filter.box()) {
+        px = x + jx;  // in float, as before filters existed: the same images
+        py = y + jy;
+    } else {
+        px = x + 0.5 + f.filter.offset(jx);
+        py = y + 0.5 + f.filter.offset(jy);
+    }
+    CameraRay ray = f.lens ? f.camera.generate_ray(px, py, sampler.next(), sampler.next())
+                           : f.camera.generate_ray(px, py);
+    Vec3f org(ray.org), dir(ray.dir);
+    if (ray.tnear > 0)
+        org = Vec3f(ray.org + ray.dir * ray.tnear);  // front clipping: start at the plane
+    bool clipped_far = std::isfinite(ray.tfar);
+
+    PathResult r;
+    bool trace = true;
+    if (f.primary) {
+        float tfar = clipped_far ? static_cast<float>(ray.tfar - ray.tnear) : infinity;
+        std::optional<SurfaceHit> hit = f.accel.intersect(org, dir, 0, tfar, {}, true);
+        if (hit) {
+            // The path's first hit is this one: nothing nearer, and it is in range.
+            st.albedo += first_hit_albedo(f.ctx, *hit);
+            st.normal += hit->normal;
+            st.depth = std::min(st.depth, static_cast<float>(hit->t + ray.tnear));
+        } else if (clipped_far) {
+            // Geometry beyond the back plane must not show: the camera ray missed.
+            r.radiance = f.ctx.background;
+            trace = false;
+        }
+    }
+    if (trace)
+        r = trace_path(f.ctx, org, dir, sampler);
+    if (s.transparent_background && !r.hit)
+        r.radiance = Vec3f();
+    st.radiance += r.radiance;
+    st.hits += r.hit ? 1 : 0;
+    st.samples += 1;
+    double l = luminance(r.radiance);
+    st.luminance += l;
+    st.luminance_sq += l * l;
+}
+
+/// The pass schedule: cumulative samples per pixel at the end of each pass.
+std::vector<int> pass_targets(const RenderSettings& s)
+{
+    int spp = s.samples_per_pixel;
+    std::vector<int> targets;
+    if (s.passes > 0) {
+        for (int k = 1; k <= s.passes; ++k)
+            targets.push_back(std::max(1, int(std::int64_t(spp) * k / s.passes)));
+    } else {
+        for (int n = std::min(spp, first_pass_samples);; n = std::min(spp, n * 2)) {
+            targets.push_back(n);
+            if (n == spp)
+                break;
+        }
+    }
+    targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
+    return targets;
+}
+
+/// Relative standard error of a pixel's mean luminance (infinite when too few samples).
+double relative_error(const PixelState& st)
+{
+    if (st.samples < std::uint32_t(min_adaptive_samples))
+        return std::numeric_limits<double>::infinity();
+    double n = st.samples, mean = st.luminance / n;
+    double variance = std::max(0.0, (st.luminance_sq - st.luminance * mean) / (n - 1));
+    return std::sqrt(variance / n) / std::max(mean, 0.01);
+}
+
+/// Marks pixels whose 3x3 neighbourhood meets the noise target as done.
+void mark_converged(std::vector<PixelState>& px, int w, int h, double target)
+{
+    std::vector<double> err(px.size());
+    for (std::size_t i = 0; i < px.size(); ++i)
+        err[i] = px[i].done ? 0.0 : relative_error(px[i]);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            double worst = 0;
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    int nx = std::clamp(x + dx, 0, w - 1), ny = std::clamp(y + dy, 0, h - 1);
+                    worst = std::max(worst, err[std::size_t(ny) * w + nx]);
+                }
+            if (worst <= target)
+                px[std::size_t(y) * w + x].done = true;
+        }
+}
+
+/// The image of the sums so far.
+Image resolve(const std::vector<PixelState>& px, const RenderSettings& s)
+{
+    Image img{s.width, s.height, std::vector<float>(px.size() * 4)};
+    img.transparent = s.transparent_background;
+    if (s.aovs) {
+        img.albedo.assign(px.size() * 3, 0.0f);
+        img.normal.assign(px.size() * 3, 0.0f);
+        img.depth.assign(px.size(), infinity);
+    }
+    for (std::size_t i = 0; i < px.size(); ++i) {
+        const PixelState& st = px[i];
+        if (st.samples == 0)
+            continue;
+        float inv = 1.0f / static_cast<float>(st.samples);
+        img.rgba[i * 4 + 0] = st.radiance.x * inv;
+        img.rgba[i * 4 + 1] = st.radiance.y * inv;
+        img.rgba[i * 4 + 2] = st.radiance.z * inv;
+        img.rgba[i * 4 + 3] = static_cast<float>(st.hits) * inv;
+        if (s.aovs) {
+            Vec3f a = st.albedo * inv, n = st.normal * inv;
+            img.albedo[i * 3 + 0] = a.x;
+            img.albedo[i * 3 + 1] = a.y;
+            img.albedo[i * 3 + 2] = a.z;
+            img.normal[i * 3 + 0] = n.x;
+            img.normal[i * 3 + 1] = n.y;
+            img.normal[i * 3 + 2] = n.z;
+            img.depth[i] = st.depth;
+        }
+    }
+    return img;
+}
+
+/// The progress line on stderr, redrawn at most 4 times a second by whichever thread
+/// finishes a tile first.
+class ProgressLine {
+public:
+    ProgressLine(bool enabled, Clock::time_point start) : m_enabled(enabled), m_start(start) {}
+
+    void set_total(double total) { m_total.store(total); }
+    void add(std::uint64_t samples)
+    {
+        std::uint64_t done = m_done.fetch_add(samples) + samples;
+        if (!m_enabled)
+            return;
+        std::unique_lock lock(m_mutex, std::try_to_lock);
+        if (!lock.owns_lock())
+            return;
+        auto now = Clock::now();
+        if (now - m_last < std::chrono::milliseconds(250))
+            return;
+        m_last = now;
+        draw(double(done));
+    }
+    void finish()
+    {
+        if (!m_enabled)
+            return;
+        std::lock_guard lock(m_mutex);
+        draw(double(m_done.load()));  // 100% unless stopped early
+        std::fputc('\n', stderr);
+    }
+    std::uint64_t done() const { return m_done.load(); }
+
+private:
+    void draw(double done) const
+    {
+        double elapsed = std::chrono::duration<double>(Clock::now() - m_start).count();
+        double total = m_total.load();
+        double fraction = total > 0 ? std::min(1.0, done / total) : 0.0;
+        std::fprintf(stderr, "\r%s   ", format_progress(fraction, elapsed).c_str());
+        std::fflush(stderr);
+    }
+
+    bool m_enabled;
+    Clock::time_point m_start, m_last{};
+    std::atomic<std::uint64_t> m_done{0};
+    std::atomic<double> m_total{0};
+    std::mutex m_mutex;
+};
+
+std::atomic<bool> interrupted{false};
+
+extern "C" void on_interrupt(int) { interrupted.store(true); }
+
+std::string clock_time(double seconds)
+{
+    long s = std::lround(std::max(0.0, seconds));
+    char buffer[32];
+    if (s >= 3600)
+        std::snprintf(buffer, sizeof buffer, "%ld:%02ld:%02ld", s / 3600, s / 60 % 60, s % 60);
+    else
+        std::snprintf(buffer, sizeof buffer, "%ld:%02ld", s / 60, s % 60);
+    return buffer;
 }
 
 }  // namespace
 
-Image render(const geom::Scene& scene, const RenderSettings& settings)
+std::string format_progress(double fraction, double elapsed_s)
+{
+    fraction = std::clamp(fraction, 0.0, 1.0);
+    std::string line = "render " + std::to_string(int(std::floor(fraction * 100))) + "%  elapsed " +
+                       clock_time(elapsed_s) + "  remaining ";
+    if (fraction <= 0)
+        return line + "?";
+    return line + clock_time(elapsed_s * (1 - fraction) / fraction);
+}
+
+const std::atomic<bool>* install_interrupt_handler()
+{
+    static std::once_flag once;
+    std::call_once(once, [] {
+        struct sigaction action {};
+        action.sa_handler = &on_interrupt;
+        sigemptyset(&action.sa_mask);
+        // The second Ctrl-C finds the default action again and ends the process.
+        action.sa_flags = SA_RESETHAND;
+        sigaction(SIGINT, &action, nullptr);
+    });
+    return &interrupted;
+}
+
+Image render(const geom::Scene& scene, const RenderSettings& settings, RenderReport* report)
 {
     check_settings(settings);
     Camera camera = make_camera(scene.view, scene.bounds, settings.width, settings.height);
-    return render(scene, camera, settings);
+    if (settings.aperture_radius > 0)
+        camera = camera.with_lens(settings.aperture_radius, settings.focus_distance);
+    return render(scene, camera, settings, report);
 }
 
-Image render(const geom::Scene& scene, const Camera& camera, const RenderSettings& settings)
+Image render(const geom::Scene& scene, const Camera& camera, const RenderSettings& settings,
+             RenderReport* report)
 {
     check_settings(settings);
     if (camera.width() != settings.width || camera.height() != settings.height)
         throw Error("render: the camera's image size differs from the settings'");
+    auto start = Clock::now();
+    auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
     tbb::task_arena arena(settings.threads > 0 ? settings.threads
                                                : tbb::task_arena::automatic);
-    Image image{settings.width, settings.height,
-                std::vector<float>(std::size_t(settings.width) * settings.height * 4)};
+    const int w = settings.width, h = settings.height;
+    std::vector<PixelState> pixels(std::size_t(w) * h);
+    RenderReport rep;
     arena.execute([&] {
+        std::unique_ptr<TextureSet> textures;
+        if (!scene.textures.empty())
+            textures = std::make_unique<TextureSet>(scene.textures, settings.texture_folder);
         // Embree builds with TBB too, so the build also stays within the arena.
-        EmbreeScene accel(scene, camera);
+        EmbreeScene accel(scene, camera, textures.get());
         PathContext ctx;
         ctx.accel = &accel;
+        ctx.textures = textures.get();
         ctx.materials = make_materials(scene.materials);
         ctx.lights = make_lights(scene.lights);
         ctx.background = decode_display(scene.background);
-        ctx.environment = {settings.ambient.r, settings.ambient.g, settings.ambient.b};
+        ctx.environment = settings.environment.get();
+        ctx.environment_visible = settings.environment != nullptr;
+        ctx.ambient = {settings.ambient.r, settings.ambient.g, settings.ambient.b};
         ctx.max_depth = settings.max_depth;
         ctx.roulette_depth = settings.roulette_depth;
 
-        int tiles_x = (settings.width + tile_size - 1) / tile_size;
-        int tiles_y = (settings.height + tile_size - 1) / tile_size;
-        // Each tile writes only its own pixels; no exception leaves a task.
-        tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1),
-                          [&](const tbb::blocked_range<int>& r) {
-                              for (int t = r.begin(); t != r.end(); ++t)
-                                  render_tile(ctx, camera, settings, t, image);
-                          });
+        const bool clipping = std::isfinite(camera.clip_near()) || std::isfinite(camera.clip_far());
+        Frame frame{ctx, accel, camera, settings,
+                    FilterTable(settings.filter, settings.filter_radius),
+                    camera.aperture_radius() > 0 &&
+                        camera.projection() == Camera::Projection::perspective,
+                    settings.aovs || clipping};
+
+        const int tiles_x = (w + tile_size - 1) / tile_size;
+        const int tiles_y = (h + tile_size - 1) / tile_size;
+        std::vector<int> targets = pass_targets(settings);
+        ProgressLine progress(settings.progress, start);
+        std::atomic<bool> stop{false}, cancelled{false}, out_of_time{false};
+        double last_pass_s = 0;
+        std::uint64_t last_pass_samples = 0;
+        auto should_stop = [&] {
+            if (settings.cancel && settings.cancel->load(std::memory_order_relaxed)) {
+                cancelled = true;
+                stop = true;
+            }
+            if (settings.time_budget_s > 0 && elapsed() > settings.time_budget_s) {
+                out_of_time = true;
+                stop = true;
+            }
+            return stop.load(std::memory_order_relaxed);
+        };
+
+        for (std::size_t pass = 0; pass < targets.size(); ++pass) {
+            const std::uint32_t target = static_cast<std::uint32_t>(targets[pass]);
+            // Samples still to take to reach the end of the render, for the progress line.
+            std::uint64_t pass_samples = 0, remaining = 0;
+            for (const PixelState& st : pixels)
+                if (!st.done) {
+                    pass_samples += target > st.samples ? target - st.samples : 0;
+                    remaining += std::uint32_t(settings.samples_per_pixel) - st.samples;
+                }
+            if (pass_samples == 0)
+                break;
+            progress.set_total(double(progress.done() + remaining));
+            if (settings.time_budget_s > 0 && pass > 0 && last_pass_samples > 0) {
+                double predicted = last_pass_s * double(pass_samples) / double(last_pass_samples);
+                if (elapsed() + predicted > settings.time_budget_s) {
+                    out_of_time = true;
+                    break;
+                }
+            }
+            auto pass_start = Clock::now();
+            // Each tile writes only its own pixels; no exception leaves a task.
+            tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1),
+                              [&](const tbb::blocked_range<int>& r) {
+                for (int t = r.begin(); t != r.end(); ++t) {
+                    int x0 = (t % tiles_x) * tile_size, y0 = (t / tiles_x) * tile_size;
+                    std::uint64_t taken = 0;
+                    // Checked every row, so even passes of thousands of samples stop soon.
+                    for (int y = y0; y < std::min(y0 + tile_size, h) && !should_stop(); ++y)
+                        for (int x = x0; x < std::min(x0 + tile_size, w); ++x) {
+                            PixelState& st = pixels[std::size_t(y) * w + x];
+                            if (st.done)
+                                continue;
+                            for (std::uint32_t i = st.samples; i < target; ++i, ++taken)
+                                take_sample(frame, x, y, i, st);
+                        }
+                    progress.add(taken);
+                }
+            });
+            if (stop)
+                break;
+            last_pass_s = std::chrono::duration<double>(Clock::now() - pass_start).count();
+            last_pass_samples = pass_samples;
+            rep.passes += 1;
+            if (settings.noise_target > 0)
+                mark_converged(pixels, w, h, settings.noise_target);
+            if (settings.on_pass)
+                settings.on_pass(resolve(pixels, settings));
+        }
+        progress.finish();
+        rep.cancelled = cancelled;
+        rep.out_of_time = out_of_time;
     });
+    for (const PixelState& st : pixels)
+        rep.samples += st.samples;
+    Image image = resolve(pixels, settings);
+    rep.seconds = elapsed();
+    if (report)
+        *report = rep;
     return image;
 }
 

@@ -2,17 +2,33 @@
 // The render layer's entry points: render a Scene to an Image, write it to a file.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <string>
 
 #include "geom/scene.h"
 #include "render/camera.h"
+#include "render/environment.h"
 #include "render/film.h"
 
 namespace cambium::render {
 
+/// The pixel reconstruction filter. Filters are importance sampled: each sample's
+/// position within the pixel's footprint is drawn from the filter (tabulated, 64 bins
+/// per radius) and weighted 1, so every pixel stays a pure function of its own samples.
+enum class PixelFilter {
+    box,              ///< uniform over the pixel (radius fixed at 0.5): cpfg-like crisp edges
+    gaussian,         ///< exp(-x^2 / (2 s^2)) - its edge value, s = radius / 3
+    blackman_harris,  ///< the 4-term Blackman-Harris window over [-radius, radius]
+};
+
 /// How to render a frame.
 struct RenderSettings {
     int width = 640, height = 480;  ///< cpfg's default window
+    /// Samples per pixel; with a noise target or a time budget, the most any pixel gets.
     int samples_per_pixel = 64;
     /// Path segments at most: 1 = direct light only, 2 = one bounce, ...
     int max_depth = 6;
@@ -22,16 +38,87 @@ struct RenderSettings {
     int threads = 0;  ///< 0 = all cores
     /// Radiance (linear RGB) of the uniform environment that secondary rays see when they
     /// escape: the physically-based stand-in for cpfg's ambient term. Camera rays that
-    /// miss see the background colour instead.
+    /// miss see the background colour instead. Ignored when `environment` is set.
     geom::Rgb ambient{0.05f, 0.05f, 0.05f};
+    /// What escaping rays see instead of `ambient` (make_sky_environment,
+    /// make_map_environment); null = the uniform ambient.
+    std::shared_ptr<const Environment> environment;
+    /// The folder that relative texture paths (Scene::textures) are taken from: the
+    /// view file's folder.
+    std::filesystem::path texture_folder;
+
+    /// Reconstruction filter and its radius in pixels (0 = the filter's default: 1.5 for
+    /// gaussian, 1.0 for blackman_harris; box is always 0.5). Default box: the same image
+    /// as before filters existed, and cpfg's window is unfiltered too.
+    PixelFilter filter = PixelFilter::box;
+    float filter_radius = 0;
+
+    /// Progressive rendering: the samples are taken in passes over the whole image (each
+    /// pass adds samples to every pixel still sampled), so `on_pass`, `cancel`, the time
+    /// budget and adaptive sampling act on whole-image states and an interrupted render
+    /// is sampled evenly. 0 = automatic: 8 spp first, doubling each pass; N = N equal
+    /// passes (1 = a single pass). The image does not depend on the passes (each pixel
+    /// sums its samples in the same order).
+    int passes = 0;
+    /// Adaptive sampling (0 = off): a pixel stops being sampled once the standard error
+    /// of its mean luminance, relative to max(mean, 0.01), is at most this for it and
+    /// its 8 neighbours (checked after each pass; 16 samples at least). e.g. 0.02.
+    /// Deterministic: the same image for any thread count.
+    float noise_target = 0;
+    /// Stop after about this many seconds (0 = no limit): no pass is started that is
+    /// predicted not to fit, and a pass still running at the limit stops at the next
+    /// tile row. The image then depends on the machine's speed (not bit-reproducible);
+    /// `samples_per_pixel` still caps it, so set that high.
+    double time_budget_s = 0;
+
+    /// Thin lens (perspective views): aperture radius in world units (0 = pinhole) and
+    /// the distance from the eye to the plane in focus (0 = the view reference point).
+    double aperture_radius = 0;
+    double focus_distance = 0;
+
+    /// Camera rays that miss contribute nothing instead of the background: RGB is
+    /// premultiplied by the coverage alpha (Image::transparent) for PNG/TIFF/EXR output.
+    bool transparent_background = false;
+    /// Compute the albedo, normal and depth layers (Image::albedo/normal/depth): one
+    /// extra camera-ray intersection per sample.
+    bool aovs = true;
+
+    /// Print progress to stderr as one updating line (percentage, elapsed, remaining).
+    bool progress = false;
+    /// Checked every tile row: when it becomes true, render() stops and returns the image
+    /// so far (each pixel averages the samples it got; pixels never reached are black
+    /// with alpha 0). See install_interrupt_handler().
+    const std::atomic<bool>* cancel = nullptr;
+    /// Called on the calling thread after each completed pass with the image so far
+    /// (e.g. to write a preview).
+    std::function<void(const Image&)> on_pass;
 };
 
-/// Renders the scene as cpfg frames it (make_camera) with a unidirectional path tracer.
-/// The result depends on the scene, the settings and the seed, never on the thread count.
-/// Throws cambium::Error on invalid settings or an Embree failure.
-Image render(const geom::Scene& scene, const RenderSettings& settings);
+/// What happened during a render.
+struct RenderReport {
+    std::uint64_t samples = 0;  ///< camera samples taken in all
+    int passes = 0;             ///< passes completed
+    bool cancelled = false;     ///< stopped by `cancel`
+    bool out_of_time = false;   ///< stopped by the time budget
+    double seconds = 0;         ///< wall time, including the Embree build
+};
 
-/// Renders with an explicit camera (tests, turntables).
-Image render(const geom::Scene& scene, const Camera& camera, const RenderSettings& settings);
+/// Renders the scene as cpfg frames it (make_camera, plus the settings' thin lens) with
+/// a unidirectional path tracer. Without a time budget the result depends on the scene,
+/// the settings and the seed, never on the thread count or pass count.
+/// Throws cambium::Error on invalid settings or an Embree failure.
+Image render(const geom::Scene& scene, const RenderSettings& settings,
+             RenderReport* report = nullptr);
+
+/// Renders with an explicit camera (tests, turntables); the settings' lens is not applied.
+Image render(const geom::Scene& scene, const Camera& camera, const RenderSettings& settings,
+             RenderReport* report = nullptr);
+
+/// Installs a SIGINT handler that sets the returned flag (pass it as
+/// RenderSettings::cancel); a second Ctrl-C kills the process as usual. Idempotent.
+const std::atomic<bool>* install_interrupt_handler();
+
+/// The progress line: "render  42%  elapsed 0:12  remaining 0:17" (hours when needed).
+std::string format_progress(double fraction, double elapsed_s);
 
 }  // namespace cambium::render

@@ -1,2 +1,138 @@
 // SPDX-License-Identifier: Apache-2.0
-// (placeholder: being written)
+// The view file's textures, looked up through one OpenImageIO TextureSystem per render.
+#include "render/texture.h"
+
+#include <OpenImageIO/texture.h>
+
+#include <string>
+
+#include "base/diagnostics.h"
+#include "render/color.h"
+
+namespace cambium::render {
+
+namespace {
+
+/// Destroys an unshared TextureSystem (and its own ImageCache).
+struct SystemDeleter {
+    void operator()(OIIO::TextureSystem* ts) const { OIIO::TextureSystem::destroy(ts, true); }
+};
+
+struct Entry {
+    OIIO::TextureSystem::TextureHandle* handle = nullptr;
+    OIIO::TextureOpt options;
+    int channels = 3;
+    bool srgb = true;
+    bool decal = false;
+};
+
+}  // namespace
+
+struct TextureSet::Impl {
+    std::unique_ptr<OIIO::TextureSystem, SystemDeleter> system;
+    std::vector<Entry> entries;
+};
+
+TextureSet::TextureSet(const std::vector<geom::TextureDef>& defs,
+                       const std::filesystem::path& base)
+    : m_impl(std::make_unique<Impl>())
+{
+    if (defs.empty())
+        return;
+    // One private system per render: no state shared with other renders in the process.
+    m_impl->system.reset(OIIO::TextureSystem::create(false));
+    OIIO::TextureSystem& ts = *m_impl->system;
+    ts.attribute("automip", 1);          // plain images get MIP levels built in memory
+    ts.attribute("max_memory_MB", 512.0f);
+    // Keep colours as stored (cpfg's OpenGL textures are not premultiplied by alpha).
+    ts.attribute("unassociatedalpha", 1);
+    for (const geom::TextureDef& def : defs) {
+        std::filesystem::path file = def.file;
+        if (file.is_relative() && !base.empty())
+            file = base / file;
+        // As cpfg, a texture that cannot be read is a warning and the surfaces it
+        // names are drawn untextured (the corpus names maple.rgb beside a maple.png).
+        Entry e;
+        if (!std::filesystem::is_regular_file(file)) {
+            warn(FileLoc{file.string()}, "texture not found; drawing without it");
+            m_impl->entries.push_back(e);
+            continue;
+        }
+        e.handle = ts.get_texture_handle(OIIO::ustring(file.string()));
+        const OIIO::ImageSpec* spec = e.handle ? ts.imagespec(e.handle, nullptr) : nullptr;
+        if (!spec) {
+            std::string why = ts.geterror();
+            warn(FileLoc{file.string()}, "texture cannot be read" +
+                                             (why.empty() ? std::string() : ": " + why) +
+                                             "; drawing without it");
+            e.handle = nullptr;
+            m_impl->entries.push_back(e);
+            continue;
+        }
+        e.channels = spec->nchannels;
+        e.srgb = !spec->format.is_floating_point();
+        e.decal = def.decal;
+        e.options.swrap = e.options.twrap = OIIO::TextureOpt::WrapPeriodic;
+        e.options.interpmode = def.linear_filter ? OIIO::TextureOpt::InterpBilinear
+                                                 : OIIO::TextureOpt::InterpClosest;
+        e.options.mipmode = def.mipmap ? OIIO::TextureOpt::MipModeTrilinear
+                                       : OIIO::TextureOpt::MipModeNoMIP;
+        e.options.fill = 1;
+        m_impl->entries.push_back(e);
+    }
+}
+
+TextureSet::~TextureSet() = default;
+
+std::size_t TextureSet::size() const { return m_impl->entries.size(); }
+
+bool TextureSet::valid(int index) const
+{
+    return index >= 0 && static_cast<std::size_t>(index) < m_impl->entries.size() &&
+           m_impl->entries[static_cast<std::size_t>(index)].handle != nullptr;
+}
+
+bool TextureSet::decal(int index) const { return valid(index) && m_impl->entries[index].decal; }
+
+bool TextureSet::has_alpha(int index) const
+{
+    return valid(index) && (m_impl->entries[index].channels == 2 ||
+                            m_impl->entries[index].channels >= 4);
+}
+
+Texel TextureSet::lookup(int index, float s, float t, float width) const
+{
+    if (!valid(index))
+        return {};
+    const Entry& e = m_impl->entries[index];
+    OIIO::TextureOpt options = e.options;  // the lookup may write to it
+    float v[4] = {1, 1, 1, 1};
+    int n = e.channels >= 4 ? 4 : (e.channels == 2 ? 2 : (e.channels == 1 ? 1 : 3));
+    // OIIO's t runs down the image, OpenGL's up.
+    bool ok = m_impl->system->texture(e.handle, nullptr, options, s, 1 - t, width, 0, 0, width,
+                                      n, v);
+    if (!ok)
+        return {};
+    Texel texel;
+    if (n <= 2) {
+        texel.colour = Vec3f(v[0]);
+        texel.alpha = n == 2 ? v[1] : 1;
+    } else {
+        texel.colour = {v[0], v[1], v[2]};
+        texel.alpha = n == 4 ? v[3] : 1;
+    }
+    if (e.srgb)
+        texel.colour = {srgb_to_linear(texel.colour.x), srgb_to_linear(texel.colour.y),
+                        srgb_to_linear(texel.colour.z)};
+    return texel;
+}
+
+Vec3f TextureSet::apply(int index, const Vec3f& diffuse, float s, float t) const
+{
+    if (!valid(index))
+        return diffuse;
+    Texel texel = lookup(index, s, t);
+    return decal(index) ? texel.colour : diffuse * texel.colour;
+}
+
+}  // namespace cambium::render

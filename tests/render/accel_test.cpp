@@ -85,7 +85,8 @@ std::pair<int, int> count_rehits(const geom::Scene& s, float half_width)
             continue;
         ++n;
         Vec3f org = hit->position + hit->normal * hit->spawn_offset;
-        BsdfSample bs = bsdf_sample(Lambertian{Vec3f(1)}, hit->normal, sm.next(), sm.next());
+        BsdfSample bs = bsdf_sample(lambertian(Vec3f(1)), hit->normal, Vec3f(0, 0, 1), sm.next(),
+                                    sm.next());
         rehits += accel.intersect(org, bs.wi, 0, inf, hit->prim()) ? 1 : 0;
     }
     return {rehits, n};

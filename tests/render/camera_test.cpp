@@ -129,5 +129,57 @@ TEST(Camera, GeneratedRayPassesThroughProjectedPoint)
     }
 }
 
+// A thin lens: rays from different lens points through the same pixel meet on the
+// plane in focus, where the pinhole ray passes too; the lens points lie within the
+// aperture on the plane through the eye perpendicular to the view.
+TEST(Camera, ThinLensRaysMeetOnTheFocusPlane)
+{
+    Camera pinhole = Camera::perspective({1, 2, 30}, {1, 2, 0}, {0, 1, 0}, 40, 80, 60);
+    Camera lens = pinhole.with_lens(0.5, 12.0);
+    EXPECT_DOUBLE_EQ(lens.focus_distance(), 12.0);
+    EXPECT_DOUBLE_EQ(pinhole.with_lens(0.5).focus_distance(), 30.0);  // the reference point
+    CameraRay centre = pinhole.generate_ray(13.3, 47.9);
+    // The pinhole ray reaches depth 12 (along -z from the eye) at t = 12 / cos.
+    geom::Vec3 target = centre.org + centre.dir * (12.0 / -centre.dir.z);
+    for (double u : {0.0, 0.3, 0.999})
+        for (double v : {0.1, 0.5, 0.8}) {
+            CameraRay r = lens.generate_ray(13.3, 47.9, u, v);
+            EXPECT_NEAR(r.org.z, 30.0, 1e-12);
+            EXPECT_LE(std::hypot(r.org.x - 1, r.org.y - 2), 0.5 + 1e-12);
+            geom::Vec3 p = r.org + r.dir * ((30.0 - 12.0 - r.org.z) / r.dir.z);
+            EXPECT_NEAR(p.x, target.x, 1e-9);
+            EXPECT_NEAR(p.y, target.y, 1e-9);
+        }
+    // A pinhole ignores the lens numbers.
+    CameraRay same = pinhole.generate_ray(13.3, 47.9, 0.9, 0.1);
+    EXPECT_EQ(same.org.x, centre.org.x);
+    EXPECT_EQ(same.dir.y, centre.dir.y);
+}
+
+// Perspective clipping planes are at depths along the view direction: an oblique ray
+// reaches them at depth / cos(angle).
+TEST(Camera, PerspectiveClippingGivesRayIntervals)
+{
+    geom::View view;
+    view.perspective = true;
+    view.viewpoint = {0, 0, 10};
+    view.front_distance = 4;
+    view.back_distance = 9;
+    Camera c = make_camera(view, box({-1, -1, -1}, {1, 1, 1}), 100, 100);
+    CameraRay axis = c.generate_ray(50, 50);
+    EXPECT_NEAR(axis.tnear, 4.0, 1e-9);
+    EXPECT_NEAR(axis.tfar, 9.0, 1e-9);
+    CameraRay corner = c.generate_ray(0, 0);
+    double cos = -corner.dir.z;
+    EXPECT_NEAR(corner.tnear, 4.0 / cos, 1e-9);
+    EXPECT_NEAR(corner.tfar, 9.0 / cos, 1e-9);
+    // Without planes, rays are unbounded.
+    view.front_distance.reset();
+    view.back_distance.reset();
+    CameraRay open = make_camera(view, box({-1, -1, -1}, {1, 1, 1}), 100, 100).generate_ray(0, 0);
+    EXPECT_EQ(open.tnear, 0.0);
+    EXPECT_TRUE(std::isinf(open.tfar));
+}
+
 }  // namespace
 }  // namespace cambium::render

@@ -1,0 +1,408 @@
+// SPDX-License-Identifier: Apache-2.0
+// Render benchmark: BVH build, peak memory and path-tracer rays per second on a large
+// synthetic plant, beside raw Embree rtcIntersect1 on the same rays. Prints one JSON object.
+//
+// Usage: render [--scale S] [--threads N] [--size WxH] [--spp N] [--depth N]
+// Default (scale 1): 1 M round linear segments in 5 000 branches plus 100 000 instances
+// of a 6-triangle leaf prototype; 320x240 at 16 spp, depth 4.
+//
+// The path tracer's rays are counted by interposing rtcIntersect1 / rtcOccluded1: this
+// executable defines them, cambium_render (a static library) links to these definitions,
+// and they forward to Embree's through dlsym(RTLD_NEXT). The interposer also keeps the
+// render's Embree scene alive and records the first rays it traces, which are then
+// replayed with raw rtcIntersect1 on that same scene (no filter function) for the
+// comparison.
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <dlfcn.h>
+#include <sys/resource.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "geom/scene.h"
+#include "render/accel.h"
+#include "render/render.h"
+#include "render/sampler.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t)
+{
+    return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+double peak_rss_mb()
+{
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return static_cast<double>(usage.ru_maxrss) / 1024.0;  // KiB
+}
+
+// ---- The interposer ------------------------------------------------------------------
+
+struct Recorder {
+    std::atomic<std::uint64_t> intersections{0}, occlusions{0};
+    std::atomic<bool> started{false};
+    Clock::time_point first_call;
+    std::mutex mutex;
+    RTCScene scene = nullptr;          // retained: outlives the render
+    std::vector<RTCRay> rays;          // the first rays traced, as given
+    std::size_t capacity = 0;
+    std::atomic<bool> full{false};
+};
+Recorder recorder;
+
+using Intersect1 = void (*)(RTCScene, RTCIntersectContext*, RTCRayHit*);
+using Occluded1 = void (*)(RTCScene, RTCIntersectContext*, RTCRay*);
+
+Intersect1 real_intersect()
+{
+    static auto f = reinterpret_cast<Intersect1>(dlsym(RTLD_NEXT, "rtcIntersect1"));
+    return f;
+}
+
+Occluded1 real_occluded()
+{
+    static auto f = reinterpret_cast<Occluded1>(dlsym(RTLD_NEXT, "rtcOccluded1"));
+    return f;
+}
+
+void note_call(RTCScene scene)
+{
+    if (!recorder.started.load(std::memory_order_relaxed)) {
+        std::lock_guard lock(recorder.mutex);
+        if (!recorder.started) {
+            recorder.first_call = Clock::now();
+            recorder.scene = scene;
+            rtcRetainScene(scene);
+            recorder.started = true;
+        }
+    }
+}
+
+}  // namespace
+
+extern "C" void rtcIntersect1(RTCScene scene, RTCIntersectContext* context, RTCRayHit* rayhit)
+{
+    if (recorder.capacity > 0) {
+        note_call(scene);
+        recorder.intersections.fetch_add(1, std::memory_order_relaxed);
+        if (!recorder.full.load(std::memory_order_relaxed)) {
+            std::lock_guard lock(recorder.mutex);
+            if (recorder.rays.size() < recorder.capacity)
+                recorder.rays.push_back(rayhit->ray);
+            else
+                recorder.full = true;
+        }
+    }
+    real_intersect()(scene, context, rayhit);
+}
+
+extern "C" void rtcOccluded1(RTCScene scene, RTCIntersectContext* context, RTCRay* ray)
+{
+    if (recorder.capacity > 0) {
+        note_call(scene);
+        recorder.occlusions.fetch_add(1, std::memory_order_relaxed);
+    }
+    real_occluded()(scene, context, ray);
+}
+
+namespace {
+
+// ---- The synthetic plant ------------------------------------------------------------
+
+struct Random {
+    std::uint64_t state;
+    float next()
+    {
+        state += 0x9e3779b97f4a7c15ULL;
+        return static_cast<float>(cambium::render::mix64(state) >> 40) * 0x1.0p-24f;
+    }
+    float range(float lo, float hi) { return lo + (hi - lo) * next(); }
+};
+
+using cambium::geom::Vec3;
+
+/// Appends a polyline of round linear segments with neighbour flags closing its joints.
+void add_polyline(cambium::geom::LinearCurves& lines, const std::vector<Vec3>& points,
+                  float r0, float r1, std::uint16_t material)
+{
+    auto first = static_cast<std::uint32_t>(lines.keys.size());
+    std::size_t n = points.size();
+    for (std::size_t i = 0; i < n; ++i) {
+        float r = r0 + (r1 - r0) * float(i) / float(n - 1);
+        lines.keys.push_back({float(points[i].x), float(points[i].y), float(points[i].z), r});
+    }
+    for (std::size_t i = 0; i + 1 < n; ++i) {
+        lines.segments.push_back(first + static_cast<std::uint32_t>(i));
+        std::uint8_t flags = 0;
+        if (i > 0)
+            flags |= cambium::geom::CurveFlags::neighbour_left;
+        if (i + 2 < n)
+            flags |= cambium::geom::CurveFlags::neighbour_right;
+        lines.flags.push_back(flags);
+        lines.material.push_back(material);
+    }
+}
+
+/// A flat diamond leaf of 6 triangles in the xy plane, base at the origin, tip at y = 1.
+cambium::geom::Prototype leaf_prototype()
+{
+    cambium::geom::Prototype p;
+    p.name = "leaf";
+    auto& m = p.geometry.mesh;
+    m.positions = {{0, 0, 0}, {-0.25f, 0.35f, 0}, {0, 0.4f, 0}, {0.25f, 0.35f, 0},
+                   {-0.2f, 0.7f, 0}, {0.2f, 0.7f, 0}, {0, 1, 0}};
+    m.normals.assign(m.positions.size(), {0, 0, 1});
+    m.uvs.assign(m.positions.size(), {0, 0});
+    m.triangles = {{0, 2, 1}, {0, 3, 2}, {1, 2, 4}, {2, 3, 5}, {2, 5, 4}, {4, 5, 6}};
+    m.material.assign(m.triangles.size(), cambium::geom::inherit_material);
+    m.back_material.assign(m.triangles.size(), cambium::geom::inherit_material);
+    m.texture.assign(m.triangles.size(), cambium::geom::no_texture);
+    return p;
+}
+
+/// A rotation by `angle` about the unit `axis`, scaled, then moved to `at`: Embree's
+/// column-major 3x4 layout.
+std::array<float, 12> placement(const Vec3& axis, double angle, double scale, const Vec3& at)
+{
+    double c = std::cos(angle), s = std::sin(angle), t = 1 - c;
+    double x = axis.x, y = axis.y, z = axis.z;
+    double r[3][3] = {{t * x * x + c, t * x * y - s * z, t * x * z + s * y},
+                      {t * x * y + s * z, t * y * y + c, t * y * z - s * x},
+                      {t * x * z - s * y, t * y * z + s * x, t * z * z + c}};
+    std::array<float, 12> m{};
+    for (int col = 0; col < 3; ++col)
+        for (int row = 0; row < 3; ++row)
+            m[std::size_t(col * 3 + row)] = static_cast<float>(r[row][col] * scale);
+    m[9] = float(at.x);
+    m[10] = float(at.y);
+    m[11] = float(at.z);
+    return m;
+}
+
+/// A tree: a trunk and wandering branches of 200 segments each, leaves on the branches.
+cambium::geom::Scene make_plant(std::size_t segments, std::size_t leaves)
+{
+    cambium::geom::Scene s;
+    Random rng{42};
+    constexpr int per_branch = 200;
+    constexpr double height = 20;
+    std::vector<Vec3> trunk;
+    for (int i = 0; i <= per_branch; ++i)
+        trunk.push_back({0.3 * std::sin(i * 0.05), height * i / per_branch, 0});
+    add_polyline(s.geometry.lines, trunk, 0.6f, 0.15f, 1);
+    std::vector<Vec3> tips;  // where leaves go
+    std::size_t branches = segments > per_branch ? segments / per_branch - 1 : 0;
+    for (std::size_t b = 0; b < branches; ++b) {
+        double y0 = rng.range(0.25f, 0.95f) * height;
+        double phi = rng.range(0, 6.2831853f);
+        Vec3 dir = cambium::geom::normalize(
+            Vec3{std::cos(phi), rng.range(0.1f, 0.8f), std::sin(phi)});
+        std::vector<Vec3> points{{0.3 * std::sin(y0 / height * per_branch * 0.05), y0, 0}};
+        double step = 0.05 * (1.2 - y0 / height);
+        for (int i = 0; i < per_branch; ++i) {
+            Vec3 wobble{rng.range(-0.15f, 0.15f), rng.range(-0.1f, 0.15f),
+                        rng.range(-0.15f, 0.15f)};
+            dir = cambium::geom::normalize(dir + wobble);
+            points.push_back(points.back() + dir * step);
+        }
+        add_polyline(s.geometry.lines, points, 0.06f, 0.008f, 1);
+        for (int i = per_branch / 2; i <= per_branch; i += 10)
+            tips.push_back(points[std::size_t(i)]);
+    }
+    if (leaves > 0 && !tips.empty()) {
+        s.prototypes.push_back(leaf_prototype());
+        for (std::size_t i = 0; i < leaves; ++i) {
+            Vec3 at = tips[i % tips.size()];
+            Vec3 axis = cambium::geom::normalize(
+                Vec3{rng.range(-1, 1), rng.range(-1, 1), rng.range(-1, 1)} + Vec3{0, 0, 1e-3});
+            cambium::geom::Instance inst;
+            inst.prototype = 0;
+            inst.transform = placement(axis, rng.range(0, 6.2831853f), 0.5, at);
+            inst.material = inst.back_material = 2;
+            s.instances.push_back(inst);
+        }
+    }
+    for (const auto& k : s.geometry.lines.keys)
+        s.bounds.extend(Vec3{k[0], k[1], k[2]});
+    s.materials[1].diffuse = {0.45f, 0.33f, 0.2f};
+    s.materials[2].diffuse = {0.25f, 0.6f, 0.2f};
+    s.background = {0.8f, 0.85f, 0.95f};
+    cambium::geom::Light sun;
+    sun.kind = cambium::geom::Light::Kind::directional;
+    sun.direction = {0.4, 1, 0.6};
+    s.lights.push_back(sun);
+    // Perspective, off every axis (axis-parallel rays are a slow case for curves).
+    s.view.perspective = true;
+    s.view.viewpoint = {12, 14, 19};
+    s.view.reference_point = {0, 10, 0};
+    s.view.viewing_angle_deg = 50;
+    return s;
+}
+
+/// Whether the acceleration structure draws instances: one leaf in front of a camera.
+bool accel_draws_instances()
+{
+    cambium::geom::Scene s;
+    s.prototypes.push_back(leaf_prototype());
+    cambium::geom::Instance inst;
+    inst.material = inst.back_material = 2;
+    s.instances.push_back(inst);  // identity: the leaf in the xy plane, y 0..1
+    s.bounds.extend(Vec3{-1, -1, -1});
+    s.bounds.extend(Vec3{1, 1, 1});
+    auto camera = cambium::render::make_camera(s.view, s.bounds, 16, 16);
+    cambium::render::EmbreeScene accel(s, camera);
+    return accel.intersect({0, 0.5f, 5}, {0, 0, -1}, 0, 100).has_value();
+}
+
+/// Raw rtcIntersect1 over the recorded rays, in parallel; returns seconds.
+double replay(RTCScene scene, const std::vector<RTCRay>& rays, std::uint64_t& hits)
+{
+    std::atomic<std::uint64_t> hit_count{0};
+    auto t0 = Clock::now();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 1024),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        std::uint64_t local = 0;
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            RTCRayHit rh;
+            rh.ray = rays[i];
+            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            real_intersect()(scene, &context, &rh);
+            local += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
+        }
+        hit_count += local;
+    });
+    hits = hit_count;
+    return seconds_since(t0);
+}
+
+int run(int argc, char** argv)
+{
+    double scale = 1;
+    int threads = 0, width = 320, height = 240, spp = 16, depth = 4;
+    for (int i = 1; i < argc; ++i) {
+        std::string a = argv[i];
+        auto value = [&]() -> std::string {
+            if (i + 1 >= argc)
+                throw std::runtime_error(a + " needs a value");
+            return argv[++i];
+        };
+        if (a == "--scale")
+            scale = std::stod(value());
+        else if (a == "--threads")
+            threads = std::stoi(value());
+        else if (a == "--spp")
+            spp = std::stoi(value());
+        else if (a == "--depth")
+            depth = std::stoi(value());
+        else if (a == "--size") {
+            std::string v = value();
+            if (std::sscanf(v.c_str(), "%dx%d", &width, &height) != 2)
+                throw std::runtime_error("--size wants WxH");
+        } else
+            throw std::runtime_error("unknown option " + a +
+                                     " (--scale S --threads N --size WxH --spp N --depth N)");
+    }
+    if (!(scale > 0) || scale > 100)
+        throw std::runtime_error("--scale must be in (0, 100]");
+    auto segments = static_cast<std::size_t>(1'000'000 * scale);
+    auto leaves = static_cast<std::size_t>(100'000 * scale);
+
+    auto t0 = Clock::now();
+    cambium::geom::Scene scene = make_plant(segments, leaves);
+    double generate_s = seconds_since(t0);
+    bool instances = accel_draws_instances();
+
+    tbb::task_arena arena(threads > 0 ? threads : tbb::task_arena::automatic);
+    cambium::render::RenderSettings settings;
+    settings.width = width;
+    settings.height = height;
+    settings.samples_per_pixel = spp;
+    settings.max_depth = depth;
+    settings.threads = threads;
+    settings.ambient = {0.1f, 0.1f, 0.1f};
+    settings.aovs = false;  // the path tracer alone
+    auto camera = cambium::render::make_camera(scene.view, scene.bounds, width, height);
+
+    // BVH build, on its own.
+    double build_s = 0, rss_after_build = 0;
+    std::size_t built_segments = 0;
+    arena.execute([&] {
+        auto b0 = Clock::now();
+        cambium::render::EmbreeScene accel(scene, camera);
+        build_s = seconds_since(b0);
+        built_segments = accel.segment_count();
+        rss_after_build = peak_rss_mb();
+    });
+
+    // The path tracer, counted by the interposer.
+    recorder.capacity = 2'000'000;
+    auto r0 = Clock::now();
+    cambium::render::RenderReport report;
+    cambium::render::Image image = cambium::render::render(scene, camera, settings, &report);
+    double render_s = seconds_since(r0);
+    double trace_s = std::chrono::duration<double>(Clock::now() - recorder.first_call).count();
+    recorder.capacity = 0;
+    std::uint64_t intersections = recorder.intersections, occlusions = recorder.occlusions;
+    double covered = 0;
+    for (std::size_t i = 3; i < image.rgba.size(); i += 4)
+        covered += image.rgba[i];
+
+    // Raw Embree on the same (recorded) rays, same scene, same threads.
+    std::uint64_t raw_hits = 0;
+    double raw_s = 0;
+    arena.execute([&] { raw_s = replay(recorder.scene, recorder.rays, raw_hits); });
+    rtcReleaseScene(recorder.scene);
+
+    double rays = double(intersections + occlusions);
+    std::printf(
+        "{\"scale\":%g,\"threads\":%d,\"segments\":%zu,\"embree_segments\":%zu,"
+        "\"instances\":%zu,\"instances_in_accel\":%s,\"generate_s\":%.3f,\"build_s\":%.3f,"
+        "\"peak_rss_mb_after_build\":%.1f,\"image\":\"%dx%d\",\"spp\":%d,\"max_depth\":%d,"
+        "\"render_s\":%.3f,\"trace_s\":%.3f,\"paths\":%llu,\"coverage\":%.3f,"
+        "\"intersect_rays\":%llu,\"occlusion_rays\":%llu,\"rays_per_s\":%.0f,"
+        "\"paths_per_s\":%.0f,\"raw_embree\":{\"rays\":%zu,\"seconds\":%.3f,"
+        "\"rays_per_s\":%.0f,\"hit_fraction\":%.3f},\"path_tracer_intersect_rays_per_s\":%.0f,"
+        "\"peak_rss_mb\":%.1f}\n",
+        scale, threads, scene.geometry.lines.segment_count(), built_segments,
+        scene.instances.size(), instances ? "true" : "false", generate_s, build_s,
+        rss_after_build, width, height, spp, depth, render_s, trace_s,
+        static_cast<unsigned long long>(report.samples), covered / (double(width) * height),
+        static_cast<unsigned long long>(intersections),
+        static_cast<unsigned long long>(occlusions), rays / trace_s,
+        double(report.samples) / trace_s, recorder.rays.size(), raw_s,
+        double(recorder.rays.size()) / raw_s,
+        recorder.rays.empty() ? 0.0 : double(raw_hits) / double(recorder.rays.size()),
+        double(intersections) / trace_s, peak_rss_mb());
+    return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
+    try {
+        return run(argc, argv);
+    } catch (const std::exception& e) {
+        std::printf("{\"error\":\"%s\"}\n", e.what());
+        return 1;
+    }
+}

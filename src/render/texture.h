@@ -1,0 +1,57 @@
+// SPDX-License-Identifier: Apache-2.0
+// The view file's textures, looked up through one OpenImageIO TextureSystem per render.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <vector>
+
+#include "geom/scene.h"
+#include "render/vecf.h"
+
+namespace cambium::render {
+
+/// One filtered texture sample: linear RGB and coverage alpha.
+struct Texel {
+    Vec3f colour{1.0f};
+    float alpha = 1;
+};
+
+/// The Scene's TextureDefs, opened once (mipmapped on demand by OIIO, any format OIIO reads,
+/// SGI .rgb included). Thread-safe lookups after construction.
+///
+/// Coordinates are OpenGL's: (s, t) in [0, 1]^2 with t = 0 the image's bottom row; both
+/// wrap (GL_REPEAT). 8-bit and 16-bit images hold display values and are decoded as sRGB
+/// after filtering; floating-point images are taken as linear (docs/materials.md).
+class TextureSet {
+public:
+    /// Opens every texture; relative paths are taken relative to `base` (the view file's
+    /// folder). A file that is missing or unreadable is a warning naming it, and its
+    /// index is not valid(): what it textures is drawn untextured, as cpfg does.
+    explicit TextureSet(const std::vector<geom::TextureDef>& defs,
+                        const std::filesystem::path& base = {});
+    ~TextureSet();
+    TextureSet(const TextureSet&) = delete;
+    TextureSet& operator=(const TextureSet&) = delete;
+
+    std::size_t size() const;
+    /// Whether `index` is a texture (not no_texture and in range).
+    bool valid(int index) const;
+    /// E: decal (replaces the diffuse colour) rather than modulate.
+    bool decal(int index) const;
+    /// Whether the image has an alpha channel (cut-outs are tested only then).
+    bool has_alpha(int index) const;
+
+    /// The filtered texel at (s, t); `width` is the lookup's footprint in texture units
+    /// (0: the finest level). Invalid indices give white, alpha 1.
+    Texel lookup(int index, float s, float t, float width = 0) const;
+
+    /// The diffuse albedo after texture `index` at (s, t): modulated or replaced.
+    Vec3f apply(int index, const Vec3f& diffuse, float s, float t) const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> m_impl;
+};
+
+}  // namespace cambium::render

@@ -1,0 +1,156 @@
+// SPDX-License-Identifier: Apache-2.0
+// The BSDF: Lambertian reflection and transmission, the normalized Phong lobe, sampling
+// against independent quadrature, energy bounds, and the cpfg material mapping.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "render/color.h"
+#include "render/material.h"
+#include "render/sampler.h"
+
+namespace cambium::render {
+namespace {
+
+constexpr float pi = std::numbers::pi_v<float>;
+const Vec3f up(0, 0, 1);
+
+Vec3f incidence(float theta) { return {std::sin(theta), 0, std::cos(theta)}; }
+
+/// Mean of bsdf_sample's weights: the BSDF's directional albedo by importance sampling.
+Vec3f sampled_albedo(const Bsdf& b, const Vec3f& wo, int n = 200000)
+{
+    double r = 0, g = 0, bl = 0;
+    for (int i = 0; i < n; ++i) {
+        Sampler s(static_cast<std::uint32_t>(i), 0, 0, 11);
+        BsdfSample bs = bsdf_sample(b, up, wo, s.next(), s.next());
+        r += bs.weight.x;
+        g += bs.weight.y;
+        bl += bs.weight.z;
+    }
+    return Vec3f(float(r / n), float(g / n), float(bl / n));
+}
+
+/// The same albedo by uniform sampling of the sphere: independent of bsdf_sample and pdf.
+/// Also returns the integral of the pdf over the sphere.
+Vec3f quadrature_albedo(const Bsdf& b, const Vec3f& wo, double* pdf_integral, int n = 400000)
+{
+    double r = 0, g = 0, bl = 0, p = 0;
+    for (int i = 0; i < n; ++i) {
+        Sampler s(static_cast<std::uint32_t>(i), 1, 0, 13);
+        float z = 1 - 2 * s.next(), phi = 2 * pi * s.next();
+        float rad = std::sqrt(std::fmax(0.0f, 1 - z * z));
+        Vec3f wi(rad * std::cos(phi), rad * std::sin(phi), z);
+        Vec3f f = bsdf_eval(b, up, wo, wi) * (std::fabs(z) * 4 * pi);
+        r += f.x;
+        g += f.y;
+        bl += f.z;
+        p += bsdf_pdf(b, up, wo, wi) * 4 * pi;
+    }
+    *pdf_integral = p / n;
+    return Vec3f(float(r / n), float(g / n), float(bl / n));
+}
+
+TEST(Material, LambertianSampleWeightIsTheAlbedo)
+{
+    Bsdf b = lambertian({0.2f, 0.5f, 0.9f});
+    for (int i = 0; i < 100; ++i) {
+        Sampler s(static_cast<std::uint32_t>(i), 0, 0, 1);
+        BsdfSample bs = bsdf_sample(b, up, incidence(0.3f), s.next(), s.next());
+        ASSERT_GT(bs.wi.z, 0);
+        EXPECT_NEAR(bs.weight.y, 0.5f, 1e-5f);
+        EXPECT_NEAR(bs.pdf, bs.wi.z / pi, 1e-5f);
+    }
+    EXPECT_NEAR(bsdf_eval(b, up, up, {0, 0, -1}).x, 0, 0);  // nothing through
+}
+
+// Sampling agrees with quadrature of eval for every lobe mixture: pdf and eval match.
+TEST(Material, SamplingMatchesQuadrature)
+{
+    SurfaceMaterial m;
+    m.diffuse = {0.6f, 0.6f, 0.6f};
+    m.translucency = 0.3f;
+    m.specular = {0.3f, 0.3f, 0.3f};
+    m.exponent = 8;
+    Bsdf b = make_bsdf(m);
+    for (float theta : {0.0f, 0.7f, 1.3f}) {
+        double pdf_integral = 0;
+        Vec3f q = quadrature_albedo(b, incidence(theta), &pdf_integral);
+        Vec3f s = sampled_albedo(b, incidence(theta));
+        EXPECT_NEAR(s.x, q.x, 0.01f) << theta;
+        // The pdf integrates to 1 less the glossy samples that fall below the surface.
+        EXPECT_LE(pdf_integral, 1.01);
+        EXPECT_GT(pdf_integral, 0.7);
+    }
+}
+
+// Normalized Phong: albedo = specular at normal incidence for any exponent, less (never
+// more) at oblique incidence.
+TEST(Material, GlossyLobeConservesEnergy)
+{
+    for (float exponent : {0.0f, 4.0f, 16.0f}) {
+        Bsdf b{Vec3f(), Vec3f(), Vec3f(1.0f), exponent};
+        double unused = 0;
+        Vec3f normal = quadrature_albedo(b, up, &unused);
+        EXPECT_NEAR(normal.x, 1.0f, exponent > 8 ? 0.03f : 0.01f) << exponent;
+        for (float theta : {0.5f, 1.0f, 1.4f}) {
+            Vec3f a = sampled_albedo(b, incidence(theta), 50000);
+            EXPECT_LE(a.x, 1.005f) << exponent << " " << theta;
+            EXPECT_GT(a.x, 0.1f);  // lost below the horizon at grazing angles
+        }
+    }
+}
+
+// Translucency moves that fraction of the diffuse albedo to the other side.
+TEST(Material, TranslucencySplitsDiffuseAlbedo)
+{
+    SurfaceMaterial m;
+    m.diffuse = Vec3f(0.8f);
+    m.translucency = 0.25f;
+    Bsdf b = make_bsdf(m);
+    double below = 0, above = 0;
+    const int n = 100000;
+    for (int i = 0; i < n; ++i) {
+        Sampler s(static_cast<std::uint32_t>(i), 2, 0, 5);
+        BsdfSample bs = bsdf_sample(b, up, incidence(0.4f), s.next(), s.next());
+        (bs.wi.z < 0 ? below : above) += bs.weight.x;
+    }
+    EXPECT_NEAR(below / n, 0.8 * 0.25, 2e-3);
+    EXPECT_NEAR(above / n, 0.8 * 0.75, 2e-3);
+    EXPECT_NEAR(bsdf_eval(b, up, up, {0, 0, -1}).x, 0.2f / pi, 1e-6f);
+}
+
+// Diffuse plus specular never exceeds 1: the diffuse keeps 1 - max(specular).
+TEST(Material, GlossyTakesItsShareFromDiffuse)
+{
+    SurfaceMaterial m;
+    m.diffuse = Vec3f(1);
+    m.specular = Vec3f(0.25f);
+    m.exponent = 10;
+    Bsdf b = make_bsdf(m);
+    EXPECT_NEAR(b.reflect.x, 0.75f, 1e-6f);
+    double unused = 0;
+    EXPECT_NEAR(quadrature_albedo(b, up, &unused).x, 1.0f, 0.01f);
+}
+
+TEST(Material, MapsCpfgMaterials)
+{
+    geom::Material g;
+    g.diffuse = {0.5f, 0.5f, 0.5f};
+    g.specular = {1, 1, 1};
+    g.shininess = 64;
+    g.transparency = 0.25f;
+    g.translucency = 0.4f;
+    g.emission = {0.2f, 0, 0};
+    SurfaceMaterial m = make_materials({g})[0];
+    EXPECT_FLOAT_EQ(m.diffuse.x, srgb_to_linear(0.5f));
+    EXPECT_FLOAT_EQ(m.specular.x, 1);
+    EXPECT_FLOAT_EQ(m.exponent, 16);
+    EXPECT_FLOAT_EQ(m.opacity, 0.75f);
+    EXPECT_FLOAT_EQ(m.translucency, 0.4f);
+    EXPECT_FLOAT_EQ(m.emission.x, srgb_to_linear(0.2f));
+}
+
+}  // namespace
+}  // namespace cambium::render

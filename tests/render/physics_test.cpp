@@ -1,0 +1,348 @@
+// SPDX-License-Identifier: Apache-2.0
+// The integrator against closed forms: white furnaces (diffuse, translucent, glossy; sphere,
+// curves, instanced mesh), direct light from point and directional lights, two-sided and
+// translucent leaves, transparency, emission, environment MIS.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <memory>
+#include <numbers>
+
+#include "render/accel.h"
+#include "render/color.h"
+#include "geom_scenes.h"
+
+namespace cambium::render {
+namespace {
+
+using namespace testing;
+
+constexpr float pi = std::numbers::pi_v<float>;
+
+geom::Rgb grey(float display) { return {display, display, display}; }
+
+/// A context over accel with the scene's materials and lights.
+PathContext context(const geom::Scene& s, const EmbreeScene& accel, float ambient, int depth)
+{
+    PathContext ctx;
+    ctx.accel = &accel;
+    ctx.materials = make_materials(s.materials);
+    ctx.lights = make_lights(s.lights);
+    ctx.background = decode_display(s.background);
+    ctx.ambient = Vec3f(ambient);
+    ctx.max_depth = depth;
+    return ctx;
+}
+
+/// White furnace: environment and background of radiance 1, mean over a block of pixels
+/// that all see the object (coverage must be 1).
+float furnace(const geom::Scene& s, const Camera& camera, int x0, int y0, int x1, int y1,
+              int spp, int roulette_depth, const Environment* env = nullptr)
+{
+    EmbreeScene accel(s, camera);
+    PathContext ctx = context(s, accel, 1, 200);
+    // The uniform environment as an object: the integrator must see it needs no NEE.
+    std::unique_ptr<Environment> uniform = make_uniform_environment(Vec3f(1));
+    ctx.environment = env ? env : uniform.get();
+    ctx.background = Vec3f(1);
+    ctx.roulette_depth = roulette_depth;
+    BlockMean m = trace_block(ctx, camera, x0, y0, x1, y1, spp);
+    EXPECT_EQ(m.coverage, 1.0);
+    return m.radiance.y;
+}
+
+geom::Scene white(float translucency)
+{
+    geom::Scene s;
+    s.materials[1].diffuse = grey(1);
+    s.materials[1].translucency = translucency;
+    return s;
+}
+
+// 16x16 pixels over 8x8 units; the block x, y in 5..11 sees a radius-3 sphere at the centre.
+TEST(Physics, WhiteFurnaceSphere)
+{
+    for (float tr : {0.0f, 0.5f}) {
+        geom::Scene s = white(tr);
+        add_sphere(s.geometry, {0, 0, 0}, 3);
+        Camera c = top_camera(0, 0, 8, 16, 16);
+        float exact = furnace(s, c, 5, 5, 11, 11, 8, 1000);
+        EXPECT_NEAR(exact, 1.0f, 1e-3f) << "translucency " << tr;
+        float rr = furnace(s, c, 5, 5, 11, 11, 32, 2);
+        EXPECT_NEAR(rr, 1.0f, 0.02f) << "translucency " << tr << " with Russian roulette";
+        std::printf("[furnace] sphere translucency %.1f: %.5f (RR off) %.5f (RR on)\n", tr,
+                    exact, rr);
+    }
+}
+
+TEST(Physics, WhiteFurnaceRoundCurves)
+{
+    for (float tr : {0.0f, 0.5f}) {
+        geom::Scene s = white(tr);
+        add_hermite(s.geometry, {-5, -1, 0, 2}, {10, 2, 0, 0}, {5, 1, 0, 2}, {10, 2, 0, 0});
+        add_hermite(s.geometry, {-5, 1, -1, 1.5f}, {10, -2, 0, 0}, {5, -1, -1, 1.5f},
+                    {10, -2, 0, 0});
+        Camera c = top_camera(0, 0, 8, 16, 16);
+        float v = furnace(s, c, 4, 6, 12, 10, 16, 1000);
+        EXPECT_NEAR(v, 1.0f, 2e-3f) << "translucency " << tr;
+        std::printf("[furnace] hermite curves translucency %.1f: %.5f\n", tr, v);
+    }
+}
+
+// A closed cube as a prototype, rotated and scaled by its instance: rays inside meet the
+// back faces (same white material) until they get out.
+TEST(Physics, WhiteFurnaceInstancedMesh)
+{
+    for (float tr : {0.0f, 0.5f}) {
+        geom::Scene s = white(tr);
+        geom::Prototype p;
+        add_cube(p.geometry, 1, geom::inherit_material, geom::inherit_material);
+        s.prototypes.push_back(p);
+        geom::Instance inst;
+        float c = std::cos(0.5f), sn = std::sin(0.5f);
+        inst.transform = transform({3 * c, -3 * sn, 0, 3 * sn, 3 * c, 0, 0, 0, 2});
+        inst.material = inst.back_material = 1;
+        s.instances.push_back(inst);
+        Camera cam = top_camera(0, 0, 8, 16, 16);
+        float v = furnace(s, cam, 6, 6, 10, 10, 16, 1000);
+        EXPECT_NEAR(v, 1.0f, 2e-3f) << "translucency " << tr;
+        std::printf("[furnace] instanced cube translucency %.1f: %.5f\n", tr, v);
+    }
+}
+
+// Normalized Phong: at normal incidence its albedo is exactly the specular colour, for
+// any shininess; on a sphere (all incidences) it may lose energy, never gain it.
+TEST(Physics, GlossyFurnace)
+{
+    for (float shininess : {0.0f, 32.0f, 128.0f}) {
+        geom::Scene s;
+        s.materials[1].diffuse = grey(0);
+        s.materials[1].specular = grey(1);
+        s.materials[1].shininess = shininess;
+        add_quad(s.geometry, -10, -10, 10, 10, 0, 1, 1);
+        Camera c = top_camera(0, 0, 8, 16, 16);
+        float plane = furnace(s, c, 4, 4, 12, 12, 16, 1000);
+        EXPECT_NEAR(plane, 1.0f, 0.02f) << shininess;
+        geom::Scene ball = s;
+        ball.geometry = {};
+        add_sphere(ball.geometry, {0, 0, 0}, 3.5f);
+        float sphere = furnace(ball, c, 4, 4, 12, 12, 8, 1000);
+        EXPECT_LE(sphere, 1.01f) << shininess;
+        EXPECT_GT(sphere, 0.6f) << shininess;
+        std::printf("[furnace] glossy shininess %.0f: plane %.4f sphere %.4f\n", shininess, plane,
+                    sphere);
+    }
+}
+
+/// Mean radiance of the 2x2 pixels at the centre of a 0.2-unit camera looking down at (x, y).
+float radiance_at(const geom::Scene& s, float x, float y, int depth = 1, int spp = 4,
+                  bool from_below = false)
+{
+    Camera c = from_below ? Camera::parallel({x, y, 0}, {0, 0, 1}, {0, 1, 0}, 0.01, 100, 20, 20)
+                          : top_camera(x, y, 0.2, 20, 20);
+    EmbreeScene accel(s, c);
+    PathContext ctx = context(s, accel, 0, depth);
+    return trace_block(ctx, c, 9, 9, 11, 11, spp).radiance.y;
+}
+
+geom::Scene lit_plane(float albedo_display)
+{
+    geom::Scene s;
+    s.materials[1].diffuse = grey(albedo_display);
+    add_quad(s.geometry, -50, -50, 50, 50, 0, 1, 1);
+    return s;
+}
+
+// A point light of colour 1 at height h with cpfg's T: c l q: L = albedo cos / (c + l d + q d^2).
+TEST(Physics, PointLightWithAttenuationMatchesClosedForm)
+{
+    geom::Scene s = lit_plane(0.8f);
+    geom::Light l;
+    l.position = {0, 0, 5};
+    l.attenuation_constant = 1;
+    l.attenuation_linear = 0.1f;
+    l.attenuation_quadratic = 0.02f;
+    s.lights.push_back(l);
+    float a = srgb_to_linear(0.8f);
+    for (float x : {0.0f, 3.0f, 8.0f}) {
+        float d = std::sqrt(x * x + 25);
+        float expect = a * (5 / d) / (1 + 0.1f * d + 0.02f * d * d);
+        float got = radiance_at(s, x, 0);
+        EXPECT_NEAR(got, expect, 0.01f * expect) << x;
+        std::printf("[direct] point light x=%.0f: %.5f expected %.5f (%.3f%%)\n", x, got, expect,
+                    100 * (got - expect) / expect);
+    }
+}
+
+TEST(Physics, DirectionalLightMatchesClosedForm)
+{
+    geom::Scene s = lit_plane(0.6f);
+    geom::Light l;
+    l.kind = geom::Light::Kind::directional;
+    l.direction = {1, 0, 1};
+    s.lights.push_back(l);
+    float expect = srgb_to_linear(0.6f) / std::sqrt(2.0f);
+    float got = radiance_at(s, 1, 2);
+    EXPECT_NEAR(got, expect, 0.01f * expect);
+    std::printf("[direct] directional 45 deg: %.5f expected %.5f\n", got, expect);
+}
+
+geom::Light directional(const geom::Vec3& toward)
+{
+    geom::Light l;
+    l.kind = geom::Light::Kind::directional;
+    l.direction = toward;
+    return l;
+}
+
+// Seen from below and lit from below, a triangle shows its back material.
+TEST(Physics, BackMaterialOnBackFaces)
+{
+    geom::Scene s;
+    s.materials[1].diffuse = grey(0.2f);
+    s.materials[2].diffuse = grey(0.9f);
+    add_quad(s.geometry, -5, -5, 5, 5, 0, 1, 2);
+    s.lights.push_back(directional({0, 0, -1}));
+    EXPECT_NEAR(radiance_at(s, 0, 0, 1, 4, true), srgb_to_linear(0.9f), 1e-3f);
+    s.lights[0] = directional({0, 0, 1});
+    EXPECT_NEAR(radiance_at(s, 0, 0), srgb_to_linear(0.2f), 1e-3f);
+}
+
+// Interpolated normals tilted far from the facet must not let light through an opaque sheet:
+// a light below the sheet (but above the tilted shading normal) leaves its top side dark.
+TEST(Physics, ShadingNormalsDoNotLeakLightThroughSheets)
+{
+    geom::Scene s;
+    s.materials[1].diffuse = grey(1);
+    geom::Float3 n{0.866f, 0, 0.5f};
+    add_triangle(s.geometry, {{{-5, -5, 0}, {5, -5, 0}, {0, 5, 0}}}, {n, n, n},
+                 {{{0, 0}, {1, 0}, {0, 1}}}, 1, 1);
+    s.lights.push_back(directional({1, 0, -0.2}));
+    EXPECT_EQ(radiance_at(s, 0, 0), 0.0f);
+    // Lit from above, the same sheet is lit (the shading normal's cosine).
+    s.lights[0] = directional({0, 0, 1});
+    EXPECT_NEAR(radiance_at(s, 0, 0), 0.5f, 1e-3f);
+}
+
+// A translucent leaf lit from behind shows translucency * albedo; an opaque one nothing.
+TEST(Physics, TranslucentLeafLitFromBehind)
+{
+    geom::Scene s;
+    s.materials[1].diffuse = grey(0.7f);
+    s.materials[1].translucency = 0.4f;
+    add_quad(s.geometry, -5, -5, 5, 5, 0, 1, 1);
+    s.lights.push_back(directional({0, 0, -1}));
+    EXPECT_NEAR(radiance_at(s, 0, 0), 0.4f * srgb_to_linear(0.7f), 1e-3f);
+    s.materials[1].translucency = 0;
+    EXPECT_EQ(radiance_at(s, 0, 0), 0.0f);
+}
+
+// Transparency 0.5: half the camera rays pass (black behind), and a shadow through it is half.
+TEST(Physics, TransparencyPassesLightStochastically)
+{
+    geom::Scene s;
+    s.materials[1].diffuse = grey(1);
+    s.materials[1].transparency = 0.5f;
+    add_quad(s.geometry, -5, -5, 5, 5, 0, 1, 1);
+    s.lights.push_back(directional({0, 0, 1}));
+    float seen = radiance_at(s, 0, 0, 1, 1024);
+    EXPECT_NEAR(seen, 0.5f, 0.03f);
+    // An opaque plane below, seen through the transparent one: lit at half strength, seen
+    // half the time, plus the transparent plane itself the other half.
+    s.materials[2].diffuse = grey(1);
+    add_quad(s.geometry, -50, -50, 50, 50, -1, 2, 2);
+    float through = radiance_at(s, 0, 0, 1, 1024);
+    EXPECT_NEAR(through, 0.5f + 0.5f * 0.5f, 0.03f);
+    std::printf("[transparency] %.4f (0.5), stacked %.4f (0.75)\n", seen, through);
+}
+
+// A sphere of emitted radiance Le, radius R, centre at distance D from a plane point, at
+// angle theta from its normal: E = pi Le (R/D)^2 cos theta, so L = albedo Le (R/D)^2 cos
+// theta, found by BSDF rays alone.
+TEST(Physics, EmissiveSphereLightsByBsdfRays)
+{
+    geom::Scene s = lit_plane(1);
+    s.materials[2].diffuse = grey(0);
+    s.materials[2].emission = grey(1);
+    add_sphere(s.geometry, {0, 0, 3}, 1, 2);
+    float got = radiance_at(s, 2, 0, 2, 4096);  // D^2 = 13, cos theta = 3 / sqrt 13
+    float expect = 1.0f / 13 * 3 / std::sqrt(13.0f);
+    EXPECT_NEAR(got, expect, 0.06f * expect);
+    std::printf("[emission] %.5f expected %.5f\n", got, expect);
+}
+
+/// Radiance L above the horizon, none below; sampled cosine-weighted about +z.
+class Sky final : public Environment {
+public:
+    explicit Sky(float l) : m_l(l) {}
+    Vec3f radiance(const Vec3f& d) const override { return Vec3f(d.z > 0 ? m_l : 0.0f); }
+    EnvironmentSample sample(float u1, float u2) const override
+    {
+        float r = std::sqrt(u1), phi = 2 * pi * u2;
+        Vec3f d(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::fmax(0.0f, 1 - u1)));
+        return {d, radiance(d), pdf(d)};
+    }
+    float pdf(const Vec3f& d) const override { return std::fmax(d.z, 0.0f) / pi; }
+    bool black() const override { return m_l <= 0; }
+
+private:
+    float m_l;
+};
+
+/// Radiance 1 everywhere, but sampled half uniformly, half toward +z: not "uniform" to the
+/// integrator, so NEE and BSDF sampling are weighted against each other.
+class LopsidedWhite final : public Environment {
+public:
+    Vec3f radiance(const Vec3f&) const override { return Vec3f(1); }
+    EnvironmentSample sample(float u1, float u2) const override
+    {
+        Vec3f d;
+        if (u1 < 0.5f) {
+            float z = 1 - 4 * u1, r = std::sqrt(std::fmax(0.0f, 1 - z * z));
+            d = {r * std::cos(2 * pi * u2), r * std::sin(2 * pi * u2), z};
+        } else {
+            float u = 2 * u1 - 1, r = std::sqrt(u);
+            d = {r * std::cos(2 * pi * u2), r * std::sin(2 * pi * u2),
+                 std::sqrt(std::fmax(0.0f, 1 - u))};
+        }
+        return {d, Vec3f(1), pdf(d)};
+    }
+    float pdf(const Vec3f& d) const override
+    {
+        return 0.5f / (4 * pi) + 0.5f * std::fmax(d.z, 0.0f) / pi;
+    }
+    bool black() const override { return false; }
+};
+
+TEST(Physics, EnvironmentSamplingWithMis)
+{
+    geom::Scene s = lit_plane(0.5f);
+    Camera c = top_camera(0, 0, 0.2, 20, 20);
+    EmbreeScene accel(s, c);
+    Sky sky(2);
+    PathContext ctx = context(s, accel, 0, 1);
+    ctx.environment = &sky;
+    ctx.max_depth = 2;
+    float got = trace_block(ctx, c, 9, 9, 11, 11, 512).radiance.y;
+    float expect = srgb_to_linear(0.5f) * 2;
+    EXPECT_NEAR(got, expect, 0.01f * expect);
+    std::printf("[environment] sky over plane %.5f expected %.5f\n", got, expect);
+
+    for (float tr : {0.0f, 0.3f}) {
+        geom::Scene ball = white(tr);
+        add_sphere(ball.geometry, {0, 0, 0}, 3);
+        LopsidedWhite lop;
+        float v = furnace(ball, top_camera(0, 0, 8, 16, 16), 5, 5, 11, 11, 512, 1000, &lop);
+        EXPECT_NEAR(v, 1.0f, 0.02f);
+        std::printf("[furnace] sphere (translucency %.1f) under a non-uniformly sampled white "
+                    "environment: %.5f\n", tr, v);
+        geom::Scene plane = white(tr);
+        add_quad(plane.geometry, -10, -10, 10, 10, 0, 1, 1);
+        v = furnace(plane, top_camera(0, 0, 8, 16, 16), 5, 5, 11, 11, 32, 1000, &lop);
+        EXPECT_NEAR(v, 1.0f, 0.02f);
+        std::printf("[furnace] plane (translucency %.1f): %.5f\n", tr, v);
+    }
+}
+
+}  // namespace
+}  // namespace cambium::render

@@ -1,0 +1,374 @@
+// SPDX-License-Identifier: Apache-2.0
+// Rendering features: passes, adaptive sampling, cancel, filters, thin lens, clipping,
+// transparency, convergence rate, progress line.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cmath>
+#include <csignal>
+#include <cstring>
+
+#include "render/color.h"
+#include "render/render.h"
+#include "test_scenes.h"
+
+namespace cambium::render {
+namespace {
+
+using testing::add_segment;
+using testing::empty_scene;
+
+RenderSettings small(int w, int h, int spp, int depth = 1)
+{
+    RenderSettings s;
+    s.width = w;
+    s.height = h;
+    s.samples_per_pixel = spp;
+    s.max_depth = depth;
+    s.threads = 2;
+    s.ambient = {0, 0, 0};
+    return s;
+}
+
+geom::Light directional(const geom::Vec3& toward_light)
+{
+    geom::Light l;
+    l.kind = geom::Light::Kind::directional;
+    l.direction = toward_light;
+    return l;
+}
+
+/// Two crossing lit segments with ambient light: every pixel of them is noisy.
+geom::Scene crossing_scene()
+{
+    geom::Scene s = empty_scene({-10, -6, -1}, {10, 6, 1});
+    add_segment(s, {-5, -4, 0}, {5, 4, 0}, 1.5f);
+    add_segment(s, {-5, 4, 1}, {5, -4, 1}, 1.5f);
+    s.lights.push_back(directional({1, 1, 1}));
+    return s;
+}
+
+bool same_bits(const Image& a, const Image& b)
+{
+    return a.rgba.size() == b.rgba.size() &&
+           std::memcmp(a.rgba.data(), b.rgba.data(), a.rgba.size() * sizeof(float)) == 0;
+}
+
+TEST(Progressive, PassesDoNotChangeTheImage)
+{
+    geom::Scene s = crossing_scene();
+    RenderSettings set = small(40, 24, 12, 4);
+    set.ambient = {0.2f, 0.2f, 0.2f};
+    set.passes = 1;
+    Image one = render(s, set);
+    set.passes = 0;  // automatic: 8, 12
+    EXPECT_TRUE(same_bits(one, render(s, set)));
+    set.passes = 5;  // 2, 4, 7, 9, 12 samples
+    int calls = 0;
+    set.on_pass = [&](const Image& img) {
+        ++calls;
+        EXPECT_EQ(img.width, 40);
+    };
+    RenderReport report;
+    Image five = render(s, set, &report);
+    EXPECT_TRUE(same_bits(one, five));
+    EXPECT_EQ(calls, 5);
+    EXPECT_EQ(report.passes, 5);
+    EXPECT_EQ(report.samples, 40u * 24u * 12u);
+    EXPECT_FALSE(report.cancelled);
+}
+
+TEST(Adaptive, BitIdenticalForAnyThreadCountAndSavesSamples)
+{
+    geom::Scene s = crossing_scene();
+    RenderSettings set = small(48, 40, 128, 4);
+    set.ambient = {0.2f, 0.2f, 0.2f};
+    set.noise_target = 0.05f;
+    set.threads = 1;
+    RenderReport r1, r2;
+    Image one = render(s, set, &r1);
+    set.threads = 2;
+    Image two = render(s, set, &r2);
+    EXPECT_TRUE(same_bits(one, two));
+    EXPECT_EQ(r1.samples, r2.samples);
+    // The black background converges at the first check (16 spp, zero variance); the
+    // lit segments need more, but not all get the maximum.
+    std::uint64_t pixels = 48 * 40;
+    EXPECT_LT(r1.samples, pixels * 128 / 2);
+    EXPECT_GT(r1.samples, pixels * 16);
+    // Against a 1024-spp reference, the adaptive image's error on the segments is about
+    // the target (relative error of the mean luminance ~ 0.05), far below 8 spp's.
+    RenderSettings ref = set;
+    ref.noise_target = 0;
+    ref.samples_per_pixel = 512;
+    ref.seed = 99;
+    Image reference = render(s, ref);
+    RenderSettings few = ref;
+    few.samples_per_pixel = 8;
+    few.seed = 0;
+    Image rough = render(s, few);
+    double err_adaptive = 0, err_rough = 0, total = 0;
+    for (int y = 0; y < 40; ++y)
+        for (int x = 0; x < 48; ++x) {
+            if (reference.at(x, y, 3) < 1)
+                continue;
+            double r = reference.at(x, y, 1);
+            err_adaptive += std::abs(one.at(x, y, 1) - r);
+            err_rough += std::abs(rough.at(x, y, 1) - r);
+            total += r;
+        }
+    ASSERT_GT(total, 0);
+    EXPECT_LT(err_adaptive / total, 0.06);
+    EXPECT_LT(err_adaptive, 0.5 * err_rough);
+}
+
+TEST(Progressive, CancelReturnsTheImageSoFar)
+{
+    geom::Scene s = crossing_scene();
+    RenderSettings set = small(40, 24, 8, 2);
+    std::atomic<bool> cancel{false};
+    set.cancel = &cancel;
+    set.passes = 4;
+    set.on_pass = [&](const Image&) { cancel = true; };
+    RenderReport report;
+    Image img = render(s, set, &report);
+    EXPECT_TRUE(report.cancelled);
+    EXPECT_EQ(report.passes, 1);
+    EXPECT_EQ(report.samples, 40u * 24u * 2u);  // exactly the first pass
+    // The image so far is the 2-spp image.
+    RenderSettings two = small(40, 24, 2, 2);
+    EXPECT_TRUE(same_bits(img, render(s, two)));
+
+    cancel = true;  // cancelled before anything: nothing sampled, all transparent black
+    set.on_pass = nullptr;
+    Image none = render(s, set, &report);
+    EXPECT_EQ(report.samples, 0u);
+    for (float v : none.rgba)
+        ASSERT_EQ(v, 0.0f);
+}
+
+// A budget that is over before the first tile: nothing is sampled, and the report says why.
+TEST(Progressive, SpentTimeBudgetStopsBeforeSampling)
+{
+    geom::Scene s = crossing_scene();
+    RenderSettings set = small(40, 24, 8, 2);
+    set.time_budget_s = 1e-9;
+    RenderReport report;
+    Image img = render(s, set, &report);
+    EXPECT_TRUE(report.out_of_time);
+    EXPECT_FALSE(report.cancelled);
+    EXPECT_EQ(report.samples, 0u);
+    EXPECT_EQ(img.at(20, 12, 3), 0.0f);
+}
+
+TEST(Progressive, InterruptHandlerSetsTheFlag)
+{
+    const std::atomic<bool>* flag = install_interrupt_handler();
+    ASSERT_NE(flag, nullptr);
+    EXPECT_EQ(install_interrupt_handler(), flag);
+    EXPECT_FALSE(flag->load());
+    std::raise(SIGINT);
+    EXPECT_TRUE(flag->load());
+    std::signal(SIGINT, SIG_DFL);
+}
+
+TEST(Progressive, ProgressLineFormat)
+{
+    EXPECT_EQ(format_progress(0.42, 12), "render 42%  elapsed 0:12  remaining 0:17");
+    EXPECT_EQ(format_progress(0.5, 3700), "render 50%  elapsed 1:01:40  remaining 1:01:40");
+    EXPECT_EQ(format_progress(0, 5), "render 0%  elapsed 0:05  remaining ?");
+    EXPECT_EQ(format_progress(1, 65), "render 100%  elapsed 1:05  remaining 0:00");
+}
+
+// A horizontal segment of radius 2 seen at 5 px per unit: rows 40..60 of a 40x100 window
+// on its middle. Any normalised filter keeps the covered area; a wide one blurs the edges.
+TEST(Filter, KeepsCoverageAndWidensEdges)
+{
+    geom::Scene s = empty_scene({-20, -5, 0}, {20, 5, 0});
+    add_segment(s, {-10, 0, 0}, {10, 0, 0}, 2.0f);
+    Camera camera = Camera::parallel({0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 0.2, 10, 40, 100);
+    RenderSettings set = small(40, 100, 64);
+    set.aovs = false;
+    // Mean covered height over the columns (averages the noise), partial rows in one.
+    auto column = [&](const Image& img, double& area, int& partial) {
+        area = 0;
+        partial = 0;
+        for (int y = 0; y < 100; ++y) {
+            for (int x = 0; x < 40; ++x)
+                area += img.at(x, y, 3) / 40.0;
+            float a = img.at(20, y, 3);
+            partial += a > 0.01f && a < 0.99f ? 1 : 0;
+        }
+    };
+    double box_area, gauss_area, bh_area;
+    int box_partial, gauss_partial, bh_partial;
+    column(render(s, camera, set), box_area, box_partial);
+    set.filter = PixelFilter::gaussian;
+    set.filter_radius = 3;
+    column(render(s, camera, set), gauss_area, gauss_partial);
+    set.filter = PixelFilter::blackman_harris;
+    column(render(s, camera, set), bh_area, bh_partial);
+    EXPECT_NEAR(box_area, 20.0, 0.1);  // 4 units * 5 px
+    EXPECT_NEAR(gauss_area, 20.0, 0.1);
+    EXPECT_NEAR(bh_area, 20.0, 0.1);
+    EXPECT_LE(box_partial, 2);
+    EXPECT_GE(gauss_partial, 4);
+    EXPECT_GE(bh_partial, 4);
+}
+
+// Perspective from z = 20 at the origin, fov 30 deg, 64 px: 0.1675 units per pixel at
+// the focus plane. A lens of radius 1 focused at 20: a segment at z = 0 stays sharp; one
+// at z = 10 (distance 10) is blurred by a circle of 2 units = 12 px on the focus plane.
+TEST(ThinLens, FocusPlaneSharpElsewhereBlurred)
+{
+    auto partial_rows = [](const Image& img) {
+        int n = 0;
+        for (int y = 0; y < img.height; ++y) {
+            float a = img.at(img.width / 2, y, 3);
+            n += a > 0.02f && a < 0.98f ? 1 : 0;
+        }
+        return n;
+    };
+    Camera pinhole = Camera::perspective({0, 0, 20}, {0, 0, 0}, {0, 1, 0}, 30, 64, 64);
+    Camera lens = pinhole.with_lens(1.0, 20.0);
+    RenderSettings set = small(64, 64, 32);
+    set.aovs = false;
+    geom::Scene near = empty_scene({-5, -5, -5}, {5, 5, 5});
+    add_segment(near, {-20, 0, 10}, {20, 0, 10}, 0.5f);  // 12 px tall at distance 10
+    geom::Scene focused = empty_scene({-5, -5, -5}, {5, 5, 5});
+    add_segment(focused, {-20, 0, 0}, {20, 0, 0}, 1.0f);
+    EXPECT_LE(partial_rows(render(focused, pinhole, set)), 2);
+    EXPECT_LE(partial_rows(render(focused, lens, set)), 4);
+    EXPECT_LE(partial_rows(render(near, pinhole, set)), 2);
+    EXPECT_GE(partial_rows(render(near, lens, set)), 10);
+    // Through settings: the lens applies to make_camera's perspective view.
+    focused.view.perspective = true;
+    focused.view.viewpoint = {0, 0, 20};
+    focused.view.viewing_angle_deg = 30;
+    near.view = focused.view;
+    set.aperture_radius = 1.0;  // focus: the reference point, distance 20
+    EXPECT_LE(partial_rows(render(focused, set)), 4);
+    EXPECT_GE(partial_rows(render(near, set)), 10);
+}
+
+// Default parallel view from +z (viewpoint (0,0,1), looking along -z). Segment A at
+// z = 2 (material 1) in front of segment B at z = -2 (material 2).
+TEST(Clipping, FrontAndBackDistancesHideGeometry)
+{
+    geom::Scene s = empty_scene({-10, -3, -3}, {10, 3, 3});
+    add_segment(s, {-8, 0, 2}, {8, 0, 2}, 0.5f, 1);
+    add_segment(s, {-8, 0, -2}, {8, 0, -2}, 0.5f, 2);
+    s.materials[1].diffuse = {1, 0, 0};
+    s.materials[2].diffuse = {0, 0, 1};
+    s.background = {0, 1, 0};
+    RenderSettings set = small(100, 30, 1);
+    auto centre = [&](const geom::Scene& scene) { return render(scene, set); };
+    Image open = centre(s);
+    EXPECT_GT(open.albedo[(15 * 100 + 50) * 3 + 0], 0.9f);  // A, red
+    // Planes relative to the viewpoint (z = 1) along -z: [0, 10] keeps z <= 1 only.
+    s.view.front_distance = 0;
+    s.view.back_distance = 10;
+    Image front = centre(s);
+    EXPECT_GT(front.albedo[(15 * 100 + 50) * 3 + 2], 0.9f);  // B, blue
+    EXPECT_EQ(front.at(50, 15, 3), 1.0f);
+    // Order does not matter in parallel projection (corpus views use both).
+    s.view.front_distance = 10;
+    s.view.back_distance = 0;
+    EXPECT_TRUE(same_bits(front, centre(s)));
+    // [0, 2] keeps -1 <= z <= 1: nothing; the background shows.
+    s.view.front_distance = 0;
+    s.view.back_distance = 2;
+    Image none = centre(s);
+    EXPECT_EQ(none.at(50, 15, 3), 0.0f);
+    EXPECT_FLOAT_EQ(none.at(50, 15, 1), 1.0f);
+    EXPECT_TRUE(std::isinf(none.depth[15 * 100 + 50]));
+}
+
+TEST(Transparent, MissesContributeNothingAndAlphaIsCoverage)
+{
+    geom::Scene s = empty_scene({-20, -5, 0}, {20, 5, 0});
+    add_segment(s, {-10, 0, 0}, {10, 0, 0}, 2.0f);
+    s.background = {0.5f, 0.5f, 0.5f};
+    s.lights.push_back(directional({0, 0, 1}));
+    RenderSettings set = small(200, 100, 4);
+    Image opaque = render(s, set);
+    set.transparent_background = true;
+    Image clear = render(s, set);
+    EXPECT_TRUE(clear.transparent);
+    EXPECT_EQ(clear.at(5, 5, 0), 0.0f);
+    EXPECT_EQ(clear.at(5, 5, 3), 0.0f);
+    EXPECT_GT(opaque.at(5, 5, 0), 0.2f);
+    // Fully covered pixels are the same either way.
+    EXPECT_EQ(clear.at(100, 50, 0), opaque.at(100, 50, 0));
+    EXPECT_EQ(clear.at(100, 50, 3), 1.0f);
+}
+
+// A white furnace lit only by a constant environment map (ambient 0): every pixel is
+// the map's radiance on average, so the environment does reach the path tracer.
+TEST(EnvironmentSetting, ConstantMapLightsAWhiteFurnace)
+{
+    geom::Scene s = empty_scene({-10, -6, -1}, {10, 6, 1});
+    add_segment(s, {-5, -4, 0}, {5, 4, 0}, 2.0f);
+    s.materials[1].diffuse = {1, 1, 1};
+    float e = 0.5f;
+    s.background = {linear_to_srgb(e), linear_to_srgb(e), linear_to_srgb(e)};
+    float bg = decode_display(s.background).x;
+    RenderSettings set = small(32, 24, 16, 32);
+    set.roulette_depth = 1000;
+    set.environment = make_map_environment(4, 2, std::vector<float>(4 * 2 * 3, bg));
+    Image img = render(s, set);
+    double sum = 0;
+    int covered = 0;
+    for (int y = 0; y < 24; ++y)
+        for (int x = 0; x < 32; ++x)
+            if (img.at(x, y, 3) == 1.0f) {
+                sum += img.at(x, y, 1);
+                ++covered;
+            }
+    ASSERT_GT(covered, 50);
+    EXPECT_NEAR(sum / covered, bg, 0.02 * bg);
+}
+
+// Error against a high-sample reference falls as 1/sqrt(samples): the log-log slope of
+// RMS error over 4, 16, 64 spp is -1/2 (the reference's own noise makes it ~-0.48).
+TEST(Convergence, ErrorFallsAsInverseSquareRootOfSamples)
+{
+    geom::Scene s = crossing_scene();
+    s.materials[1].diffuse = {0.7f, 0.7f, 0.7f};
+    RenderSettings set = small(32, 24, 1024, 4);
+    set.ambient = {0.3f, 0.3f, 0.3f};
+    set.aovs = false;
+    set.seed = 12345;
+    Image reference = render(s, set);
+    double xs[3], ys[3];
+    int k = 0;
+    for (int spp : {4, 16, 64}) {
+        // Mean squared error over all pixels and three seeds.
+        set.samples_per_pixel = spp;
+        double sq = 0, count = 0;
+        for (std::uint64_t seed : {1, 2, 3}) {
+            set.seed = seed;
+            Image img = render(s, set);
+            for (std::size_t i = 0; i < img.rgba.size(); ++i)
+                if (i % 4 != 3) {
+                    sq += std::pow(img.rgba[i] - reference.rgba[i], 2);
+                    count += 1;
+                }
+        }
+        xs[k] = std::log(double(spp));
+        ys[k] = 0.5 * std::log(sq / count);
+        ++k;
+    }
+    double mx = (xs[0] + xs[1] + xs[2]) / 3, my = (ys[0] + ys[1] + ys[2]) / 3;
+    double num = 0, den = 0;
+    for (int i = 0; i < 3; ++i) {
+        num += (xs[i] - mx) * (ys[i] - my);
+        den += (xs[i] - mx) * (xs[i] - mx);
+    }
+    double slope = num / den;
+    EXPECT_GE(slope, -0.6);
+    EXPECT_LE(slope, -0.4);
+}
+
+}  // namespace
+}  // namespace cambium::render

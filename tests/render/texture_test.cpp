@@ -1,0 +1,228 @@
+// SPDX-License-Identifier: Apache-2.0
+// TextureSet (OIIO TextureSystem): orientation, sRGB decoding, modulate/decal, formats,
+// missing files, and alpha cut-outs in EmbreeScene.
+#include <gtest/gtest.h>
+
+#include <OpenImageIO/imageio.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "base/diagnostics.h"
+#include "render/accel.h"
+#include "render/color.h"
+#include "render/texture.h"
+#include "geom_scenes.h"
+
+namespace cambium::render {
+namespace {
+
+using namespace testing;
+namespace fs = std::filesystem;
+
+constexpr float inf = std::numeric_limits<float>::infinity();
+
+/// A fresh folder under the system temp dir for this test.
+fs::path temp_dir()
+{
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    fs::path d = fs::temp_directory_path() /
+                 (std::string("cambium_texture_") + info->name() + "_" +
+                  std::to_string(::getpid()));
+    fs::create_directories(d);
+    return d;
+}
+
+/// Writes an 8-bit image of w x h pixels, `channels` per pixel, top row first.
+void write_image(const fs::path& file, int w, int h, int channels,
+                 const std::vector<std::uint8_t>& pixels)
+{
+    auto out = OIIO::ImageOutput::create(file.string());
+    ASSERT_TRUE(out) << OIIO::geterror();
+    OIIO::ImageSpec spec(w, h, channels, OIIO::TypeDesc::UINT8);
+    ASSERT_TRUE(out->open(file.string(), spec)) << out->geterror();
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
+    out->close();
+}
+
+/// 2x2 RGBA: top row red (opaque), green (alpha 0); bottom row blue (opaque), 50% grey
+/// (alpha 1).
+std::vector<std::uint8_t> quadrants()
+{
+    return {255, 0, 0, 255, 0, 255, 0, 0, 0, 0, 255, 255, 128, 128, 128, 255};
+}
+
+geom::TextureDef nearest(const fs::path& file)
+{
+    geom::TextureDef d;
+    d.file = file;
+    d.linear_filter = false;
+    d.mipmap = false;
+    return d;
+}
+
+// OpenGL's t runs up: t near 1 is the image's top row; 8-bit values decode as sRGB.
+TEST(Texture, OrientationAndDecoding)
+{
+    fs::path dir = temp_dir();
+    write_image(dir / "q.png", 2, 2, 4, quadrants());
+    TextureSet set({nearest(dir / "q.png")});
+    ASSERT_EQ(set.size(), 1u);
+    EXPECT_TRUE(set.has_alpha(0));
+    Texel top_left = set.lookup(0, 0.25f, 0.75f);
+    EXPECT_NEAR(top_left.colour.x, 1, 1e-4f);
+    EXPECT_NEAR(top_left.colour.y, 0, 1e-4f);
+    EXPECT_NEAR(top_left.alpha, 1, 1e-4f);
+    // Colours are not multiplied by alpha (cpfg's GL textures are unassociated).
+    Texel top_right = set.lookup(0, 0.75f, 0.75f);
+    EXPECT_NEAR(top_right.colour.y, 1, 1e-4f);
+    EXPECT_NEAR(top_right.alpha, 0, 1e-4f);
+    EXPECT_NEAR(set.lookup(0, 0.25f, 0.25f).colour.z, 1, 1e-4f);
+    EXPECT_NEAR(set.lookup(0, 0.75f, 0.25f).colour.x, srgb_to_linear(128 / 255.0f), 1e-3f);
+    // Coordinates wrap (GL_REPEAT): (1.25, -0.25) is (0.25, 0.75), the red texel.
+    EXPECT_NEAR(set.lookup(0, 1.25f, -0.25f).colour.x, 1, 1e-4f);
+    EXPECT_NEAR(set.lookup(0, 1.25f, -0.25f).colour.z, 0, 1e-4f);
+    fs::remove_all(dir);
+}
+
+TEST(Texture, ModulateAndDecal)
+{
+    fs::path dir = temp_dir();
+    write_image(dir / "q.png", 2, 2, 4, quadrants());
+    geom::TextureDef modulate = nearest(dir / "q.png"), decal = modulate;
+    decal.decal = true;
+    TextureSet set({modulate, decal});
+    Vec3f grey = set.apply(0, Vec3f(0.5f), 0.75f, 0.25f);
+    float g = srgb_to_linear(128 / 255.0f);
+    EXPECT_NEAR(grey.x, 0.5f * g, 1e-4f);
+    Vec3f replaced = set.apply(1, Vec3f(0.5f), 0.75f, 0.25f);
+    EXPECT_NEAR(replaced.x, g, 1e-4f);
+    EXPECT_EQ(set.apply(geom::no_texture, Vec3f(0.5f), 0, 0), Vec3f(0.5f));
+    fs::remove_all(dir);
+}
+
+// cpfg's usual format: SGI .rgb, relative to the view file's folder.
+TEST(Texture, ReadsSgiRelativeToBase)
+{
+    fs::path dir = temp_dir();
+    write_image(dir / "leaf.rgb", 2, 2, 3, {10, 20, 30, 40, 50, 60, 70, 80, 90, 200, 210, 220});
+    geom::TextureDef d = nearest("leaf.rgb");
+    TextureSet set({d}, dir);
+    EXPECT_FALSE(set.has_alpha(0));
+    EXPECT_NEAR(set.lookup(0, 0.75f, 0.25f).colour.x, srgb_to_linear(200 / 255.0f), 1e-3f);
+    EXPECT_NEAR(set.lookup(0, 0.25f, 0.75f).colour.z, srgb_to_linear(30 / 255.0f), 1e-3f);
+    fs::remove_all(dir);
+}
+
+TEST(Texture, MissingFileIsSkippedAndLooksUpWhite)
+{
+    geom::TextureDef d;
+    d.file = "/nonexistent/cambium/bark.rgb";
+    TextureSet set({d});
+    EXPECT_EQ(set.size(), 1u);  // the index keeps its place for @Tx
+    EXPECT_FALSE(set.valid(0));
+    Texel t = set.lookup(0, 0.5f, 0.5f);
+    EXPECT_EQ(t.colour.x, 1.0f);
+    EXPECT_EQ(t.alpha, 1.0f);
+}
+
+TEST(Texture, UnreadableFileIsSkipped)
+{
+    fs::path dir = temp_dir();
+    {
+        std::ofstream(dir / "bad.png") << "not an image";
+    }
+    geom::TextureDef d;
+    d.file = dir / "bad.png";
+    TextureSet set({d});
+    EXPECT_FALSE(set.valid(0));
+    EXPECT_FALSE(set.has_alpha(0));
+    fs::remove_all(dir);
+}
+
+// The silhouette of a textured quad is the texture's alpha mask, also through an instance.
+TEST(Texture, AlphaCutOutSilhouetteIsTheMask)
+{
+    fs::path dir = temp_dir();
+    // 8x8 mask: opaque where (col + 2 row) % 3 == 0, top row first.
+    const int n = 8;
+    std::vector<std::uint8_t> pixels;
+    auto opaque = [](int col, int row) { return (col + 2 * row) % 3 == 0; };
+    for (int row = 0; row < n; ++row)
+        for (int col = 0; col < n; ++col)
+            for (std::uint8_t c : {200, 100, 50, opaque(col, row) ? 255 : 0})
+                pixels.push_back(static_cast<std::uint8_t>(c));
+    write_image(dir / "mask.png", n, n, 4, pixels);
+    TextureSet set({nearest(dir / "mask.png")});
+
+    geom::Scene s;
+    add_quad(s.geometry, 0, 0, 8, 8, 0, 1, 1, 0);  // uv (0,0)..(1,1) over x, y 0..8
+    geom::Prototype p;
+    add_quad(p.geometry, 0, 0, 8, 8, 0, geom::inherit_material, geom::inherit_material);
+    s.prototypes.push_back(p);
+    geom::Instance inst;
+    inst.transform = transform({1, 0, 0, 0, 1, 0, 0, 0, 1}, {20, 0, 0});
+    inst.texture = 0;
+    s.instances.push_back(inst);
+    EmbreeScene accel(s, top_camera(0, 0, 10, 10, 10), &set);
+    int mismatches = 0;
+    for (int row = 0; row < n; ++row)
+        for (int col = 0; col < n; ++col) {
+            // Texel (col, row) lies at x = col + 0.5, y = 8 - (row + 0.5) (t runs up).
+            float x = col + 0.5f, y = n - (row + 0.5f);
+            for (float dx : {0.0f, 20.0f}) {
+                bool hit = accel.intersect({x + dx, y, 5}, {0, 0, -1}, 0, inf).has_value();
+                bool blocked = accel.occluded({x + dx, y, 5}, {0, 0, -1}, 0, inf);
+                mismatches += (hit != opaque(col, row)) + (blocked != opaque(col, row));
+            }
+        }
+    EXPECT_EQ(mismatches, 0);
+    // Without the texture set nothing is cut out.
+    EmbreeScene plain(s, top_camera(0, 0, 10, 10, 10));
+    EXPECT_TRUE(plain.intersect({1.5f, 7.5f, 5}, {0, 0, -1}, 0, inf));
+    EXPECT_FALSE(opaque(1, 0));
+    fs::remove_all(dir);
+}
+
+// Rendered: a white quad under a white light shows the texture's decoded colours, and
+// the background where it is cut out.
+TEST(Texture, TexturedQuadRendersTheTexture)
+{
+    fs::path dir = temp_dir();
+    write_image(dir / "q.png", 2, 2, 4, quadrants());
+    TextureSet set({nearest(dir / "q.png")});
+    geom::Scene s;
+    s.materials[1].diffuse = {1, 1, 1};
+    add_quad(s.geometry, 0, 0, 8, 8, 0, 1, 1, 0);
+    geom::Light light;
+    light.kind = geom::Light::Kind::directional;
+    light.direction = {0, 0, 1};
+    s.lights.push_back(light);
+    auto at = [&](float x, float y) {
+        Camera c = top_camera(x, y, 0.2, 20, 20);
+        EmbreeScene accel(s, c, &set);
+        PathContext ctx;
+        ctx.accel = &accel;
+        ctx.textures = &set;
+        ctx.materials = make_materials(s.materials);
+        ctx.lights = make_lights(s.lights);
+        ctx.background = Vec3f(0.25f);
+        ctx.max_depth = 1;
+        return trace_block(ctx, c, 9, 9, 11, 11, 1).radiance;
+    };
+    Vec3f red = at(2, 6), blue = at(2, 2), grey = at(6, 2), cut = at(6, 6);
+    EXPECT_NEAR(red.x, 1, 1e-4f);
+    EXPECT_NEAR(red.y, 0, 1e-4f);
+    EXPECT_NEAR(blue.z, 1, 1e-4f);
+    EXPECT_NEAR(grey.y, srgb_to_linear(128 / 255.0f), 1e-3f);
+    EXPECT_EQ(cut, Vec3f(0.25f));
+    fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace cambium::render
