@@ -2,6 +2,7 @@
 // The `cambium` command line: cpfg's options that make sense offline, plus modern ones.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -16,22 +17,64 @@ struct ColourFile {
     std::filesystem::path file;
 };
 
+/// How much cpfg-style tracing to print (-v warnings, -V verbose).
+enum class Verbosity { normal, warnings, verbose };
+
 struct Options {
     std::filesystem::path lsystem, view;
     std::optional<std::filesystem::path> animation;
     std::vector<ColourFile> colour_files;
     int colour_block = 1;  ///< -c n
+
+    // Language (cpfg options)
+    std::string preprocessor = "cpp";          ///< -P
+    std::size_t max_modules = 100'000'000;     ///< --max-modules
+    std::optional<int> steps;                  ///< --steps: derivation steps instead of the file's
+    Verbosity verbosity = Verbosity::normal;
+    bool environment_requested = false;        ///< -e: no environment program is connected
+    bool allow_system_calls = false;           ///< @S runs commands only with this
+
+    // Outputs besides images (cpfg options, file names may be format strings)
+    std::optional<std::filesystem::path> string_text;    ///< -str
+    std::optional<std::filesystem::path> string_binary;  ///< -strb
+    bool homomorphism_in_string = false;                  ///< -homo
+    std::optional<std::filesystem::path> view_volume;    ///< -vv
+
+    // Rendering
     int width = 640, height = 480;
-    std::vector<std::filesystem::path> outputs;
+    std::vector<std::filesystem::path> outputs;  ///< -o (and cpfg's -rgb / -tga)
     int samples_per_pixel = 64;
     int max_depth = 6;
     int threads = 0;
     std::uint64_t seed = 0;
     bool quiet = false;
+    std::string filter = "box";        ///< --filter box|gaussian|blackman-harris
+    float filter_radius = 0;           ///< --filter-radius (0: the filter's default)
+    float noise_target = 0;            ///< --noise-target: adaptive sampling (0 = off)
+    double time_budget_s = 0;          ///< --time-budget seconds (0 = none)
+    double aperture_radius = 0;        ///< --aperture: thin-lens radius (0 = pinhole)
+    double focus_distance = 0;         ///< --focus-distance (0 = view reference point)
+    float exposure = 0;                ///< --exposure stops, for PNG/TIFF/JPEG
+    bool transparent = false;          ///< --transparent: no background, alpha = coverage
+    float ambient = 0.05f;             ///< --ambient: uniform environment radiance
+    bool sky = false;                  ///< --sky: analytic sun and sky
+    std::vector<float> sun_direction;  ///< --sun X Y Z (with --sky)
+    std::optional<std::filesystem::path> environment_map;  ///< --env file.exr|.hdr
+    float environment_scale = 1;       ///< --env-scale
+
+    /// Whether an image is to be rendered: an -o was given, or no other output was.
+    bool renders() const
+    {
+        return !outputs.empty() || (!string_text && !string_binary && !view_volume);
+    }
 };
 
 /// Parses argv. Returns nullopt after printing help (exit 0); throws cambium::Error
 /// on a malformed command line.
 std::optional<Options> parse_command_line(int argc, char** argv);
+
+/// The same from words (tests, and the corpus's recorded cpfg command lines), without
+/// the program name.
+std::optional<Options> parse_command_line(const std::vector<std::string>& args);
 
 }  // namespace cambium::app

@@ -1,15 +1,21 @@
 // SPDX-License-Identifier: Apache-2.0
 // The `cambium` command: derive a cpfg L-system, interpret it, path-trace it, write images.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <exception>
+#include <fstream>
+#include <functional>
+
+#include <unistd.h>
+
+#include <fmt/format.h>
 
 #include "app/command_line.h"
+#include "app/pipeline.h"
 #include "base/diagnostics.h"
-#include "geom/interpreter.h"
-#include "geom/palette.h"
-#include "geom/view_file.h"
-#include "lsys/lsystem.h"
+#include "geom/view_volume.h"
+#include "lsys/string_io.h"
 #include "render/render.h"
 
 namespace cambium::app {
@@ -22,24 +28,108 @@ double seconds_since(Clock::time_point start)
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-geom::Palette load_palette(const Options& options)
+/// Without -o (and without any other output), the image is named after the L-system
+/// file, in the current folder.
+std::vector<std::filesystem::path> image_outputs(const Options& options)
 {
-    geom::Palette palette;
-    for (const ColourFile& f : options.colour_files) {
-        if (f.materials)
-            palette.load_materials(f.block, f.file);
-        else
-            palette.load_colormap(f.block, f.file);
-    }
-    return palette;
-}
-
-/// Without -o, the image is named after the L-system file, in the current folder.
-std::vector<std::filesystem::path> output_files(const Options& options)
-{
-    if (!options.outputs.empty())
+    if (!options.outputs.empty() || !options.renders())
         return options.outputs;
     return {options.lsystem.stem().string() + ".png"};
+}
+
+render::PixelFilter pixel_filter(const std::string& name)
+{
+    if (name == "gaussian")
+        return render::PixelFilter::gaussian;
+    if (name == "blackman-harris")
+        return render::PixelFilter::blackman_harris;
+    return render::PixelFilter::box;
+}
+
+render::RenderSettings render_settings(const Options& options,
+                                       const std::vector<std::filesystem::path>& images)
+{
+    render::RenderSettings settings;
+    settings.width = options.width;
+    settings.height = options.height;
+    settings.samples_per_pixel = options.samples_per_pixel;
+    settings.max_depth = options.max_depth;
+    settings.seed = options.seed;
+    settings.threads = options.threads;
+    settings.filter = pixel_filter(options.filter);
+    settings.filter_radius = options.filter_radius;
+    settings.noise_target = options.noise_target;
+    settings.time_budget_s = options.time_budget_s;
+    settings.aperture_radius = options.aperture_radius;
+    settings.focus_distance = options.focus_distance;
+    settings.transparent_background = options.transparent;
+    settings.ambient = {options.ambient, options.ambient, options.ambient};
+    if (options.sky) {
+        render::SkyParameters sky;
+        if (!options.sun_direction.empty())
+            sky.sun_direction = render::normalize(render::Vec3f(
+                options.sun_direction[0], options.sun_direction[1], options.sun_direction[2]));
+        settings.environment = render::make_sky_environment(sky);
+    } else if (options.environment_map) {
+        settings.environment =
+            render::make_map_environment(*options.environment_map, options.environment_scale);
+    }
+    settings.progress = !options.quiet && isatty(fileno(stderr));
+    // The albedo, normal and depth layers cost a camera-ray intersection; only EXR keeps them.
+    settings.aovs = std::any_of(images.begin(), images.end(), [](const auto& f) {
+        std::string ext = f.extension().string();
+        return ext == ".exr" || ext == ".EXR";
+    });
+    settings.cancel = render::install_interrupt_handler();
+    return settings;
+}
+
+/// Writes `text` to `file` through a temporary name, so a failure leaves nothing behind.
+template <typename Write>
+void write_atomically(const std::filesystem::path& file, Write write)
+{
+    std::filesystem::path temporary = file;
+    temporary += ".cambium-tmp";
+    {
+        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+        if (out)
+            write(out);
+        if (!out) {
+            out.close();
+            std::error_code ignored;
+            std::filesystem::remove(temporary, ignored);
+            throw Error(FileLoc{file.string()}, "cannot be written");
+        }
+    }
+    std::error_code ec;
+    std::filesystem::rename(temporary, file, ec);
+    if (ec) {
+        std::filesystem::remove(temporary, ec);
+        throw Error(FileLoc{file.string()}, "cannot be written: " + ec.message());
+    }
+}
+
+/// -str and -strb: the derived string in cpfg's formats; names may be format strings
+/// (plant%03d.str) that receive the derivation step.
+void write_strings(const Model& model, const lsys::ModuleString& string, const Options& options,
+                   const std::function<void(const std::string&)>& say)
+{
+    int step = options.steps.value_or(model.lsystem.derivation_length());
+    if (options.string_text) {
+        std::filesystem::path file = lsys::format_frame_name(options.string_text->string(), step);
+        write_atomically(file, [&](std::ostream& out) {
+            lsys::write_string_text(string, model.lsystem.symbols(), out);
+        });
+        say("wrote " + file.string());
+    }
+    if (options.string_binary) {
+        std::filesystem::path file =
+            lsys::format_frame_name(options.string_binary->string(), step);
+        write_atomically(file, [&](std::ostream& out) {
+            lsys::write_string_binary(string, model.lsystem.symbols(), out, step);
+        });
+        say("wrote " + file.string());
+    }
 }
 
 int run(const Options& options)
@@ -48,42 +138,50 @@ int run(const Options& options)
         if (!options.quiet)
             std::printf("%s\n", text.c_str());
     };
-    for (const auto& out : output_files(options))
+    std::vector<std::filesystem::path> images = image_outputs(options);
+    for (const auto& out : images)
         render::check_output_format(out);  // fail before the work, not after
     if (options.animation)
         warn(FileLoc{options.animation->string()},
              "animation files are not interpreted yet; rendering the last derivation step");
+    if (options.environment_requested)
+        warn("-e: no environmental program is connected; ?E modules keep their parameters");
 
     auto start = Clock::now();
-    geom::Palette palette = load_palette(options);
-    geom::ViewFile view = geom::read_view_file(options.view);
-    lsys::LSystem lsystem = lsys::LSystem::load(options.lsystem);
-    lsys::ModuleString string = lsystem.derive();
-    say("derived " + std::to_string(string.size()) + " modules in " +
-        std::to_string(seconds_since(start)) + " s");
+    Model model = load_model(options);
+    lsys::ModuleString string = derive(model, options);
+    say(fmt::format("derived {} modules in {:.3f} s", string.size(), seconds_since(start)));
+    write_strings(model, string, options, say);
 
-    geom::Scene scene = geom::interpret(string, lsystem.symbols(), view);
-    scene.materials = palette.entries(options.colour_block);
-    scene.background = palette.background(options.colour_block);
-    say("interpreted " + std::to_string(scene.geometry.lines.segment_count()) + " segments");
+    geom::Scene scene = interpret(model, string, options);
+    const geom::Geometry& g = scene.geometry;
+    say(fmt::format("interpreted {} cylinders, {} cylinder curves, {} spheres, {} discs, "
+                    "{} triangles, {} instances",
+                    g.lines.segment_count(), g.curves.segment_count(), g.spheres.size(),
+                    g.discs.size(), g.mesh.size(), scene.instances.size()));
+    if (options.view_volume) {
+        // As cpfg, the view file's `box:` wins over the computed bounds.
+        geom::write_view_volume(scene.view.box.value_or(scene.bounds), *options.view_volume);
+        say("wrote " + options.view_volume->string());
+    }
+    if (images.empty())
+        return 0;
 
-    render::RenderSettings settings;
-    settings.width = options.width;
-    settings.height = options.height;
-    settings.samples_per_pixel = options.samples_per_pixel;
-    settings.max_depth = options.max_depth;
-    settings.seed = options.seed;
-    settings.threads = options.threads;
-    auto render_start = Clock::now();
-    render::Image image = render::render(scene, settings);
-    say("rendered " + std::to_string(options.width) + "x" + std::to_string(options.height) +
-        " at " + std::to_string(options.samples_per_pixel) + " spp in " +
-        std::to_string(seconds_since(render_start)) + " s");
-
-    for (const auto& out : output_files(options)) {
-        render::write_image(image, out);
+    render::RenderSettings settings = render_settings(options, images);
+    render::RenderReport report;
+    render::Image image = render::render(scene, settings, &report);
+    say(fmt::format("rendered {}x{}, {:.1f} samples per pixel on average, in {:.2f} s{}",
+                    options.width, options.height,
+                    double(report.samples) / (double(options.width) * options.height),
+                    report.seconds, report.cancelled ? " (interrupted)" : ""));
+    render::WriteOptions write;
+    write.exposure = options.exposure;
+    for (const auto& out : images) {
+        render::write_image(image, out, write);
         say("wrote " + out.string());
     }
+    if (report.cancelled)
+        return 130;  // the image so far is written; the shell sees the interrupt
     return 0;
 }
 

@@ -1,0 +1,42 @@
+// SPDX-License-Identifier: Apache-2.0
+// A model as cpfg loads it (view file, colours, functions, L-system), derived and
+// interpreted. The `cambium` command and the corpus tests share this path to a Scene.
+#pragma once
+
+#include <memory>
+
+#include "app/command_line.h"
+#include "geom/function.h"
+#include "geom/palette.h"
+#include "geom/scene.h"
+#include "geom/view_file.h"
+#include "lsys/lsystem.h"
+
+namespace cambium::app {
+
+/// Everything read from a model's files, before derivation. The L-system's hooks
+/// (func(), the query pass) refer to the view and functions held here by shared
+/// pointers, so a Model may be moved.
+struct Model {
+    std::shared_ptr<const geom::ViewFile> view;
+    geom::Palette palette;
+    std::shared_ptr<const geom::FunctionSet> functions;
+    lsys::LSystem lsystem;
+};
+
+/// Reads the colour files, the view file, its functions and then the L-system, in that
+/// order (a function set defines names for the L-system's preprocessor). Throws
+/// cambium::Error naming file, line and column.
+Model load_model(const Options& options);
+
+/// The string after the derivation length (or --steps), decomposition included: what
+/// cpfg's -str writes (homomorphism_in_string: after the homomorphism, as -homo).
+lsys::ModuleString derive(const Model& model, const Options& options);
+
+/// The turtle's interpretation of a derived string (the homomorphism applied first),
+/// with the materials of the selected colour block, the view file's translucency
+/// settings and its background scene.
+geom::Scene interpret(const Model& model, const lsys::ModuleString& derived,
+                      const Options& options);
+
+}  // namespace cambium::app

@@ -1,0 +1,64 @@
+// SPDX-License-Identifier: Apache-2.0
+// The corpus's models as the tests see them: folder, cpfg command line, oracle folder.
+#include "corpus_model.h"
+
+#include <algorithm>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace cambium::test {
+
+namespace fs = std::filesystem;
+
+std::optional<fs::path> corpus_dir()
+{
+    const char* env = std::getenv("CAMBIUM_CORPUS");
+    fs::path dir = env ? fs::path(env) : fs::path(CAMBIUM_CORPUS_DEFAULT);
+    if (!fs::exists(dir / "cpfg"))
+        return std::nullopt;
+    return dir;
+}
+
+std::vector<CorpusModel> corpus_models(const fs::path& corpus)
+{
+    std::vector<CorpusModel> models;
+    for (const auto& entry : fs::recursive_directory_iterator(corpus / "cpfg")) {
+        if (entry.path().filename() != "model.json")
+            continue;
+        std::ifstream in(entry.path());
+        nlohmann::json json = nlohmann::json::parse(in);
+        CorpusModel m;
+        m.id = json.at("id").get<std::string>();
+        m.folder = entry.path().parent_path();
+        m.oracle = corpus / "oracle" / m.id;
+        m.environmental = json.value("env_program", false);
+        std::istringstream words(json.at("command").get<std::string>());
+        std::string word;
+        words >> word;  // "cpfg"
+        while (words >> word)
+            m.command.push_back(word);
+        models.push_back(std::move(m));
+    }
+    std::sort(models.begin(), models.end(),
+              [](const CorpusModel& a, const CorpusModel& b) { return a.id < b.id; });
+    return models;
+}
+
+app::Options model_options(const CorpusModel& model)
+{
+    app::Options o = *app::parse_command_line(model.command);
+    auto absolute = [&](fs::path& p) { p = model.folder / p; };
+    absolute(o.lsystem);
+    absolute(o.view);
+    if (o.animation)
+        absolute(*o.animation);
+    for (auto& f : o.colour_files)
+        absolute(f.file);
+    o.quiet = true;
+    return o;
+}
+
+}  // namespace cambium::test

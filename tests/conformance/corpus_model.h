@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: Apache-2.0
+// The corpus's models as the tests see them: folder, cpfg command line, oracle folder.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "app/command_line.h"
+
+namespace cambium::test {
+
+struct CorpusModel {
+    std::string id;                  ///< "11-CPFG/01-Introduction/01-quadratic-Koch"
+    std::filesystem::path folder;    ///< corpus/cpfg/<id>
+    std::filesystem::path oracle;    ///< corpus/oracle/<id> (may not exist)
+    std::vector<std::string> command;  ///< cpfg's arguments, without "cpfg"
+    bool environmental = false;      ///< talks to an environmental program (?E)
+};
+
+/// The corpus folder ($CAMBIUM_CORPUS or the build's default), if it exists.
+std::optional<std::filesystem::path> corpus_dir();
+
+/// Every model of corpus/cpfg with a model.json, sorted by id.
+std::vector<CorpusModel> corpus_models(const std::filesystem::path& corpus);
+
+/// The model's command line parsed by Cambium's own parser, with the files it names
+/// made absolute (relative to the model's folder).
+app::Options model_options(const CorpusModel& model);
+
+}  // namespace cambium::test
