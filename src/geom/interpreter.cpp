@@ -629,9 +629,12 @@ private:
             m_chain_open = false;  // the joint key cannot carry two widths
     }
 
-    /// `@;` and `@,`: the back colour, by the second colour increment or set.
+    /// `@;` and `@,`: the back colour, by the second colour increment or set; only
+    /// when `initial color:` gave two indices (otherwise the back follows the front).
     void change_back_color(std::span<const float> p, int sign)
     {
+        if (!m_view.separate_back_color)
+            return;
         int color = p.empty() ? m_turtle.back_color + sign * m_view.back_color_increment
                               : static_cast<int>(p[0]);
         if (color > 255)
@@ -650,6 +653,9 @@ private:
         if (color < 0)
             color += 256;
         m_turtle.color = color;
+        // Manual 5.1.9: sides differ only when `initial color:` gives two indices.
+        if (!m_view.separate_back_color)
+            m_turtle.back_color = color;
     }
 
     bool tapers() const { return m_view.tapered_lines && !m_scene.line_radius_in_pixels; }

@@ -282,7 +282,8 @@ void apply_command(ViewFile& v, const std::string& name, ValueReader& in)
         v.angle_increment_deg = in.number();
     } else if (name == "initial color") {
         v.initial_color = in.integer();
-        v.initial_back_color = in.at_end() ? v.initial_color : in.integer();
+        v.separate_back_color = !in.at_end();
+        v.initial_back_color = v.separate_back_color ? in.integer() : v.initial_color;
     } else if (name == "color increment") {
         v.color_increment = in.integer();
         v.back_color_increment = in.at_end() ? v.color_increment : in.integer();

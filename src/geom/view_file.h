@@ -44,6 +44,9 @@ struct ViewFile {
     LineStyle line_style = LineStyle::pixel;
     int initial_color = 128;
     int initial_back_color = 128;
+    /// `initial color:` gave two indices: surfaces may have a different back colour
+    /// (`@;`, `@,`); otherwise the back always has the front's colour (manual 5.1.9).
+    bool separate_back_color = false;
     int color_increment = 1;
     int back_color_increment = 1;
     double initial_scale = 1;

@@ -139,7 +139,7 @@ TEST(TurtleFeatures, ScreenDiscFacesTheViewer)
 
 TEST(TurtleFeatures, HLDiscFacesUpWithFrontAndBackMaterials)
 {
-    Scene scene = run(";(3) @;(9) & @c(1)", "angle increment: 90\n");
+    Scene scene = run(";(3) @;(9) & @c(1)", "angle increment: 90\ninitial color: 1 1\n");
     ASSERT_EQ(scene.geometry.discs.size(), 1u);
     const auto& n = scene.geometry.discs.normals[0];  // & by 90: H = -z, U = -y
     EXPECT_NEAR(n[1], -1, 1e-6);
@@ -149,8 +149,18 @@ TEST(TurtleFeatures, HLDiscFacesUpWithFrontAndBackMaterials)
 
 TEST(TurtleFeatures, BackColourIncrementsWrap)
 {
-    Scene scene = run("@,(0) @, @c", "color increment: 1 5\n");
+    Scene scene = run("@,(0) @, @c", "initial color: 1 1\ncolor increment: 1 5\n");
     EXPECT_EQ(scene.geometry.discs.back_material[0], 251);
+}
+
+TEST(TurtleFeatures, BackFollowsFrontUnlessInitialColorGivesTwoIndices)
+{
+    // Manual 5.1.9: sides differ only when `initial color:` has two parameters.
+    Scene one = run(";(3) @;(9) @c(1)", "initial color: 1\n");
+    EXPECT_EQ(one.geometry.discs.material[0], 3);
+    EXPECT_EQ(one.geometry.discs.back_material[0], 3);
+    Scene two = run(";(3) @;(9) @c(1)", "initial color: 1 2\n");
+    EXPECT_EQ(two.geometry.discs.back_material[0], 9);
 }
 
 TEST(TurtleFeatures, PolygonFromFAndDotVertices)
