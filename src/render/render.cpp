@@ -409,7 +409,10 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
         ctx.lights = make_lights(scene.lights);
         ctx.background = decode_display(scene.background);
         ctx.environment = settings.environment.get();
-        ctx.environment_visible = settings.environment != nullptr;
+        // A parallel camera looks along one direction: its misses would all see the same
+        // environment radiance, so they keep cpfg's background there.
+        ctx.environment_visible = settings.environment != nullptr &&
+                                  camera.projection() == Camera::Projection::perspective;
         ctx.ambient = {settings.ambient.r, settings.ambient.g, settings.ambient.b};
         ctx.max_depth = settings.max_depth;
         ctx.roulette_depth = settings.roulette_depth;

@@ -3,6 +3,7 @@
 #include "render/texture.h"
 
 #include <OpenImageIO/texture.h>
+#include <tbb/enumerable_thread_specific.h>
 
 #include <string>
 
@@ -31,6 +32,26 @@ struct Entry {
 struct TextureSet::Impl {
     std::unique_ptr<OIIO::TextureSystem, SystemDeleter> system;
     std::vector<Entry> entries;
+    /// Each render thread's OIIO lookup state, owned here rather than left in OIIO's
+    /// thread-specific storage: a TBB worker that outlives this set would otherwise
+    /// free that state at its exit, after the system and its tiles are gone (a crash
+    /// at process exit, found by the corpus sweep).
+    tbb::enumerable_thread_specific<OIIO::TextureSystem::Perthread*> per_thread{nullptr};
+
+    OIIO::TextureSystem::Perthread* thread_info()
+    {
+        OIIO::TextureSystem::Perthread*& info = per_thread.local();
+        if (!info)
+            info = system->create_thread_info();
+        return info;
+    }
+
+    ~Impl()
+    {
+        for (OIIO::TextureSystem::Perthread* info : per_thread)
+            if (info)
+                system->destroy_thread_info(info);
+    }
 };
 
 TextureSet::TextureSet(const std::vector<geom::TextureDef>& defs,
@@ -58,8 +79,8 @@ TextureSet::TextureSet(const std::vector<geom::TextureDef>& defs,
             m_impl->entries.push_back(e);
             continue;
         }
-        e.handle = ts.get_texture_handle(OIIO::ustring(file.string()));
-        const OIIO::ImageSpec* spec = e.handle ? ts.imagespec(e.handle, nullptr) : nullptr;
+        e.handle = ts.get_texture_handle(OIIO::ustring(file.string()), m_impl->thread_info());
+        const OIIO::ImageSpec* spec = e.handle ? ts.imagespec(e.handle, m_impl->thread_info()) : nullptr;
         if (!spec) {
             std::string why = ts.geterror();
             warn(FileLoc{file.string()}, "texture cannot be read" +
@@ -109,7 +130,7 @@ Texel TextureSet::lookup(int index, float s, float t, float width) const
     float v[4] = {1, 1, 1, 1};
     int n = e.channels >= 4 ? 4 : (e.channels == 2 ? 2 : (e.channels == 1 ? 1 : 3));
     // OIIO's t runs down the image, OpenGL's up.
-    bool ok = m_impl->system->texture(e.handle, nullptr, options, s, 1 - t, width, 0, 0, width,
+    bool ok = m_impl->system->texture(e.handle, m_impl->thread_info(), options, s, 1 - t, width, 0, 0, width,
                                       n, v);
     if (!ok)
         return {};
