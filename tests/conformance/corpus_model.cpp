@@ -7,7 +7,12 @@
 #include <fstream>
 #include <sstream>
 
+#include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+
+#include <cstdio>
+
+#include "base/diagnostics.h"
 
 namespace cambium::test {
 
@@ -59,6 +64,47 @@ app::Options model_options(const CorpusModel& model)
         absolute(f.file);
     o.quiet = true;
     return o;
+}
+
+std::string read_text(const fs::path& file)
+{
+    std::ifstream in(file, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return text.str();
+}
+
+void compare_with_oracle(
+    const std::string& oracle_file, const std::set<std::string>& known,
+    const std::function<std::string(const CorpusModel&, const std::string&)>& compare)
+{
+    auto corpus = corpus_dir();
+    if (!corpus)
+        GTEST_SKIP() << "corpus not found";
+    int total = 0, matched = 0;
+    set_warnings_enabled(false);
+    for (const CorpusModel& model : corpus_models(*corpus)) {
+        fs::path reference = model.oracle / oracle_file;
+        if (!fs::exists(reference))
+            continue;
+        ++total;
+        std::string difference;
+        try {
+            difference = compare(model, read_text(reference));
+        } catch (const std::exception& e) {
+            difference = e.what();
+        }
+        if (difference.empty()) {
+            ++matched;
+            continue;
+        }
+        std::printf("  %s differs: %s\n", model.id.c_str(), difference.c_str());
+        if (!known.count(model.id))
+            ADD_FAILURE() << model.id << ": " << difference;
+    }
+    set_warnings_enabled(true);
+    std::printf("%d of %d models match\n", matched, total);
+    EXPECT_GT(total, 0);
 }
 
 }  // namespace cambium::test

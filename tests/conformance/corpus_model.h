@@ -3,7 +3,9 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -28,5 +30,16 @@ std::vector<CorpusModel> corpus_models(const std::filesystem::path& corpus);
 /// The model's command line parsed by Cambium's own parser, with the files it names
 /// made absolute (relative to the model's folder).
 app::Options model_options(const CorpusModel& model);
+
+/// The text of a file (empty when it cannot be read).
+std::string read_text(const std::filesystem::path& file);
+
+/// Runs `compare(model, reference text)` on every model whose oracle folder holds
+/// `oracle_file`; compare returns "" when the model matches, else what differs (an
+/// exception counts as a difference). Prints each difference and "N of M models match",
+/// and fails the test for every difference not in `known`.
+void compare_with_oracle(
+    const std::string& oracle_file, const std::set<std::string>& known,
+    const std::function<std::string(const CorpusModel&, const std::string&)>& compare);
 
 }  // namespace cambium::test
