@@ -12,6 +12,7 @@
 
 #include "geom/gencyl.h"
 #include "geom/interpreter.h"
+#include "module_text.h"
 #include "geom/turtle.h"
 #include "geom/view_volume.h"
 #include "lsys/string_io.h"
@@ -20,27 +21,6 @@ using namespace cambium;
 using namespace cambium::geom;
 
 namespace {
-
-/// Builds a string from space-separated modules, e.g. "@Gs F(2) @Gt(1,2) @Ge".
-lsys::ModuleString make_string(lsys::SymbolTable& symbols, const std::string& text)
-{
-    lsys::ModuleString s;
-    std::istringstream in(text);
-    std::string token;
-    while (in >> token) {
-        std::size_t open = token.find('(');
-        std::vector<float> params;
-        if (open != std::string::npos) {
-            std::string list = token.substr(open + 1, token.size() - open - 2);
-            std::istringstream values(list);
-            std::string value;
-            while (std::getline(values, value, ','))
-                params.push_back(std::stof(value));
-        }
-        s.append(symbols.intern(token.substr(0, open)), params);
-    }
-    return s;
-}
 
 std::filesystem::path temp_dir()
 {
@@ -52,7 +32,7 @@ std::filesystem::path temp_dir()
 Scene run(const std::string& text, const std::string& view_text = "line style: cylinder\n")
 {
     lsys::SymbolTable symbols;
-    lsys::ModuleString s = make_string(symbols, text);
+    lsys::ModuleString s = text_modules(symbols, text);
     std::filesystem::path dir = temp_dir();
     ViewFile view = parse_view_file(view_text, (dir / "t.v").string());
     view.path = dir / "t.v";

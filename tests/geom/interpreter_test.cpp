@@ -5,33 +5,17 @@
 #include <string>
 
 #include "geom/interpreter.h"
+#include "module_text.h"
 
 using namespace cambium;
 using namespace cambium::geom;
 
 namespace {
 
-/// Builds a string from single-character modules, `F(2)` style parameters allowed.
-lsys::ModuleString make_string(lsys::SymbolTable& symbols, const std::string& text)
-{
-    lsys::ModuleString s;
-    for (std::size_t i = 0; i < text.size(); ++i) {
-        lsys::SymbolId id = symbols.intern(std::string(1, text[i]));
-        std::vector<float> params;
-        if (i + 1 < text.size() && text[i + 1] == '(') {
-            std::size_t close = text.find(')', i);
-            params.push_back(std::stof(text.substr(i + 2, close - i - 2)));
-            i = close;
-        }
-        s.append(id, params);
-    }
-    return s;
-}
-
 Scene run(const std::string& text, const std::string& view_text)
 {
     lsys::SymbolTable symbols;
-    lsys::ModuleString s = make_string(symbols, text);
+    lsys::ModuleString s = text_modules(symbols, text);
     return interpret(s, symbols, parse_view_file(view_text, "t.v"));
 }
 

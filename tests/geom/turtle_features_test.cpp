@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "geom/interpreter.h"
+#include "module_text.h"
 #include "geom/query.h"
 
 using namespace cambium;
@@ -17,32 +18,11 @@ using namespace cambium::geom;
 
 namespace {
 
-/// Builds a string from space-separated modules: "F(2) @M(1,2,3) ?P(0,0,0)".
-lsys::ModuleString make_string(lsys::SymbolTable& symbols, const std::string& text)
-{
-    lsys::ModuleString s;
-    std::istringstream in(text);
-    std::string word;
-    while (in >> word) {
-        std::size_t open = word.find('(');
-        std::vector<float> params;
-        if (open != std::string::npos) {
-            std::string list = word.substr(open + 1, word.size() - open - 2);
-            std::stringstream items(list);
-            std::string item;
-            while (std::getline(items, item, ','))
-                params.push_back(std::stof(item));
-        }
-        s.append(symbols.intern(word.substr(0, open)), params);
-    }
-    return s;
-}
-
 Scene run(const std::string& text, const std::string& view_text = "",
           std::vector<std::string> strings = {})
 {
     lsys::SymbolTable symbols;
-    lsys::ModuleString s = make_string(symbols, text);
+    lsys::ModuleString s = text_modules(symbols, text);
     InterpretOptions options;
     options.strings = strings;
     return interpret(s, symbols, parse_view_file(view_text, "t.v"), options);
@@ -286,7 +266,7 @@ TEST(TurtleFeatures, SystemCallsAndRayshadeModulesAreIgnored)
 TEST(TurtleFeatures, QueriesReceiveTheTurtleState)
 {
     lsys::SymbolTable symbols;
-    lsys::ModuleString s = make_string(symbols, "F + ?P(0,0,0) f ?H(0,0) ?L(9,9,9) ?U(0,0,0,7) X(5)");
+    lsys::ModuleString s = text_modules(symbols, "F + ?P(0,0,0) f ?H(0,0) ?L(9,9,9) ?U(0,0,0,7) X(5)");
     answer_queries(s, symbols, parse_view_file("angle increment: 90\n", "t.v"));
     std::vector<std::vector<float>> params;
     s.for_each([&](lsys::ModuleRef m) { params.emplace_back(m.params.begin(), m.params.end()); });
