@@ -515,43 +515,34 @@ void shift(std::uint16_t& m, std::uint16_t offset)
         m = static_cast<std::uint16_t>(m + offset);
 }
 
+/// Appends curve segments: `keys` are the vertex arrays (LinearCurves::keys,
+/// HermiteCurves::points) whose indices the segments hold; the tangents, if any, are
+/// the caller's.
+template <typename Curves>
+void append_curves(Curves& a, const Curves& b, std::vector<Float4>& a_keys,
+                   const std::vector<Float4>& b_keys)
+{
+    auto base = static_cast<std::uint32_t>(a_keys.size());
+    fill_to(a.v, a_keys.size(), 0.0f);
+    fill_to(a.texture, a.segments.size(), no_texture);
+    append(a_keys, b_keys);
+    append(a.v, b.v);
+    fill_to(a.v, a_keys.size(), 0.0f);
+    for (std::uint32_t s : b.segments)
+        a.segments.push_back(s + base);
+    append(a.flags, b.flags);
+    append(a.material, b.material);
+    append(a.texture, b.texture);
+    fill_to(a.texture, a.segments.size(), no_texture);
+}
+
 }  // namespace
 
 void append_geometry(Geometry& into, const Geometry& from)
 {
-    {
-        LinearCurves& a = into.lines;
-        const LinearCurves& b = from.lines;
-        auto base = static_cast<std::uint32_t>(a.keys.size());
-        fill_to(a.v, a.keys.size(), 0.0f);
-        fill_to(a.texture, a.segments.size(), no_texture);
-        append(a.keys, b.keys);
-        append(a.v, b.v);
-        fill_to(a.v, a.keys.size(), 0.0f);
-        for (std::uint32_t s : b.segments)
-            a.segments.push_back(s + base);
-        append(a.flags, b.flags);
-        append(a.material, b.material);
-        append(a.texture, b.texture);
-        fill_to(a.texture, a.segments.size(), no_texture);
-    }
-    {
-        HermiteCurves& a = into.curves;
-        const HermiteCurves& b = from.curves;
-        auto base = static_cast<std::uint32_t>(a.points.size());
-        fill_to(a.v, a.points.size(), 0.0f);
-        fill_to(a.texture, a.segments.size(), no_texture);
-        append(a.points, b.points);
-        append(a.tangents, b.tangents);
-        append(a.v, b.v);
-        fill_to(a.v, a.points.size(), 0.0f);
-        for (std::uint32_t s : b.segments)
-            a.segments.push_back(s + base);
-        append(a.flags, b.flags);
-        append(a.material, b.material);
-        append(a.texture, b.texture);
-        fill_to(a.texture, a.segments.size(), no_texture);
-    }
+    append_curves(into.lines, from.lines, into.lines.keys, from.lines.keys);
+    append(into.curves.tangents, from.curves.tangents);
+    append_curves(into.curves, from.curves, into.curves.points, from.curves.points);
     {
         Spheres& a = into.spheres;
         fill_to(a.texture, a.centres.size(), no_texture);
