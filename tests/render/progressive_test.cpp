@@ -17,26 +17,8 @@ namespace {
 
 using testing::add_segment;
 using testing::empty_scene;
-
-RenderSettings small(int w, int h, int spp, int depth = 1)
-{
-    RenderSettings s;
-    s.width = w;
-    s.height = h;
-    s.samples_per_pixel = spp;
-    s.max_depth = depth;
-    s.threads = 2;
-    s.ambient = {0, 0, 0};
-    return s;
-}
-
-geom::Light directional(const geom::Vec3& toward_light)
-{
-    geom::Light l;
-    l.kind = geom::Light::Kind::directional;
-    l.direction = toward_light;
-    return l;
-}
+using testing::small;
+using testing::directional;
 
 /// Two crossing lit segments with ambient light: every pixel of them is noisy.
 geom::Scene crossing_scene()

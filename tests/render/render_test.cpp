@@ -15,26 +15,8 @@ namespace {
 
 using testing::add_segment;
 using testing::empty_scene;
-
-RenderSettings small(int w, int h, int spp, int depth = 1)
-{
-    RenderSettings s;
-    s.width = w;
-    s.height = h;
-    s.samples_per_pixel = spp;
-    s.max_depth = depth;
-    s.threads = 2;
-    s.ambient = {0, 0, 0};
-    return s;
-}
-
-geom::Light directional(const geom::Vec3& toward_light)
-{
-    geom::Light l;
-    l.kind = geom::Light::Kind::directional;
-    l.direction = toward_light;
-    return l;
-}
+using testing::small;
+using testing::directional;
 
 // Bounds x -20..20, y -5..5 at 200x100: k = min(200/40, 100/10) = 5 px per unit, centre
 // (100, 50). A segment x -10..10 of radius 2 covers rows 40..60 and (with its round caps)

@@ -5,6 +5,7 @@
 #include <array>
 
 #include "geom/scene.h"
+#include "render/render.h"
 
 namespace cambium::render::testing {
 
@@ -27,6 +28,28 @@ inline geom::Scene empty_scene(const geom::Vec3& lo, const geom::Vec3& hi)
     s.bounds.extend(lo);
     s.bounds.extend(hi);
     return s;
+}
+
+/// Settings for a small test render: no ambient, 2 threads, direct light by default.
+inline RenderSettings small(int w, int h, int spp, int depth = 1)
+{
+    RenderSettings s;
+    s.width = w;
+    s.height = h;
+    s.samples_per_pixel = spp;
+    s.max_depth = depth;
+    s.threads = 2;
+    s.ambient = {0, 0, 0};
+    return s;
+}
+
+/// A white directional light toward `toward_light`.
+inline geom::Light directional(const geom::Vec3& toward_light)
+{
+    geom::Light l;
+    l.kind = geom::Light::Kind::directional;
+    l.direction = toward_light;
+    return l;
 }
 
 }  // namespace cambium::render::testing
