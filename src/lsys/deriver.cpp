@@ -58,6 +58,7 @@ Deriver::Deriver(const Program& program, DeriveLimits limits)
             for (const auto& p : set->productions)
                 frame = std::max(frame, p.frame_size);
     m_frame.assign(static_cast<std::size_t>(frame) + 1, 0.0);
+    m_storage.assign(program.storage_size, 0.0);
 
     m_runtime.globals.assign(program.global_names.size(), 0.0);
     for (const auto& a : program.arrays)
@@ -66,21 +67,76 @@ Deriver::Deriver(const Program& program, DeriveLimits limits)
     m_runtime.function = &m_limits.function;
     m_runtime.curve = &m_limits.curve;
     m_runtime.file_name = &program.file_name;
+    m_warning = [this](const std::string& message, int site) {
+        warn(location(site), message + ", " + context());
+    };
+    m_runtime.warning = &m_warning;
+    m_query_symbol.assign(symbols.size(), 0);
+    for (const char* name : {"?P", "?H", "?L", "?U"})
+        if (int id = symbols.find(name); id >= 0)
+            m_query_symbol[static_cast<std::size_t>(id)] = 1;
+    try {
+        start();
+    } catch (const EvaluationError& e) {
+        fail(e);
+    }
+}
 
-    const LSystemDefinition& main = program.lsystems.front();
-    if (main.derivation_length)
+void Deriver::start()
+{
+    const LSystemDefinition& main = m_program.lsystems.front();
+    if (main.derivation_length) {
+        in_block("'derivation length:'");
         m_runtime.derivation_length =
             static_cast<int>(evaluate(*main.derivation_length, m_frame, m_runtime));
+    }
     // seed: makes the L-system stochastic. The production choice draws from erand48 on
     // a state that starts at 0 and that cpfg (the build the corpus oracle comes from)
     // never seeds: RandomMoss (seed: 2454) matches cpfg only this way.
     m_stochastic.set_state(0);
     if (!m_limits.start)
         return;
-    evaluate(program.start_block, m_frame, m_runtime);
+    in_block("the Start block");
+    evaluate(m_program.start_block, m_frame, m_runtime);
+    // cpfg's derivation loop resets its animation flag after the Start block has run, so
+    // a stop() there does not end the derivation
+    m_runtime.stop_requested = false;
+    in_block("the axiom");
     for (const auto& m : main.axiom)
         append_evaluated(m, m_string);
     decompose();
+}
+
+bool Deriver::is_query(int symbol) const
+{
+    return symbol >= 0 && static_cast<std::size_t>(symbol) < m_query_symbol.size() &&
+           m_query_symbol[static_cast<std::size_t>(symbol)] != 0;
+}
+
+FileLoc Deriver::location(int site) const
+{
+    if (site >= 0 && static_cast<std::size_t>(site) < m_program.sites.size())
+        return m_program.sites[static_cast<std::size_t>(site)];
+    if (m_production)
+        return m_production->loc;
+    return FileLoc{m_program.file_name, 0, 0};
+}
+
+std::string Deriver::context() const
+{
+    if (m_production)
+        return "in production '" + m_production->text + "'";
+    return std::string("in ") + (m_block ? m_block : "the L-system");
+}
+
+void Deriver::fail(const EvaluationError& e) const
+{
+    FileLoc loc = location(e.site());
+    std::string where = context();
+    // a production that spans lines: say where it starts, too
+    if (m_production && m_production->loc.line != loc.line && m_production->loc.line > 0)
+        where += " (line " + std::to_string(m_production->loc.line) + ")";
+    throw Error(loc, std::string(e.what()) + ", " + where);
 }
 
 int Deriver::lsystem_index(double id) const
@@ -98,6 +154,7 @@ void Deriver::set_runtime(const Runtime& runtime)
     m_runtime.curve = &m_limits.curve;
     m_runtime.file_name = &m_program.file_name;
     m_runtime.strings = &m_program.strings;
+    m_runtime.warning = &m_warning;
 }
 
 void Deriver::index(const ModuleString& s, Indexed& out, bool force) const
@@ -131,6 +188,16 @@ void Deriver::index(const ModuleString& s, Indexed& out, bool force) const
 
 void Deriver::step()
 {
+    try {
+        step_located();
+    } catch (const EvaluationError& e) {
+        fail(e);
+    }
+}
+
+void Deriver::step_located()
+{
+    in_block("the StartEach block");
     evaluate(m_program.start_each_block, m_frame, m_runtime);
     index(m_string, m_indexed);
     m_next.clear();
@@ -144,6 +211,7 @@ void Deriver::step()
     m_param_growth = growth(params, m_next.param_total());
     std::swap(m_string, m_next);
     decompose();
+    in_block("the EndEach block");
     evaluate(m_program.end_each_block, m_frame, m_runtime);
     ++m_steps;
 }
@@ -154,13 +222,22 @@ ModuleString Deriver::take_string()
     return std::move(m_string);
 }
 
-void Deriver::finish() { evaluate(m_program.end_block, m_frame, m_runtime); }
+void Deriver::finish()
+{
+    in_block("the End block");
+    try {
+        evaluate(m_program.end_block, m_frame, m_runtime);
+    } catch (const EvaluationError& e) {
+        fail(e);
+    }
+}
 
 void Deriver::decompose()
 {
     const ProductionSet& set = m_program.lsystems.front().decomposition;
     if (set.productions.empty())
         return;
+    in_block("the decomposition's 'maximum depth:'");
     int depth = set.max_depth ? static_cast<int>(evaluate(*set.max_depth, m_frame, m_runtime)) : 1;
     std::size_t applied = 0;
     for (int pass = 0; pass < depth; ++pass) {
@@ -296,7 +373,6 @@ bool Deriver::apply_stochastic(const ProductionSet& set, const LSystemDefinition
     // cpfg collects every applicable production with its probability, summed in
     // single precision, then draws once per module, even where nothing applies
     m_matches.clear();
-    m_match_frames.clear();
     m_match_probs.clear();
     float total = 0;
     if (const auto* candidates = set.candidates(src.string->symbol(i))) {
@@ -310,27 +386,34 @@ bool Deriver::apply_stochastic(const ProductionSet& set, const LSystemDefinition
             total += prob;
             m_matches.push_back(index);
             m_match_probs.push_back(prob);
-            // each cpfg production keeps its own variables: save this one's bindings
-            m_match_frames.insert(m_match_frames.end(), m_frame.begin(),
-                                  m_frame.begin() + p.frame_size);
         }
     }
     auto scaled = static_cast<float>(total * m_stochastic.next_double());
-    std::size_t frame_offset = 0;
     for (std::size_t k = 0; k < m_matches.size(); ++k) {
         const Production& p = set.productions[m_matches[k]];
         scaled -= m_match_probs[k];
         if (scaled <= 0) {
-            std::copy_n(m_match_frames.begin() + static_cast<std::ptrdiff_t>(frame_offset),
-                        p.frame_size, m_frame.begin());
+            use_frame_of(p);  // its variables as its match left them
+            in_production(p);
             run_post_block(p);
             produce(p, dst);
             consumed = p.predecessor.size();
             return true;
         }
-        frame_offset += static_cast<std::size_t>(p.frame_size);
     }
     return false;
+}
+
+void Deriver::use_frame_of(const Production& p)
+{
+    if (m_frame_owner == &p)
+        return;
+    if (m_frame_owner)
+        std::copy_n(m_frame.begin(), m_frame_owner->frame_size,
+                    m_storage.begin() + static_cast<std::ptrdiff_t>(m_frame_owner->storage));
+    std::copy_n(m_storage.begin() + static_cast<std::ptrdiff_t>(p.storage), p.frame_size,
+                m_frame.begin());
+    m_frame_owner = &p;
 }
 
 bool Deriver::bind(const FormalModule& f, const ModuleString& s, std::size_t k,
@@ -350,7 +433,8 @@ bool Deriver::match(const Production& p, const LSystemDefinition& ls, const Inde
     const ModuleString& s = *src.string;
     if (i + p.predecessor.size() > s.size())
         return false;
-    std::fill(m_frame.begin(), m_frame.begin() + p.frame_size, 0.0);
+    in_production(p);
+    use_frame_of(p);
     for (std::size_t k = 0; k < p.predecessor.size(); ++k) {
         if (!bind(p.predecessor[k], s, i + k, offset))
             return false;
@@ -437,6 +521,7 @@ std::size_t Deriver::branch_end(const Indexed& src, std::size_t k) const
 
 bool Deriver::condition_holds(const Production& p)
 {
+    in_production(p);
     std::span<double> frame(m_frame);
     if (!p.pre_block.empty())
         evaluate(p.pre_block, frame, m_runtime);
@@ -445,12 +530,14 @@ bool Deriver::condition_holds(const Production& p)
 
 void Deriver::run_post_block(const Production& p)
 {
+    in_production(p);
     if (!p.post_block.empty())
         evaluate(p.post_block, std::span<double>(m_frame), m_runtime);
 }
 
 void Deriver::produce(const Production& p, ModuleString& dst)
 {
+    in_production(p);
     if (p.constant_successor) {
         dst.append(*p.constant_successor);
         return;
@@ -474,11 +561,33 @@ namespace {
 
 constexpr int max_homomorphism_depth = 1000;
 
+ParamLink make_link(std::size_t from, std::size_t to, std::size_t count)
+{
+    return ParamLink{static_cast<std::uint32_t>(from), static_cast<std::uint32_t>(to),
+                     static_cast<std::uint32_t>(count)};
+}
+
 }  // namespace
 
-void Deriver::apply_homomorphism(const ModuleString& in, ModuleString& out)
+void Deriver::apply_homomorphism(const ModuleString& in, ModuleString& out,
+                                 std::vector<ParamLink>* query_links, bool keep_objects)
+{
+    m_keep_objects = keep_objects;
+    try {
+        homomorphism_located(in, out, query_links);
+    } catch (const EvaluationError& e) {
+        m_keep_objects = false;
+        fail(e);
+    }
+    m_keep_objects = false;
+}
+
+void Deriver::homomorphism_located(const ModuleString& in, ModuleString& out,
+                                   std::vector<ParamLink>* query_links)
 {
     out.clear();
+    if (query_links)
+        query_links->clear();
     bool any = false, contexts = false;
     for (const auto& ls : m_program.lsystems) {
         any |= !ls.homomorphism.productions.empty();
@@ -486,6 +595,10 @@ void Deriver::apply_homomorphism(const ModuleString& in, ModuleString& out)
             contexts |= !p.left_context.empty() || !p.right_context.empty();
     }
     if (!any) {
+        if (query_links)
+            for (std::size_t i = 0, offset = 0; i < in.size(); offset += in.param_count(i), ++i)
+                if (is_query(in.symbol(i)))
+                    query_links->push_back(make_link(offset, offset, in.param_count(i)));
         out.append(in);
         return;
     }
@@ -493,6 +606,7 @@ void Deriver::apply_homomorphism(const ModuleString& in, ModuleString& out)
     index(in, ctx, contexts);
     // Each pass starts the homomorphism's own random stream afresh from its seed:
     const ProductionSet& main_set = m_program.lsystems.front().homomorphism;
+    in_block("the homomorphism's 'seed:' or 'maximum depth:'");
     m_homomorphism_random.seed(
         main_set.seed ? static_cast<long>(evaluate(*main_set.seed, m_frame, m_runtime)) : 0);
     std::vector<int> depth_of(m_program.lsystems.size(), 1);
@@ -519,9 +633,17 @@ void Deriver::apply_homomorphism(const ModuleString& in, ModuleString& out)
         int sym = in.symbol(i);
         std::size_t first = i, first_offset = offset;
         if (ls.homomorphism.candidates(static_cast<SymbolId>(sym)) && depth_of[l] > 0) {
+            std::size_t before = out.size(), before_params = out.param_total();
             homomorphism_module(ls.homomorphism, ls, in, i, offset, ctx, i, i + 1, 0,
                                 depth_of[l], out);
+            // a query module that no production rewrote is answered in place
+            if (query_links && is_query(sym) && i == first + 1 && out.size() == before + 1 &&
+                out.symbol(before) == sym && out.param_count(before) == in.param_count(first))
+                query_links->push_back(
+                    make_link(first_offset, before_params, in.param_count(first)));
         } else {
+            if (query_links && is_query(sym))
+                query_links->push_back(make_link(offset, out.param_total(), in.param_count(i)));
             out.append(static_cast<SymbolId>(sym),
                        std::span<const float>(in.param_data() + offset, in.param_count(i)));
             offset += in.param_count(i);
@@ -547,7 +669,8 @@ bool Deriver::match_at(const Production& p, const LSystemDefinition& ls, const M
 {
     if (k + p.predecessor.size() > s.size())
         return false;
-    std::fill(m_frame.begin(), m_frame.begin() + p.frame_size, 0.0);
+    in_production(p);
+    use_frame_of(p);
     for (std::size_t j = 0; j < p.predecessor.size(); ++j) {
         if (!bind(p.predecessor[j], s, k + j, offset))
             return false;
@@ -582,7 +705,6 @@ const Production* Deriver::find_homomorphism(const ProductionSet& set,
     // by their probabilities, drawing from the homomorphism's own generator
     std::vector<const Production*> applicable;
     std::vector<float> probs;
-    std::vector<double> frames;
     float total = 0;
     for (std::uint32_t index : *candidates) {
         const Production& p = set.productions[index];
@@ -593,18 +715,15 @@ const Production* Deriver::find_homomorphism(const ProductionSet& set,
         total += prob;
         applicable.push_back(&p);
         probs.push_back(prob);
-        frames.insert(frames.end(), m_frame.begin(), m_frame.begin() + p.frame_size);
     }
     auto scaled = static_cast<float>(total * m_homomorphism_random.next_double());
-    std::size_t frame_offset = 0;
     for (std::size_t j = 0; j < applicable.size(); ++j) {
         scaled -= probs[j];
         if (scaled <= 0) {
-            std::copy_n(frames.begin() + static_cast<std::ptrdiff_t>(frame_offset),
-                        applicable[j]->frame_size, m_frame.begin());
+            use_frame_of(*applicable[j]);
+            in_production(*applicable[j]);
             return applicable[j];
         }
-        frame_offset += static_cast<std::size_t>(applicable[j]->frame_size);
     }
     return nullptr;
 }
@@ -628,6 +747,10 @@ void Deriver::homomorphism_module(const ProductionSet& set, const LSystemDefinit
         if (set.warnings)
             warn(p->loc, "maximum depth of the homomorphism reached for module '" +
                              std::string(m_program.symbols.name(s.symbol(k))) + "'");
+        copy_one();
+        return;
+    }
+    if (m_keep_objects && is_instanceable_object(*p)) {
         copy_one();
         return;
     }

@@ -21,17 +21,33 @@ struct DeriveLimits {
     bool start = true;
 };
 
+/// Where the parameters of one module of a string went in its homomorphism expansion:
+/// the query pass answers ?P ?H ?L ?U there and copies the values back.
+struct ParamLink {
+    std::uint32_t from = 0;   ///< first parameter in the derived string
+    std::uint32_t to = 0;     ///< first parameter in the expanded string
+    std::uint32_t count = 0;
+};
+
 /// One derivation run: global variables, random generators and the current string.
 /// A Deriver is created from a Program, runs the Start block and builds the axiom; each
 /// step() rewrites the string once (then decomposes it); finish() runs the End block.
+/// A failure while evaluating throws cambium::Error naming the file, the position and
+/// the production or block that was running.
 class Deriver {
 public:
     Deriver(const Program& program, DeriveLimits limits = {});
+    Deriver(const Deriver&) = delete;
+    Deriver& operator=(const Deriver&) = delete;
 
     const ModuleString& string() const { return m_string; }
     int steps_done() const { return m_steps; }
     int derivation_length() const { return m_runtime.derivation_length; }
+    /// stop() was called in a step (a call in the Start block does not count, as in cpfg)
     bool stop_requested() const { return m_runtime.stop_requested; }
+    /// ... with an argument other than 1: the End block runs even though the derivation
+    /// stopped early
+    bool stop_runs_end() const { return m_runtime.stop_runs_end; }
     void step();
     void finish();
     /// Moves the current string out (the Deriver is spent afterwards).
@@ -43,11 +59,32 @@ public:
     void set_runtime(const Runtime& runtime);
 
     /// `in` with the homomorphism productions applied (recursively to each set's
-    /// maximum depth, with its seed: and warnings), for interpretation. Object
-    /// productions (-o>) are expanded like the others.
-    void apply_homomorphism(const ModuleString& in, ModuleString& out);
+    /// maximum depth, with its seed: and warnings), for interpretation. With
+    /// `keep_objects`, a module that an object production (-o>, one module, no
+    /// context) applies to stays as it is, for geom to instance; otherwise objects are
+    /// expanded like the others. With `query_links`, says where each ?P ?H ?L ?U module
+    /// of `in` that the homomorphism leaves as it is went.
+    void apply_homomorphism(const ModuleString& in, ModuleString& out,
+                            std::vector<ParamLink>* query_links = nullptr,
+                            bool keep_objects = false);
 
 private:
+    void start();
+    void step_located();
+    void homomorphism_located(const ModuleString& in, ModuleString& out,
+                              std::vector<ParamLink>* query_links);
+    /// What is being evaluated, for messages: a production, else a block
+    void in_block(const char* block)
+    {
+        m_production = nullptr;
+        m_block = block;
+    }
+    void in_production(const Production& p) { m_production = &p; }
+    FileLoc location(int site) const;
+    std::string context() const;
+    [[noreturn]] void fail(const EvaluationError& e) const;
+    bool is_query(int symbol) const;
+
     /// A string with the lookup tables context matching needs.
     struct Indexed {
         const ModuleString* string = nullptr;
@@ -98,18 +135,27 @@ private:
     ModuleString m_string, m_next;
     Indexed m_indexed;
     std::vector<double> m_frame;
+    /// Every production's variables between applications (Production::storage); the
+    /// frame holds those of m_frame_owner and goes back there when another takes it.
+    std::vector<double> m_storage;
+    const Production* m_frame_owner = nullptr;
+    void use_frame_of(const Production& p);
     std::vector<std::vector<char>> m_ignored;  ///< per L-system, by symbol
     std::vector<int> m_lsystem_stack;
     std::vector<std::uint32_t> m_matches;     ///< stochastic candidates
     std::vector<float> m_match_probs;         ///< their probabilities
-    std::vector<double> m_match_frames;       ///< their bound variables, concatenated
     int m_steps = 0;
     bool m_needs_index = false;          ///< some production has a context
+    bool m_keep_objects = false;         ///< apply_homomorphism leaves objects as they are
     double m_module_growth = 1.0, m_param_growth = 1.0;  ///< last step's, for reserve()
     int m_bracket_open = -1, m_bracket_close = -1, m_cut = -1, m_sub_start = -1, m_sub_end = -1;
     int m_equals = -1;
     std::vector<ModuleString> m_homomorphism_stack;  ///< successor buffers, by depth
     Rand48 m_homomorphism_random;
+    std::vector<char> m_query_symbol;                ///< by symbol: ?P ?H ?L ?U
+    const Production* m_production = nullptr;        ///< being evaluated, if any
+    const char* m_block = nullptr;                   ///< else the block being run
+    std::function<void(const std::string&, int)> m_warning;  ///< Runtime::warning
 };
 
 }  // namespace cambium::lsys

@@ -129,7 +129,10 @@ double call(Function f, const double* a, Runtime& rt)
         rt.function_random.seed(static_cast<long>(a[0]));
         rt.normal_cached = false;
         return 0;
-    case Function::Stop: rt.stop_requested = true; return 0;
+    case Function::Stop:
+        rt.stop_requested = true;
+        rt.stop_runs_end = a[0] != 1;
+        return 0;
     case Function::GetDerivationLength: return rt.derivation_length;
     case Function::SetDerivationLength:
         rt.derivation_length = static_cast<int>(a[0]);
@@ -139,17 +142,17 @@ double call(Function f, const double* a, Runtime& rt)
         auto text = [&](double index) -> std::string {
             auto i = static_cast<std::size_t>(index);
             if (!rt.strings || index < 0 || i >= rt.strings->size())
-                throw Error(FileLoc{l_file, 0, 0}, "fopen needs a file name and a mode in quotes");
+                throw EvaluationError("fopen needs a file name and a mode in quotes");
             return (*rt.strings)[i];
         };
         std::string base = std::filesystem::path(l_file).parent_path().string();
-        return rt.files->open(base, text(a[0]), text(a[1]), l_file);
+        return rt.files->open(base, text(a[0]), text(a[1]));
     }
     case Function::Fclose:
-        rt.files->close(a[0], rt.file_name ? *rt.file_name : std::string());
+        rt.files->close(a[0]);
         return 0;
     case Function::Fflush:
-        std::fflush(rt.files->get(a[0], rt.file_name ? *rt.file_name : std::string()));
+        std::fflush(rt.files->get(a[0]));
         return 0;
     case Function::Func:
         // function sets live in the view file (geom); the caller binds them
@@ -260,23 +263,53 @@ int scan_values(std::FILE* file, const std::string& format, double* values, int 
     return read;
 }
 
-double int_modulo(double a, double b)
+std::string number_text(double v)
 {
-    int divisor = static_cast<int>(b);
-    return divisor == 0 ? 0.0 : static_cast<double>(static_cast<int>(a) % divisor);
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
 }
 
-bool element_index(const ArrayValues& a, const double* idx, int n, std::size_t& flat)
+double int_modulo(double a, double b)
 {
-    flat = 0;
+    // cpfg takes % on ints, and its int % 0 kills the process: say so instead
+    double divisor = std::trunc(b);
+    if (divisor == 0 || !std::isfinite(b))
+        throw EvaluationError("'%' with divisor " + number_text(b) +
+                              " (the remainder is taken on integers; the divisor truncates to 0)");
+    if (!std::isfinite(a) || std::fabs(a) > 2147483647.0 || std::fabs(divisor) > 2147483647.0)
+        return std::fmod(std::trunc(a), divisor);
+    return static_cast<double>(static_cast<int>(a) % static_cast<int>(divisor));
+}
+
+/// The row-major offset of an element. cpfg warns about a subscript outside the array
+/// and clamps it; here it is an error that names the array, the subscript and the range.
+std::size_t element_index(const ArrayValues& a, const double* idx, int n, const std::string& name)
+{
+    if (n != static_cast<int>(a.dims.size()))
+        throw EvaluationError("array '" + name + "' has " + std::to_string(a.dims.size()) +
+                              " dimension(s) but is used with " + std::to_string(n) +
+                              " subscript(s)");
+    std::size_t flat = 0;
     for (int d = 0; d < n; ++d) {
-        int i = static_cast<int>(idx[d]);
-        int size = d < static_cast<int>(a.dims.size()) ? a.dims[static_cast<std::size_t>(d)] : 1;
-        if (i < 0 || i >= size)
-            return false;
-        flat = flat * static_cast<std::size_t>(size) + static_cast<std::size_t>(i);
+        int size = a.dims[static_cast<std::size_t>(d)];
+        // cpfg's test: a subscript is out of range when < 0 or >= the size
+        if (!(idx[d] >= 0 && idx[d] < size))
+            throw EvaluationError("subscript " + std::to_string(d + 1) + " of array '" + name +
+                                  "' is " + number_text(idx[d]) + ", outside 0.." +
+                                  std::to_string(size - 1));
+        flat = flat * static_cast<std::size_t>(size) + static_cast<std::size_t>(idx[d]);
     }
-    return flat < a.values.size();
+    return flat;
+}
+
+void warn_division_by_zero(Runtime& rt, int site)
+{
+    std::string message = "division by 0; cpfg divides by 1 instead";
+    if (rt.warning && *rt.warning)
+        (*rt.warning)(message, site);
+    else
+        warn(FileLoc{rt.file_name ? *rt.file_name : std::string(), 0, 0}, message);
 }
 
 }  // namespace
@@ -289,25 +322,25 @@ OpenFiles::~OpenFiles()
 }
 
 int OpenFiles::open(const std::string& base_dir, const std::string& name,
-                    const std::string& mode, const std::string& l_file)
+                    const std::string& mode)
 {
     if (mode != "r" && mode != "w" && mode != "a")
-        throw Error(FileLoc{l_file, 0, 0}, "fopen(\"" + name + "\", \"" + mode +
-                                               "\"): the mode must be \"r\", \"w\" or \"a\"");
+        throw EvaluationError("fopen(\"" + name + "\", \"" + mode +
+                              "\"): the mode must be \"r\", \"w\" or \"a\"");
     std::size_t slot = 0;
     while (slot < m_files.size() && m_files[slot])
         ++slot;
     if (slot >= static_cast<std::size_t>(max_open))
-        throw Error(FileLoc{l_file, 0, 0}, "fopen(\"" + name + "\"): more than " +
-                                               std::to_string(max_open) + " files open at once");
+        throw EvaluationError("fopen(\"" + name + "\"): more than " +
+                              std::to_string(max_open) + " files open at once");
     std::filesystem::path path(name);
     if (path.is_relative() && !base_dir.empty())
         path = std::filesystem::path(base_dir) / path;
     std::FILE* f = std::fopen(path.string().c_str(), mode.c_str());
     if (!f)
-        throw Error(FileLoc{l_file, 0, 0}, "fopen: cannot open '" + path.string() + "' for " +
-                                               (mode == "r" ? "reading" : "writing") + ": " +
-                                               std::strerror(errno));
+        throw EvaluationError("fopen: cannot open '" + path.string() + "' for " +
+                              (mode == "r" ? "reading" : "writing") + ": " +
+                              std::strerror(errno));
     if (slot == m_files.size())
         m_files.push_back(f);
     else
@@ -315,18 +348,18 @@ int OpenFiles::open(const std::string& base_dir, const std::string& name,
     return static_cast<int>(slot);
 }
 
-std::FILE* OpenFiles::get(double index, const std::string& l_file) const
+std::FILE* OpenFiles::get(double index) const
 {
-    auto i = static_cast<long long>(index);
-    if (index < 0 || i >= static_cast<long long>(m_files.size()) || !m_files[static_cast<std::size_t>(i)])
-        throw Error(FileLoc{l_file, 0, 0},
-                    "file index " + std::to_string(i) + " does not name a file opened with fopen");
-    return m_files[static_cast<std::size_t>(i)];
+    if (!(index >= 0 && index < static_cast<double>(m_files.size())) ||
+        !m_files[static_cast<std::size_t>(index)])
+        throw EvaluationError("file index " + number_text(index) +
+                              " does not name a file opened with fopen");
+    return m_files[static_cast<std::size_t>(index)];
 }
 
-void OpenFiles::close(double index, const std::string& l_file)
+void OpenFiles::close(double index)
 {
-    std::FILE* f = get(index, l_file);
+    std::FILE* f = get(index);
     std::fclose(f);
     m_files[static_cast<std::size_t>(index)] = nullptr;
 }
@@ -339,13 +372,15 @@ const FunctionInfo* find_function(std::string_view name)
     return nullptr;
 }
 
-double evaluate(const Code& code, std::span<double> frame, Runtime& rt)
+namespace {
+
+double run(const Code& code, std::span<double> frame, Runtime& rt, std::size_t& pc)
 {
     std::array<double, max_stack_depth> stack;
     int sp = 0;
     const Instr* instrs = code.instrs.data();
     const std::size_t count = code.instrs.size();
-    for (std::size_t pc = 0; pc < count; ++pc) {
+    for (pc = 0; pc < count; ++pc) {
         const Instr& in = instrs[pc];
         switch (in.op) {
         case Op::Const: stack[sp++] = in.value; break;
@@ -355,19 +390,16 @@ double evaluate(const Code& code, std::span<double> frame, Runtime& rt)
         case Op::StoreGlobal: rt.globals[static_cast<std::size_t>(in.arg)] = stack[--sp]; break;
         case Op::LoadElement: {
             sp -= in.arg2;
-            std::size_t flat;
             const auto& a = rt.arrays[static_cast<std::size_t>(in.arg)];
-            double v = element_index(a, &stack[sp], in.arg2, flat) ? a.values[flat] : 0.0;
-            stack[sp++] = v;
+            stack[sp] = a.values[element_index(a, &stack[sp], in.arg2, a.name)];
+            ++sp;
             break;
         }
         case Op::StoreElement: {
             double v = stack[--sp];
             sp -= in.arg2;
-            std::size_t flat;
             auto& a = rt.arrays[static_cast<std::size_t>(in.arg)];
-            if (element_index(a, &stack[sp], in.arg2, flat))
-                a.values[flat] = v;
+            a.values[element_index(a, &stack[sp], in.arg2, a.name)] = v;
             break;
         }
         case Op::Neg: stack[sp - 1] = -stack[sp - 1]; break;
@@ -384,7 +416,15 @@ double evaluate(const Code& code, std::span<double> frame, Runtime& rt)
         CAMBIUM_BINARY(Sub, a - b)
         CAMBIUM_BINARY(Mul, a * b)
         // cpfg divides by 1 instead of 0 (with a warning) and takes % on ints
-        CAMBIUM_BINARY(Div, a / (b == 0.0 ? 1.0 : b))
+        case Op::Div: {
+            double b = stack[--sp];
+            if (b == 0.0) {
+                warn_division_by_zero(rt, static_cast<int>(in.value));
+                b = 1.0;
+            }
+            stack[sp - 1] /= b;
+            break;
+        }
         CAMBIUM_BINARY(Mod, int_modulo(a, b))
         CAMBIUM_BINARY(Pow, std::pow(a, b))
         CAMBIUM_BINARY(Less, a < b ? 1.0 : 0.0)
@@ -430,7 +470,7 @@ double evaluate(const Code& code, std::span<double> frame, Runtime& rt)
             break;
         case Op::FilePrint: {
             sp -= in.arg2;
-            std::FILE* f = rt.files->get(stack[sp - 1], rt.file_name ? *rt.file_name : "");
+            std::FILE* f = rt.files->get(stack[sp - 1]);
             if (rt.strings)
                 std::fputs(format_values((*rt.strings)[static_cast<std::size_t>(in.arg)],
                                          &stack[sp], in.arg2)
@@ -444,7 +484,7 @@ double evaluate(const Code& code, std::span<double> frame, Runtime& rt)
             int n = in.arg2;
             sp -= n;
             double* values = &stack[sp];
-            std::FILE* f = rt.files->get(stack[sp - 1], rt.file_name ? *rt.file_name : "");
+            std::FILE* f = rt.files->get(stack[sp - 1]);
             std::array<double, max_stack_depth> read_values;
             int count = rt.strings ? scan_values(f, (*rt.strings)[static_cast<std::size_t>(in.arg)],
                                                  read_values.data(), n)
@@ -458,6 +498,21 @@ double evaluate(const Code& code, std::span<double> frame, Runtime& rt)
         }
     }
     return sp > 0 ? stack[sp - 1] : 0.0;
+}
+
+}  // namespace
+
+double evaluate(const Code& code, std::span<double> frame, Runtime& rt)
+{
+    std::size_t pc = 0;
+    try {
+        return run(code, frame, rt, pc);
+    } catch (EvaluationError& e) {
+        // the failing instruction knows where in the source it came from
+        if (e.site() < 0 && pc < code.instrs.size())
+            e.set_site(static_cast<int>(code.instrs[pc].value));
+        throw;
+    }
 }
 
 }  // namespace cambium::lsys

@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,9 @@ enum class Function : std::uint8_t {
     CurveX, CurveY, CurveZ, CurveLength, Fopen, Fclose, Fflush,
 };
 
+/// Instructions that can fail or warn at run time (LoadElement, StoreElement, Div, Mod,
+/// Call, FilePrint, FileScan) keep in `value` the index of their source position in
+/// Program::sites, so a runtime error names the column, not only the production.
 struct Instr {
     Op op;
     std::uint8_t arg2 = 0;
@@ -60,6 +64,7 @@ struct Code {
 
 /// A defined array (section 5.1.4): dimensions and row-major values.
 struct ArrayValues {
+    std::string name;  ///< for error messages
     std::vector<int> dims;
     std::vector<double> values;
 };
@@ -74,11 +79,11 @@ public:
     OpenFiles& operator=(const OpenFiles&) = delete;
     ~OpenFiles();
     /// Opens `name` (relative to `base_dir`) with mode "r", "w" or "a"; returns its index.
-    int open(const std::string& base_dir, const std::string& name, const std::string& mode,
-             const std::string& l_file);
-    /// The open file with `index`, or throws naming `l_file`.
-    std::FILE* get(double index, const std::string& l_file) const;
-    void close(double index, const std::string& l_file);
+    /// Failures throw EvaluationError.
+    int open(const std::string& base_dir, const std::string& name, const std::string& mode);
+    /// The open file with `index`, or throws EvaluationError.
+    std::FILE* get(double index) const;
+    void close(double index);
 
 private:
     std::vector<std::FILE*> m_files;
@@ -94,7 +99,11 @@ struct Runtime {
     double normal_spare = 0;     ///< nran's cached second deviate
     bool normal_cached = true;   ///< cpfg starts "cached" with a spare of 0
     int derivation_length = 0;
+    /// stop() was called; stop_runs_end: with an argument other than 1 (cpfg's STOP,
+    /// after which the End block runs; stop(1) is cpfg's RUN, which ends a batch
+    /// derivation too but skips the End block). The last call decides.
     bool stop_requested = false;
+    bool stop_runs_end = false;
     /// func(id, x): the view file's functions, provided by the caller (may be empty)
     const std::function<double(int, double)>* function = nullptr;
     /// curveX/Y/Z(id, t) and curveGAL(id): the view file's curves (may be empty)
@@ -102,7 +111,27 @@ struct Runtime {
     /// named in the warning that an unprovided func() evaluates to 0
     const std::string* file_name = nullptr;
     bool function_warned = false;
+    /// Reports a runtime warning (cpfg's "division by 0") at Program::sites[site] (-1:
+    /// unknown); the Deriver names the production. Unset: a plain warning.
+    const std::function<void(const std::string& message, int site)>* warning = nullptr;
     std::shared_ptr<OpenFiles> files = std::make_shared<OpenFiles>();
+};
+
+/// A failure while evaluating: an array subscript out of range, '%' by 0, a file
+/// function misused. It holds no file position: the Deriver, which knows the production
+/// or block it was running, turns it into a cambium::Error that names them.
+class EvaluationError : public std::runtime_error {
+public:
+    EvaluationError(const std::string& message, int site = -1)
+        : std::runtime_error(message), m_site(site)
+    {
+    }
+    /// Index into Program::sites of the failing expression; -1 when unknown.
+    int site() const { return m_site; }
+    void set_site(int site) { m_site = site; }
+
+private:
+    int m_site;
 };
 
 /// Runs `code` with the given local frame. Returns the value left on top of the stack

@@ -53,6 +53,13 @@ public:
     /// The rest of the current line, raw (for `lsystem:` labels), consuming it.
     std::string rest_of_line();
     FileLoc loc() const { return FileLoc{m_state.file, m_state.line, m_state.column}; }
+    /// The read position in the text, and the raw text between two positions (the
+    /// source of a production, quoted in runtime errors).
+    std::size_t offset() const { return m_state.pos; }
+    std::string_view source(std::size_t from, std::size_t to) const
+    {
+        return m_text.substr(from, to > from ? to - from : 0);
+    }
 
 private:
     struct State {

@@ -72,6 +72,8 @@ LSystem::LSystem(std::unique_ptr<Program> program, LoadOptions options)
     const SymbolTable& symbols = m_program->symbols;
     for (const char* name : {"?P", "?H", "?L", "?U"})
         m_has_queries |= uses_symbol(*m_program, symbols.find(name));
+    for (const auto& ls : m_program->lsystems)
+        m_has_homomorphism |= !ls.homomorphism.productions.empty();
     // cpfg's ?E talks to an environmental program (out of scope): say so once
     if (uses_symbol(*m_program, symbols.find("?E")))
         warn(FileLoc{m_program->file_name, 0, 0},
@@ -135,36 +137,61 @@ bool LSystem::has_queries() const { return m_has_queries; }
 ModuleString LSystem::derive(std::optional<int> steps) const
 {
     Deriver deriver(*m_program, limits_of(m_options));
-    auto between_steps = [&] {
-        if (m_has_queries && m_options.query)
-            run_query(deriver.mutable_string());
-        if (m_options.on_step)
-            m_options.on_step(deriver.steps_done(), deriver.string());
-    };
-    between_steps();
+    if (m_options.on_step)
+        m_options.on_step(0, deriver.string());
     int n = steps.value_or(deriver.derivation_length());
     for (int i = 0; i < n; ++i) {
+        // cpfg (with its default "environment display" off) answers queries while
+        // interpreting the string before each step, not after the last one
+        if (m_has_queries && m_options.query)
+            run_query(deriver);
         deriver.step();
-        between_steps();
+        if (m_options.on_step)
+            m_options.on_step(deriver.steps_done(), deriver.string());
+        // stop() ends the derivation once the step that called it is complete
+        if (deriver.stop_requested())
+            break;
     }
-    deriver.finish();
+    bool stopped_early = deriver.stop_requested() && deriver.steps_done() < n;
+    if (!stopped_early || deriver.stop_runs_end())
+        deriver.finish();
     m_last_runtime = std::make_shared<Runtime>(deriver.runtime());
     return deriver.take_string();
 }
 
-void LSystem::run_query(ModuleString& s) const
+void LSystem::run_query(Deriver& deriver) const
 {
-    if (m_program->split_commands.empty()) {
+    ModuleString& s = deriver.mutable_string();
+    auto changed_count = [&] {
+        return Error(FileLoc{m_program->file_name, 0, 0},
+                     "internal: the query pass changed the number of parameters");
+    };
+    if (!m_has_homomorphism && m_program->split_commands.empty()) {
         m_options.query(s);
         return;
     }
-    // '@' has no parameters, so the joined string holds the same values in the same order
-    ModuleString joined = join_at_commands(s);
+    if (!m_has_homomorphism) {
+        // '@' has no parameters, so the joined string holds the same values in the same order
+        ModuleString joined = join_at_commands(s);
+        m_options.query(joined);
+        if (joined.param_total() != s.param_total())
+            throw changed_count();
+        std::copy_n(joined.param_data(), joined.param_total(), s.mutable_params().data());
+        return;
+    }
+    // cpfg answers queries while interpreting the string with the homomorphism applied,
+    // with the derivation's own variables
+    ModuleString expanded;
+    std::vector<ParamLink> links;
+    deriver.apply_homomorphism(s, expanded, &links);
+    ModuleString joined = join_at_commands(expanded);
+    std::size_t total = joined.param_total();
     m_options.query(joined);
-    if (joined.param_total() != s.param_total())
-        throw Error(FileLoc{m_program->file_name, 0, 0},
-                    "internal: the query pass changed the number of parameters");
-    std::copy_n(joined.param_data(), joined.param_total(), s.mutable_params().data());
+    if (joined.param_total() != total)
+        throw changed_count();
+    float* params = s.mutable_params().data();
+    for (const ParamLink& link : links)
+        std::copy_n(joined.param_data() + link.to, link.count, params + link.from);
 }
 
 ModuleString LSystem::join_at_commands(const ModuleString& s) const
@@ -205,7 +232,8 @@ ModuleString LSystem::join_at_commands(const ModuleString& s) const
     return out;
 }
 
-ModuleString LSystem::interpretation_string(const ModuleString& derived) const
+ModuleString LSystem::interpretation_string(const ModuleString& derived,
+                                           ObjectHandling objects) const
 {
     DeriveLimits limits = limits_of(m_options);
     limits.start = m_last_runtime == nullptr;  // else the Start block gives the globals
@@ -213,7 +241,7 @@ ModuleString LSystem::interpretation_string(const ModuleString& derived) const
     if (m_last_runtime)
         deriver.set_runtime(*m_last_runtime);
     ModuleString out;
-    deriver.apply_homomorphism(derived, out);
+    deriver.apply_homomorphism(derived, out, nullptr, objects == ObjectHandling::keep);
     return join_at_commands(out);
 }
 
@@ -221,7 +249,7 @@ bool LSystem::is_object_symbol(int symbol) const
 {
     for (const auto& ls : m_program->lsystems)
         for (const auto& p : ls.homomorphism.productions)
-            if (p.object_production && !p.predecessor.empty() && p.predecessor.front().symbol == symbol)
+            if (is_instanceable_object(p) && p.predecessor.front().symbol == symbol)
                 return true;
     return false;
 }

@@ -16,6 +16,7 @@ namespace cambium::lsys {
 
 struct Program;
 struct Runtime;
+class Deriver;
 
 struct LoadOptions {
     std::vector<std::string> defines;      ///< extra -D NAME[=VALUE] for the preprocessor
@@ -29,17 +30,22 @@ struct LoadOptions {
     /// Unset: they evaluate to 0 with one warning.
     std::function<double(char which, int id, double t)> curve;
     /// The interpretation pass that fills the parameters of ?P ?H ?L ?U from the turtle
-    /// (geom). Called, when the program has query modules, on the axiom and after every
-    /// derivation step (so before each next step and after the last one), as cpfg
-    /// interprets the string between steps. It gets the string with @-commands joined
-    /// (as interpretation_string() would join them) and may change parameter values
-    /// only, not modules or parameter counts. Homomorphism is not applied to it.
+    /// (geom). Called, when the program has query modules, before every derivation step
+    /// (on the axiom, ..., on the string of step n-1; not after the last step), as cpfg
+    /// does with its default "environment display" off. It gets the string with the homomorphism
+    /// applied (as cpfg interprets it; the answers of query modules the homomorphism
+    /// leaves as they are go back into the derived string) and @-commands joined (as
+    /// interpretation_string() would join them), and may change parameter values only,
+    /// not modules or parameter counts.
     std::function<void(ModuleString&)> query;
     /// Called with the axiom (step 0) and after every step (cpfg's -V output).
     std::function<void(int step, const ModuleString&)> on_step;
 };
 
 /// A parsed and compiled .l file.
+/// What interpretation_string does with object productions (-o>).
+enum class ObjectHandling { expand, keep };
+
 class LSystem {
 public:
     /// Reads, preprocesses (with -I the file's folder) and compiles `file`.
@@ -61,7 +67,12 @@ public:
     int derivation_length() const;
     /// The main L-system's axiom, its parameters evaluated after the Start block.
     ModuleString axiom() const;
-    /// Derives `steps` steps from the axiom (default: derivation_length()).
+    /// Derives `steps` steps from the axiom (default: derivation_length()). stop()
+    /// called in a step ends the derivation after that step (its EndEach block
+    /// included), as cpfg's batch derivation does; the End block then runs for stop(n)
+    /// with n != 1 and not for stop(1). stop() in the Start block is ignored. Failures
+    /// (array subscript out of range, '%' by 0, file functions) throw cambium::Error
+    /// naming file:line:col and the production or block.
     ModuleString derive(std::optional<int> steps = std::nullopt) const;
     /// The compiled program (productions, decomposition, homomorphism, globals).
     const Program& program() const;
@@ -75,9 +86,12 @@ public:
     /// (see docs: cpfg's one-character string) joined back into their turtle names.
     /// Global variables are those the last derive() left (else after the Start block).
     /// Not thread-safe with derive() on the same LSystem.
-    ModuleString interpretation_string(const ModuleString& derived) const;
-    /// Whether `symbol` is the predecessor of an object production (-o>) in a
-    /// homomorphism: geom may instance its expansion instead of repeating it.
+    /// With ObjectHandling::keep, modules an instanceable object production applies to
+    /// stay unexpanded: geom instances them through is_object_symbol/expand_object.
+    ModuleString interpretation_string(const ModuleString& derived,
+                                       ObjectHandling objects = ObjectHandling::expand) const;
+    /// Whether `symbol` is the predecessor of an object production (-o>, one module, no
+    /// context) in a homomorphism: geom may instance its expansion instead of repeating it.
     bool is_object_symbol(int symbol) const;
     /// The homomorphism successor of one module (context-free, recursively to the
     /// maximum depth), @-commands joined: the geometry of one instance of an object.
@@ -85,7 +99,7 @@ public:
 
 private:
     explicit LSystem(std::unique_ptr<Program> program, LoadOptions options);
-    void run_query(ModuleString& s) const;
+    void run_query(Deriver& deriver) const;
     ModuleString join_at_commands(const ModuleString& s) const;
 
     std::unique_ptr<Program> m_program;
@@ -93,6 +107,7 @@ private:
     /// Globals and arrays after the last derive(), for interpretation_string()
     mutable std::shared_ptr<Runtime> m_last_runtime;
     bool m_has_queries = false;
+    bool m_has_homomorphism = false;
 };
 
 }  // namespace cambium::lsys

@@ -4,6 +4,9 @@
 
 #include <cstdlib>
 #include <functional>
+#include <optional>
+#include <set>
+#include <utility>
 
 #include "lsys/lexer.h"
 
@@ -48,6 +51,8 @@ struct Scope {
     bool global = false;
     std::vector<std::pair<std::string, int>> locals;
     int next_slot = 0;
+    /// Names read before any definition, warned about once the production is parsed
+    std::vector<std::pair<std::string, FileLoc>> undefined;
 
     int local_slot(const std::string& name)
     {
@@ -134,14 +139,60 @@ private:
     void parse_file_call(Emitter& e, const Token& name);
     int parse_indices(Emitter& e);
     void emit_load(Emitter& e, const Token& name);
-    VariableRef resolve(const std::string& name);
+    void check_subscripts(const Token& name, const VariableRef& ref, int n) const;
+    std::optional<VariableRef> lookup(const std::string& name) const;
+    VariableRef resolve(const Token& name, bool reading);
+    void warn_undefined(const std::string& name, const FileLoc& loc, const std::string& where);
+    double site(const FileLoc& loc);
     double constant_expression();
 
     Lexer m_lexer;
     Program& m_program;
     Scope* m_scope = nullptr;
+    std::string m_context;             ///< the global block or header item being compiled
+    std::set<std::string> m_warned;    ///< undefined names already reported
     int m_nesting = 0;
 };
+
+/// The source of a production on one line: line markers and comments dropped, blanks
+/// collapsed, long ones shortened.
+std::string one_line(std::string_view raw)
+{
+    std::string out;
+    bool line_start = true, blank = false;
+    for (std::size_t i = 0; i < raw.size(); ++i) {
+        char c = raw[i];
+        if (line_start && c == '#') {  // a cpp line marker
+            while (i < raw.size() && raw[i] != '\n')
+                ++i;
+            continue;
+        }
+        if (c == '/' && i + 1 < raw.size() && raw[i + 1] == '*') {
+            std::size_t end = raw.find("*/", i + 2);
+            i = end == std::string_view::npos ? raw.size() : end + 1;
+            blank = true;
+            continue;
+        }
+        if (c == '/' && i + 1 < raw.size() && raw[i + 1] == '/') {
+            while (i + 1 < raw.size() && raw[i + 1] != '\n')
+                ++i;
+            continue;
+        }
+        line_start = c == '\n';
+        if (c == ' ' || c == '\t' || c == '\n' || c == '\r') {
+            blank = true;
+            continue;
+        }
+        if (blank && !out.empty())
+            out += ' ';
+        blank = false;
+        out += c;
+    }
+    constexpr std::size_t max_length = 90;
+    if (out.size() > max_length)
+        out = out.substr(0, max_length - 3) + "...";
+    return out;
+}
 
 // ---------------------------------------------------------------- tokens
 
@@ -257,6 +308,7 @@ bool Parser::parse_item(LSystemDefinition& ls)
     if (t.text == "seed:" || t.text == "derivation length:") {
         Scope scope = global_scope();
         m_scope = &scope;
+        m_context = "'" + t.text + "'";
         (t.text == "seed:" ? ls.seed : ls.derivation_length) = compile_expression();
         m_scope = nullptr;
         expect_eol(t.text.c_str());
@@ -269,6 +321,10 @@ bool Parser::parse_item(LSystemDefinition& ls)
         parse_define_block();
     } else if (t.text == "start:" || t.text == "end:" || t.text == "start each:" ||
                t.text == "end each:") {
+        m_context = t.text == "start:"        ? "the Start block"
+                    : t.text == "end:"        ? "the End block"
+                    : t.text == "start each:" ? "the StartEach block"
+                                              : "the EndEach block";
         Code block = parse_global_block();
         Code& target = t.text == "start:"        ? m_program.start_block
                        : t.text == "end:"        ? m_program.end_block
@@ -323,6 +379,7 @@ void Parser::parse_array_definition()
     Token name = expect(LexMode::Expression, TokenKind::Name, "an array name");
     ArrayDefinition def;
     def.name = name.text;
+    def.initial.name = name.text;
     std::size_t total = 1;
     while (accept_operator("[")) {
         int dim = static_cast<int>(constant_expression());
@@ -354,17 +411,29 @@ double Parser::constant_expression()
     Scope scope = global_scope();
     Scope* saved = m_scope;
     m_scope = &scope;
+    std::string saved_context = std::exchange(m_context, "an array definition");
     Code code = compile_expression();
+    m_context = std::move(saved_context);
     m_scope = saved;
     Runtime rt;
     rt.globals.assign(m_program.global_names.size(), 0.0);
-    return evaluate(code, {}, rt);
+    for (const auto& a : m_program.arrays)
+        rt.arrays.push_back(a.initial);
+    rt.strings = &m_program.strings;
+    try {
+        return evaluate(code, {}, rt);
+    } catch (const EvaluationError& e) {
+        throw Error(e.site() >= 0 ? m_program.sites[static_cast<std::size_t>(e.site())]
+                                  : m_lexer.loc(),
+                    e.what());
+    }
 }
 
 void Parser::parse_axiom(LSystemDefinition& ls)
 {
     Scope scope = global_scope();
     m_scope = &scope;
+    m_context = "the axiom";
     ls.axiom = parse_modules(false);
     m_scope = nullptr;
 }
@@ -388,6 +457,7 @@ void Parser::parse_decomposition(LSystemDefinition& ls)
     skip_blank_lines();
     if (at_keyword("maximum depth:")) {
         next(LexMode::Module);
+        m_context = "the decomposition's 'maximum depth:'";
         ls.decomposition.max_depth = compile_expression();
         expect_eol("'maximum depth:'");
     }
@@ -402,10 +472,12 @@ void Parser::parse_homomorphism(LSystemDefinition& ls)
         skip_blank_lines();
         if (at_keyword("maximum depth:")) {
             next(LexMode::Module);
+            m_context = "the homomorphism's 'maximum depth:'";
             ls.homomorphism.max_depth = compile_expression();
             expect_eol("'maximum depth:'");
         } else if (at_keyword("seed:")) {
             next(LexMode::Module);
+            m_context = "the homomorphism's 'seed:'";
             ls.homomorphism.seed = compile_expression();
             expect_eol("'seed:'");
         } else {
@@ -434,6 +506,8 @@ void Parser::parse_production(ProductionSet& set)
     Production p;
     Scope scope;
     m_scope = &scope;
+    m_context.clear();
+    std::size_t start = m_lexer.offset();
     p.loc = peek(LexMode::Module).loc;
     parse_predecessor(p);
     Token t = next(LexMode::Module);
@@ -445,8 +519,13 @@ void Parser::parse_production(ProductionSet& set)
         fail(t, "'-->'");
     p.object_production = t.kind == TokenKind::ObjectYields;
     parse_successor(p);
+    p.text = one_line(m_lexer.source(start, m_lexer.offset()));
+    for (const auto& [name, loc] : scope.undefined)
+        warn_undefined(name, loc, "production '" + p.text + "'");
     build_constant_successor(p);
     p.frame_size = scope.next_slot;
+    p.storage = m_program.storage_size;
+    m_program.storage_size += static_cast<std::size_t>(p.frame_size);
     m_scope = nullptr;
     set.productions.push_back(std::move(p));
 }
@@ -671,24 +750,19 @@ void Parser::parse_assignment_or_expression(Emitter& e)
         Lexer before_name = m_lexer;  // an expression statement starts the same way
         next(LexMode::Expression);
         Token after = peek(LexMode::Expression);
-        VariableRef ref = resolve(first.text);
-        if (after.text == "[" && ref.kind == VariableRef::Array) {
-            next(LexMode::Expression);
-            int n = 1;
-            parse_expression(e);
-            expect_operator("]");
-            while (accept_operator("[")) {
-                parse_expression(e);
-                expect_operator("]");
-                ++n;
-            }
+        std::optional<VariableRef> known = lookup(first.text);
+        if (after.text == "[" && known && known->kind == VariableRef::Array) {
+            int n = parse_indices(e);
+            check_subscripts(first, *known, n);
             expect_operator("=");
             parse_expression(e);
-            e.emit(Op::StoreElement, -(n + 1), ref.index, static_cast<std::uint8_t>(n));
+            e.emit(Op::StoreElement, -(n + 1), known->index, static_cast<std::uint8_t>(n),
+                   site(first.loc));
             expect_operator(";");
             return;
         }
         if (after.kind == TokenKind::Operator && after.text == "=") {
+            VariableRef ref = resolve(first, false);
             next(LexMode::Expression);
             parse_expression(e);
             if (ref.kind == VariableRef::Array)
@@ -821,7 +895,8 @@ void Parser::parse_multiplicative(Emitter& e)
             return;
         next(LexMode::Expression);
         parse_power(e);
-        e.emit(t.text == "*" ? Op::Mul : t.text == "/" ? Op::Div : Op::Mod, -1);
+        e.emit(t.text == "*" ? Op::Mul : t.text == "/" ? Op::Div : Op::Mod, -1, 0, 0,
+               t.text == "*" ? 0.0 : site(t.loc));
     }
 }
 
@@ -910,7 +985,12 @@ void Parser::parse_call(Emitter& e, const Token& name)
     if (f->arity >= 0 && n != f->arity && !(f->arity == 1 && n == 0))
         throw Error(name.loc, "'" + name.text + "' takes " + std::to_string(f->arity) +
                                   " argument(s), " + std::to_string(n) + " given");
-    e.emit(Op::Call, 1 - n, static_cast<std::int32_t>(f->function), static_cast<std::uint8_t>(n));
+    if (f->arity == 1 && n == 0) {  // stop() is stop(0): give the argument a value
+        e.emit(Op::Const, 1, 0, 0, 0.0);
+        n = 1;
+    }
+    e.emit(Op::Call, 1 - n, static_cast<std::int32_t>(f->function), static_cast<std::uint8_t>(n),
+           site(name.loc));
 }
 
 void Parser::parse_file_call(Emitter& e, const Token& name)
@@ -930,14 +1010,14 @@ void Parser::parse_file_call(Emitter& e, const Token& name)
         expect(LexMode::Expression, TokenKind::RParen, "')'");
         if (n > max_stack)
             throw Error(name.loc, "too many arguments");
-        e.emit(Op::FilePrint, -n, format_index, static_cast<std::uint8_t>(n));
+        e.emit(Op::FilePrint, -n, format_index, static_cast<std::uint8_t>(n), site(name.loc));
         return;
     }
     std::vector<VariableRef> targets;
     while (accept_operator(",")) {
         accept_operator("&");
         Token var = expect(LexMode::Expression, TokenKind::Name, "a variable to read into");
-        VariableRef ref = resolve(var.text);
+        VariableRef ref = resolve(var, false);
         if (ref.kind == VariableRef::Array)
             throw Error(var.loc, "fscanf reads into variables, not arrays ('" + var.text + "')");
         e.emit(ref.kind == VariableRef::Local ? Op::LoadLocal : Op::LoadGlobal, 1, ref.index);
@@ -946,7 +1026,8 @@ void Parser::parse_file_call(Emitter& e, const Token& name)
             throw Error(var.loc, "too many variables");
     }
     expect(LexMode::Expression, TokenKind::RParen, "')'");
-    e.emit(Op::FileScan, 0, format_index, static_cast<std::uint8_t>(targets.size()));
+    e.emit(Op::FileScan, 0, format_index, static_cast<std::uint8_t>(targets.size()),
+           site(name.loc));
     for (auto it = targets.rbegin(); it != targets.rend(); ++it)
         e.emit(it->kind == VariableRef::Local ? Op::StoreLocal : Op::StoreGlobal, -1, it->index);
 }
@@ -964,31 +1045,70 @@ int Parser::parse_indices(Emitter& e)
 
 void Parser::emit_load(Emitter& e, const Token& name)
 {
-    VariableRef ref = resolve(name.text);
+    VariableRef ref = resolve(name, true);
     if (ref.kind == VariableRef::Array) {
         int n = parse_indices(e);
-        e.emit(Op::LoadElement, 1 - n, ref.index, static_cast<std::uint8_t>(n));
+        check_subscripts(name, ref, n);
+        e.emit(Op::LoadElement, 1 - n, ref.index, static_cast<std::uint8_t>(n), site(name.loc));
     } else {
         e.emit(ref.kind == VariableRef::Local ? Op::LoadLocal : Op::LoadGlobal, 1, ref.index);
     }
 }
 
-VariableRef Parser::resolve(const std::string& name)
+void Parser::check_subscripts(const Token& name, const VariableRef& ref, int n) const
+{
+    std::size_t dims = m_program.arrays[static_cast<std::size_t>(ref.index)].initial.dims.size();
+    if (static_cast<std::size_t>(n) != dims)
+        throw Error(name.loc, "array '" + name.text + "' has " + std::to_string(dims) +
+                                  " dimension(s) but is used with " + std::to_string(n) +
+                                  " subscript(s)");
+}
+
+std::optional<VariableRef> Parser::lookup(const std::string& name) const
 {
     for (std::size_t i = 0; i < m_program.arrays.size(); ++i)
         if (m_program.arrays[i].name == name)
-            return {VariableRef::Array, static_cast<int>(i)};
+            return VariableRef{VariableRef::Array, static_cast<int>(i)};
     if (m_scope && !m_scope->global)
         for (const auto& [n, slot] : m_scope->locals)
             if (n == name)
-                return {VariableRef::Local, slot};
+                return VariableRef{VariableRef::Local, slot};
     for (std::size_t i = 0; i < m_program.global_names.size(); ++i)
         if (m_program.global_names[i] == name)
-            return {VariableRef::Global, static_cast<int>(i)};
-    if (m_scope && !m_scope->global)
-        return {VariableRef::Local, m_scope->local_slot(name)};
-    m_program.global_names.push_back(name);
+            return VariableRef{VariableRef::Global, static_cast<int>(i)};
+    return std::nullopt;
+}
+
+VariableRef Parser::resolve(const Token& name, bool reading)
+{
+    if (auto known = lookup(name.text))
+        return *known;
+    // A name read before anything defines it: cpfg warns ("not previously defined") and
+    // reads 0. In a production the warning waits until its text is known.
+    bool in_production = m_scope && !m_scope->global;
+    if (reading && in_production)
+        m_scope->undefined.emplace_back(name.text, name.loc);
+    else if (reading)
+        warn_undefined(name.text, name.loc, m_context.empty() ? "an expression" : m_context);
+    if (in_production)
+        return {VariableRef::Local, m_scope->local_slot(name.text)};
+    m_program.global_names.push_back(name.text);
     return {VariableRef::Global, static_cast<int>(m_program.global_names.size() - 1)};
+}
+
+void Parser::warn_undefined(const std::string& name, const FileLoc& loc, const std::string& where)
+{
+    if (!m_warned.insert(name).second)
+        return;  // once per name
+    warn(loc, "identifier '" + name + "' is read but not defined before (not a formal "
+                                      "parameter, nor a variable assigned earlier); it "
+                                      "evaluates to 0, in " + where);
+}
+
+double Parser::site(const FileLoc& loc)
+{
+    m_program.sites.push_back(loc);
+    return static_cast<double>(m_program.sites.size() - 1);
 }
 
 }  // namespace
@@ -1053,34 +1173,26 @@ const SplitCommand* split_of(const Program& program, SymbolId symbol)
     return nullptr;
 }
 
-void split_templates(const Program& program, std::vector<ModuleTemplate>& modules)
+/// Replaces each module that names a split command by '@' and its letters; the last
+/// letter keeps the parameters (`params`: a template's expressions or a formal's slots).
+template <class Module, class Params>
+void split_modules(const Program& program, std::vector<Module>& modules, Params Module::*params)
 {
-    std::vector<ModuleTemplate> out;
+    std::vector<Module> out;
     for (auto& m : modules) {
         const SplitCommand* c = split_of(program, m.symbol);
         if (!c) {
             out.push_back(std::move(m));
             continue;
         }
-        for (std::size_t i = 0; i + 1 < c->parts.size(); ++i)
-            out.push_back(ModuleTemplate{c->parts[i], {}});
-        out.push_back(ModuleTemplate{c->parts.back(), std::move(m.params)});
-    }
-    modules = std::move(out);
-}
-
-void split_formals(const Program& program, std::vector<FormalModule>& modules)
-{
-    std::vector<FormalModule> out;
-    for (auto& m : modules) {
-        const SplitCommand* c = split_of(program, m.symbol);
-        if (!c) {
-            out.push_back(std::move(m));
-            continue;
+        for (std::size_t i = 0; i + 1 < c->parts.size(); ++i) {
+            Module letter = m;
+            letter.symbol = c->parts[i];
+            letter.*params = {};
+            out.push_back(std::move(letter));
         }
-        for (std::size_t i = 0; i + 1 < c->parts.size(); ++i)
-            out.push_back(FormalModule{c->parts[i], {}, m.loc});
-        out.push_back(FormalModule{c->parts.back(), std::move(m.param_slots), m.loc});
+        m.symbol = c->parts.back();
+        out.push_back(std::move(m));
     }
     modules = std::move(out);
 }
@@ -1101,15 +1213,15 @@ void split_at_commands(Program& program)
     if (program.split_commands.empty())
         return;
     for (auto& ls : program.lsystems) {
-        split_templates(program, ls.axiom);
+        split_modules(program, ls.axiom, &ModuleTemplate::params);
         split_symbols(program, ls.ignore);
         split_symbols(program, ls.consider);
         for (ProductionSet* set : production_sets(ls))
             for (auto& p : set->productions) {
-                split_formals(program, p.predecessor);
-                split_formals(program, p.left_context);
-                split_formals(program, p.right_context);
-                split_templates(program, p.successor);
+                split_modules(program, p.predecessor, &FormalModule::param_slots);
+                split_modules(program, p.left_context, &FormalModule::param_slots);
+                split_modules(program, p.right_context, &FormalModule::param_slots);
+                split_modules(program, p.successor, &ModuleTemplate::params);
                 if (p.constant_successor) {
                     ModuleString constant;
                     for (const auto& m : p.successor)

@@ -40,8 +40,20 @@ struct Production {
     std::optional<Code> probability;          ///< stochastic productions only
     bool object_production = false;           ///< '-o>'
     int frame_size = 0;                       ///< formal parameters + local variables
+    /// Where this production's variables live between applications (Program::storage_size):
+    /// cpfg keeps each production's variables from its previous application.
+    std::size_t storage = 0;
     FileLoc loc;
+    std::string text;                         ///< its source on one line, for messages
 };
+
+/// An object production geom may instance: -o> with one predecessor module and no
+/// context, so the module alone decides its expansion.
+inline bool is_instanceable_object(const Production& p)
+{
+    return p.object_production && p.predecessor.size() == 1 && p.left_context.empty() &&
+           p.right_context.empty();
+}
 
 /// Productions of one section with their lookup by first predecessor symbol.
 struct ProductionSet {
@@ -101,6 +113,10 @@ struct Program {
     std::vector<std::string> strings;
     std::string file_name;
     std::vector<SplitCommand> split_commands;
+    /// Source positions of the instructions that can fail at run time (Instr::value)
+    std::vector<FileLoc> sites;
+    /// Sum of the productions' frame sizes: the persistent variables of all productions
+    std::size_t storage_size = 0;
 };
 
 }  // namespace cambium::lsys
