@@ -237,5 +237,24 @@ endlsystem
     EXPECT_EQ(a.size(), 7u);
 }
 
+// cpfg keeps each production's variables from its previous application: a block that
+// skips its assignment sees the old value (corpus 06-phyllotaxis-ridley relies on it).
+TEST(Derive, ProductionVariablesPersistBetweenApplications)
+{
+    const std::string source = "lsystem: 1\nderivation length: 3\naxiom: A(1)\n"
+                               "A(n) : 1 { if (n == 1) { x = 5; } } --> B(x) A(n+1)\n"
+                               "endlsystem\n";
+    EXPECT_EQ(derive_text(source), "B(5)B(5)B(5)A(4)");
+}
+
+TEST(Derive, EachProductionHasItsOwnVariables)
+{
+    const std::string source = "lsystem: 1\nderivation length: 2\naxiom: A C\n"
+                               "A : 1 { x = x + 1; } --> B(x) A\n"
+                               "C : 1 { x = x + 10; } --> D(x) C\n"
+                               "endlsystem\n";
+    EXPECT_EQ(derive_text(source), "B(1)B(2)AD(10)D(20)C");
+}
+
 }  // namespace
 }  // namespace cambium::lsys
