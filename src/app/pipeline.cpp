@@ -4,11 +4,8 @@
 #include "app/pipeline.h"
 
 #include "base/diagnostics.h"
-#include <algorithm>
-#include <sstream>
-
 #include "geom/background_scene.h"
-#include "geom/contour.h"
+#include "geom/function.h"
 #include "geom/interpreter.h"
 #include "geom/query.h"
 #include "lsys/program.h"
@@ -28,53 +25,6 @@ geom::Palette load_palette(const Options& options)
     return palette;
 }
 
-/// The view file's `curve:` contours (ids from 1, in order) for curveX/Y/Z and
-/// curveGAL: each resampled finely at equal arc length, so a parameter t in [0, 1] is
-/// the fraction of the curve's length (the L-systems walk curves by arc length).
-class CurveSet {
-public:
-    explicit CurveSet(const geom::ViewFile& view)
-    {
-        for (const geom::ViewCommand& c : view.deferred) {
-            if (c.name != "curve")
-                continue;
-            std::string file;
-            std::istringstream(c.value) >> file;
-            try {
-                m_curves.push_back(geom::resample(
-                    geom::read_contour(view.path.parent_path() / file), samples));
-            } catch (const Error& e) {
-                // The `version: 1.4` B-spline curve format is not read yet.
-                warn(c.loc, std::string("curve not read, its coordinates are 0: ") + e.what());
-                m_curves.emplace_back();
-            }
-        }
-    }
-
-    bool empty() const { return m_curves.empty(); }
-
-    double evaluate(char which, int id, double t) const
-    {
-        if (id < 1 || id > static_cast<int>(m_curves.size())) {
-            warn("curve id " + std::to_string(id) + " is not defined by the view file; using 0");
-            return 0;
-        }
-        const geom::ContourSamples& c = m_curves[static_cast<std::size_t>(id - 1)];
-        if (which == 'l' || c.vertices.size() < 2)
-            return which == 'l' ? c.length : 0.0;
-        const std::vector<geom::Vec3>& v = c.vertices;
-        std::size_t edges = c.closed ? v.size() : v.size() - 1;
-        double at = std::clamp(t, 0.0, 1.0) * static_cast<double>(edges);
-        std::size_t i = std::min(static_cast<std::size_t>(at), edges - 1);
-        double f = at - static_cast<double>(i);
-        geom::Vec3 p = v[i] * (1 - f) + v[(i + 1) % v.size()] * f;
-        return which == 'x' ? p.x : which == 'y' ? p.y : p.z;
-    }
-
-private:
-    static constexpr int samples = 2048;
-    std::vector<geom::ContourSamples> m_curves;
-};
 
 /// The symbol table the query pass needs exists only once the L-system is loaded,
 /// after the hook is made; the hook finds it here.
@@ -82,6 +32,16 @@ struct QueryContext {
     std::shared_ptr<const geom::ViewFile> view;
     const lsys::SymbolTable* symbols = nullptr;
 };
+
+/// Per symbol id: whether an -o> production makes it an object geom may instance.
+std::vector<char> object_symbols(const lsys::LSystem& lsystem)
+{
+    std::vector<char> objects(lsystem.symbols().size(), 0);
+    bool any = false;
+    for (std::size_t s = 0; s < objects.size(); ++s)
+        any |= (objects[s] = lsystem.is_object_symbol(static_cast<int>(s)) ? 1 : 0) != 0;
+    return any ? objects : std::vector<char>{};
+}
 
 }  // namespace
 
@@ -98,7 +58,7 @@ Model load_model(const Options& options)
     load.defines = functions->define_names();
     if (!functions->empty())
         load.function = [functions](int id, double x) { return functions->evaluate(id, x); };
-    auto curves = std::make_shared<const CurveSet>(*view);
+    auto curves = std::make_shared<const geom::CurveSet>(geom::CurveSet::from_view_file(*view));
     if (!curves->empty())
         load.curve = [curves](char which, int id, double t) {
             return curves->evaluate(which, id, t);
@@ -132,11 +92,24 @@ lsys::ModuleString derive(const Model& model, const Options& options)
 geom::Scene interpret(const Model& model, const lsys::ModuleString& derived,
                       const Options& options)
 {
-    lsys::ModuleString string = options.homomorphism_in_string
-                                    ? derived
-                                    : model.lsystem.interpretation_string(derived);
     geom::InterpretOptions interpret_options;
     interpret_options.strings = model.lsystem.program().strings;
+    // -o> objects become prototypes and instances (docs: manual 8.1); with -homo the
+    // string already holds their expansions.
+    std::vector<char> objects =
+        options.homomorphism_in_string ? std::vector<char>{} : object_symbols(model.lsystem);
+    if (!objects.empty()) {
+        const lsys::LSystem& lsystem = model.lsystem;
+        interpret_options.is_object = [objects](lsys::SymbolId s) {
+            return s < objects.size() && objects[s] != 0;
+        };
+        interpret_options.expand_object = [&lsystem](lsys::ModuleRef m) { return lsystem.expand_object(m); };
+    }
+    lsys::ModuleString string =
+        options.homomorphism_in_string
+            ? derived
+            : model.lsystem.interpretation_string(
+                  derived, objects.empty() ? lsys::ObjectHandling::expand : lsys::ObjectHandling::keep);
     geom::Scene scene =
         geom::interpret(string, model.lsystem.symbols(), *model.view, interpret_options);
     scene.materials = model.palette.entries(options.colour_block);

@@ -436,4 +436,17 @@ std::vector<Contour> read_contour_gallery(const std::filesystem::path& file)
     return parse_contour_gallery(read_text_file(file, "contour gallery"), file.string());
 }
 
+std::vector<Contour> parse_contours(std::string_view text, const std::string& file_name)
+{
+    std::size_t start = text.find_first_not_of(" \t\r\n");
+    if (start != std::string_view::npos && text.substr(start).starts_with("contourgalleryver"))
+        return parse_contour_gallery(text, file_name);
+    return {parse_contour(text, file_name)};
+}
+
+std::vector<Contour> read_contours(const std::filesystem::path& file)
+{
+    return parse_contours(read_text_file(file, "contour file"), file.string());
+}
+
 }  // namespace cambium::geom

@@ -63,6 +63,13 @@ Contour read_contour(const std::filesystem::path& file);
 std::vector<Contour> parse_contour_gallery(std::string_view text, const std::string& file_name);
 std::vector<Contour> read_contour_gallery(const std::filesystem::path& file);
 
+/// What `contour: id file` reads: one contour from a contour file, or every item of a
+/// gallery (a file starting with `contourgalleryver`), in order. cpfg itself reads only
+/// contour files there; Cambium gives gallery item k the id `id + k - 1`, so
+/// `contour: 1 shapes.cset` numbers the items from 1 as the manual (5.4.5) numbers them.
+std::vector<Contour> parse_contours(std::string_view text, const std::string& file_name);
+std::vector<Contour> read_contours(const std::filesystem::path& file);
+
 /// The contours a view file defines (`contour: id file`), by id; id 0 is the circle
 /// and is never stored here.
 using ContourTable = std::map<int, Contour>;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// Generalized cylinders: Hermite axes, radius profiles, contours swept along frames.
+// Generalized cylinders: Hermite and B-spline axes, radius profiles, contours swept along frames.
 #include "geom/gencyl.h"
 
 #include <algorithm>
@@ -135,6 +135,14 @@ bool RadiusProfile::linear() const
     return t0[0] == 1 && t1[0] == 1 && t0[1] == slope && t1[1] == slope;
 }
 
+std::array<Vec3, 4> bspline_as_hermite(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& p3)
+{
+    // The uniform B-spline basis at u = 0 is (1, 4, 1, 0) / 6 and its derivative
+    // (-3, 0, 3, 0) / 6; at u = 1 they are (0, 1, 4, 1) / 6 and (0, -3, 0, 3) / 6.
+    return {(p0 + p1 * 4.0 + p2) * (1.0 / 6.0), (p1 + p2 * 4.0 + p3) * (1.0 / 6.0), (p2 - p0) * 0.5,
+            (p3 - p1) * 0.5};
+}
+
 Vec3 rmf_step(const Vec3& x0, const Vec3& t0, const Vec3& up0, const Vec3& x1, const Vec3& t1)
 {
     // First reflection in the bisector plane of x0 x1, then one that aligns the tangents.
@@ -188,7 +196,16 @@ CylinderSettings cylinder_settings(const ViewFile& view)
             }
             try {
                 std::filesystem::path path = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : folder / file;
-                s.contours[id] = read_contour(path);
+                // A gallery's items take the ids id, id + 1, ... (a Cambium extension).
+                std::vector<Contour> read = read_contours(path);
+                for (std::size_t k = 0; k < read.size(); ++k) {
+                    int item_id = id + static_cast<int>(k);
+                    if (item_id == 0)
+                        continue;  // the circle keeps id 0
+                    // cpfg looks contours up in file order: the first with an id wins.
+                    if (!s.contours.emplace(item_id, std::move(read[k])).second)
+                        warn(c.loc, "contour id " + std::to_string(item_id) + " is defined twice; the first is used");
+                }
             } catch (const Error& e) {
                 warn(c.loc, std::string("contour ") + std::to_string(id) + " not loaded: " + e.what());
             }
@@ -209,6 +226,8 @@ void CylinderBuilder::start(Turtle& turtle)
     CylinderState& c = turtle.cylinder;
     c.mode = CylinderMode::modules;  // cpfg: F and f do not add points after @Gs
     c.closed = false;
+    c.bspline = false;
+    c.bspline_points.reset();
     c.default_strips = default_cylinder_strips;
     c.points = 0;
     add_point(turtle, 0);
@@ -220,6 +239,8 @@ void CylinderBuilder::control_point(Turtle& turtle, std::span<const float> p)
     if (c.mode == CylinderMode::none) {  // cpfg starts an open curve whose F's add points
         c.mode = CylinderMode::moves;
         c.closed = false;
+        c.bspline = false;
+        c.bspline_points.reset();
         c.default_strips = default_cylinder_strips;
         c.points = 0;
     }
@@ -242,13 +263,11 @@ void CylinderBuilder::open_curve(Turtle& turtle, std::span<const float> p)
     CylinderState& c = turtle.cylinder;
     c.mode = CylinderMode::moves;
     c.closed = type == 2 || type == 4;
+    c.bspline = type >= 3;
+    c.bspline_points.reset();
     int rings = p.size() >= 2 ? static_cast<int>(p[1]) : 0;
     c.default_strips = rings <= 0 ? default_cylinder_strips : std::min(rings, max_strips);
     c.points = 0;
-    if (type >= 3 && !m_warned_bspline) {
-        warn("B-spline generalized cylinders ({(3), {(4)) are drawn with Hermite axes");
-        m_warned_bspline = true;
-    }
 }
 
 void CylinderBuilder::close_curve(Turtle& turtle)
@@ -258,16 +277,26 @@ void CylinderBuilder::close_curve(Turtle& turtle)
         warn("a generalized cylinder is ended that was not started; ignored");
         return;
     }
-    if (c.closed && c.points > 1) {
+    if (c.bspline && c.closed && c.points >= 3 && c.bspline_points) {
+        // cpfg adds the first three control points again, with their turtles.
+        std::shared_ptr<const BsplinePoints> points = c.bspline_points;
+        for (const CylinderPoint& p : points->opening) {
+            CylinderPoint again = p;
+            again.key = -1;
+            again.ring = -1;
+            add_bspline_point(turtle, again, 0);
+        }
+    } else if (!c.bspline && c.closed && c.points > 1) {
         // The axis returns to its first point, with that point's turtle.
         CylinderPoint target = c.first;
         target.key = -1;
         target.ring = -1;
         CylinderPoint from = c.last;
-        draw_segment(from, target, c, c.default_strips);
+        draw_segment(from, target, c.default_strips);
     }
     c.mode = CylinderMode::none;
     c.points = 0;
+    c.bspline_points.reset();
 }
 
 void CylinderBuilder::moved(Turtle& turtle)
@@ -350,26 +379,75 @@ void CylinderBuilder::add_point(Turtle& turtle, int strips)
     point.color = turtle.color;
     point.back_color = turtle.back_color;
     point.tangent_out = c.tangent_parameter[1];
+    point.tangent_in = c.tangent_parameter[0];
     point.radius_tangent_out = c.radius_tangent[1];
+    point.radius_tangent_in = c.radius_tangent[0];
+    point.scale_radius_tangents = c.scale_radius_tangents;
     point.texture = turtle.texture;
     point.v = turtle.texture_v;
 
+    if (c.bspline) {
+        add_bspline_point(turtle, point, strips);
+        return;
+    }
     if (c.points == 0) {
         c.first = point;
         c.last = point;
         c.points = 1;
         return;
     }
-    draw_segment(c.last, point, c, strips > 0 ? strips : c.default_strips);
+    draw_segment(c.last, point, strips > 0 ? strips : c.default_strips);
     turtle.texture_v = point.v;
     c.last = point;
     ++c.points;
 }
 
+void CylinderBuilder::add_bspline_point(Turtle& turtle, const CylinderPoint& point, int strips)
+{
+    CylinderState& c = turtle.cylinder;
+    // Copied on write: a branch ([) shares the points it started with.
+    auto next = c.bspline_points ? std::make_shared<BsplinePoints>(*c.bspline_points)
+                                 : std::make_shared<BsplinePoints>();
+    if (c.points < 3) {  // cpfg draws nothing until the fourth point
+        auto i = static_cast<std::size_t>(c.points);
+        next->window[i] = point;
+        next->opening[i] = point;
+        if (c.points == 0)
+            c.first = point;
+        ++c.points;
+        c.bspline_points = std::move(next);
+        return;
+    }
+    const std::array<CylinderPoint, 3>& w = next->window;
+    std::array<Vec3, 4> axis = bspline_as_hermite(w[0].position, w[1].position, w[2].position, point.position);
+    auto direction = [](const Vec3& tangent, const Vec3& fallback) {
+        return length(tangent) > 1e-7 ? normalize(tangent) : fallback;  // coinciding points
+    };
+    // The segment starts where the previous one ended (the first: at P1's turtle) and
+    // ends with the second-last point's turtle.
+    CylinderPoint from = c.last;
+    if (c.points == 3) {
+        from = w[1];
+        from.position = axis[0];
+        from.heading = direction(axis[2], w[1].heading);
+        from.key = -1;
+        from.ring = -1;
+    }
+    CylinderPoint to = w[2];
+    to.position = axis[1];
+    to.heading = direction(axis[3], w[2].heading);
+    draw_segment(from, to, strips > 0 ? strips : c.default_strips, &axis);
+    turtle.texture_v = to.v;
+    c.last = to;
+    ++c.points;
+    next->window = {w[1], w[2], point};
+    c.bspline_points = std::move(next);
+}
+
 /// Draws the part of the cylinder between two control points and leaves in `to` the
 /// frame, texture v, key and ring the next segment continues from.
-void CylinderBuilder::draw_segment(const CylinderPoint& from, CylinderPoint& to, const CylinderState& state,
-                                   int strips)
+void CylinderBuilder::draw_segment(const CylinderPoint& from, CylinderPoint& to, int strips,
+                                   const std::array<Vec3, 4>* axis_override)
 {
     double len = length(to.position - from.position);
     Vec3 h0 = normalize(from.heading), h1 = normalize(to.heading);
@@ -377,10 +455,12 @@ void CylinderBuilder::draw_segment(const CylinderPoint& from, CylinderPoint& to,
 
     // The axis: Hermite with tangents scaled by the control points' distance; the start
     // uses the coefficient leaving the first point, the end the one arriving here.
-    Vec3 axis[4] = {from.position, to.position, h0 * (len * from.tangent_out),
-                    h1 * (len * state.tangent_parameter[0])};
+    // B-spline segments give their axis (the same cubic in Hermite form).
+    Vec3 axis[4] = {from.position, to.position, h0 * (len * from.tangent_out), h1 * (len * to.tangent_in)};
+    if (axis_override)
+        std::copy(axis_override->begin(), axis_override->end(), axis);
     RadiusProfile profile = RadiusProfile::make(0.5 * from.line_width, 0.5 * to.line_width, from.radius_tangent_out,
-                                                state.radius_tangent[0], state.scale_radius_tangents, len);
+                                                to.radius_tangent_in, to.scale_radius_tangents, len);
 
     // Rings at cpfg's strip boundaries; frames carried by double reflection.
     std::vector<SweepRing> rings(static_cast<std::size_t>(strips) + 1);

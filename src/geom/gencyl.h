@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
 // Generalized cylinders (graphical-extensions report, section 3; manual 5.1.9 "Drawing
-// generalized cylinders"): Hermite axes through turtle control points, radius profiles,
-// contours swept along rotation-minimising frames.
+// generalized cylinders"): Hermite or B-spline axes from turtle control points, radius
+// profiles, contours swept along rotation-minimising frames.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 
 #include "geom/contour.h"
@@ -42,7 +43,12 @@ struct CylinderPoint {
     int color = 1;
     int back_color = 1;
     double tangent_out = default_tangent_parameter;  ///< tangent_parameter[1] here
+    double tangent_in = default_tangent_parameter;   ///< tangent_parameter[0] here
     std::array<double, 2> radius_tangent_out{0, 0};  ///< radius_tangent[1] here
+    /// radius_tangent[0] and @Gr(1) here: a B-spline segment ends with those of its
+    /// second-last control point (cpfg), not of the turtle that adds the last one.
+    std::array<double, 2> radius_tangent_in{0, 0};
+    bool scale_radius_tangents = false;
     int texture = -1;  ///< the turtle's texture (the segment from here uses it)
     double v = 0;      ///< texture v along the cylinder
     /// HermiteCurves point holding this point's key (shared if it is still the last).
@@ -50,6 +56,14 @@ struct CylinderPoint {
     /// First TriangleMesh vertex of this point's ring, and its contour size.
     std::int64_t ring = -1;
     int ring_sides = 0;
+};
+
+/// The control points a B-spline axis ({(3), {(4)) keeps: cpfg draws the segment of the
+/// last four points when the fourth arrives, so the three before it wait here; a closed
+/// axis adds its first three again at `}`.
+struct BsplinePoints {
+    std::array<CylinderPoint, 3> window;   ///< the last three control points, oldest first
+    std::array<CylinderPoint, 3> opening;  ///< the first three (for closed axes)
 };
 
 /// The generalized-cylinder part of the turtle state: copied by `[` and restored by
@@ -65,11 +79,14 @@ struct CylinderState {
     int sides = 8;                       ///< @! and `contour sides:`
 
     CylinderMode mode = CylinderMode::none;
-    bool closed = false;  ///< {(2): the axis returns to its first point at }
+    bool closed = false;  ///< {(2), {(4): the axis returns to its first point(s) at }
+    bool bspline = false; ///< {(3), {(4): the control points define a uniform cubic B-spline
     int default_strips = default_cylinder_strips;
     int points = 0;       ///< control points so far
     CylinderPoint last;   ///< the active control point
     CylinderPoint first;  ///< for closed axes
+    /// B-spline axes: the points still needed (shared, copied on write: `[` copies it).
+    std::shared_ptr<const BsplinePoints> bspline_points;
 };
 
 /// What the view file says about generalized cylinders.
@@ -107,6 +124,11 @@ struct RadiusProfile {
     bool linear() const;             ///< u(s) = s and the radius linear
 };
 
+/// The uniform cubic B-spline segment of control points P0..P3 as a cubic Hermite
+/// segment (exact): from (P0 + 4 P1 + P2) / 6 to (P1 + 4 P2 + P3) / 6 with tangents
+/// (P2 - P0) / 2 and (P3 - P1) / 2. Returns {p0, p1, t0, t1} for hermite().
+std::array<Vec3, 4> bspline_as_hermite(const Vec3& p0, const Vec3& p1, const Vec3& p2, const Vec3& p3);
+
 /// One double-reflection step (Wang et al. 2008) of a rotation-minimising frame: the
 /// `up` vector at (x0, t0) carried to (x1, t1).
 Vec3 rmf_step(const Vec3& x0, const Vec3& t0, const Vec3& up0, const Vec3& x1, const Vec3& t1);
@@ -125,7 +147,13 @@ public:
     void start(Turtle& turtle);                                   ///< @Gs
     void control_point(Turtle& turtle, std::span<const float> p); ///< @Gc(strips)
     void end(Turtle& turtle, std::span<const float> p);           ///< @Ge(strips)
-    /// `{(type[, strips])` with type 1..4 (hermite open/closed; b-spline types are drawn as Hermite).
+    /// `{(type[, strips])` with type 1..4: Hermite open/closed, B-spline open/closed.
+    /// B-spline axes (cpfg): control points P0, P1, ... are not on the axis; each new
+    /// point Pk (k >= 3) draws the segment of Pk-3..Pk, from (Pk-3 + 4 Pk-2 + Pk-1) / 6 to
+    /// (Pk-2 + 4 Pk-1 + Pk) / 6, with the line width, colour, contour and texture of Pk-2
+    /// at its start and of Pk-1 at its end; open axes do not reach their end points
+    /// (n points give n - 3 segments); closed ones add their first three points at `}`
+    /// (n segments).
     void open_curve(Turtle& turtle, std::span<const float> p);
     /// `}(type)` with type != 0.
     void close_curve(Turtle& turtle);
@@ -141,8 +169,11 @@ public:
 
 private:
     void add_point(Turtle& turtle, int strips);
-    void draw_segment(const CylinderPoint& from, CylinderPoint& to, const CylinderState& state,
-                      int strips);
+    void add_bspline_point(Turtle& turtle, const CylinderPoint& point, int strips);
+    /// The segment arrives with `to`'s tangent coefficient and radius tangent (cpfg's
+    /// tu2); `axis_override` replaces the Hermite axis from the points' headings.
+    void draw_segment(const CylinderPoint& from, CylinderPoint& to, int strips,
+                      const std::array<Vec3, 4>* axis_override = nullptr);
     void draw_round(const std::vector<SweepRing>& rings, const RadiusProfile& profile, const Vec3 (&axis)[4],
                     const CylinderPoint& from, CylinderPoint& to);
     void draw_mesh(const std::vector<SweepRing>& rings, const CylinderPoint& from, CylinderPoint& to,
@@ -157,7 +188,6 @@ private:
     Bounds3& m_bounds;
     std::map<std::pair<int, int>, ContourSamples> m_sample_cache;
     bool m_warned_unknown_contour = false;
-    bool m_warned_bspline = false;
 };
 
 }  // namespace cambium::geom

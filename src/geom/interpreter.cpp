@@ -5,8 +5,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <memory>
 #include <numbers>
+#include <optional>
+#include <sstream>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "geom/patch.h"
@@ -34,6 +39,126 @@ std::vector<TurtleOp> symbol_ops(const lsys::SymbolTable& symbols)
     return ops;
 }
 
+/// Whether `format` is text around exactly one printf conversion of a double: flags,
+/// width and precision of at most two digits each, conversion e E f F g G (an `l` may
+/// precede it, as in cpfg's "%lg"). Anything else must not reach snprintf.
+bool is_float_format(const std::string& format)
+{
+    std::size_t percent = format.find('%');
+    if (percent == std::string::npos || format.find('%', percent + 1) != std::string::npos)
+        return false;
+    std::size_t i = format.find_first_not_of("-+ #0", percent + 1);
+    auto digits = [&](std::size_t& at) {
+        std::size_t start = at;
+        while (at < format.size() && at - start < 3 && format[at] >= '0' && format[at] <= '9')
+            ++at;
+        return at - start <= 2;
+    };
+    if (i == std::string::npos || !digits(i))
+        return false;
+    if (i < format.size() && format[i] == '.' && !digits(++i))
+        return false;
+    if (i < format.size() && format[i] == 'l')
+        ++i;
+    return i < format.size() && std::string_view("eEfFgG").find(format[i]) != std::string_view::npos;
+}
+
+/// The sizes of every array of a Geometry, to cut it back to them.
+struct GeometrySizes {
+    explicit GeometrySizes(const Geometry& g)
+        : line_keys(g.lines.keys.size()), line_v(g.lines.v.size()), line_segments(g.lines.segments.size()),
+          curve_points(g.curves.points.size()), curve_v(g.curves.v.size()),
+          curve_segments(g.curves.segments.size()), spheres(g.spheres.centres.size()),
+          sphere_textures(g.spheres.texture.size()), discs(g.discs.centres.size()),
+          positions(g.mesh.positions.size()), uvs(g.mesh.uvs.size()), triangles(g.mesh.triangles.size()),
+          mesh_textures(g.mesh.texture.size())
+    {
+    }
+
+    void truncate(Geometry& g) const
+    {
+        auto cut = [](auto& v, std::size_t n) {
+            if (v.size() > n)
+                v.resize(n);
+        };
+        LinearCurves& l = g.lines;
+        cut(l.keys, line_keys), cut(l.v, line_v), cut(l.segments, line_segments), cut(l.flags, line_segments);
+        cut(l.material, line_segments), cut(l.texture, line_segments);
+        HermiteCurves& c = g.curves;
+        cut(c.points, curve_points), cut(c.tangents, curve_points), cut(c.v, curve_v);
+        cut(c.segments, curve_segments), cut(c.flags, curve_segments), cut(c.material, curve_segments);
+        cut(c.texture, curve_segments);
+        cut(g.spheres.centres, spheres), cut(g.spheres.material, spheres), cut(g.spheres.texture, sphere_textures);
+        cut(g.discs.centres, discs), cut(g.discs.normals, discs), cut(g.discs.material, discs);
+        cut(g.discs.back_material, discs);
+        TriangleMesh& m = g.mesh;
+        cut(m.positions, positions), cut(m.normals, positions), cut(m.uvs, uvs), cut(m.triangles, triangles);
+        cut(m.material, triangles), cut(m.back_material, triangles), cut(m.texture, mesh_textures);
+    }
+
+    std::size_t line_keys, line_v, line_segments, curve_points, curve_v, curve_segments, spheres,
+        sphere_textures, discs, positions, uvs, triangles, mesh_textures;
+};
+
+Float3 place_point(const std::array<float, 12>& m, const Float3& p)
+{
+    return {m[0] * p[0] + m[3] * p[1] + m[6] * p[2] + m[9], m[1] * p[0] + m[4] * p[1] + m[7] * p[2] + m[10],
+            m[2] * p[0] + m[5] * p[1] + m[8] * p[2] + m[11]};
+}
+
+/// A normal under the placement: by the inverse transpose of its 3x3 part (the
+/// cofactor matrix over the determinant, of which only the sign matters), normalised.
+Float3 place_normal(const std::array<float, 12>& m, const Float3& n)
+{
+    Vec3 x{m[0], m[1], m[2]}, y{m[3], m[4], m[5]}, z{m[6], m[7], m[8]};
+    Vec3 r = cross(y, z) * n[0] + cross(z, x) * n[1] + cross(x, y) * n[2];
+    if (dot(x, cross(y, z)) < 0)
+        r = r * -1.0;
+    double len = std::sqrt(dot(r, r));
+    if (len == 0)
+        return n;
+    return {static_cast<float>(r.x / len), static_cast<float>(r.y / len), static_cast<float>(r.z / len)};
+}
+
+/// Appends a prototype's triangles placed by an instance (transform, materials in place
+/// of inherit_material, texture for untextured triangles): a `~x` surface inside an
+/// `-o>` object becomes part of the object's own geometry, since the renderer's
+/// instances are one level deep. Surfaces are triangle meshes only.
+void append_placed_mesh(TriangleMesh& into, const TriangleMesh& from, const Instance& instance)
+{
+    auto base = static_cast<std::uint32_t>(into.positions.size());
+    for (std::size_t i = 0; i < from.positions.size(); ++i) {
+        into.positions.push_back(place_point(instance.transform, from.positions[i]));
+        into.normals.push_back(i < from.normals.size() ? place_normal(instance.transform, from.normals[i])
+                                                       : Float3{0, 0, 0});
+        into.uvs.push_back(i < from.uvs.size() ? from.uvs[i] : Float2{0, 0});
+    }
+    auto pick = [](std::uint16_t own, std::uint16_t inherited) {
+        return own == inherit_material ? inherited : own;
+    };
+    for (std::size_t t = 0; t < from.triangles.size(); ++t) {
+        const auto& tri = from.triangles[t];
+        into.triangles.push_back({base + tri[0], base + tri[1], base + tri[2]});
+        std::uint16_t front = t < from.material.size() ? from.material[t] : inherit_material;
+        std::uint16_t back = t < from.back_material.size() ? from.back_material[t] : front;
+        into.material.push_back(pick(front, instance.material));
+        into.back_material.push_back(pick(back, instance.back_material));
+        std::int16_t texture = t < from.texture.size() ? from.texture[t] : no_texture;
+        into.texture.push_back(texture == no_texture ? instance.texture : texture);
+    }
+}
+
+/// The placement of an object built in the turtle's starting frame (H = +y, L = -x,
+/// U = -z at the origin): its x axis goes to -L, y to H, z to -U, the origin to the
+/// turtle. No scale: the object was built with the first occurrence's turtle scale
+/// (cpfg's rayshade output prints the same transformation).
+std::array<float, 12> object_transform(const Turtle& t)
+{
+    auto f = [](double v) { return static_cast<float>(v); };
+    return {f(-t.left.x), f(-t.left.y), f(-t.left.z), f(t.heading.x), f(t.heading.y), f(t.heading.z),
+            f(-t.up.x),   f(-t.up.y),   f(-t.up.z),   f(t.position.x), f(t.position.y), f(t.position.z)};
+}
+
 /// One pass of the turtle over the string, cpfg's interpret.c semantics.
 ///
 /// A segment's top width is the turtle's width when the segment ends, at the next
@@ -48,9 +173,12 @@ class Interpreter {
     };
 
 public:
-    Interpreter(const ViewFile& view, const InterpretOptions& options)
-        : m_view(view), m_options(options),
-          m_cylinders(cylinder_settings(view), m_scene.geometry, m_scene.bounds)
+    /// `root`: the interpreter of the whole string when this one builds an `-o>`
+    /// object's prototype (it shares root's surfaces and places no objects itself).
+    Interpreter(const ViewFile& view, const InterpretOptions& options, Interpreter* root = nullptr)
+        : m_view(view), m_options(options), m_root(root ? root : this),
+          m_cylinders(root ? root->m_cylinders.settings() : cylinder_settings(view), m_scene.geometry,
+                      m_scene.bounds)  // the root's: its contour files are read once
     {
         m_turtle.cylinder.sides = m_cylinders.settings().sides;
         m_turtle.line_width = view.initial_line_width;
@@ -71,18 +199,20 @@ public:
         m_scene.view = view.view;
         m_scene.lights = effective_lights(view);
         m_scene.bounds.extend(Vec3{0, 0, 0});  // cpfg's box always holds the origin
-        load_surfaces();
+        if (m_root == this) {
+            load_surfaces();
+            m_keying = object_keying(view);
+            // Prototypes cannot carry line widths in pixels (render converts only the
+            // scene's own lines), so objects are expanded inline with that style.
+            m_instancing = options.is_object && options.expand_object && view.line_style != LineStyle::pixel;
+        }
     }
 
     void run(const lsys::ModuleString& string, const lsys::SymbolTable& symbols)
     {
-        std::vector<TurtleOp> ops = symbol_ops(symbols);
-        std::vector<int> surfaces = surface_slots(symbols);
+        prepare(symbols);
         string.for_each([&](lsys::ModuleRef m) {
-            if (int slot = surfaces[m.symbol]; slot != not_a_surface)
-                draw_surface(slot, symbols.name(m.symbol)[1], m.params);
-            else
-                apply(ops[m.symbol], m.params);
+            interpret_module(m, m_root == this);
             ++m_module_index;
         });
         end_node();
@@ -97,6 +227,173 @@ public:
     Scene take() { return std::move(m_scene); }
 
 private:
+    /// Per symbol of the string's table, looked up once (a prototype's builder uses its
+    /// root's).
+    struct SymbolTables {
+        const lsys::SymbolTable* symbols = nullptr;
+        std::vector<TurtleOp> ops;
+        std::vector<int> surfaces;
+        std::vector<char> objects;  ///< empty without object hooks
+    };
+
+    void prepare(const lsys::SymbolTable& symbols)
+    {
+        if (m_root != this) {
+            m_tables = m_root->m_tables;
+            return;
+        }
+        auto tables = std::make_shared<SymbolTables>();
+        tables->symbols = &symbols;
+        tables->ops = symbol_ops(symbols);
+        tables->surfaces = surface_slots(symbols);
+        if (m_options.is_object && m_options.expand_object) {
+            tables->objects.resize(symbols.size());
+            for (std::size_t id = 0; id < symbols.size(); ++id)
+                tables->objects[id] = m_options.is_object(static_cast<lsys::SymbolId>(id)) ? 1 : 0;
+        }
+        m_tables = std::move(tables);
+    }
+
+    /// `top`: a module of the string itself. Modules of an object's expansion are never
+    /// objects again: the homomorphism has already been applied to its full depth.
+    void interpret_module(lsys::ModuleRef m, bool top)
+    {
+        const SymbolTables& t = *m_tables;
+        if (top && !t.objects.empty() && t.objects[m.symbol]) {
+            if (m_instancing)
+                place_object(m);
+            else
+                interpret_expansion(*expansion(m));
+        } else if (int slot = t.surfaces[m.symbol]; slot != not_a_surface) {
+            draw_surface(slot, t.symbols->name(m.symbol)[1], m.params);
+        } else {
+            apply(t.ops[m.symbol], m.params);
+        }
+    }
+
+    void interpret_expansion(const lsys::ModuleString& expansion)
+    {
+        expansion.for_each([&](lsys::ModuleRef x) { interpret_module(x, false); });
+    }
+
+    /// The homomorphism successor of an object module, kept per exact module (the hook
+    /// depends on the module only) up to a bounded number of modules.
+    std::shared_ptr<const lsys::ModuleString> expansion(lsys::ModuleRef m)
+    {
+        std::string exact(reinterpret_cast<const char*>(&m.symbol), sizeof m.symbol);
+        exact.append(reinterpret_cast<const char*>(m.params.data()), m.params.size_bytes());
+        if (auto it = m_expansions.find(exact); it != m_expansions.end())
+            return it->second;
+        auto e = std::make_shared<const lsys::ModuleString>(m_options.expand_object(m));
+        if (m_cached_modules + e->size() > max_cached_expansion_modules) {
+            m_expansions.clear();
+            m_cached_modules = 0;
+        }
+        m_cached_modules += e->size() + 1;
+        m_expansions.emplace(std::move(exact), e);
+        return e;
+    }
+
+    /// An object module (manual 8.1): an instance of its prototype at the turtle, then
+    /// the turtle goes through the expansion as cpfg's rayshade output does ("has to go
+    /// through geometry to set turtle properly").
+    void place_object(lsys::ModuleRef m)
+    {
+        std::shared_ptr<const lsys::ModuleString> e = expansion(m);
+        int prototype = object_prototype(m, *e);
+        if (prototype >= 0)
+            m_scene.instances.push_back(Instance{static_cast<std::uint32_t>(prototype), object_transform(m_turtle),
+                                                 material(m_turtle.color), material(m_turtle.back_color),
+                                                 no_texture});  // a texture would reach untextured parts
+        advance(*e);
+    }
+
+    /// The key cpfg's hash table compares: the module's name and its parameters printed
+    /// with the `rayshade objects:` format, and with `turtle considered` the turtle's
+    /// line width, scale, colours and texture.
+    std::string object_key(lsys::ModuleRef m) const
+    {
+        std::string key = std::string(m_tables->symbols->name(m.symbol));
+        char buffer[512];
+        for (float p : m.params) {
+            std::snprintf(buffer, sizeof buffer, m_keying.format.c_str(), static_cast<double>(p));
+            key += '_';
+            key += buffer;
+        }
+        if (m_keying.turtle_considered) {
+            const Turtle& t = m_turtle;
+            std::snprintf(buffer, sizeof buffer, "|%a|%a|%d|%d|%d", t.line_width, t.scale, t.color,
+                          t.back_color, t.texture);
+            key += buffer;
+        }
+        return key;
+    }
+
+    /// The prototype of an object key, built the first time from this occurrence's
+    /// expansion in the turtle's starting frame with the current width, scale, colours
+    /// and texture (cpfg's stage 2); -1 when it draws nothing.
+    int object_prototype(lsys::ModuleRef m, const lsys::ModuleString& e)
+    {
+        std::string key = object_key(m);
+        if (auto it = m_object_prototypes.find(key); it != m_object_prototypes.end())
+            return it->second;
+        Interpreter builder(m_view, m_options, this);
+        builder.carry(m_turtle);
+        builder.run(e, *m_tables->symbols);
+        Scene built = builder.take();
+        int index = -1;
+        if (!built.geometry.empty()) {
+            index = static_cast<int>(m_scene.prototypes.size());
+            m_scene.prototypes.push_back(Prototype{key, std::move(built.geometry)});
+        }
+        m_object_prototypes.emplace(std::move(key), index);
+        return index;
+    }
+
+    /// A prototype's builder starts with the placing turtle's drawing state.
+    void carry(const Turtle& t)
+    {
+        m_turtle.line_width = t.line_width;
+        m_turtle.scale = t.scale;
+        m_turtle.color = t.color;
+        m_turtle.back_color = t.back_color;
+        m_turtle.texture = t.texture;
+        m_sub_scales.back() = t.scale;
+    }
+
+    /// Interprets an object's expansion for its effect on the turtle, the bounds, the
+    /// labels and polygons begun before it; the geometry it draws is the instance's and
+    /// is cut away again.
+    void advance(const lsys::ModuleString& e)
+    {
+        GeometrySizes before(m_scene.geometry);
+        const Geometry& g = m_scene.geometry;
+        std::optional<std::uint8_t> line_flag, curve_flag;
+        if (!g.lines.flags.empty())
+            line_flag = g.lines.flags.back();
+        if (!g.curves.flags.empty())
+            curve_flag = g.curves.flags.back();
+        std::size_t instances = m_scene.instances.size();
+        m_polygon_floor = m_polygons.size();
+        m_advancing = true;
+        interpret_expansion(e);
+        m_advancing = false;
+        bool drew_lines = m_scene.geometry.lines.keys.size() != before.line_keys;
+        before.truncate(m_scene.geometry);
+        if (line_flag)
+            m_scene.geometry.lines.flags.back() = *line_flag;  // no longer continued
+        if (curve_flag)
+            m_scene.geometry.curves.flags.back() = *curve_flag;
+        m_scene.instances.resize(instances);
+        if (drew_lines) {
+            m_chain_open = false;  // the last key was the object's
+            m_taper_open = false;
+        }
+        for (const std::vector<PolygonCorner>& p : m_outer_polygons)
+            emit_polygon(p);
+        m_outer_polygons.clear();
+    }
+
     static constexpr int not_a_surface = -1;
     static constexpr int undefined_surface = -2;
 
@@ -162,15 +459,19 @@ private:
             }
             return;
         }
-        const SurfaceDef& def = m_surfaces[static_cast<std::size_t>(slot)];
+        const SurfaceDef& def = m_root->m_surfaces[static_cast<std::size_t>(slot)];
         const Turtle& t = m_turtle;
         Vec3 s = surface_scale(p, t.scale);
         if (s.x != 0 && s.y != 0 && s.z != 0) {
             std::int16_t texture = def.texture ? *def.texture : static_cast<std::int16_t>(t.texture);
-            m_scene.instances.push_back(Instance{
-                surface_prototype(slot, texture),
-                surface_instance_transform(def, t.position, t.heading, t.left, t.up, s),
-                material(t.color), material(t.back_color), texture});
+            Instance instance{m_root->surface_prototype(slot, texture),
+                              surface_instance_transform(def, t.position, t.heading, t.left, t.up, s),
+                              material(t.color), material(t.back_color), texture};
+            if (m_root == this)
+                m_scene.instances.push_back(instance);
+            else  // inside an object's prototype: instances are one level deep
+                append_placed_mesh(m_scene.geometry.mesh,
+                                   m_root->m_scene.prototypes[instance.prototype].geometry.mesh, instance);
             for (const Vec3& q : def.hull_points)
                 m_scene.bounds.extend(t.position + t.left * (s.x * q.x) + t.heading * (s.y * q.y) +
                                       t.up * (s.z * q.z));
@@ -429,7 +730,13 @@ private:
             return;
         }
         end_node();
-        emit_polygon(m_polygons.back());
+        if (m_advancing && m_polygons.size() <= m_polygon_floor) {
+            // begun before an object and closed in it: the scene's own polygon
+            m_outer_polygons.push_back(std::move(m_polygons.back()));
+            m_polygon_floor = m_polygons.size() - 1;
+        } else {
+            emit_polygon(m_polygons.back());
+        }
         m_polygons.pop_back();
     }
 
@@ -750,8 +1057,11 @@ private:
     static constexpr std::size_t max_polygon_vertices = 10'000'000;
     static constexpr std::size_t max_sub_lsystem_depth = 100'000;
 
+    static constexpr std::size_t max_cached_expansion_modules = 4'000'000;
+
     const ViewFile& m_view;
     InterpretOptions m_options;
+    Interpreter* m_root;  ///< this, or the interpreter whose object this one builds
     Scene m_scene;
     Turtle m_turtle;
     CylinderBuilder m_cylinders;  ///< generalized cylinders, into m_scene
@@ -767,6 +1077,16 @@ private:
     };
     std::vector<SurfacePrototypes> m_surface_prototypes;  ///< per surface
     LsystemPatches m_patches;
+    std::shared_ptr<const SymbolTables> m_tables;
+    // `-o>` objects (root only)
+    ObjectKeying m_keying;
+    bool m_instancing = false;
+    std::unordered_map<std::string, int> m_object_prototypes;  ///< key -> prototype, -1: empty
+    std::unordered_map<std::string, std::shared_ptr<const lsys::ModuleString>> m_expansions;
+    std::size_t m_cached_modules = 0;
+    bool m_advancing = false;              ///< inside advance(): geometry is cut afterwards
+    std::size_t m_polygon_floor = 0;       ///< polygons below this index began before the object
+    std::vector<std::vector<PolygonCorner>> m_outer_polygons;
     std::size_t m_module_index = 0;
     bool m_warned_system = false, m_warned_include = false, m_warned_grid = false;
     bool m_warned_scale = false, m_warned_unmatched_polygon = false, m_warned_movement = false;
@@ -779,6 +1099,29 @@ private:
 };
 
 }  // namespace
+
+ObjectKeying object_keying(const ViewFile& view)
+{
+    ObjectKeying keying;
+    for (const ViewCommand& c : view.deferred) {
+        if (c.name != "rayshade objects")
+            continue;
+        // cpfg's rsReadViewCommand: tokens split at blanks and colons
+        std::string text = c.value;
+        std::replace(text.begin(), text.end(), ':', ' ');
+        std::istringstream in(text);
+        std::string format, word, flag;
+        if (!(in >> format))
+            continue;
+        if (is_float_format(format))
+            keying.format = format;
+        else
+            warn(c.loc, "rayshade objects: '" + format + "' is not a printf format of one number; using %g");
+        if (in >> word >> flag && word == "turtle" && flag.starts_with("considered"))
+            keying.turtle_considered = true;
+    }
+    return keying;
+}
 
 std::vector<Light> effective_lights(const ViewFile& view)
 {

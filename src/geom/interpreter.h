@@ -2,6 +2,7 @@
 // Interprets an L-system string with the turtle and builds the renderer-independent Scene.
 #pragma once
 
+#include <functional>
 #include <span>
 #include <string>
 
@@ -22,7 +23,31 @@ struct InterpretOptions {
     /// The L-system's string constants (lsys::Program::strings): `@L("text")` holds
     /// the index of its text there as its first parameter. Empty: labels get no text.
     std::span<const std::string> strings;
+
+    /// `-o>` object productions (manual 8.1). When both hooks are set, a module whose
+    /// symbol `is_object` is left unexpanded in the string and `expand_object` gives
+    /// its homomorphism successor. The first module with a given key (its symbol and
+    /// parameters printed with the view file's `rayshade objects:` format, default %g,
+    /// plus line width, scale, colours and texture with `turtle considered`) becomes a
+    /// Scene prototype built in the turtle's starting frame with the turtle's width,
+    /// scale, colours and texture; each occurrence places an instance with the turtle's
+    /// frame, and the turtle moves through the module's own expansion as if it were
+    /// inline (so what follows, and the bounds, are as with `-->`). `expand_object` must
+    /// depend on the module alone (it is called once per distinct module). Modules of an
+    /// expansion are never objects again. With `line style: pixel` objects are expanded
+    /// inline. Unset: the string is interpreted as it is.
+    std::function<bool(lsys::SymbolId)> is_object;
+    std::function<lsys::ModuleString(lsys::ModuleRef)> expand_object;
 };
+
+/// The view file's `rayshade objects: FORMAT [turtle considered]` (cpfg's
+/// rsReadViewCommand). A format that is not one printf conversion of a float (with
+/// flags, width, precision, text around it) is replaced by %g with a warning.
+struct ObjectKeying {
+    std::string format = "%g";
+    bool turtle_considered = false;
+};
+ObjectKeying object_keying(const ViewFile& view);
 
 Scene interpret(const lsys::ModuleString& string, const lsys::SymbolTable& symbols,
                 const ViewFile& view, const InterpretOptions& options);

@@ -173,7 +173,7 @@ SurfaceCommand parse_surface_command(const ViewCommand& command)
 {
     SurfaceCommand sc;
     sc.loc = command.loc;
-    if (command.name == "surface")
+    if (command.name == "surface" || command.name == "line")
         sc.kind = SurfaceCommand::Kind::bicubic;
     else if (command.name == "tsurface")
         sc.kind = SurfaceCommand::Kind::triangles;
@@ -201,6 +201,11 @@ SurfaceCommand parse_surface_command(const ViewCommand& command)
     if (rest.size() >= 2) {
         sc.s_steps = rest[0];
         sc.t_steps = rest[1];
+    }
+    if (command.name == "line" && rest.size() == 1) {
+        warn(command.loc, "line: a single number after the size is not read by cpfg (it reads "
+                          "'s t [texture]'); ignored");
+        return sc;
     }
     if (rest.size() == 1 || rest.size() == 3)
         sc.texture = texture_from_view(rest.back(), command.loc);
@@ -520,7 +525,7 @@ std::vector<SurfaceDef> load_view_surfaces(const ViewFile& view)
     std::set<char> letters;
     const std::filesystem::path base_dir = view.path.parent_path();
     for (const ViewCommand& command : view.deferred) {
-        if (command.name != "surface" && command.name != "tsurface")
+        if (command.name != "surface" && command.name != "tsurface" && command.name != "line")
             continue;
         SurfaceCommand sc = parse_surface_command(command);
         if (letters.count(sc.letter)) {

@@ -34,8 +34,16 @@ struct SurfaceCommand {
     FileLoc loc;
 };
 
-/// Parses a deferred view command named "surface" or "tsurface" (Error otherwise or
-/// when malformed).
+/// Parses a deferred view command named "surface", "tsurface" or "line" (Error
+/// otherwise or when malformed).
+///
+/// `line: id file size [s t [tex]]` defines a bicubic surface exactly as `surface:` does
+/// (cpfg reads it with the same read_surface; `~id` draws it). cpfg also records the id
+/// as its "line type", meant for drawing F segments as that surface, but that drawing is
+/// disabled in cpfg (its segment code is commented out), so segments are not affected
+/// here either. Unlike `surface:`, a single number after the size is not a texture:
+/// cpfg reads precisions as a pair, then the texture; a lone number is ignored (with a
+/// warning here).
 SurfaceCommand parse_surface_command(const ViewCommand& command);
 
 /// A predefined surface, ready to be instanced.
@@ -85,7 +93,7 @@ SurfaceDef parse_surface_text(std::string_view text, const std::string& file_nam
 
 /// (The tsurface reader, parse_tsurface_text, is in geom/tsurface.h.)
 
-/// Every `surface:` and `tsurface:` of the view file, read, in order. A file that
+/// Every `surface:`, `tsurface:` and `line:` of the view file, read, in order. A file that
 /// cannot be read or a letter used twice is a warning and the surface is skipped
 /// (cpfg does the same); malformed contents are an Error.
 std::vector<SurfaceDef> load_view_surfaces(const ViewFile& view);

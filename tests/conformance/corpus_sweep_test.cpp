@@ -20,12 +20,6 @@ const std::set<std::string> drawn_empty_by_cpfg = {
     "11-CPFG/01-Introduction/02-snowflake-exercise",
 };
 
-/// Models that need what Cambium does not read yet (docs/deviations.md).
-const std::set<std::string> known_incomplete = {
-    "10-manuals/11-CPFG/Ridley",                         // `curve:` format 1.4
-    "11-CPFG/03-inverse-modeling/06-phyllotaxis-ridley",  // the same
-};
-
 /// Fraction of the image's pixels the geometry covers (alpha is coverage).
 double coverage(const render::Image& image)
 {
@@ -60,7 +54,7 @@ TEST(CorpusSweep, EverySelfContainedModelRendersInFrame)
             double covered = coverage(image);
             // Something of the plant is in the frame, and it is not all over the frame
             // (which would mean a camera inside the geometry).
-            if (!drawn_empty_by_cpfg.count(model.id) && !known_incomplete.count(model.id)) {
+            if (!drawn_empty_by_cpfg.count(model.id)) {
                 EXPECT_GT(covered, 0.0) << model.id << ": nothing visible";
             }
             EXPECT_LT(covered, 0.98) << model.id << ": the frame is all plant";

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// Tests of generalized cylinders: Hermite axes, radius profiles, frames, and the
-// interpreter's @G modules producing HermiteCurves and meshes.
+// Tests of generalized cylinders: Hermite and B-spline axes, radius profiles, frames,
+// contour galleries, and the interpreter's @G modules producing HermiteCurves and meshes.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -317,6 +317,119 @@ TEST(GeneralizedCylinder, TwistIsMinimisedUnlessAskedFor)
     // Halfway the twist is half done: 45 degrees from U toward the new U.
     std::size_t middle = 9;
     EXPECT_NEAR(b.positions[middle][0], b.positions[middle][2] * -1, 1e-5);
+}
+
+TEST(GeneralizedCylinderMath, BsplineSegmentAsHermiteIsTheSameCubic)
+{
+    // The uniform cubic B-spline at u = 1/2 weighs its points (1, 23, 23, 1) / 48; u = 1/4
+    // is checked against the basis polynomials.
+    Vec3 p0{0, 0, 0}, p1{1, 2, -1}, p2{3, 2, 4}, p3{4, -1, 2};
+    std::array<Vec3, 4> h = bspline_as_hermite(p0, p1, p2, p3);
+    Vec3 mid = hermite(h[0], h[1], h[2], h[3], 0.5);
+    Vec3 expected = (p0 + p1 * 23 + p2 * 23 + p3) / 48.0;
+    EXPECT_NEAR(length(mid - expected), 0, 1e-12);
+    double u = 0.25, v = 1 - u;
+    Vec3 quarter = (p0 * (v * v * v) + p1 * (3 * u * u * u - 6 * u * u + 4) +
+                    p2 * (-3 * u * u * u + 3 * u * u + 3 * u + 1) + p3 * (u * u * u)) / 6.0;
+    EXPECT_NEAR(length(hermite(h[0], h[1], h[2], h[3], u) - quarter), 0, 1e-12);
+}
+
+TEST(GeneralizedCylinder, BsplineAxisStartsAtTheSixthWeightsOfItsControlPoints)
+{
+    // Control points P0..P3 = (0,1), (-1,1), (-1,0), (0,0) (f and left turns); the one
+    // segment runs from (P0 + 4 P1 + P2) / 6 to (P1 + 4 P2 + P3) / 6 with tangents
+    // (P2 - P0) / 2 and (P3 - P1) / 2.
+    Scene scene = run("{(3) f(1) +(90) f(1) +(90) f(1) +(90) f(1) }(3)");
+    const HermiteCurves& c = scene.geometry.curves;
+    ASSERT_EQ(c.segment_count(), 1u);
+    expect_key(c.points[0], -5.0 / 6, 5.0 / 6, 0, 0.5);
+    expect_key(c.points[1], -5.0 / 6, 1.0 / 6, 0, 0.5);
+    expect_key(c.tangents[0], -0.5, -0.5, 0, 0);
+    expect_key(c.tangents[1], 0.5, -0.5, 0, 0);
+}
+
+TEST(GeneralizedCylinder, OpenBsplineDoesNotReachItsEndPoints)
+{
+    // Five points along +y at 1..5: two segments from y = 2 to 4 (n - 3 segments).
+    Scene scene = run("{(3) f(1) f(1) f(1) f(1) f(1) }(3)");
+    const HermiteCurves& c = scene.geometry.curves;
+    ASSERT_EQ(c.segment_count(), 2u);
+    EXPECT_EQ(c.points.size(), 3u);  // equal tangents at the joint share the key
+    expect_key(c.points[0], 0, 2, 0, 0.5);
+    expect_key(c.points[1], 0, 3, 0, 0.5);
+    expect_key(c.points[2], 0, 4, 0, 0.5);
+    expect_key(c.tangents[0], 0, 1, 0, 0);
+    // Three points draw nothing.
+    EXPECT_EQ(run("{(3) f(1) f(1) f(1) }(3)").geometry.curves.segment_count(), 0u);
+}
+
+TEST(GeneralizedCylinder, BsplineSegmentsTakeTheMiddlePointsWidths)
+{
+    // Widths 1, 2, 3, 4 at P0..P3: the segment goes from P1's radius (1) to P2's (1.5).
+    Scene scene = run("{(3) !(1) f(1) !(2) f(1) !(3) f(1) !(4) f(1) }(3)");
+    const HermiteCurves& c = scene.geometry.curves;
+    ASSERT_EQ(c.segment_count(), 1u);
+    expect_key(c.points[0], 0, 2, 0, 1);
+    expect_key(c.points[1], 0, 3, 0, 1.5);
+}
+
+TEST(GeneralizedCylinder, ClosedBsplineAddsItsFirstThreePoints)
+{
+    // The square's four corners: four segments, the last ending where the first starts.
+    Scene scene = run("{(4) f(1) +(90) f(1) +(90) f(1) +(90) f(1) }(4)");
+    const HermiteCurves& c = scene.geometry.curves;
+    ASSERT_EQ(c.segment_count(), 4u);
+    expect_key(c.points[c.segments[0]], -5.0 / 6, 5.0 / 6, 0, 0.5);
+    expect_key(c.points[c.segments[3] + 1], -5.0 / 6, 5.0 / 6, 0, 0.5);
+    // The second segment starts where the first ends.
+    expect_key(c.points[c.segments[1]], -5.0 / 6, 1.0 / 6, 0, 0.5);
+}
+
+TEST(GeneralizedCylinder, BsplineBranchesCopyTheirControlPoints)
+{
+    // A branch after the third point continues the same axis; the main axis goes on
+    // without the branch's points.
+    Scene scene = run("{(3) f(1) f(1) f(1) [ +(90) f(1) ] f(1) }(3)");
+    const HermiteCurves& c = scene.geometry.curves;
+    ASSERT_EQ(c.segment_count(), 2u);
+    // Both start at (P0 + 4 P1 + P2) / 6 = (0, 2, 0).
+    expect_key(c.points[c.segments[0]], 0, 2, 0, 0.5);
+    expect_key(c.points[c.segments[1]], 0, 2, 0, 0.5);
+    // The branch ends at (P1 + 4 P2 + (-1, 3)) / 6, the main axis at y = 3.
+    expect_key(c.points[c.segments[0] + 1], -1.0 / 6, 17.0 / 6, 0, 0.5);
+    expect_key(c.points[c.segments[1] + 1], 0, 3, 0, 0.5);
+}
+
+TEST(GeneralizedCylinder, ContourGalleryItemsTakeConsecutiveIds)
+{
+    std::filesystem::path dir = temp_dir();
+    std::ofstream(dir / "shapes.cset") << "contourgalleryver 1 1\nitems: 2\n"
+                                          "cver 1 1\nname: square\npoints: 4 4\ntype: closed\n"
+                                          "1 1 0 1\n-1 1 0 1\n-1 -1 0 1\n1 -1 0 1\n"
+                                          " cver 1 1\nname: large\npoints: 4 4\ntype: closed\n"
+                                          "3 3 0 1\n-3 3 0 1\n-3 -3 0 1\n3 -3 0 1\n";
+    ViewFile view = parse_view_file("line style: cylinder\ncontour: 5 shapes.cset\ncontour sides: 8\n",
+                                    (dir / "g.v").string());
+    view.path = dir / "g.v";
+    CylinderSettings settings = cylinder_settings(view);
+    ASSERT_EQ(settings.contours.size(), 2u);
+    EXPECT_EQ(settings.contours.at(5).name, "square");
+    EXPECT_EQ(settings.contours.at(6).name, "large");
+
+    // @#(6) sweeps the large item. The rings' farthest vertices from the axis are the
+    // spline's corners (P0 + 4 P1 + P2) / 6 (the first vertex lies on one): distance
+    // sqrt(8) / 3 for the square item and three times that for the large one, at radius 1.
+    auto farthest = [&](const char* modules) {
+        lsys::SymbolTable symbols;
+        Scene scene = interpret(text_modules(symbols, modules), symbols, view);
+        double d = 0;
+        for (const Float3& p : scene.geometry.mesh.positions)
+            d = std::max(d, std::hypot(double(p[0]), double(p[2])));
+        EXPECT_GT(scene.geometry.mesh.size(), 0u);
+        return d;
+    };
+    EXPECT_NEAR(farthest("!(2) @#(5) @Gs f(1) @Ge(1)"), std::sqrt(8.0) / 3, 1e-5);
+    EXPECT_NEAR(farthest("!(2) @#(6) @Gs f(1) @Ge(1)"), std::sqrt(8.0), 1e-5);
 }
 
 namespace {

@@ -3,6 +3,7 @@
 // the cpfg oracle's rayshade output.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -207,6 +208,50 @@ TEST(Surface, CommandParsing)
     EXPECT_EQ(c.kind, SurfaceCommand::Kind::triangles);
     EXPECT_THROW(parse_surface_command({"surface", " lx leaf.s 1", FileLoc{"p.v", 3, 1}}), Error);
     EXPECT_THROW(parse_surface_command({"surface", " l leaf.s", FileLoc{"p.v", 3, 1}}), Error);
+}
+
+TEST(Surface, LineCommandDefinesASurface)
+{
+    // `line: id file size [s t [tex]]` is read as `surface:` (cpfg's read_surface) but a
+    // lone number after the size is not a texture there.
+    SurfaceCommand c = parse_surface_command({"line", " L line.s .01", FileLoc{"p.v", 3, 1}});
+    EXPECT_EQ(c.kind, SurfaceCommand::Kind::bicubic);
+    EXPECT_EQ(c.letter, 'L');
+    EXPECT_EQ(c.file, "line.s");
+    EXPECT_DOUBLE_EQ(c.scale, 0.01);
+    set_warnings_enabled(false);
+    c = parse_surface_command({"line", " L line.s 1 3", FileLoc{"p.v", 3, 1}});
+    set_warnings_enabled(true);
+    EXPECT_FALSE(c.texture.has_value());
+    EXPECT_EQ(c.s_steps, 0);
+    c = parse_surface_command({"line", " L line.s 1 2 4 3", FileLoc{"p.v", 3, 1}});
+    EXPECT_EQ(c.s_steps, 2);
+    EXPECT_EQ(c.t_steps, 4);
+    ASSERT_TRUE(c.texture.has_value());
+    EXPECT_EQ(*c.texture, 2);
+}
+
+TEST(SurfaceConformance, SedgeLineSurfaceIsLoaded)
+{
+    std::filesystem::path view = corpus() / "cpfg/10-manuals/11-CPFG/Sedge/female.v";
+    if (!std::filesystem::exists(view))
+        GTEST_SKIP() << "corpus not found";
+    set_warnings_enabled(false);  // the view names a missing bract.s
+    std::vector<SurfaceDef> defs = load_view_surfaces(read_view_file(view));
+    set_warnings_enabled(true);
+    auto line = std::find_if(defs.begin(), defs.end(), [](const SurfaceDef& d) { return d.letter == 'L'; });
+    ASSERT_NE(line, defs.end());
+    // line.s: two patches of a tube 2000 long along its heading, at size 2000 and scale
+    // 0.01, so 0.01 long: every vertex has 0 <= y <= 0.01.
+    const TriangleMesh& mesh = line->prototype.geometry.mesh;
+    ASSERT_GT(mesh.positions.size(), 0u);
+    float lo = mesh.positions[0][1], hi = lo;
+    for (const Float3& p : mesh.positions) {
+        lo = std::min(lo, p[1]);
+        hi = std::max(hi, p[1]);
+    }
+    EXPECT_NEAR(lo, 0, 1e-6);
+    EXPECT_NEAR(hi, 0.01, 1e-6);
 }
 
 TEST(Surface, ScaleParameters)
