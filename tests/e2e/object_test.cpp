@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: Apache-2.0
+// End-to-end: an L-system whose flowers are -o> objects (instanced) renders the same
+// picture as the same L-system with --> (expanded inline), through the app pipeline.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "app/pipeline.h"
+#include "render/render.h"
+
+using namespace cambium;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// A stem with three flowers; `arrow` is the flower production's delimiter.
+std::string plant(const std::string& arrow)
+{
+    return "lsystem: 1\nderivation length: 3\naxiom: A\n"
+           "A --> F(2)[+(40)K]/(137)A\n"
+           "homomorphism\n"
+           "K " + arrow + " F(1)[;(2)@O(0.8)][&(30)F(0.5)]\n"
+           "endlsystem\n";
+}
+
+struct Built {
+    geom::Scene scene;
+    render::Image image;
+};
+
+Built build(const std::string& arrow)
+{
+    fs::path dir = fs::temp_directory_path() / ("cambium_objects_" + std::to_string(arrow.size()) +
+                                                (arrow == "-o>" ? "o" : "i"));
+    fs::create_directories(dir);
+    std::ofstream(dir / "plant.l") << plant(arrow);
+    std::ofstream(dir / "plant.v") << "angle factor: 8\nline style: cylinder\ninitial line width: 0.2\n"
+                                      "light: V: 0 0 1\nscale factor: 0.9\n";
+    app::Options options;
+    options.lsystem = dir / "plant.l";
+    options.view = dir / "plant.v";
+    app::Model model = app::load_model(options);
+    Built b{app::interpret(model, app::derive(model, options), options), {}};
+    render::RenderSettings settings;
+    settings.width = 64;
+    settings.height = 64;
+    settings.samples_per_pixel = 16;
+    settings.max_depth = 2;
+    b.image = render::render(b.scene, settings);
+    fs::remove_all(dir);
+    return b;
+}
+
+}  // namespace
+
+TEST(Objects, InstancedObjectsRenderLikeInlineOnes)
+{
+    Built instanced = build("-o>");
+    Built inline_ = build("-->");
+    // independent expectation: one flower shape, three occurrences
+    EXPECT_EQ(instanced.scene.prototypes.size(), 1u);
+    EXPECT_EQ(instanced.scene.instances.size(), 3u);
+    EXPECT_TRUE(inline_.scene.instances.empty());
+    EXPECT_EQ(instanced.scene.geometry.spheres.centres.size(), 0u);
+    EXPECT_EQ(inline_.scene.geometry.spheres.centres.size(), 3u);
+
+    ASSERT_EQ(instanced.image.rgba.size(), inline_.image.rgba.size());
+    double difference = 0, coverage = 0;
+    for (std::size_t i = 0; i < instanced.image.rgba.size(); ++i) {
+        difference += std::fabs(instanced.image.rgba[i] - inline_.image.rgba[i]);
+        if (i % 4 == 3)
+            coverage += inline_.image.rgba[i];
+    }
+    difference /= static_cast<double>(instanced.image.rgba.size());
+    EXPECT_GT(coverage, 20.0);      // the plant is in the picture
+    EXPECT_LT(difference, 1e-4);    // the same picture up to float rounding of the placement
+}
