@@ -183,10 +183,16 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     cli.add_flag("--sky", options.sky, "Light with an analytic sun and sky");
     cli.add_option("--sun", options.sun_direction, "Direction toward the sun (with --sky)")
         ->expected(3);
+    cli.add_option("--turbidity", options.turbidity,
+                   "Haze of the --sky, 1.7 (very clear) .. 10 (hazy); default 3")
+        ->check(CLI::Range(1.7f, 10.0f));
     cli.add_option("--env", options.environment_map,
                    "Light with a latitude-longitude HDR map (.exr, .hdr)");
     cli.add_option("--env-scale", options.environment_scale, "Multiplies the --env map")
         ->check(CLI::Range(0.0f, 1e6f));
+    cli.add_option("--env-rotate", options.environment_rotation,
+                   "Turn the --env map (or --sky) by DEG about the up axis +y")
+        ->check(CLI::Range(-3600.0f, 3600.0f));
     cli.add_flag("--allow-system-calls", options.allow_system_calls,
                  "Run the commands of @S modules (never done by default)");
     cli.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
@@ -212,6 +218,10 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
         options.samples_per_pixel = 4096;
     if (options.sky && options.environment_map)
         throw Error("--sky and --env both set what surrounds the plant; give one");
+    if (cli.count("--turbidity") > 0 && !options.sky)
+        throw Error("--turbidity sets the haze of the --sky; give --sky too");
+    if (cli.count("--env-rotate") > 0 && !options.sky && !options.environment_map)
+        throw Error("--env-rotate turns the --env map or the --sky; give one of them");
     options.lsystem = files[0];
     options.view = files[1];
     if (files.size() == 3)

@@ -59,8 +59,10 @@ struct Options {
     float ambient = 0.05f;             ///< --ambient: uniform environment radiance
     bool sky = false;                  ///< --sky: analytic sun and sky
     std::vector<float> sun_direction;  ///< --sun X Y Z (with --sky)
+    float turbidity = 3;               ///< --turbidity: sky haze, 1.7 .. 10 (with --sky)
     std::optional<std::filesystem::path> environment_map;  ///< --env file.exr|.hdr
     float environment_scale = 1;       ///< --env-scale
+    float environment_rotation = 0;    ///< --env-rotate DEG about +y (with --env or --sky)
 
     /// Whether an image is to be rendered: an -o was given, or no other output was.
     bool renders() const

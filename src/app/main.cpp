@@ -69,11 +69,15 @@ render::RenderSettings render_settings(const Options& options,
         if (!options.sun_direction.empty())
             sky.sun_direction = render::normalize(render::Vec3f(
                 options.sun_direction[0], options.sun_direction[1], options.sun_direction[2]));
+        sky.turbidity = options.turbidity;
         settings.environment = render::make_sky_environment(sky);
     } else if (options.environment_map) {
         settings.environment =
             render::make_map_environment(*options.environment_map, options.environment_scale);
     }
+    if (settings.environment && options.environment_rotation != 0)
+        settings.environment =
+            render::make_rotated_environment(settings.environment, options.environment_rotation);
     settings.progress = !options.quiet && isatty(fileno(stderr));
     // The albedo, normal and depth layers cost a camera-ray intersection; only EXR keeps them.
     settings.aovs = std::any_of(images.begin(), images.end(), [](const auto& f) {

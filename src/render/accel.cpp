@@ -103,15 +103,17 @@ struct Mat3 {
 /// factor radii scale by (the cube root of the volume scale).
 struct Placement {
     const geom::Instance* instance = nullptr;
+    std::uint32_t index = PrimId::none;  ///< in Scene::instances
     Mat3 linear, normals;
     float radius_scale = 1;
 };
 
-Placement make_placement(const geom::Instance& inst)
+Placement make_placement(const geom::Instance& inst, std::uint32_t index)
 {
     const auto& m = inst.transform;
     Placement p;
     p.instance = &inst;
+    p.index = index;
     p.linear = {{m[0], m[1], m[2]}, {m[3], m[4], m[5]}, {m[6], m[7], m[8]}};
     const Vec3f &a = p.linear.c0, &b = p.linear.c1, &c = p.linear.c2;
     float det = dot(a, cross(b, c));
@@ -193,6 +195,9 @@ struct EmbreeScene::Impl : Lookup {
     std::vector<RTCScene> prototype_scenes;
     std::deque<Part> parts;  ///< stable addresses (Embree user data)
     std::vector<Key> world_keys;  ///< line keys with pixel radii converted (else empty)
+    /// Pixel-width lines of prototypes, placed by every instance in world space with
+    /// their radii converted (a radius in pixels depends on each copy's depth).
+    geom::Geometry placed_lines;
     std::size_t segments = 0;
 
     ~Impl()
@@ -222,7 +227,7 @@ struct EmbreeScene::Impl : Lookup {
 
     /// Adds every non-empty part of g to s; ids[geomID] = its Part.
     void add_geometry(RTCScene s, const geom::Geometry& g, std::vector<const Part*>& ids,
-                      const Key* line_keys, bool unlit, bool alpha);
+                      const Key* line_keys, bool unlit, bool alpha, bool lines = true);
     void attach(RTCScene s, RTCGeometry g, Part part, std::vector<const Part*>& ids, bool alpha);
 
 };
@@ -270,6 +275,66 @@ std::array<float, 2> texture_coords(const Part& part, std::uint32_t prim, float 
     return {0, 0};
 }
 
+/// dP/ds and dP/dt in object space at a hit (texture_coords' derivatives); zero where a
+/// coordinate does not change.
+std::array<Vec3f, 2> texture_tangents(const Part& part, std::uint32_t prim, float u,
+                                      const Vec3f& ng, float radius)
+{
+    const geom::Geometry& g = *part.geometry;
+    // Around a tube, s runs once round the circumference.
+    auto around = [&](const Vec3f& axis) {
+        return normalize(cross(axis, normalize(ng))) * (2 * pi * radius);
+    };
+    auto along = [](const Vec3f& dp_du, float dv_du) {
+        return dv_du != 0 ? dp_du * (1 / dv_du) : Vec3f();
+    };
+    switch (part.shape) {
+    case Shape::line: {
+        std::uint32_t k = g.lines.segments[prim];
+        Vec3f axis = vec(part.line_keys[k + 1]) - vec(part.line_keys[k]);
+        bool has_v = g.lines.v.size() == g.lines.keys.size();
+        float dv = has_v ? g.lines.v[k + 1] - g.lines.v[k] : 0;
+        return {around(axis), along(axis, dv)};
+    }
+    case Shape::curve: {
+        const geom::HermiteCurves& c = g.curves;
+        std::uint32_t k = c.segments[prim];
+        auto d = hermite_derivative(u);
+        Vec3f axis = vec(c.points[k]) * d[0] + vec(c.tangents[k]) * d[1] +
+                     vec(c.points[k + 1]) * d[2] + vec(c.tangents[k + 1]) * d[3];
+        float dv = c.v.size() == c.points.size() ? c.v[k + 1] - c.v[k] : 0;
+        return {around(axis), along(axis, dv)};
+    }
+    case Shape::sphere: {
+        // s = longitude / 2 pi about z, t = latitude / pi + 1/2.
+        Vec3f n = normalize(ng);
+        float rxy = std::sqrt(n.x * n.x + n.y * n.y);
+        if (rxy <= 0)
+            return {Vec3f(), Vec3f()};
+        Vec3f east(-n.y / rxy, n.x / rxy, 0), north(-n.z * n.x / rxy, -n.z * n.y / rxy, rxy);
+        return {east * (2 * pi * radius * rxy), north * (pi * radius)};
+    }
+    case Shape::triangle: {
+        const geom::TriangleMesh& m = g.mesh;
+        const auto& tri = m.triangles[prim];
+        if (m.uvs.size() != m.positions.size())
+            return {Vec3f(), Vec3f()};
+        Vec3f e1 = vec(m.positions[tri[1]]) - vec(m.positions[tri[0]]);
+        Vec3f e2 = vec(m.positions[tri[2]]) - vec(m.positions[tri[0]]);
+        const geom::Float2 &uv0 = m.uvs[tri[0]], &uv1 = m.uvs[tri[1]], &uv2 = m.uvs[tri[2]];
+        float s1 = uv1[0] - uv0[0], t1 = uv1[1] - uv0[1];
+        float s2 = uv2[0] - uv0[0], t2 = uv2[1] - uv0[1];
+        float det = s1 * t2 - s2 * t1;
+        if (!(std::fabs(det) > 1e-20f))
+            return {Vec3f(), Vec3f()};
+        float inv = 1 / det;
+        return {(e1 * t2 - e2 * t1) * inv, (e2 * s1 - e1 * s2) * inv};
+    }
+    case Shape::disc: break;
+    }
+    return {Vec3f(), Vec3f()};
+}
+
 /// Rejects hits where the primitive's texture is cut out (alpha < 0.5).
 void alpha_filter(const RTCFilterFunctionNArguments* args)
 {
@@ -290,6 +355,55 @@ void alpha_filter(const RTCFilterFunctionNArguments* args)
         if (owner.textures->lookup(texture, st[0], st[1]).alpha < 0.5f)
             args->valid[i] = 0;
     }
+}
+
+/// Most line keys that placing pixel-width prototype lines may create.
+constexpr std::size_t max_placed_keys = std::size_t{1} << 27;
+
+/// The pixel-width lines of every instance's prototype in world space: keys transformed,
+/// radii converted at each key's depth, materials and textures resolved.
+geom::LinearCurves place_pixel_lines(const geom::Scene& scene, const Camera& camera)
+{
+    geom::LinearCurves out;
+    std::size_t total = 0;
+    for (const geom::Instance& inst : scene.instances)
+        if (inst.prototype < scene.prototypes.size())
+            total += scene.prototypes[inst.prototype].geometry.lines.keys.size();
+    if (total > max_placed_keys)
+        throw Error("scene: placing pixel-width lines of prototypes would make " +
+                    std::to_string(total) + " keys (at most " +
+                    std::to_string(max_placed_keys) + ")");
+    for (const geom::Instance& inst : scene.instances) {
+        if (inst.prototype >= scene.prototypes.size())
+            continue;
+        const geom::LinearCurves& l = scene.prototypes[inst.prototype].geometry.lines;
+        if (l.segments.empty())
+            continue;
+        for (std::uint32_t k : l.segments)
+            if (k + 1 >= l.keys.size())
+                throw Error("scene: line segment starts at key " + std::to_string(k) + " of " +
+                            std::to_string(l.keys.size()));
+        const auto& m = inst.transform;
+        auto first = static_cast<std::uint32_t>(out.keys.size());
+        for (const Key& k : l.keys) {
+            geom::Vec3 p{m[0] * k[0] + m[3] * k[1] + m[6] * k[2] + m[9],
+                         m[1] * k[0] + m[4] * k[1] + m[7] * k[2] + m[10],
+                         m[2] * k[0] + m[5] * k[1] + m[8] * k[2] + m[11]};
+            out.keys.push_back({float(p.x), float(p.y), float(p.z),
+                                static_cast<float>(k[3] * camera.pixel_size_at(p))});
+        }
+        for (std::size_t k = 0; k < l.keys.size(); ++k)
+            out.v.push_back(l.v.size() == l.keys.size() ? l.v[k] : 0.0f);
+        for (std::size_t i = 0; i < l.segments.size(); ++i) {
+            out.segments.push_back(first + l.segments[i]);
+            out.flags.push_back(l.flags.size() == l.segments.size() ? l.flags[i] : 0);
+            std::uint16_t mat = at_or(l.material, i, std::uint16_t{0});
+            out.material.push_back(mat == geom::inherit_material ? inst.material : mat);
+            std::int16_t tex = at_or(l.texture, i, geom::no_texture);
+            out.texture.push_back(tex == geom::no_texture ? inst.texture : tex);
+        }
+    }
+    return out;
 }
 
 /// The keys with radii converted from pixels to world units at each key's depth.
@@ -387,10 +501,10 @@ void EmbreeScene::Impl::attach(RTCScene s, RTCGeometry g, Part part,
 
 void EmbreeScene::Impl::add_geometry(RTCScene s, const geom::Geometry& geo,
                                      std::vector<const Part*>& ids, const Key* line_keys,
-                                     bool unlit, bool alpha)
+                                     bool unlit, bool alpha, bool lines)
 {
     const geom::LinearCurves& l = geo.lines;
-    if (!l.segments.empty()) {
+    if (lines && !l.segments.empty()) {
         check_segments(l.segments, l.keys.size(), "line");
         const Key* keys = line_keys ? line_keys : l.keys.data();
         RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
@@ -457,7 +571,7 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
     : m_impl(std::make_unique<Impl>())
 {
     Impl& m = *m_impl;
-        m.textures = textures;
+    m.textures = textures;
     m.device = rtcNewDevice(nullptr);
     if (!m.device)
         throw Error(std::string("Embree: cannot create a device: ") +
@@ -473,6 +587,14 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
                    scene.line_radius_in_pixels, false);
     m.segments = own.lines.segment_count() + own.curves.segment_count();
 
+    // Pixel-width lines inside prototypes: each placed copy in world space, drawn unlit
+    // like the scene's own (cpfg's GL lines are as wide at any depth and scale).
+    if (scene.line_radius_in_pixels) {
+        m.placed_lines.lines = place_pixel_lines(scene, camera);
+        m.add_geometry(m.scene, m.placed_lines, m.top_parts, nullptr, true, false);
+        m.segments += m.placed_lines.lines.segment_count();
+    }
+
     // Prototypes: one Embree scene each, built only if some instance places it.
     std::vector<bool> placed(scene.prototypes.size(), false), textured(placed);
     for (const geom::Instance& inst : scene.instances) {
@@ -487,13 +609,18 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
     m.proto_parts.resize(scene.prototypes.size());
     for (std::size_t i = 0; i < scene.prototypes.size(); ++i) {
         const geom::Geometry& g = scene.prototypes[i].geometry;
-        if (!placed[i] || g.empty())
+        // With pixel-width lines placed above, a prototype of lines alone has nothing left.
+        bool lines_only = g.curves.segment_count() == 0 && g.spheres.size() == 0 &&
+                          g.discs.size() == 0 && g.mesh.size() == 0;
+        if (!placed[i] || g.empty() || (scene.line_radius_in_pixels && lines_only))
             continue;
         m.prototype_scenes[i] = m.new_scene();
-        m.add_geometry(m.prototype_scenes[i], g, m.proto_parts[i], nullptr, false, textured[i]);
+        m.add_geometry(m.prototype_scenes[i], g, m.proto_parts[i], nullptr, false, textured[i],
+                       !scene.line_radius_in_pixels);
         rtcCommitScene(m.prototype_scenes[i]);
     }
-    for (const geom::Instance& inst : scene.instances) {
+    for (std::uint32_t index = 0; index < scene.instances.size(); ++index) {
+        const geom::Instance& inst = scene.instances[index];
         RTCScene proto = m.prototype_scenes[inst.prototype];
         if (!proto)
             continue;
@@ -505,7 +632,7 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
         rtcReleaseGeometry(g);
         if (m.placements.size() <= id)
             m.placements.resize(id + 1);
-        m.placements[id] = make_placement(inst);
+        m.placements[id] = make_placement(inst, index);
     }
     if (m.top_parts.size() < m.placements.size())
         m.top_parts.resize(m.placements.size(), nullptr);
@@ -611,6 +738,8 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     h.prim_id = rh.hit.primID;
     h.inst_id = rh.hit.instID[0];
     const Placement* placement = m.placement(h.inst_id);
+    if (placement)
+        h.instance = placement->index;
     const Part& part = *m.part(h.inst_id, h.geom_id);
     h.shape = part.shape;
     h.unlit = part.unlit;
@@ -665,6 +794,9 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
         auto st = texture_coords(part, h.prim_id, rh.hit.u, rh.hit.v, ng);
         h.u = st[0];
         h.v = st[1];
+        auto [dpds, dpdt] = texture_tangents(part, h.prim_id, rh.hit.u, ng, local.radius);
+        h.dpds = placement ? placement->linear * dpds : dpds;
+        h.dpdt = placement ? placement->linear * dpdt : dpdt;
     }
 
     float scale = std::fmax(std::fabs(h.position.x),

@@ -35,10 +35,14 @@ struct SurfaceHit {
     Vec3f geometric_normal;    ///< unit true surface normal, facing the incoming ray
     std::uint32_t geom_id = 0;
     std::uint32_t prim_id = 0;
-    std::uint32_t inst_id = PrimId::none;  ///< the Instance's index + its geometry id
+    std::uint32_t inst_id = PrimId::none;  ///< the instance's Embree geometry id
+    std::uint32_t instance = PrimId::none;  ///< in Scene::instances (none: own geometry)
     std::uint16_t material = 0;  ///< index into Scene::materials (side and instance resolved)
     std::int16_t texture = geom::no_texture;  ///< index into Scene::textures
     float u = 0, v = 0;        ///< texture coordinates (OpenGL's s, t)
+    /// World-space change of position per unit of s and of t at the hit (textured hits
+    /// only; zero where a coordinate is constant): turns ray footprints into texture ones.
+    Vec3f dpds, dpdt;
     Shape shape = Shape::line;
     bool back = false;         ///< the ray hit the back side of a disc or triangle
     bool inside = false;       ///< the ray hit a closed primitive from within

@@ -1,16 +1,26 @@
 // SPDX-License-Identifier: Apache-2.0
 // Environments: uniform ambient, an analytic sun-and-sky, a lat-long HDR map.
 //
-// sky: not Preetham's model but a small documented one, cheap and smooth, meant for
-// plants lit from outdoors. With up = +y, h = clamp((turbidity - 2) / 8, 0, 1):
-// - dome (y >= 0): lerp(horizon, zenith, sqrt(y)) * (1 + glow), zenith = (0.10, 0.18,
-//   0.32), horizon = lerp((0.35, 0.42, 0.50), (0.55, 0.55, 0.55), h), both times
-//   sky_intensity; glow = (0.3 + 1.7 h) * max(0, cos(angle to the sun))^(16 - 12 h).
-// - ground (y < 0): ground_albedo * (pi * sun_intensity * max(0, sun.y) * sun colour
-//   + the horizon colour * pi) / pi, i.e. a Lambertian ground lit by sun and sky.
-// - sun: a disk of angular radius 0.2665 deg whose radiance gives irradiance
-//   pi * sun_intensity * colour, colour = exp(-tau * airmass), tau = (0.02, 0.04, 0.08)
-//   * (turbidity / 3), airmass = 1 / max(sun.y, 0.05).
+// sky: Preetham, Shirley & Smits, "A Practical Analytic Model for Daylight" (SIGGRAPH 1999).
+// With up = +y, theta the angle of a direction from the zenith and gamma its angle to the
+// sun (theta_s for the sun), each of Y (luminance, kcd/m^2) and the chromaticities x, y is
+//   value = zenith value * F(theta, gamma) / F(0, theta_s),
+//   F = (1 + A exp(B / cos theta)) (1 + C exp(D gamma) + E cos^2 gamma),
+// with A..E linear in the turbidity T (the paper's appendix), zenith Y from
+// chi = (4/9 - T/120)(pi - 2 theta_s): Y_z = (4.0453 T - 4.9710) tan chi - 0.2155 T + 2.4192,
+// zenith x, y cubic in theta_s and quadratic in T. xyY -> XYZ -> linear sRGB (D65).
+// - Units: 1 unit of radiance is 128 000 / pi cd/m^2 (the sun's 128 klux outside the
+//   atmosphere give irradiance pi, the view-file light convention); the dome is scaled
+//   by sky_intensity, the sun by sun_intensity (both 1: their physical ratio).
+// - sun: a disk of angular radius 0.2665 deg whose radiance outside the atmosphere gives
+//   irradiance pi * sun_intensity, attenuated per channel by exp(-m (tau_R + tau_A)):
+//   Rayleigh tau_R = 0.008735 lambda^-4.08 and Angstrom aerosol tau_A = beta lambda^-1.3,
+//   beta = 0.04608 T - 0.04586 (the paper's appendix), lambda = 0.65 / 0.55 / 0.45 um for
+//   R / G / B, m the relative air mass (Kasten & Young 1989).
+// - Sun below the horizon: no disk; the dome is the theta_s = 90 deg one fading linearly
+//   to black at 6 deg below (civil twilight), a documented approximation.
+// - ground (y < 0): ground_albedo / pi times the irradiance of sun and dome on a
+//   horizontal plane (the dome's integrated once, numerically).
 // Sampling: the sun cone with probability 1/2 (when the sun is up), else the uniform
 // sphere; pdf() is that mixture, so MIS weights are exact.
 #include "render/environment.h"
@@ -57,9 +67,28 @@ private:
     Vec3f m_radiance;
 };
 
-Vec3f lerp(const Vec3f& a, const Vec3f& b, float t) { return a + (b - a) * t; }
-
 Vec3f exp(const Vec3f& v) { return {std::exp(v.x), std::exp(v.y), std::exp(v.z)}; }
+
+/// The Perez luminance distribution's five coefficients.
+struct Perez {
+    float a, b, c, d, e;
+    float operator()(float cos_theta, float gamma, float cos_gamma) const
+    {
+        return (1 + a * std::exp(b / std::max(cos_theta, 1e-3f))) *
+               (1 + c * std::exp(d * gamma) + e * cos_gamma * cos_gamma);
+    }
+};
+
+/// Linear sRGB (D65) of CIE xyY.
+Vec3f xyY_to_rgb(float x, float y, float Y)
+{
+    if (!(y > 0))
+        return {};
+    float X = x * Y / y, Z = (1 - x - y) * Y / y;
+    return {std::max(0.0f, 3.2406f * X - 1.5372f * Y - 0.4986f * Z),
+            std::max(0.0f, -0.9689f * X + 1.8758f * Y + 0.0415f * Z),
+            std::max(0.0f, 0.0557f * X - 0.2040f * Y + 1.0570f * Z)};
+}
 
 class SkyEnvironment final : public Environment {
 public:
@@ -68,34 +97,53 @@ public:
         m_sun = normalize(p.sun_direction);
         if (length(m_sun) == 0)
             m_sun = {0, 1, 0};
-        float t = std::clamp(p.turbidity, 1.0f, 20.0f);
-        float h = std::clamp((t - 2) / 8, 0.0f, 1.0f);
-        m_zenith = Vec3f(0.10f, 0.18f, 0.32f) * p.sky_intensity;
-        m_horizon = lerp({0.35f, 0.42f, 0.50f}, Vec3f(0.55f), h) * p.sky_intensity;
-        m_glow_strength = 0.3f + 1.7f * h;
-        m_glow_exponent = 16 - 12 * h;
-        float airmass = 1 / std::max(m_sun.y, 0.05f);
-        Vec3f colour = exp(Vec3f(0.02f, 0.04f, 0.08f) * (-(t / 3) * airmass));
+        const float t = std::clamp(p.turbidity, sky_min_turbidity, sky_max_turbidity);
+        // Below the horizon the dome is the sunset one, fading out by -6 degrees.
+        float elevation = std::asin(std::clamp(m_sun.y, -1.0f, 1.0f));
+        float fade = std::clamp(1 + elevation / (6 * pi / 180), 0.0f, 1.0f);
+        m_theta_s = std::min(pi / 2 - elevation, pi / 2);
+        m_sun_dome = m_sun.y >= 0 ? m_sun : normalize(Vec3f(m_sun.x, 0, m_sun.z));
+        if (length(m_sun_dome) == 0)
+            m_sun_dome = {0, 1, 0};
+
+        m_Y = {0.1787f * t - 1.4630f, -0.3554f * t + 0.4275f, -0.0227f * t + 5.3251f,
+               0.1206f * t - 2.5771f, -0.0670f * t + 0.3703f};
+        m_x = {-0.0193f * t - 0.2592f, -0.0665f * t + 0.0008f, -0.0004f * t + 0.2125f,
+               -0.0641f * t - 0.8989f, -0.0033f * t + 0.0452f};
+        m_y = {-0.0167f * t - 0.2608f, -0.0950f * t + 0.0092f, -0.0079f * t + 0.2102f,
+               -0.0441f * t - 1.6537f, -0.0109f * t + 0.0529f};
+        float chi = (4.0f / 9 - t / 120) * (pi - 2 * m_theta_s);
+        float zenith_Y = std::max(0.0f, (4.0453f * t - 4.9710f) * std::tan(chi) - 0.2155f * t +
+                                            2.4192f);  // kcd/m^2
+        float th = m_theta_s, th2 = th * th, th3 = th2 * th, t2 = t * t;
+        m_zenith_x = (0.00166f * th3 - 0.00375f * th2 + 0.00209f * th) * t2 +
+                     (-0.02903f * th3 + 0.06377f * th2 - 0.03202f * th + 0.00394f) * t +
+                     (0.11693f * th3 - 0.21196f * th2 + 0.06052f * th + 0.25886f);
+        m_zenith_y = (0.00275f * th3 - 0.00610f * th2 + 0.00317f * th) * t2 +
+                     (-0.04214f * th3 + 0.08970f * th2 - 0.04153f * th + 0.00516f) * t +
+                     (0.15346f * th3 - 0.26756f * th2 + 0.06670f * th + 0.26688f);
+        m_zenith_Y =
+            zenith_Y * 1000 / sky_luminance_unit * std::max(p.sky_intensity, 0.0f) * fade;
+        m_norm_Y = m_Y(1, m_theta_s, std::cos(m_theta_s));
+        m_norm_x = m_x(1, m_theta_s, std::cos(m_theta_s));
+        m_norm_y = m_y(1, m_theta_s, std::cos(m_theta_s));
+
+        // The sun outside the atmosphere gives pi * sun_intensity; the air dims it.
         m_cos_sun = std::cos(0.2665f * pi / 180);
         m_sun_solid_angle = 2 * pi * (1 - m_cos_sun);
         m_sun_up = m_sun.y > 0 && p.sun_intensity > 0;
+        Vec3f colour = sun_transmittance(t, m_sun.y);
         m_sun_radiance = m_sun_up ? colour * (pi * p.sun_intensity / m_sun_solid_angle) : Vec3f();
         Vec3f sun_irradiance = m_sun_up ? colour * (pi * p.sun_intensity * m_sun.y) : Vec3f();
-        m_ground = p.ground_albedo * (sun_irradiance + m_horizon * pi) * (1 / pi);
-        m_black = is_black(m_zenith) && is_black(m_horizon) && !m_sun_up;
+        m_ground = p.ground_albedo * (sun_irradiance + dome_irradiance()) * (1 / pi);
+        m_black = !(m_zenith_Y > 0) && !m_sun_up;
         m_sun_probability = m_sun_up ? 0.5f : 0.0f;
     }
 
     Vec3f radiance(const Vec3f& d) const override
     {
         float cos_sun = dot(d, m_sun);
-        Vec3f sky;
-        if (d.y < 0) {
-            sky = m_ground;
-        } else {
-            float glow = m_glow_strength * std::pow(std::max(cos_sun, 0.0f), m_glow_exponent);
-            sky = lerp(m_horizon, m_zenith, std::sqrt(d.y)) * (1 + glow);
-        }
+        Vec3f sky = d.y < 0 ? m_ground : dome(d);
         if (m_sun_up && cos_sun >= m_cos_sun)
             sky += m_sun_radiance;
         return sky;
@@ -132,10 +180,87 @@ public:
     bool black() const override { return m_black; }
 
 private:
-    Vec3f m_sun, m_zenith, m_horizon, m_ground, m_sun_radiance;
-    float m_glow_strength = 0, m_glow_exponent = 1;
+    /// Preetham's dome along d (d.y >= 0), without the sun disk.
+    Vec3f dome(const Vec3f& d) const
+    {
+        if (!(m_zenith_Y > 0))
+            return {};
+        float cos_gamma = std::clamp(dot(d, m_sun_dome), -1.0f, 1.0f);
+        float gamma = std::acos(cos_gamma);
+        float Y = m_zenith_Y * m_Y(d.y, gamma, cos_gamma) / m_norm_Y;
+        float x = m_zenith_x * m_x(d.y, gamma, cos_gamma) / m_norm_x;
+        float y = m_zenith_y * m_y(d.y, gamma, cos_gamma) / m_norm_y;
+        return xyY_to_rgb(x, y, std::max(Y, 0.0f));
+    }
+
+    /// The dome's irradiance on a horizontal plane: a midpoint rule in (cos theta, phi).
+    Vec3f dome_irradiance() const
+    {
+        constexpr int n_cos = 32, n_phi = 64;
+        Vec3f sum;
+        for (int i = 0; i < n_cos; ++i) {
+            float c = (i + 0.5f) / n_cos, s = std::sqrt(1 - c * c);
+            for (int j = 0; j < n_phi; ++j) {
+                float phi = 2 * pi * (j + 0.5f) / n_phi;
+                sum += dome({s * std::cos(phi), c, s * std::sin(phi)}) * c;
+            }
+        }
+        return sum * (2 * pi / (n_cos * n_phi));
+    }
+
+    /// Rayleigh and Angstrom aerosol transmittance for R, G, B (0.65, 0.55, 0.45 um).
+    static Vec3f sun_transmittance(float turbidity, float cos_zenith)
+    {
+        float zenith_deg = std::acos(std::clamp(cos_zenith, 0.0f, 1.0f)) * 180 / pi;
+        float airmass = 1 / (std::max(cos_zenith, 0.0f) +
+                             0.50572f * std::pow(96.07995f - zenith_deg, -1.6364f));
+        float beta = 0.04608f * turbidity - 0.04586f;
+        auto tau = [&](float um) {
+            return 0.008735f * std::pow(um, -4.08f) + beta * std::pow(um, -1.3f);
+        };
+        return exp(Vec3f(tau(0.65f), tau(0.55f), tau(0.45f)) * -airmass);
+    }
+
+    Vec3f m_sun, m_sun_dome, m_ground, m_sun_radiance;
+    Perez m_Y{}, m_x{}, m_y{};
+    float m_theta_s = 0, m_zenith_Y = 0, m_zenith_x = 0, m_zenith_y = 0;
+    float m_norm_Y = 1, m_norm_x = 1, m_norm_y = 1;
     float m_cos_sun = 1, m_sun_solid_angle = 0, m_sun_probability = 0;
     bool m_sun_up = false, m_black = false;
+};
+
+/// Another environment turned about +y.
+class RotatedEnvironment final : public Environment {
+public:
+    RotatedEnvironment(std::shared_ptr<const Environment> inner, float degrees)
+        : m_inner(std::move(inner))
+    {
+        double radians = double(degrees) * std::numbers::pi / 180;
+        m_cos = static_cast<float>(std::cos(radians));
+        m_sin = static_cast<float>(std::sin(radians));
+    }
+    Vec3f radiance(const Vec3f& d) const override { return m_inner->radiance(unturn(d)); }
+    EnvironmentSample sample(float u1, float u2) const override
+    {
+        EnvironmentSample s = m_inner->sample(u1, u2);
+        s.direction = turn(s.direction);
+        return s;
+    }
+    float pdf(const Vec3f& d) const override { return m_inner->pdf(unturn(d)); }
+    bool black() const override { return m_inner->black(); }
+
+private:
+    Vec3f turn(const Vec3f& d) const
+    {
+        return {m_cos * d.x + m_sin * d.z, d.y, -m_sin * d.x + m_cos * d.z};
+    }
+    Vec3f unturn(const Vec3f& d) const
+    {
+        return {m_cos * d.x - m_sin * d.z, d.y, m_sin * d.x + m_cos * d.z};
+    }
+
+    std::shared_ptr<const Environment> m_inner;
+    float m_cos = 1, m_sin = 0;
 };
 
 /// A piecewise-constant 1D distribution over [0, 1) with n equal bins.
@@ -281,6 +406,16 @@ std::unique_ptr<Environment> make_uniform_environment(const Vec3f& radiance)
 std::unique_ptr<Environment> make_sky_environment(const SkyParameters& parameters)
 {
     return std::make_unique<SkyEnvironment>(parameters);
+}
+
+std::unique_ptr<Environment> make_rotated_environment(std::shared_ptr<const Environment> inner,
+                                                      float degrees)
+{
+    if (!inner)
+        throw Error("environment: nothing to rotate");
+    if (!std::isfinite(degrees))
+        throw Error("environment: the rotation must be a finite angle");
+    return std::make_unique<RotatedEnvironment>(std::move(inner), degrees);
 }
 
 std::unique_ptr<Environment> make_map_environment(int width, int height, std::vector<float> rgb)

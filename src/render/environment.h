@@ -36,21 +36,27 @@ public:
 /// The same radiance from every direction (the stand-in for cpfg's ambient term).
 std::unique_ptr<Environment> make_uniform_environment(const Vec3f& radiance);
 
-/// A simple analytic daylight sky with a sun disk (docs: render/environment.cpp, "sky").
-/// World up is +y (cpfg's turtle grows along +y).
+/// Preetham's (1999) analytic daylight sky with a sun disk (docs: render/environment.cpp,
+/// "sky"). World up is +y (cpfg's turtle grows along +y).
 struct SkyParameters {
-    /// Unit vector toward the sun; below the horizon there is no sun disk.
+    /// Unit vector toward the sun; below the horizon there is no sun disk and the dome
+    /// fades out by 6 degrees below.
     Vec3f sun_direction{0.5f, 0.8f, 0.33f};
-    /// Haze, 2 (clear) .. 10 (hazy): whiter horizon, wider glow, redder and dimmer sun.
+    /// Haze, 2 (clear) .. 10 (hazy), clamped to [sky_min_turbidity, sky_max_turbidity].
     float turbidity = 3;
-    /// A white Lambertian surface facing the unobstructed sun shows this radiance from
-    /// the sun alone (the view-file light convention: irradiance pi * sun_intensity).
+    /// The sun outside the atmosphere gives irradiance pi * sun_intensity (the view-file
+    /// light convention); the atmosphere dims it.
     float sun_intensity = 1;
-    /// Scales the sky dome (zenith radiance is about 0.3 * sky_intensity in blue).
+    /// Scales the dome, whose radiance 1 is sky_luminance_unit cd/m^2.
     float sky_intensity = 1;
     /// Linear reflectance of the ground seen below the horizon.
     Vec3f ground_albedo{0.2f, 0.18f, 0.15f};
 };
+/// The range of turbidity the model's fit covers.
+inline constexpr float sky_min_turbidity = 1.7f, sky_max_turbidity = 10;
+/// Luminance (cd/m^2) of radiance 1: 128 000 lux of sunlight outside
+/// the atmosphere (the solar illuminance constant) becomes irradiance pi.
+inline constexpr float sky_luminance_unit = 128000 / 3.14159265f;
 std::unique_ptr<Environment> make_sky_environment(const SkyParameters& parameters = {});
 
 /// A latitude-longitude HDR map (EXR, HDR or anything OpenImageIO reads), linear RGB,
@@ -63,6 +69,11 @@ std::unique_ptr<Environment> make_sky_environment(const SkyParameters& parameter
 /// cannot be read or is larger than 2^25 texels.
 std::unique_ptr<Environment> make_map_environment(const std::filesystem::path& file,
                                                   float scale = 1);
+
+/// `inner` turned by `degrees` about the world up axis +y (right-handed: +90 takes what
+/// was seen along +z to +x). Radiance, sampling and pdf all follow the turn exactly.
+std::unique_ptr<Environment> make_rotated_environment(std::shared_ptr<const Environment> inner,
+                                                      float degrees);
 
 /// The same from texels in memory (rows top to bottom, 3 floats each): tests, generated maps.
 std::unique_ptr<Environment> make_map_environment(int width, int height,

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
-// The unidirectional path tracer: next-event estimation toward the view file's lights and
-// the environment (MIS against BSDF sampling), transmission, opacity, Russian roulette.
+// The unidirectional path tracer: next-event estimation toward the view file's lights, the
+// environment and emissive primitives (MIS against BSDF sampling), transmission, opacity,
+// Russian roulette, ray cones for texture filtering.
 #include "render/integrator.h"
 
 #include <array>
@@ -28,19 +29,17 @@ struct Probes {
 class EnvironmentView {
 public:
     explicit EnvironmentView(const PathContext& ctx)
-        : m_env(ctx.environment), m_ambient(ctx.ambient)
     {
-        m_black = m_env ? m_env->black() : is_black(m_ambient);
+        const Environment* env = ctx.environment;
+        m_black = env ? env->black() : is_black(ctx.ambient);
         // A uniform environment is sampled perfectly by the BSDF alone (exactly, for a
         // Lambertian surface), so NEE toward it would only add noise. Sixteen probes tell;
         // a wrong "uniform" costs variance only, never bias. Non-uniform ones fail fast.
-        m_nee = m_env && !m_black && !looks_uniform(*m_env);
+        m_nee = env && !m_black && !looks_uniform(*env);
     }
     bool black() const { return m_black; }
     /// Whether to sample it for next-event estimation (and weight BSDF hits by MIS).
     bool nee() const { return m_nee; }
-    Vec3f radiance(const Vec3f& d) const { return m_env ? m_env->radiance(d) : m_ambient; }
-    const Environment& environment() const { return *m_env; }
 
 private:
     static bool looks_uniform(const Environment& env)
@@ -54,8 +53,6 @@ private:
         return true;
     }
 
-    const Environment* m_env;
-    Vec3f m_ambient;
     bool m_black = true, m_nee = false;
 };
 
@@ -161,9 +158,32 @@ Vec3f light_delta(const PathContext& ctx, bool transparent, const Vertex& v)
     return sum;
 }
 
-/// One environment sample, weighted against BSDF sampling of the same direction.
+/// One point on an emissive primitive, weighted against BSDF sampling of the same
+/// direction (weight 1 at the path's last vertex, where no BSDF ray follows).
+Vec3f light_area(const PathContext& ctx, bool transparent, const Vertex& v, bool last,
+                 float u0, float u1, float u2)
+{
+    std::optional<AreaLightSample> ls = ctx.area_lights->sample(v.hit.position, u0, u1, u2);
+    if (!ls)
+        return {};
+    Vec3f f = bsdf_eval(v.bsdf, v.hit.normal, v.wo, ls->wi);
+    float cos = std::fabs(dot(v.hit.normal, ls->wi));
+    if (is_black(f) || cos <= 0 || !same_side(v.hit, ls->wi))
+        return {};
+    // Stop just short of the light, whose own surface must not block the ray.
+    float through = transmittance(ctx, transparent, spawn(v.hit, ls->wi), ls->wi,
+                                  ls->distance - ls->margin);
+    if (through <= 0)
+        return {};
+    float w = last ? 1.0f
+                   : power_heuristic(ls->pdf, bsdf_pdf(v.bsdf, v.hit.normal, v.wo, ls->wi));
+    return f * ls->radiance * (cos * through * w / ls->pdf);
+}
+
+/// One environment sample, weighted against BSDF sampling of the same direction
+/// (weight 1 at the path's last vertex, where no BSDF ray follows).
 Vec3f light_environment(const PathContext& ctx, const Environment& env, bool transparent,
-                        const Vertex& v, float u1, float u2)
+                        const Vertex& v, bool last, float u1, float u2)
 {
     EnvironmentSample es = env.sample(u1, u2);
     if (es.pdf <= 0 || is_black(es.radiance))
@@ -176,41 +196,91 @@ Vec3f light_environment(const PathContext& ctx, const Environment& env, bool tra
                                   infinity);
     if (through <= 0)
         return {};
-    float w = power_heuristic(es.pdf, bsdf_pdf(v.bsdf, v.hit.normal, v.wo, es.direction));
+    float w = last ? 1.0f
+                   : power_heuristic(es.pdf,
+                                     bsdf_pdf(v.bsdf, v.hit.normal, v.wo, es.direction));
     return f * es.radiance * (cos * through * w / es.pdf);
 }
 
 }  // namespace
 
+TextureFootprint texture_footprint(const SurfaceHit& hit, const Vec3f& dir, float width)
+{
+    const Vec3f &dpds = hit.dpds, &dpdt = hit.dpdt;
+    if (!(width > 0) || (is_black(dpds) && is_black(dpdt)))
+        return {};
+    const Vec3f& n = hit.geometric_normal;
+    // Grazing views stretch the footprint; beyond 50:1 it would only blur.
+    float cos = std::fmax(std::fabs(dot(dir, n)), 0.02f);
+    Vec3f minor = cross(dir, n), unused;
+    if (dot(minor, minor) < 1e-12f)
+        make_basis(n, minor, unused);
+    minor = normalize(minor);
+    Vec3f major = normalize(cross(n, minor)) * (width / cos);
+    minor = minor * width;
+    float a = dot(dpds, dpds), b = dot(dpds, dpdt), c = dot(dpdt, dpdt);
+    float det = a * c - b * b;
+    auto to_st = [&](const Vec3f& w) -> std::array<float, 2> {
+        float x = dot(dpds, w), y = dot(dpdt, w);
+        if (det > 1e-12f * a * c)
+            return {(c * x - b * y) / det, (a * y - b * x) / det};
+        // One coordinate constant (or both parallel): each on its own.
+        return {a > 0 ? x / a : 0.0f, c > 0 ? y / c : 0.0f};
+    };
+    auto [dsdx, dtdx] = to_st(major);
+    auto [dsdy, dtdy] = to_st(minor);
+    return {dsdx, dtdx, dsdy, dtdy};
+}
+
+namespace {
+
+PathContext::Prepared scene_facts(const PathContext& ctx)
+{
+    const EnvironmentView env(ctx);
+    return {any_transparent(ctx), env.black(), env.nee()};
+}
+
+}  // namespace
+
+void prepare_path_context(PathContext& ctx) { ctx.prepared = scene_facts(ctx); }
+
 PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec3f& camera_dir,
                       Sampler& sampler)
 {
-    // Scene-wide facts, cheap enough per path next to the rays it traces.
-    const EnvironmentView env(ctx);
-    const bool env_nee = env.nee();
-    const bool transparent = any_transparent(ctx);
+    const PathContext::Prepared facts = ctx.prepared ? *ctx.prepared : scene_facts(ctx);
+    const bool env_nee = facts.environment_nee;
+    const bool env_black = facts.environment_black;
+    const bool transparent = facts.transparent;
+    auto env_radiance = [&](const Vec3f& d) {
+        return ctx.environment ? ctx.environment->radiance(d) : ctx.ambient;
+    };
+    const bool area_nee = ctx.area_lights && !ctx.area_lights->empty();
 
     PathResult result;
     Vec3f beta(1.0f);
     Vec3f org = camera_org, dir = camera_dir;
     PrimId leaving;        // the primitive the current ray leaves (none for the camera ray)
     float bsdf_pdf_prev = 0;  // pdf the current ray's direction was drawn with
+    Vec3f scatter_prev;       // where it was drawn (the last scattering vertex)
     int passes = 0;
+    float travelled = 0;  // along the path, for the ray cone
     for (int depth = 0; depth < ctx.max_depth;) {
         std::optional<SurfaceHit> hit =
             ctx.accel->intersect(org, dir, 0, infinity, leaving, depth == 0);
         if (!hit) {
             if (depth == 0 && ctx.environment_visible) {
-                result.radiance += beta * env.radiance(dir);
+                result.radiance += beta * env_radiance(dir);
             } else if (depth == 0) {
                 result.radiance += beta * ctx.background;
-            } else if (!env.black()) {
-                float w =
-                    env_nee ? power_heuristic(bsdf_pdf_prev, env.environment().pdf(dir)) : 1.0f;
-                result.radiance += beta * env.radiance(dir) * w;
+            } else if (!env_black) {
+                float w = env_nee
+                              ? power_heuristic(bsdf_pdf_prev, ctx.environment->pdf(dir))
+                              : 1.0f;
+                result.radiance += beta * env_radiance(dir) * w;
             }
             break;
         }
+        travelled += hit->t;
         const SurfaceMaterial& material = material_of(ctx, *hit);
         // Opacity: the ray stops here with probability opacity, else passes on unchanged.
         if (material.opacity < 1 && sampler.next() >= material.opacity) {
@@ -224,19 +294,36 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             result.hit = true;
         Vec3f diffuse = material.diffuse;
         if (ctx.textures && hit->texture != geom::no_texture)
-            diffuse = ctx.textures->apply(hit->texture, diffuse, hit->u, hit->v);
+            diffuse = ctx.textures->apply(
+                hit->texture, diffuse, hit->u, hit->v,
+                texture_footprint(*hit, dir,
+                                  ctx.camera_cone.width + ctx.camera_cone.spread * travelled));
         if (hit->unlit) {
             result.radiance += beta * (diffuse + material.emission);
             break;
         }
-        result.radiance += beta * material.emission;
+        if (!is_black(material.emission)) {
+            // A BSDF-sampled hit on a listed light: weighted against sampling the light.
+            float w = 1;
+            if (depth > 0 && area_nee) {
+                float light_pdf = ctx.area_lights->pdf(scatter_prev, *hit);
+                if (light_pdf > 0)
+                    w = power_heuristic(bsdf_pdf_prev, light_pdf);
+            }
+            result.radiance += beta * material.emission * w;
+        }
         Bsdf bsdf = make_bsdf(material, diffuse);
         Vertex vertex{*hit, bsdf, -dir};
+        const bool last = depth + 1 == ctx.max_depth;
         result.radiance += beta * light_delta(ctx, transparent, vertex);
         float e1 = sampler.next(), e2 = sampler.next();
         if (env_nee)
-            result.radiance +=
-                beta * light_environment(ctx, env.environment(), transparent, vertex, e1, e2);
+            result.radiance += beta * light_environment(ctx, *ctx.environment, transparent,
+                                                        vertex, last, e1, e2);
+        if (area_nee) {
+            float a0 = sampler.next(), a1 = sampler.next(), a2 = sampler.next();
+            result.radiance += beta * light_area(ctx, transparent, vertex, last, a0, a1, a2);
+        }
         if (++depth == ctx.max_depth)
             break;
 
@@ -259,6 +346,7 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         dir = bs.wi;
         leaving = s.skip;
         bsdf_pdf_prev = bs.pdf;
+        scatter_prev = hit->position;
     }
     return result;
 }

@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: Apache-2.0
-// The unidirectional path tracer: next-event estimation toward the view file's lights and
-// the environment (MIS against BSDF sampling), transmission, opacity, Russian roulette.
+// The unidirectional path tracer: next-event estimation toward the view file's lights, the
+// environment and emissive primitives (MIS against BSDF sampling), transmission, opacity,
+// Russian roulette, ray cones for texture filtering.
 #pragma once
 
+#include <optional>
 #include <vector>
 
 #include "render/accel.h"
+#include "render/area_light.h"
 #include "render/environment.h"
 #include "render/light.h"
 #include "render/material.h"
@@ -15,11 +18,22 @@
 
 namespace cambium::render {
 
+/// A ray's footprint as a cone: `width` at its origin, growing by `spread` per unit of
+/// distance (a pixel's angle). Camera rays carry one so textures are filtered over what a
+/// pixel sees (mipmapping); paths keep growing it after they scatter.
+struct RayCone {
+    float width = 0;
+    float spread = 0;
+};
+
 /// Everything a path needs, read-only and shared by all threads.
 struct PathContext {
     const EmbreeScene* accel = nullptr;
     std::vector<SurfaceMaterial> materials;
     std::vector<RenderLight> lights;
+    /// Emissive primitives sampled for next-event estimation (MIS against BSDF hits on
+    /// them); not owned. Null: emission is found by BSDF sampling only.
+    const AreaLights* area_lights = nullptr;
     const TextureSet* textures = nullptr;  ///< textures of hits (none: untextured)
     Vec3f background;  ///< linear; seen by camera rays that miss
     /// Seen by secondary rays that escape and sampled for next-event estimation (MIS
@@ -31,7 +45,26 @@ struct PathContext {
     bool environment_visible = false;
     int max_depth = 6;
     int roulette_depth = 3;
+    /// The camera rays' cone (zero: textures are looked up at their finest level).
+    RayCone camera_cone;
+
+    /// Scene-wide facts trace_path needs, found once by prepare_path_context() (else
+    /// worked out again for every path, which costs a scan of the materials each time).
+    struct Prepared {
+        bool transparent = false;      ///< some material lets light through
+        bool environment_black = true; ///< escaping rays see nothing
+        bool environment_nee = false;  ///< the environment is sampled for NEE
+    };
+    std::optional<Prepared> prepared;
 };
+
+/// Fills ctx.prepared; call after setting the materials and the environment.
+void prepare_path_context(PathContext& ctx);
+
+/// The texture footprint of `hit` seen along `dir` through a cone `width` wide there: an
+/// ellipse `width` across, stretched by 1 / cos along the incidence plane, taken into (s, t)
+/// through the hit's dpds and dpdt (least squares).
+TextureFootprint texture_footprint(const SurfaceHit& hit, const Vec3f& dir, float width);
 
 /// The radiance of one path and whether its camera ray hit geometry.
 struct PathResult {

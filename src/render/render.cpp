@@ -145,14 +145,26 @@ const SurfaceMaterial& material_of(const PathContext& ctx, std::uint16_t m)
 
 /// The albedo layer's colour: the (textured) diffuse albedo, or the flat colour of an
 /// unlit line.
-Vec3f first_hit_albedo(const PathContext& ctx, const SurfaceHit& hit)
+Vec3f first_hit_albedo(const PathContext& ctx, const SurfaceHit& hit, const Vec3f& dir)
 {
     const SurfaceMaterial& m = material_of(ctx, hit.material);
     if (hit.unlit)
         return flat_colour(m);
-    if (ctx.textures && ctx.textures->valid(hit.texture))
-        return ctx.textures->apply(hit.texture, m.diffuse, hit.u, hit.v);
+    if (ctx.textures && ctx.textures->valid(hit.texture)) {
+        float width = ctx.camera_cone.width + ctx.camera_cone.spread * hit.t;
+        return ctx.textures->apply(hit.texture, m.diffuse, hit.u, hit.v,
+                                   texture_footprint(hit, dir, width));
+    }
     return m.diffuse;
+}
+
+/// A camera ray's cone: a parallel camera's rays are a pixel wide; a perspective one's
+/// start at a point and widen by a pixel's angle.
+RayCone camera_cone(const Camera& camera)
+{
+    if (camera.projection() == Camera::Projection::parallel)
+        return {static_cast<float>(camera.pixel_size()), 0};
+    return {0, static_cast<float>(camera.pixel_size_at(camera.origin() + camera.forward()))};
 }
 
 /// Sample i of pixel (x, y), added to its sums.
@@ -183,7 +195,7 @@ void take_sample(const Frame& f, int x, int y, std::uint32_t i, PixelState& st)
         std::optional<SurfaceHit> hit = f.accel.intersect(org, dir, 0, tfar, {}, true);
         if (hit) {
             // The path's first hit is this one: nothing nearer, and it is in range.
-            st.albedo += first_hit_albedo(f.ctx, *hit);
+            st.albedo += first_hit_albedo(f.ctx, *hit, dir);
             st.normal += hit->normal;
             st.depth = std::min(st.depth, static_cast<float>(hit->t + ray.tnear));
         } else if (clipped_far) {
@@ -407,6 +419,11 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
         ctx.textures = textures.get();
         ctx.materials = make_materials(scene.materials);
         ctx.lights = make_lights(scene.lights);
+        std::unique_ptr<AreaLights> area_lights;
+        if (settings.area_lights) {
+            area_lights = std::make_unique<AreaLights>(scene, ctx.materials);
+            ctx.area_lights = area_lights.get();
+        }
         ctx.background = decode_display(scene.background);
         ctx.environment = settings.environment.get();
         // A parallel camera looks along one direction: its misses would all see the same
@@ -416,6 +433,8 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
         ctx.ambient = {settings.ambient.r, settings.ambient.g, settings.ambient.b};
         ctx.max_depth = settings.max_depth;
         ctx.roulette_depth = settings.roulette_depth;
+        ctx.camera_cone = camera_cone(camera);
+        prepare_path_context(ctx);
 
         const bool clipping = std::isfinite(camera.clip_near()) || std::isfinite(camera.clip_far());
         Frame frame{ctx, accel, camera, settings,

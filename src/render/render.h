@@ -43,6 +43,10 @@ struct RenderSettings {
     /// What escaping rays see instead of `ambient` (make_sky_environment,
     /// make_map_environment); null = the uniform ambient.
     std::shared_ptr<const Environment> environment;
+    /// Sample emissive triangles, discs and spheres directly (next-event estimation,
+    /// weighted against BSDF sampling by MIS). Off: only BSDF rays find them (the same
+    /// image on average, noisier).
+    bool area_lights = true;
     /// The folder that relative texture paths (Scene::textures) are taken from: the
     /// view file's folder.
     std::filesystem::path texture_folder;

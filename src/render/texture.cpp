@@ -123,15 +123,20 @@ bool TextureSet::has_alpha(int index) const
 
 Texel TextureSet::lookup(int index, float s, float t, float width) const
 {
+    return lookup(index, s, t, TextureFootprint{width, 0, 0, width});
+}
+
+Texel TextureSet::lookup(int index, float s, float t, const TextureFootprint& fp) const
+{
     if (!valid(index))
         return {};
     const Entry& e = m_impl->entries[index];
     OIIO::TextureOpt options = e.options;  // the lookup may write to it
     float v[4] = {1, 1, 1, 1};
     int n = e.channels >= 4 ? 4 : (e.channels == 2 ? 2 : (e.channels == 1 ? 1 : 3));
-    // OIIO's t runs down the image, OpenGL's up.
-    bool ok = m_impl->system->texture(e.handle, m_impl->thread_info(), options, s, 1 - t, width, 0, 0, width,
-                                      n, v);
+    // OIIO's t runs down the image, OpenGL's up: t derivatives change sign.
+    bool ok = m_impl->system->texture(e.handle, m_impl->thread_info(), options, s, 1 - t,
+                                      fp.dsdx, -fp.dtdx, fp.dsdy, -fp.dtdy, n, v);
     if (!ok)
         return {};
     Texel texel;
@@ -148,11 +153,12 @@ Texel TextureSet::lookup(int index, float s, float t, float width) const
     return texel;
 }
 
-Vec3f TextureSet::apply(int index, const Vec3f& diffuse, float s, float t) const
+Vec3f TextureSet::apply(int index, const Vec3f& diffuse, float s, float t,
+                        const TextureFootprint& footprint) const
 {
     if (!valid(index))
         return diffuse;
-    Texel texel = lookup(index, s, t);
+    Texel texel = lookup(index, s, t, footprint);
     return decal(index) ? texel.colour : diffuse * texel.colour;
 }
 

@@ -17,6 +17,12 @@ struct Texel {
     float alpha = 1;
 };
 
+/// A lookup's filter footprint: the change of (s, t) across one pixel's footprint along
+/// two directions on the surface (OIIO's dsdx, dtdx, dsdy, dtdy). Zero: the finest level.
+struct TextureFootprint {
+    float dsdx = 0, dtdx = 0, dsdy = 0, dtdy = 0;
+};
+
 /// The Scene's TextureDefs, opened once (mipmapped on demand by OIIO, any format OIIO reads,
 /// SGI .rgb included). Thread-safe lookups after construction.
 ///
@@ -45,9 +51,12 @@ public:
     /// The filtered texel at (s, t); `width` is the lookup's footprint in texture units
     /// (0: the finest level). Invalid indices give white, alpha 1.
     Texel lookup(int index, float s, float t, float width = 0) const;
+    /// The same filtered over an anisotropic footprint (mipmapped textures only).
+    Texel lookup(int index, float s, float t, const TextureFootprint& footprint) const;
 
     /// The diffuse albedo after texture `index` at (s, t): modulated or replaced.
-    Vec3f apply(int index, const Vec3f& diffuse, float s, float t) const;
+    Vec3f apply(int index, const Vec3f& diffuse, float s, float t,
+                const TextureFootprint& footprint = {}) const;
 
 private:
     struct Impl;

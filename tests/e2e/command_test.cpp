@@ -87,3 +87,27 @@ TEST(Command, UnknownOutputFormatFailsBeforeRendering)
     EXPECT_NE(r.output.find("p.xyz"), std::string::npos) << r.output;
     EXPECT_EQ(r.output.find("rendered"), std::string::npos) << r.output;
 }
+
+// --turbidity and --env-rotate are accepted with what they change, refused without it or
+// out of range (the model's fit covers turbidity 1.7 .. 10).
+TEST(Command, SkyTurbidityAndEnvironmentRotation)
+{
+    fs::path dir = scratch("sky");
+    write(dir / "p.l", "lsystem: 1\nderivation length: 0\naxiom: F\nendlsystem\n");
+    write(dir / "p.v", "line style: cylinder\ninitial line width: 0.2\n");
+    std::string files = (dir / "p.l").string() + " " + (dir / "p.v").string();
+    std::string out = " -q -w 16 12 --spp 1 -o " + (dir / "p.png").string() + " ";
+    Result ok = run(out + "--sky --turbidity 6 --sun 1 1 0 --env-rotate 45 " + files);
+    EXPECT_EQ(ok.status, 0) << ok.output;
+    EXPECT_TRUE(fs::exists(dir / "p.png"));
+
+    Result lonely = run(out + "--turbidity 6 " + files);
+    EXPECT_NE(lonely.status, 0);
+    EXPECT_NE(lonely.output.find("--sky"), std::string::npos) << lonely.output;
+    Result hazy = run(out + "--sky --turbidity 20 " + files);
+    EXPECT_NE(hazy.status, 0);
+    EXPECT_NE(hazy.output.find("turbidity"), std::string::npos) << hazy.output;
+    Result turn = run(out + "--env-rotate 90 " + files);
+    EXPECT_NE(turn.status, 0);
+    EXPECT_NE(turn.output.find("--env-rotate"), std::string::npos) << turn.output;
+}

@@ -71,6 +71,43 @@ TEST(EmbreeScene, ConvertsPixelRadiiThroughCamera)
     EXPECT_FALSE(accel.intersect({0, 0.6f, 10}, {0, 0, -1}, 0, inf));
 }
 
+// A prototype's line with a radius of 5 pixels, placed twice (once scaled by 4, once with an
+// inherited material): every copy is 5 px = 0.5 units thick in world space, unlit, with its
+// instance's material, and the prototype's own scene holds no unconverted copy.
+TEST(EmbreeScene, PixelLinesInsidePrototypesKeepTheirPixelWidth)
+{
+    geom::Scene s = empty_scene({-10, -5, 0}, {10, 5, 0});
+    s.line_radius_in_pixels = true;
+    geom::Prototype proto;
+    proto.geometry.lines.keys = {{-1, 0, 0, 5.0f}, {1, 0, 0, 5.0f}};
+    proto.geometry.lines.segments = {0};
+    proto.geometry.lines.material = {geom::inherit_material};
+    s.prototypes.push_back(proto);
+    geom::Instance big;
+    big.transform = {4, 0, 0, 0, 4, 0, 0, 0, 4, 0, 2, 0};  // x4, at y = 2
+    big.material = 9;
+    geom::Instance small;
+    small.transform = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, -2, 0};  // at y = -2
+    small.material = 4;
+    s.instances = {big, small};
+    Camera camera = unit_camera(s);
+    ASSERT_NEAR(camera.pixel_size(), 0.1, 1e-12);
+    EmbreeScene accel(s, camera);
+    for (float y : {2.0f, -2.0f}) {
+        auto hit = accel.intersect({0, y, 10}, {0, 0, -1}, 0, inf);
+        ASSERT_TRUE(hit) << y;
+        EXPECT_NEAR(hit->t, 9.5f, 1e-4f) << y;
+        EXPECT_NEAR(hit->radius, 0.5f, 1e-6f) << y;
+        EXPECT_TRUE(hit->unlit) << y;
+        EXPECT_EQ(hit->material, y > 0 ? 9 : 4);
+        EXPECT_FALSE(accel.intersect({0, y + 0.6f, 10}, {0, 0, -1}, 0, inf)) << y;
+    }
+    // The scaled copy spans x in [-4, 4], the other [-1, 1] (plus round caps of 0.5).
+    EXPECT_TRUE(accel.intersect({3.5f, 2, 10}, {0, 0, -1}, 0, inf));
+    EXPECT_FALSE(accel.intersect({1.8f, -2, 10}, {0, 0, -1}, 0, inf));  // past the round cap
+    EXPECT_EQ(accel.segment_count(), 2u);
+}
+
 /// Diffuse rays spawned from camera hits on the scene's curves: how many hit a curve
 /// again, of how many spawned. The scenes below are convex tubes, so every hit is spurious.
 std::pair<int, int> count_rehits(const geom::Scene& s, float half_width)

@@ -187,8 +187,10 @@ TEST(SkyEnvironment, PdfIsTheSunAndSphereMixtureAndSamplesAgree)
     EXPECT_NEAR(sun_share, 0.5f, 1e-3f);
 }
 
-// Sun at the zenith, turbidity 3: colour exp(-(0.02, 0.04, 0.08)); its disk gives
-// irradiance pi * sun_intensity * colour.
+// Sun at the zenith, turbidity 3: outside the atmosphere it gives irradiance
+// pi * sun_intensity; Rayleigh (0.008735 lambda^-4.08) and Angstrom aerosol (beta
+// lambda^-1.3, beta = 0.04608 T - 0.04586) optical depths at 0.65 and 0.45 um over one
+// air mass (Kasten & Young at zenith angle 0) dim it.
 TEST(SkyEnvironment, SunDiskDeliversTheStatedIrradiance)
 {
     SkyParameters p;
@@ -201,15 +203,122 @@ TEST(SkyEnvironment, SunDiskDeliversTheStatedIrradiance)
     Vec3f inside = sky->radiance({0, 1, 0});
     Vec3f outside = sky->radiance(normalize({0.01f, 1, 0}));  // 0.57 deg off: sky only
     Vec3f sun = (inside - outside) * solid_angle;
-    EXPECT_NEAR(sun.x, pi * 2 * std::exp(-0.02f), 2e-3f * sun.x);
-    EXPECT_NEAR(sun.z, pi * 2 * std::exp(-0.08f), 2e-3f * sun.z);
-    // Zenith bluer than red; the ground below is dimmer than the zenith sky's blue.
+    double airmass = 1 / (1 + 0.50572 * std::pow(96.07995, -1.6364));
+    double beta = 0.04608 * 3 - 0.04586;
+    auto transmitted = [&](double um) {
+        double tau = 0.008735 * std::pow(um, -4.08) + beta * std::pow(um, -1.3);
+        return std::exp(-airmass * tau);
+    };
+    EXPECT_NEAR(sun.x, pi * 2 * transmitted(0.65), 2e-3 * sun.x);
+    EXPECT_NEAR(sun.z, pi * 2 * transmitted(0.45), 2e-3 * sun.z);
+    EXPECT_GT(sun.x, sun.z);  // the direct sun is yellowish
+    // Zenith bluer than red.
     EXPECT_GT(outside.z, outside.x);
     EXPECT_FALSE(sky->black());
     // A sun below the horizon has no disk and is never sampled.
     p.sun_direction = {0, -1, 0};
     auto night = make_sky_environment(p);
     EXPECT_FLOAT_EQ(night->pdf({0, -1, 0}), 1 / (4 * pi));
+    EXPECT_TRUE(night->black());  // 90 degrees down: past civil twilight
+}
+
+float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+/// CIE xy of linear sRGB (D65 matrix of IEC 61966-2-1).
+std::pair<double, double> chromaticity(const Vec3f& c)
+{
+    double X = 0.4124 * c.x + 0.3576 * c.y + 0.1805 * c.z;
+    double Y = 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+    double Z = 0.0193 * c.x + 0.1192 * c.y + 0.9505 * c.z;
+    return {X / (X + Y + Z), Y / (X + Y + Z)};
+}
+
+// Preetham et al. 1999, appendix: zenith luminance Y_z (kcd/m^2) and chromaticity from
+// the turbidity T and the sun's zenith angle; the environment's unit is 128000 / pi cd/m^2.
+TEST(SkyEnvironment, ZenithMatchesPreethamFormulas)
+{
+    for (double turbidity : {2.0, 3.0, 6.0})
+        for (double elevation_deg : {20.0, 45.0, 70.0}) {
+            double theta_s = (90 - elevation_deg) * std::numbers::pi / 180;
+            double chi = (4.0 / 9 - turbidity / 120) * (std::numbers::pi - 2 * theta_s);
+            double yz = (4.0453 * turbidity - 4.9710) * std::tan(chi) - 0.2155 * turbidity +
+                        2.4192;
+            double t = turbidity, th = theta_s;
+            double xz = t * t * (0.00166 * th * th * th - 0.00375 * th * th + 0.00209 * th) +
+                        t * (-0.02903 * th * th * th + 0.06377 * th * th - 0.03202 * th +
+                             0.00394) +
+                        (0.11693 * th * th * th - 0.21196 * th * th + 0.06052 * th + 0.25886);
+            SkyParameters p;
+            double e = elevation_deg * std::numbers::pi / 180;
+            p.sun_direction = {float(std::cos(e)), float(std::sin(e)), 0};
+            p.turbidity = float(turbidity);
+            auto sky = make_sky_environment(p);
+            Vec3f zenith = sky->radiance({0, 1, 0});
+            double expect = yz * 1000 / (128000 / std::numbers::pi);
+            EXPECT_NEAR(luminance(zenith), expect, 2e-3 * expect)
+                << "T " << turbidity << " elevation " << elevation_deg;
+            EXPECT_NEAR(chromaticity(zenith).first, xz, 2e-3)
+                << "T " << turbidity << " elevation " << elevation_deg;
+        }
+}
+
+// The sky is brightest around the sun (Perez circumsolar term); hazier skies are whiter
+// (less saturated blue) away from the sun.
+TEST(SkyEnvironment, BrighterNearTheSunAndWhiterWhenHazy)
+{
+    SkyParameters p;
+    float e = 30 * pi / 180;
+    p.sun_direction = {std::cos(e), std::sin(e), 0};
+    auto sky = make_sky_environment(p);
+    auto at = [&](float azimuth_deg) {
+        float a = azimuth_deg * pi / 180;
+        return luminance(sky->radiance({std::cos(e) * std::cos(a), std::sin(e),
+                                        std::cos(e) * std::sin(a)}));
+    };
+    EXPECT_GT(at(5), 2 * at(90));
+    EXPECT_GT(at(90), 0.0f);
+    EXPECT_GT(at(5), at(20));
+    Vec3f away = sky->radiance(normalize({-1, 0.5f, 0}));
+    p.turbidity = 8;
+    Vec3f hazy = make_sky_environment(p)->radiance(normalize({-1, 0.5f, 0}));
+    EXPECT_GT(away.z / away.x, hazy.z / hazy.x);
+}
+
+// A map of one bright texel, turned by 90 degrees about +y: the light comes from the
+// bright texel's direction d turned right-handedly, R_y(90) d = (d.z, d.y, -d.x).
+TEST(RotatedEnvironment, LightComesFromTheTurnedDirection)
+{
+    const int w = 32, h = 16;
+    std::vector<float> rgb(std::size_t(w) * h * 3, 0.01f);
+    const int bi = 4, bj = 5;  // bright texel
+    for (int c = 0; c < 3; ++c)
+        rgb[(std::size_t(bj) * w + bi) * 3 + c] = 1000;
+    // Its centre direction from the documented layout (t = pi v, p = 2 pi u).
+    float theta = pi * (bj + 0.5f) / h, phi = 2 * pi * (bi + 0.5f) / w;
+    Vec3f d0{std::sin(theta) * std::sin(phi), std::cos(theta),
+             std::sin(theta) * std::cos(phi)};
+    std::shared_ptr<const Environment> map = make_map_environment(w, h, rgb);
+    EXPECT_GT(map->radiance(d0).x, 100.0f);
+    auto turned = make_rotated_environment(map, 90);
+    Vec3f d1{d0.z, d0.y, -d0.x};
+    EXPECT_GT(turned->radiance(d1).x, 100.0f);
+    EXPECT_LT(turned->radiance(d0).x, 1.0f);
+    EXPECT_NEAR(turned->pdf(d1), map->pdf(d0), 1e-6f * map->pdf(d0));
+    EXPECT_NEAR(pdf_integral(*turned, 20000), 1.0, 0.05);
+    // Nearly all samples come from around d1, and agree with pdf().
+    Sampler s(3, 3, 3, 3);
+    int near = 0, n = 2000;
+    for (int i = 0; i < n; ++i) {
+        EnvironmentSample e = turned->sample(s.next(), s.next());
+        ASSERT_NEAR(e.pdf, turned->pdf(e.direction), 1e-3f * e.pdf);
+        near += dot(e.direction, d1) > 0.95f ? 1 : 0;
+    }
+    EXPECT_GT(near, n * 9 / 10);
+    // +90 then -90 is the identity.
+    std::shared_ptr<const Environment> shared = std::move(turned);
+    auto back = make_rotated_environment(shared, -90);
+    EXPECT_GT(back->radiance(d0).x, 100.0f);
+    EXPECT_THROW(make_rotated_environment(nullptr, 10), Error);
 }
 
 }  // namespace

@@ -327,6 +327,11 @@ TEST(Physics, EnvironmentSamplingWithMis)
     float expect = srgb_to_linear(0.5f) * 2;
     EXPECT_NEAR(got, expect, 0.01f * expect);
     std::printf("[environment] sky over plane %.5f expected %.5f\n", got, expect);
+    // Direct light only: no BSDF ray follows the last vertex, so its environment sample
+    // must take full weight (MIS weights there would lose the BSDF strategy's share).
+    ctx.max_depth = 1;
+    float direct = trace_block(ctx, c, 9, 9, 11, 11, 512).radiance.y;
+    EXPECT_NEAR(direct, expect, 0.01f * expect);
 
     for (float tr : {0.0f, 0.3f}) {
         geom::Scene ball = white(tr);

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -18,6 +19,9 @@
 #include "render/color.h"
 #include "render/texture.h"
 #include "geom_scenes.h"
+#include "render/integrator.h"
+#include "render/light.h"
+#include "test_scenes.h"
 
 namespace cambium::render {
 namespace {
@@ -221,6 +225,114 @@ TEST(Texture, TexturedQuadRendersTheTexture)
     EXPECT_NEAR(blue.z, 1, 1e-4f);
     EXPECT_NEAR(grey.y, srgb_to_linear(128 / 255.0f), 1e-3f);
     EXPECT_EQ(cut, Vec3f(0.25f));
+    fs::remove_all(dir);
+}
+
+/// Writes a float checkerboard (0 and 1, linear) of `checks` x `checks` squares of
+/// `size` texels each.
+void write_checker(const fs::path& file, int checks, int size)
+{
+    int n = checks * size;
+    std::vector<float> pixels(std::size_t(n) * n);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x)
+            pixels[std::size_t(y) * n + x] = ((x / size + y / size) % 2) ? 1.0f : 0.0f;
+    auto out = OIIO::ImageOutput::create(file.string());
+    ASSERT_TRUE(out) << OIIO::geterror();
+    OIIO::ImageSpec spec(n, n, 1, OIIO::TypeDesc::FLOAT);
+    ASSERT_TRUE(out->open(file.string(), spec)) << out->geterror();
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+    out->close();
+}
+
+/// A white square [-h, h]^2 at z = 0 facing +z whose uv run 0..repeat, textured with 0.
+void add_tiled_plane(geom::Geometry& g, float h, float repeat)
+{
+    geom::Float3 n{0, 0, 1};
+    add_triangle(g, {{{-h, -h, 0}, {h, -h, 0}, {h, h, 0}}}, {n, n, n},
+                 {{{0, 0}, {repeat, 0}, {repeat, repeat}}}, 1, 1, 0);
+    add_triangle(g, {{{-h, -h, 0}, {h, h, 0}, {-h, h, 0}}}, {n, n, n},
+                 {{{0, 0}, {repeat, repeat}, {0, repeat}}}, 1, 1, 0);
+}
+
+/// Per-pixel radiance (green) of a camera over the plane at 1 spp, with and without the
+/// camera's ray cone.
+std::vector<float> checker_pixels(const geom::Scene& s, const TextureSet& set, const Camera& c,
+                                  bool filtered)
+{
+    EmbreeScene accel(s, c, &set);
+    PathContext ctx;
+    ctx.accel = &accel;
+    ctx.textures = &set;
+    ctx.materials = make_materials(s.materials);
+    ctx.lights = make_lights(s.lights);
+    ctx.max_depth = 1;
+    if (filtered)
+        ctx.camera_cone = {float(c.pixel_size()), 0};
+    std::vector<float> out;
+    for (int y = 0; y < c.height(); ++y)
+        for (int x = 0; x < c.width(); ++x) {
+            Sampler sm(std::uint32_t(x), std::uint32_t(y), 0, 5);
+            double jx = sm.next(), jy = sm.next();
+            CameraRay ray = c.generate_ray(x + jx, y + jy);
+            out.push_back(trace_path(ctx, Vec3f(ray.org), Vec3f(ray.dir), sm).radiance.y);
+        }
+    return out;
+}
+
+std::pair<double, double> mean_variance(const std::vector<float>& v)
+{
+    double m = 0, var = 0;
+    for (float x : v)
+        m += x;
+    m /= double(v.size());
+    for (float x : v)
+        var += (x - m) * (x - m);
+    return {m, var / double(v.size() - 1)};
+}
+
+// A checkerboard seen from so far that each pixel covers ~100 checks: with the camera's
+// footprint the mipmap gives every pixel about the mean (0.5 under a white light of
+// irradiance pi on albedo 1), while point lookups land on black or white at random.
+TEST(Texture, DistantCheckerFiltersToTheMean)
+{
+    fs::path dir = temp_dir();
+    write_checker(dir / "checker.exr", 8, 4);
+    geom::TextureDef def;
+    def.file = dir / "checker.exr";
+    TextureSet set({def});
+    ASSERT_TRUE(set.valid(0));
+    geom::Scene s;
+    s.materials[1].diffuse = {1, 1, 1};
+    s.lights.push_back(directional({0, 0, 1}));
+    add_tiled_plane(s.geometry, 100, 400);  // 400 tiles of 8 checks over 200 units
+    Camera c = top_camera(0, 0, 160, 16, 16);  // 10 units = 160 checks across a pixel
+    auto [mean, variance] = mean_variance(checker_pixels(s, set, c, true));
+    EXPECT_NEAR(mean, 0.5, 0.03);
+    EXPECT_LT(variance, 1e-3);
+    auto [raw_mean, raw_variance] = mean_variance(checker_pixels(s, set, c, false));
+    EXPECT_GT(raw_variance, 0.1);  // the aliasing the footprint removes
+    std::printf("[texture] distant checker: filtered mean %.4f var %.2g; unfiltered mean "
+                "%.4f var %.2g\n", mean, variance, raw_mean, raw_variance);
+
+    // render() gives camera rays their cone too (a perspective view from high above).
+    s.textures = {def};
+    RenderSettings settings = small(16, 16, 1);
+    settings.aovs = false;
+    Camera eye = Camera::perspective({0, 0, 200}, {0, 0, 0}, {0, 1, 0}, 40, 16, 16);
+    Image img = render(s, eye, settings);
+    std::vector<float> green;
+    for (std::size_t i = 1; i < img.rgba.size(); i += 4)
+        green.push_back(img.rgba[i]);
+    auto [seen_mean, seen_variance] = mean_variance(green);
+    EXPECT_NEAR(seen_mean, 0.5, 0.03);
+    EXPECT_LT(seen_variance, 1e-3);
+
+    // Seen up close (a pixel a fifth of a check), pixels stay black or white.
+    Camera near = top_camera(0.0625, 0.0625, 0.2, 16, 16);
+    auto [near_mean, near_variance] = mean_variance(checker_pixels(s, set, near, true));
+    EXPECT_GT(near_variance, 0.1);
+    EXPECT_NEAR(near_mean, 0.5, 0.15);
     fs::remove_all(dir);
 }
 

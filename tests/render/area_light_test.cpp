@@ -1,0 +1,247 @@
+// SPDX-License-Identifier: Apache-2.0
+// Emissive primitives as area lights: next-event estimation against closed-form
+// irradiance (disc, square, sphere, instanced square) and against BSDF-only sampling.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <vector>
+
+#include "render/accel.h"
+#include "render/area_light.h"
+#include "render/color.h"
+#include "render/render.h"
+#include "geom_scenes.h"
+#include "test_scenes.h"
+
+namespace cambium::render {
+namespace {
+
+using namespace testing;
+
+constexpr double pi = std::numbers::pi;
+
+geom::Rgb grey(float display) { return {display, display, display}; }
+
+/// Materials: 1 the receiving plane (albedo display 0.8), 2 an emitter of radiance 1
+/// with black albedo, 3 black.
+geom::Scene plane_scene()
+{
+    geom::Scene s;
+    s.materials[1].diffuse = grey(0.8f);
+    s.materials[2].diffuse = grey(0);
+    s.materials[2].emission = grey(1);
+    s.materials[3].diffuse = grey(0);
+    add_quad(s.geometry, -50, -50, 50, 50, 0, 1, 1);
+    return s;
+}
+
+double albedo() { return srgb_to_linear(0.8f); }
+
+/// Looks down -z at a 0.008-unit patch around the origin, rays starting at height
+/// `start` (below the emitter, which would hide the patch from above).
+Camera patch_camera(double start)
+{
+    return Camera::parallel({0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 0.001, start, 8, 8);
+}
+
+/// Per-pixel values (green) of 8x8 pixels at `spp` samples each.
+std::vector<double> pixels(const geom::Scene& s, const Camera& c, int depth, int spp,
+                           bool nee)
+{
+    EmbreeScene accel(s, c);
+    PathContext ctx;
+    ctx.accel = &accel;
+    ctx.materials = make_materials(s.materials);
+    AreaLights lights(s, ctx.materials);
+    ctx.area_lights = nee ? &lights : nullptr;
+    ctx.max_depth = depth;
+    std::vector<double> out;
+    for (int y = 0; y < c.height(); ++y)
+        for (int x = 0; x < c.width(); ++x) {
+            double sum = 0;
+            for (int i = 0; i < spp; ++i) {
+                Sampler sm(std::uint32_t(x), std::uint32_t(y), std::uint32_t(i), 11);
+                double jx = sm.next(), jy = sm.next();
+                CameraRay ray = c.generate_ray(x + jx, y + jy);
+                sum += trace_path(ctx, Vec3f(ray.org), Vec3f(ray.dir), sm).radiance.y;
+            }
+            out.push_back(sum / spp);
+        }
+    return out;
+}
+
+struct Stats {
+    double mean = 0, variance = 0;
+};
+
+Stats stats(const std::vector<double>& v)
+{
+    Stats s;
+    for (double x : v)
+        s.mean += x;
+    s.mean /= double(v.size());
+    for (double x : v)
+        s.variance += (x - s.mean) * (x - s.mean);
+    s.variance /= double(v.size() - 1);
+    return s;
+}
+
+// A disc of radius R at height h facing the plane: E = pi L R^2 / (h^2 + R^2) on its axis,
+// so the plane's radiance is albedo R^2 / (h^2 + R^2).
+TEST(AreaLight, DiscMatchesFormFactor)
+{
+    geom::Scene s = plane_scene();
+    const double h = 2, r = 0.5;
+    add_disc(s.geometry, {0, 0, h}, float(r), {0, 0, -1}, 2, 3);
+    double expect = albedo() * r * r / (h * h + r * r);
+    for (int depth : {1, 2}) {
+        Stats got = stats(pixels(s, patch_camera(1), depth, 64, true));
+        EXPECT_NEAR(got.mean, expect, 0.01 * expect) << "depth " << depth;
+        std::printf("[area] disc depth %d: %.5f expected %.5f\n", depth, got.mean, expect);
+    }
+}
+
+// A square of side a centred over the point at height h, emitting from its back (the
+// side facing the plane): the form factor of four corner rectangles X = Y = a / 2h,
+// F = 4 / (2 pi) * 2 X / sqrt(1 + X^2) atan(X / sqrt(1 + X^2)), E = pi L F.
+double square_expectation(double a, double h)
+{
+    double x = a / (2 * h), q = std::sqrt(1 + x * x);
+    double f = 4 / (2 * pi) * 2 * x / q * std::atan(x / q);
+    return albedo() * f;
+}
+
+TEST(AreaLight, SquareBackFaceMatchesFormFactor)
+{
+    geom::Scene s = plane_scene();
+    const float a = 1, h = 1.5f;
+    add_quad(s.geometry, -a / 2, -a / 2, a / 2, a / 2, h, 3, 2);  // front up: black
+    double expect = square_expectation(a, h);
+    Stats got = stats(pixels(s, patch_camera(0.5), 2, 64, true));
+    EXPECT_NEAR(got.mean, expect, 0.01 * expect);
+    std::printf("[area] square: %.5f expected %.5f\n", got.mean, expect);
+}
+
+// The same square as a prototype with inherited materials, placed rotated by 90 degrees
+// about z, scaled by 2 and lifted to h: the light list must follow the instance.
+TEST(AreaLight, InstancedSquareMatchesFormFactor)
+{
+    geom::Scene s = plane_scene();
+    geom::Prototype proto;
+    add_quad(proto.geometry, -0.25f, -0.25f, 0.25f, 0.25f, 0, geom::inherit_material,
+             geom::inherit_material);
+    s.prototypes.push_back(proto);
+    geom::Instance inst;
+    inst.transform = transform({0, -2, 0, 2, 0, 0, 0, 0, 2}, {0, 0, 1.5});
+    inst.material = 3;
+    inst.back_material = 2;
+    s.instances.push_back(inst);
+    double expect = square_expectation(1, 1.5);
+    EXPECT_EQ(AreaLights(s, make_materials(s.materials)).size(), 2u);
+    Stats got = stats(pixels(s, patch_camera(0.5), 2, 64, true));
+    EXPECT_NEAR(got.mean, expect, 0.01 * expect);
+    std::printf("[area] instanced square: %.5f expected %.5f\n", got.mean, expect);
+}
+
+// A sphere of radius R with its centre at height d: E = pi L (R / d)^2 below it.
+TEST(AreaLight, SphereMatchesClosedForm)
+{
+    geom::Scene s = plane_scene();
+    const double d = 3, r = 1;
+    add_sphere(s.geometry, {0, 0, d}, float(r), 2);
+    double expect = albedo() * (r / d) * (r / d);
+    Stats got = stats(pixels(s, patch_camera(1), 2, 64, true));
+    EXPECT_NEAR(got.mean, expect, 0.01 * expect);
+    std::printf("[area] sphere: %.5f expected %.5f\n", got.mean, expect);
+}
+
+// A line segment of radius R and length 2W along x at height h: the plane's radiance below
+// its middle is albedo / pi times E = integral of L cos_p cos_l / d^2 over the visible half
+// of the tube, here by a midpoint rule (for W >> h it tends to pi L R / h).
+TEST(AreaLight, CylinderSegmentMatchesQuadrature)
+{
+    geom::Scene s = plane_scene();
+    const double h = 1, r = 0.1, half = 4;
+    testing::add_segment(s, {-half, 0, h}, {half, 0, h}, float(r), 2);
+    double e = 0;
+    const int nx = 4000, nphi = 720;
+    for (int i = 0; i < nx; ++i) {
+        double x = -half + (i + 0.5) * 2 * half / nx;
+        for (int j = 0; j < nphi; ++j) {
+            double phi = (j + 0.5) * 2 * pi / nphi;
+            double ny = std::cos(phi), nz = std::sin(phi);  // outward normal
+            double px = x, py = r * ny, pz = h + r * nz;   // the tube point
+            double d2 = px * px + py * py + pz * pz, d = std::sqrt(d2);
+            double cos_l = -(ny * py + nz * pz) / d;  // toward the origin
+            double cos_p = pz / d;
+            if (cos_l > 0 && cos_p > 0)
+                e += cos_l * cos_p / d2 * r * (2 * pi / nphi) * (2 * half / nx);
+        }
+    }
+    double expect = albedo() / pi * e;
+    EXPECT_NEAR(expect, albedo() * r / h, 0.05 * albedo() * r / h);  // the long-tube limit
+    EXPECT_EQ(AreaLights(s, make_materials(s.materials)).size(), 1u);
+    // Uniform sampling along the tube is noisy (far points weigh little): 32k samples.
+    Stats got = stats(pixels(s, patch_camera(0.5), 2, 512, true));
+    EXPECT_NEAR(got.mean, expect, 0.02 * expect);
+    std::printf("[area] cylinder: %.5f expected %.5f\n", got.mean, expect);
+}
+
+// BSDF sampling alone and NEE + MIS converge to the same mean; NEE with far less noise.
+TEST(AreaLight, NeeLowersVarianceKeepingTheMean)
+{
+    geom::Scene s = plane_scene();
+    add_disc(s.geometry, {0, 0, 2}, 0.3f, {0, 0, -1}, 2, 3);
+    double expect = albedo() * 0.09 / (4 + 0.09);
+    Stats nee = stats(pixels(s, patch_camera(1), 2, 8, true));
+    Stats bsdf = stats(pixels(s, patch_camera(1), 2, 8, false));
+    double se = std::sqrt((nee.variance + bsdf.variance) / 64);
+    EXPECT_NEAR(nee.mean, bsdf.mean, 4 * se);
+    EXPECT_NEAR(nee.mean, expect, 0.02 * expect);
+    EXPECT_LT(nee.variance * 20, bsdf.variance);
+    std::printf("[area] NEE %.5f (var %.3g)  BSDF only %.5f (var %.3g)  expected %.5f\n",
+                nee.mean, nee.variance, bsdf.mean, bsdf.variance, expect);
+}
+
+// render() builds the list (RenderSettings::area_lights) and gets the same mean without it.
+TEST(AreaLight, RenderSamplesEmittersUnlessTurnedOff)
+{
+    geom::Scene s = plane_scene();
+    add_disc(s.geometry, {0, 0, 2}, 0.3f, {0, 0, -1}, 2, 3);
+    double expect = albedo() * 0.09 / (4 + 0.09);
+    RenderSettings settings;
+    settings.width = settings.height = 8;
+    settings.samples_per_pixel = 16;
+    settings.max_depth = 2;
+    settings.threads = 2;
+    settings.ambient = {0, 0, 0};
+    settings.aovs = false;
+    auto block = [&](bool area) {
+        settings.area_lights = area;
+        Image img = render(s, patch_camera(1), settings);
+        std::vector<double> g;
+        for (std::size_t i = 0; i < img.rgba.size(); i += 4)
+            g.push_back(img.rgba[i + 1]);
+        return stats(g);
+    };
+    Stats on = block(true), off = block(false);
+    EXPECT_NEAR(on.mean, expect, 0.01 * expect);
+    EXPECT_NEAR(off.mean, expect, 4 * std::sqrt(off.variance / 64) + 0.01 * expect);
+    EXPECT_LT(on.variance * 20, off.variance);
+}
+
+// Nothing emits: the list is empty and sampling gives nothing.
+TEST(AreaLight, NoEmittersNoLights)
+{
+    geom::Scene s = plane_scene();
+    s.materials[2].emission = grey(0);
+    add_sphere(s.geometry, {0, 0, 3}, 1, 2);
+    AreaLights lights(s, make_materials(s.materials));
+    EXPECT_TRUE(lights.empty());
+    EXPECT_FALSE(lights.sample({0, 0, 0}, 0.5f, 0.5f, 0.5f).has_value());
+}
+
+}  // namespace
+}  // namespace cambium::render
