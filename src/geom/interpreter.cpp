@@ -202,9 +202,7 @@ public:
         if (m_root == this) {
             load_surfaces();
             m_keying = object_keying(view);
-            // Prototypes cannot carry line widths in pixels (render converts only the
-            // scene's own lines), so objects are expanded inline with that style.
-            m_instancing = options.is_object && options.expand_object && view.line_style != LineStyle::pixel;
+            m_instancing = options.is_object && options.expand_object;
         }
     }
 

@@ -34,8 +34,7 @@ struct InterpretOptions {
     /// frame, and the turtle moves through the module's own expansion as if it were
     /// inline (so what follows, and the bounds, are as with `-->`). `expand_object` must
     /// depend on the module alone (it is called once per distinct module). Modules of an
-    /// expansion are never objects again. With `line style: pixel` objects are expanded
-    /// inline. Unset: the string is interpreted as it is.
+    /// expansion are never objects again. Unset: the string is interpreted as it is.
     std::function<bool(lsys::SymbolId)> is_object;
     std::function<lsys::ModuleString(lsys::ModuleRef)> expand_object;
 };

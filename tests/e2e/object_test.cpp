@@ -15,6 +15,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
+double mean_difference(const render::Image& a, const render::Image& b)
+{
+    double difference = 0;
+    for (std::size_t i = 0; i < a.rgba.size(); ++i)
+        difference += std::fabs(a.rgba[i] - b.rgba[i]);
+    return difference / static_cast<double>(a.rgba.size());
+}
+
 /// A stem with three flowers; `arrow` is the flower production's delimiter.
 std::string plant(const std::string& arrow)
 {
@@ -30,14 +38,15 @@ struct Built {
     render::Image image;
 };
 
-Built build(const std::string& arrow)
+Built build(const std::string& arrow, const std::string& line_style = "cylinder")
 {
     fs::path dir = fs::temp_directory_path() / ("cambium_objects_" + std::to_string(arrow.size()) +
                                                 (arrow == "-o>" ? "o" : "i"));
     fs::create_directories(dir);
     std::ofstream(dir / "plant.l") << plant(arrow);
-    std::ofstream(dir / "plant.v") << "angle factor: 8\nline style: cylinder\ninitial line width: 0.2\n"
-                                      "light: V: 0 0 1\nscale factor: 0.9\n";
+    std::ofstream(dir / "plant.v") << "angle factor: 8\nline style: " << line_style
+                                   << "\ninitial line width: " << (line_style == "pixel" ? "3" : "0.2")
+                                   << "\nlight: V: 0 0 1\nscale factor: 0.9\n";
     app::Options options;
     options.lsystem = dir / "plant.l";
     options.view = dir / "plant.v";
@@ -67,13 +76,20 @@ TEST(Objects, InstancedObjectsRenderLikeInlineOnes)
     EXPECT_EQ(inline_.scene.geometry.spheres.centres.size(), 3u);
 
     ASSERT_EQ(instanced.image.rgba.size(), inline_.image.rgba.size());
-    double difference = 0, coverage = 0;
-    for (std::size_t i = 0; i < instanced.image.rgba.size(); ++i) {
-        difference += std::fabs(instanced.image.rgba[i] - inline_.image.rgba[i]);
-        if (i % 4 == 3)
-            coverage += inline_.image.rgba[i];
-    }
-    difference /= static_cast<double>(instanced.image.rgba.size());
-    EXPECT_GT(coverage, 20.0);      // the plant is in the picture
-    EXPECT_LT(difference, 1e-4);    // the same picture up to float rounding of the placement
+    double coverage = 0;
+    for (std::size_t i = 3; i < inline_.image.rgba.size(); i += 4)
+        coverage += inline_.image.rgba[i];
+    EXPECT_GT(coverage, 20.0);  // the plant is in the picture
+    // the same picture up to float rounding of the placement
+    EXPECT_LT(mean_difference(instanced.image, inline_.image), 1e-4);
+}
+
+TEST(Objects, PixelWideLinesInsideObjectsKeepTheirWidth)
+{
+    // lines N pixels wide are sized per placed copy, at its own depth
+    Built instanced = build("-o>", "pixel");
+    Built inline_ = build("-->", "pixel");
+    EXPECT_EQ(instanced.scene.instances.size(), 3u);
+    ASSERT_EQ(instanced.image.rgba.size(), inline_.image.rgba.size());
+    EXPECT_LT(mean_difference(instanced.image, inline_.image), 1e-4);
 }

@@ -374,11 +374,12 @@ endlsystem
     expect_same_bounds(instanced, expanded);
 }
 
-TEST(ObjectInstancing, PixelWideLinesAreExpandedInline)
+TEST(ObjectInstancing, PixelWideLinesAreInstancedToo)
 {
+    // the renderer sizes a prototype's pixel lines per placed copy
     Pair p = both(three_leaves, "angle increment: 90\nline style: pixel\n");
-    EXPECT_TRUE(p.instanced.prototypes.empty());
-    EXPECT_TRUE(p.instanced.instances.empty());
+    EXPECT_EQ(p.instanced.prototypes.size(), 1u);
+    EXPECT_EQ(p.instanced.instances.size(), 3u);
     EXPECT_TRUE(same_segments(world_segments(p.instanced), world_segments(p.expanded)));
 }
 
