@@ -180,7 +180,7 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     cli.add_option("--ambient", options.ambient,
                    "Radiance of the uniform environment (default 0.05)")
         ->check(CLI::Range(0.0f, 1e6f));
-    cli.add_flag("--sky", options.sky, "Light with an analytic sun and sky");
+    cli.add_flag("--sky", options.sky, "Light with Preetham's daylight sky and sun");
     cli.add_option("--sun", options.sun_direction, "Direction toward the sun (with --sky)")
         ->expected(3);
     cli.add_option("--turbidity", options.turbidity,

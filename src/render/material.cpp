@@ -122,10 +122,14 @@ std::vector<SurfaceMaterial> make_materials(const std::vector<geom::Material>& m
         SurfaceMaterial s;
         s.diffuse = decode_display(m.diffuse);
         s.translucency = std::clamp(m.translucency, 0.0f, 1.0f);
-        s.specular = decode_display(m.specular);
         // OpenGL's shininess is a Blinn-Phong (half-vector) exponent; a Phong lobe about
         // the mirror direction is about as wide with a quarter of it.
         s.exponent = std::clamp(m.shininess, 0.0f, 128.0f) / 4;
+        // OpenGL adds an unnormalized highlight that peaks at specular x light colour.
+        // The normalized lobe peaks at albedo (n + 2) / 2 x light colour (a light of
+        // colour c gives irradiance pi c), so albedo 2 / (n + 2) x specular keeps cpfg's
+        // highlight and its small energy: a shiny stem stays its diffuse colour.
+        s.specular = decode_display(m.specular) * (2 / (s.exponent + 2));
         s.emission = decode_display(m.emission);
         s.opacity = 1 - std::clamp(m.transparency, 0.0f, 1.0f);
         out.push_back(s);

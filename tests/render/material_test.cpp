@@ -145,11 +145,27 @@ TEST(Material, MapsCpfgMaterials)
     g.emission = {0.2f, 0, 0};
     SurfaceMaterial m = make_materials({g})[0];
     EXPECT_FLOAT_EQ(m.diffuse.x, srgb_to_linear(0.5f));
-    EXPECT_FLOAT_EQ(m.specular.x, 1);
     EXPECT_FLOAT_EQ(m.exponent, 16);
+    EXPECT_FLOAT_EQ(m.specular.x, 2.0f / 18);  // OpenGL's highlight peak (next test)
     EXPECT_FLOAT_EQ(m.opacity, 0.75f);
     EXPECT_FLOAT_EQ(m.translucency, 0.4f);
     EXPECT_FLOAT_EQ(m.emission.x, srgb_to_linear(0.2f));
+}
+
+// OpenGL's specular term under a directional light of colour c facing the surface,
+// seen from the mirror direction: specular * c * (n.h)^shininess = specular * c. The
+// mapped lobe must give the same radiance there (irradiance pi c, radiance f pi c).
+TEST(Material, HighlightPeakIsOpenGLs)
+{
+    geom::Material g;
+    g.diffuse = {0, 0, 0};
+    g.specular = {1, 1, 1};
+    for (float shininess : {0.0f, 16.0f, 128.0f}) {
+        g.shininess = shininess;
+        Bsdf b = make_bsdf(make_materials({g})[0]);
+        float radiance = bsdf_eval(b, up, up, up).x * pi;  // c = 1
+        EXPECT_NEAR(radiance, 1.0f, 1e-5f) << "shininess " << shininess;
+    }
 }
 
 }  // namespace
