@@ -542,7 +542,23 @@ void append_geometry(Geometry& into, const Geometry& from)
 {
     append_curves(into.lines, from.lines, into.lines.keys, from.lines.keys);
     append(into.curves.tangents, from.curves.tangents);
-    append_curves(into.curves, from.curves, into.curves.points, from.curves.points);
+    {
+        // end colours (generalized cylinders): kept when either side has them, a
+        // segment without its own ends in its start colour
+        HermiteCurves& a = into.curves;
+        const HermiteCurves& b = from.curves;
+        bool blended = !a.end_material.empty() || !b.end_material.empty();
+        std::size_t a_segments = a.segments.size();
+        append_curves(a, b, a.points, b.points);
+        if (blended) {
+            for (std::size_t i = a.end_material.size(); i < a_segments; ++i)
+                a.end_material.push_back(a.material[i]);
+            a.end_material.resize(a_segments);
+            for (std::size_t i = 0; i < b.segments.size(); ++i)
+                a.end_material.push_back(i < b.end_material.size() ? b.end_material[i]
+                                                                    : b.material[i]);
+        }
+    }
     {
         Spheres& a = into.spheres;
         fill_to(a.texture, a.centres.size(), no_texture);
@@ -579,6 +595,7 @@ void offset_materials(Geometry& g, std::uint16_t offset)
 {
     for (auto& m : g.lines.material) shift(m, offset);
     for (auto& m : g.curves.material) shift(m, offset);
+    for (auto& m : g.curves.end_material) shift(m, offset);
     for (auto& m : g.spheres.material) shift(m, offset);
     for (auto& m : g.discs.material) shift(m, offset);
     for (auto& m : g.discs.back_material) shift(m, offset);

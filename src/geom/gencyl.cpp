@@ -62,6 +62,21 @@ double signed_area(const std::vector<Vec3>& v)
     return a;
 }
 
+/// Gives the segment just added to `hc` the material at its end. end_material stays
+/// empty while every segment is one material; once needed, it is first padded with the
+/// earlier segments' own materials.
+void set_end_material(HermiteCurves& hc, std::uint16_t end)
+{
+    std::size_t i = hc.segments.size() - 1;
+    if (end == hc.material[i] && hc.end_material.empty())
+        return;
+    if (hc.end_material.size() > i)
+        hc.end_material.resize(i);  // stale entries of segments cut away since
+    while (hc.end_material.size() < i)
+        hc.end_material.push_back(hc.material[hc.end_material.size()]);
+    hc.end_material.push_back(end);
+}
+
 double parse_number(const std::string& text, double fallback)
 {
     std::istringstream in(text);
@@ -175,6 +190,11 @@ CylinderSettings cylinder_settings(const ViewFile& view)
             // cpfg: 2^(n+1) polygons around (manual 5.2.4), kept for old view files.
             int level = std::clamp(static_cast<int>(parse_number(c.value, 2)), 1, 16);
             s.sides = 1 << (level + 1);
+        } else if (c.name == "render mode") {
+            std::istringstream in(c.value);
+            std::string word;
+            in >> word;
+            s.interpolate_colours = word == "interpolated";
         } else if (c.name == "twist of cylinders") {
             std::istringstream in(c.value);
             std::string word;
@@ -517,7 +537,7 @@ void CylinderBuilder::draw_segment(const CylinderPoint& from, CylinderPoint& to,
     to.v = rings.back().v;
 
     if (!m_settings.draw_surfaces) {
-        draw_axis_lines(rings, from);
+        draw_axis_lines(rings, from, to);
     } else if (from.contour == 0 && to.contour == 0) {
         draw_round(rings, profile, axis, from, to);
         extend_bounds(rings, from, to, len);
@@ -529,46 +549,65 @@ void CylinderBuilder::draw_segment(const CylinderPoint& from, CylinderPoint& to,
 /// The circular contour as Embree round Hermite segments: exact for the linear radius
 /// profile (one segment); a bent profile gives one segment per strip, each matching the
 /// composite curve F(Ru(s)), Rv(s) and its derivative at the strip ends.
+///
+/// Colours as cpfg draws them (strip_to_mesh): the first strip starts in the start
+/// point's colour and the others are in the end point's, since every ring after the
+/// first is a copy of the end turtle. The first strip is flat, or blends to the end
+/// colour under `render mode: interpolated`. A linear profile whose colour changes is
+/// therefore cut in two at the first ring: the cut is exact (the same cubic).
 void CylinderBuilder::draw_round(const std::vector<SweepRing>& rings, const RadiusProfile& profile,
                                  const Vec3 (&axis)[4], const CylinderPoint& from, CylinderPoint& to)
 {
     HermiteCurves& hc = m_out.curves;
-    int pieces = profile.linear() ? 1 : static_cast<int>(rings.size()) - 1;
-    double ds = 1.0 / pieces;
-    auto key_at = [&](int j, Float4& point, Float4& tangent) {
-        double s = static_cast<double>(j) / pieces;
-        double t = j == 0 ? 0 : j == pieces ? 1 : profile.u(s);
-        Vec3 p = j == 0 ? axis[0] : j == pieces ? axis[1] : hermite(axis[0], axis[1], axis[2], axis[3], t);
+    const int strips = static_cast<int>(rings.size()) - 1;
+    const std::uint16_t start_colour = material_index(from.color), end_colour = material_index(to.color);
+    // The pieces' ends, as ring indices.
+    std::vector<int> cuts;
+    if (!profile.linear()) {
+        for (int k = 0; k <= strips; ++k)
+            cuts.push_back(k);
+    } else if (start_colour != end_colour && strips > 1) {
+        cuts = {0, 1, strips};
+    } else {
+        cuts = {0, strips};
+    }
+    // The key at ring k of a piece `span` rings long (tangents scale with its length).
+    auto key_at = [&](int k, int span, Float4& point, Float4& tangent) {
+        double s = static_cast<double>(k) / strips, ds = static_cast<double>(span) / strips;
+        double t = k == 0 ? 0 : k == strips ? 1 : profile.u(s);
+        Vec3 p = k == 0 ? axis[0] : k == strips ? axis[1] : hermite(axis[0], axis[1], axis[2], axis[3], t);
         Vec3 d = hermite_derivative(axis[0], axis[1], axis[2], axis[3], t) * (profile.du(s) * ds);
-        point = f4(p, j == 0 ? profile.r0 : j == pieces ? profile.r1 : profile.radius(s));
+        point = f4(p, k == 0 ? profile.r0 : k == strips ? profile.r1 : profile.radius(s));
         tangent = f4(d, profile.dradius(s) * ds);
     };
-    auto v_at = [&](int j) { return static_cast<float>(pieces == 1 ? (j == 0 ? rings.front().v : rings.back().v)
-                                                                    : rings[static_cast<std::size_t>(j)].v); };
+    auto push_key = [&](int k, const Float4& point, const Float4& tangent) {
+        hc.points.push_back(point);
+        hc.tangents.push_back(tangent);
+        hc.v.push_back(static_cast<float>(rings[static_cast<std::size_t>(k)].v));
+    };
 
     Float4 point, tangent;
-    key_at(0, point, tangent);
-    // Share the previous segment's last key when it is the same key (equal tangents).
-    bool shared = from.key >= 0 && static_cast<std::size_t>(from.key) + 1 == hc.points.size() &&
-                  hc.points.back() == point && hc.tangents.back() == tangent;
-    if (!shared) {
-        hc.points.push_back(point);
-        hc.tangents.push_back(tangent);
-        hc.v.push_back(v_at(0));
-    }
-    for (int j = 1; j <= pieces; ++j) {
+    for (std::size_t j = 1; j < cuts.size(); ++j) {
+        int a = cuts[j - 1], b = cuts[j];
+        key_at(a, b - a, point, tangent);
+        // Share the previous key when it is the same (equal tangents): the previous
+        // piece's end, or for the first piece the previous segment's last key.
+        bool continues = j > 1 || (from.key >= 0 && static_cast<std::size_t>(from.key) + 1 == hc.points.size());
+        bool shared = continues && hc.points.back() == point && hc.tangents.back() == tangent;
+        if (!shared)
+            push_key(a, point, tangent);
         auto first = static_cast<std::uint32_t>(hc.points.size() - 1);
-        key_at(j, point, tangent);
-        hc.points.push_back(point);
-        hc.tangents.push_back(tangent);
-        hc.v.push_back(v_at(j));
+        key_at(b, b - a, point, tangent);
+        push_key(b, point, tangent);
+        // A cut piece continues its neighbour exactly (same point, radius and direction).
         bool joined = j > 1 || shared;
         if (joined)
             hc.flags.back() |= CurveFlags::neighbour_right;
         hc.segments.push_back(first);
         hc.flags.push_back(joined ? CurveFlags::neighbour_left : 0);
-        hc.material.push_back(material_index(from.color));
+        hc.material.push_back(a == 0 ? start_colour : end_colour);
         hc.texture.push_back(static_cast<std::int16_t>(from.texture >= 0 ? from.texture : no_texture));
+        set_end_material(hc, a == 0 && m_settings.interpolate_colours ? end_colour : hc.material.back());
     }
     to.key = static_cast<std::int64_t>(hc.points.size() - 1);
 }
@@ -652,8 +691,11 @@ void CylinderBuilder::draw_mesh(const std::vector<SweepRing>& rings, const Cylin
         if (flip)
             std::swap(vb, vc), std::swap(kb, kc), std::swap(ib, ic);
         mesh.triangles.push_back({va, vb, vc});
-        mesh.material.push_back(material_index(from.color));
-        mesh.back_material.push_back(material_index(from.back_color));
+        // cpfg: the first strip in the start point's colours, the others in the end's
+        // (see draw_round; `render mode: interpolated` is not blended here).
+        const CylinderPoint& colours = ka == 0 ? from : to;
+        mesh.material.push_back(material_index(colours.color));
+        mesh.back_material.push_back(material_index(colours.back_color));
         mesh.texture.push_back(static_cast<std::int16_t>(from.texture >= 0 ? from.texture : no_texture));
         Vec3 pa = vec(mesh.positions[va]), pb = vec(mesh.positions[vb]), pc = vec(mesh.positions[vc]);
         Vec3 face = cross(pb - pa, pc - pa);
@@ -688,7 +730,8 @@ void CylinderBuilder::draw_mesh(const std::vector<SweepRing>& rings, const Cylin
     to.ring_sides = sides;
 }
 
-void CylinderBuilder::draw_axis_lines(const std::vector<SweepRing>& rings, const CylinderPoint& from)
+void CylinderBuilder::draw_axis_lines(const std::vector<SweepRing>& rings, const CylinderPoint& from,
+                                      const CylinderPoint& to)
 {
     LinearCurves& lines = m_out.lines;
     for (std::size_t k = 0; k < rings.size(); ++k) {
@@ -702,7 +745,8 @@ void CylinderBuilder::draw_axis_lines(const std::vector<SweepRing>& rings, const
         if (k > 1)
             lines.flags.back() |= LinearCurves::neighbour_right;
         lines.flags.push_back(flags);
-        lines.material.push_back(material_index(from.color));
+        // The line from ring k - 1 in that ring's turtle's colour, as cpfg draws it.
+        lines.material.push_back(material_index(k == 1 ? from.color : to.color));
         lines.texture.push_back(static_cast<std::int16_t>(from.texture >= 0 ? from.texture : no_texture));
     }
 }

@@ -94,6 +94,9 @@ struct CylinderSettings {
     ContourTable contours;     ///< `contour: id file`, loaded
     int sides = 8;             ///< `contour sides:` (or `polygonization level:`)
     bool keep_twist = false;   ///< `twist of cylinders: on`
+    /// `render mode: interpolated`: the first strip of a segment blends from the start
+    /// point's colour to the end point's (cpfg's Gouraud colours); otherwise it is flat.
+    bool interpolate_colours = false;
     bool draw_surfaces = true; ///< `line style: cylinder`; otherwise the axis as lines
     std::vector<double> texture_aspect_ratios;  ///< per texture, `R:` (v = length / (pi width R))
 };
@@ -137,9 +140,13 @@ Vec3 rmf_step(const Vec3& x0, const Vec3& t0, const Vec3& up0, const Vec3& x1, c
 ///
 /// Circular contours become HermiteCurves: one cubic segment per control-point pair
 /// (the axis exactly, radius in the 4th component), or one per strip when @Gr bends the
-/// radius profile. Other contours become TriangleMesh strips: `strips` rings per pair, at
-/// cpfg's positions, with smooth normals. Bounds receive what cpfg's view volume sees
-/// (the ring vertices, or the axis points when lines are drawn).
+/// radius profile. Other contours become TriangleMesh strips: `strips` rings per pair,
+/// at cpfg's positions, with smooth normals. Colours follow cpfg: the first strip (or
+/// axis line) of a pair in the start point's colours, the rest in the end point's; a
+/// round segment whose colour changes is cut at the first ring for it, and blends
+/// across its first piece (HermiteCurves::end_material) under `render mode:
+/// interpolated`. Bounds receive what cpfg's view volume sees (the ring vertices, or
+/// the axis points when lines are drawn).
 class CylinderBuilder {
 public:
     CylinderBuilder(CylinderSettings settings, Geometry& out, Bounds3& bounds);
@@ -178,7 +185,7 @@ private:
                     const CylinderPoint& from, CylinderPoint& to);
     void draw_mesh(const std::vector<SweepRing>& rings, const CylinderPoint& from, CylinderPoint& to,
                    double len);
-    void draw_axis_lines(const std::vector<SweepRing>& rings, const CylinderPoint& from);
+    void draw_axis_lines(const std::vector<SweepRing>& rings, const CylinderPoint& from, const CylinderPoint& to);
     void extend_bounds(const std::vector<SweepRing>& rings, const CylinderPoint& from, const CylinderPoint& to,
                        double len);
     const ContourSamples& samples(int contour, int sides);

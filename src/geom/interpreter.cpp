@@ -87,7 +87,7 @@ struct GeometrySizes {
         HermiteCurves& c = g.curves;
         cut(c.points, curve_points), cut(c.tangents, curve_points), cut(c.v, curve_v);
         cut(c.segments, curve_segments), cut(c.flags, curve_segments), cut(c.material, curve_segments);
-        cut(c.texture, curve_segments);
+        cut(c.texture, curve_segments), cut(c.end_material, curve_segments);
         cut(g.spheres.centres, spheres), cut(g.spheres.material, spheres), cut(g.spheres.texture, sphere_textures);
         cut(g.discs.centres, discs), cut(g.discs.normals, discs), cut(g.discs.material, discs);
         cut(g.discs.back_material, discs);

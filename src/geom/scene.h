@@ -61,8 +61,12 @@ struct HermiteCurves {
     std::vector<float> v;                  ///< per point: texture v along the axis
     std::vector<std::uint32_t> segments;
     std::vector<std::uint8_t> flags;       ///< per segment, CurveFlags bits
-    std::vector<std::uint16_t> material;
+    std::vector<std::uint16_t> material;   ///< per segment: the material at its start
     std::vector<std::int16_t> texture;
+    /// Per segment, optional: the material at its end, blended linearly in u from
+    /// `material` (cpfg's `render mode: interpolated` colours along a generalized
+    /// cylinder). Empty, shorter than `segments` or equal to `material`: one material.
+    std::vector<std::uint16_t> end_material;
 
     std::size_t segment_count() const { return segments.size(); }
 };

@@ -4,6 +4,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -783,11 +784,21 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
             material = at_or(g.mesh.back_material, h.prim_id, material);
         break;
     }
-    if (material == geom::inherit_material)
-        material = placement ? (h.back ? placement->instance->back_material
-                                       : placement->instance->material)
-                             : 0;
-    h.material = material;
+    auto resolve = [&](std::uint16_t mat) -> std::uint16_t {
+        if (mat != geom::inherit_material)
+            return mat;
+        return placement ? (h.back ? placement->instance->back_material
+                                   : placement->instance->material)
+                         : 0;
+    };
+    h.material = resolve(material);
+    if (part.shape == Shape::curve && h.prim_id < g.curves.end_material.size()) {
+        std::uint16_t end = resolve(g.curves.end_material[h.prim_id]);
+        if (end != h.material) {
+            h.end_material = end;
+            h.material_blend = std::clamp(rh.hit.u, 0.0f, 1.0f);
+        }
+    }
     int texture = m.texture_of(part, h.prim_id, placement);
     h.texture = static_cast<std::int16_t>(texture);
     if (texture != geom::no_texture) {

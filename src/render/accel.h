@@ -38,6 +38,11 @@ struct SurfaceHit {
     std::uint32_t inst_id = PrimId::none;  ///< the instance's Embree geometry id
     std::uint32_t instance = PrimId::none;  ///< in Scene::instances (none: own geometry)
     std::uint16_t material = 0;  ///< index into Scene::materials (side and instance resolved)
+    /// A generalized cylinder's colour blends along its axis: the surface is
+    /// (1 - material_blend) `material` + material_blend `end_material` (resolved the same
+    /// way). material_blend = 0 (the usual case): `material` alone.
+    std::uint16_t end_material = 0;
+    float material_blend = 0;
     std::int16_t texture = geom::no_texture;  ///< index into Scene::textures
     float u = 0, v = 0;        ///< texture coordinates (OpenGL's s, t)
     /// World-space change of position per unit of s and of t at the hit (textured hits

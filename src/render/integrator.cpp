@@ -64,10 +64,10 @@ constexpr float infinity = std::numeric_limits<float>::infinity();
 /// Transparent surfaces a ray may pass through before it counts as blocked.
 constexpr int max_pass_throughs = 64;
 
-const SurfaceMaterial& material_of(const PathContext& ctx, const SurfaceHit& hit)
+const SurfaceMaterial& material_at(const PathContext& ctx, std::uint16_t m)
 {
     static const SurfaceMaterial fallback;
-    return hit.material < ctx.materials.size() ? ctx.materials[hit.material] : fallback;
+    return m < ctx.materials.size() ? ctx.materials[m] : fallback;
 }
 
 /// The power heuristic (beta = 2) for a sample drawn with pdf a against one of pdf b.
@@ -122,7 +122,8 @@ float transmittance(const PathContext& ctx, bool transparent_scene, Spawn s, con
         std::optional<SurfaceHit> hit = ctx.accel->intersect(s.origin, wi, 0, tfar, s.skip);
         if (!hit)
             return through;
-        through *= 1 - material_of(ctx, *hit).opacity;
+        SurfaceMaterial scratch;
+        through *= 1 - hit_material(ctx, *hit, scratch).opacity;
         if (through <= 0)
             return 0;
         tfar = std::isinf(tfar) ? tfar : tfar - hit->t;
@@ -244,6 +245,16 @@ PathContext::Prepared scene_facts(const PathContext& ctx)
 
 void prepare_path_context(PathContext& ctx) { ctx.prepared = scene_facts(ctx); }
 
+const SurfaceMaterial& hit_material(const PathContext& ctx, const SurfaceHit& hit,
+                                    SurfaceMaterial& scratch)
+{
+    const SurfaceMaterial& start = material_at(ctx, hit.material);
+    if (hit.material_blend <= 0)
+        return start;  // the usual case: no copy
+    scratch = mix(start, material_at(ctx, hit.end_material), hit.material_blend);
+    return scratch;
+}
+
 PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec3f& camera_dir,
                       Sampler& sampler)
 {
@@ -281,7 +292,8 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             break;
         }
         travelled += hit->t;
-        const SurfaceMaterial& material = material_of(ctx, *hit);
+        SurfaceMaterial blended;
+        const SurfaceMaterial& material = hit_material(ctx, *hit, blended);
         // Opacity: the ray stops here with probability opacity, else passes on unchanged.
         if (material.opacity < 1 && sampler.next() >= material.opacity) {
             if (++passes > max_pass_throughs)

@@ -58,6 +58,12 @@ struct PathContext {
     std::optional<Prepared> prepared;
 };
 
+/// The material at `hit`: ctx.materials[hit.material], or, where a generalized
+/// cylinder's colour blends (hit.material_blend > 0), the mix written into `scratch`.
+/// Out-of-range indices give a default material.
+const SurfaceMaterial& hit_material(const PathContext& ctx, const SurfaceHit& hit,
+                                    SurfaceMaterial& scratch);
+
 /// Fills ctx.prepared; call after setting the materials and the environment.
 void prepare_path_context(PathContext& ctx);
 

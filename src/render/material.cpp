@@ -60,6 +60,19 @@ float phong_term(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3f& wi
 
 }  // namespace
 
+SurfaceMaterial mix(const SurfaceMaterial& a, const SurfaceMaterial& b, float w)
+{
+    auto lerp = [w](auto x, auto y) { return x * (1 - w) + y * w; };
+    SurfaceMaterial m;
+    m.diffuse = lerp(a.diffuse, b.diffuse);
+    m.translucency = lerp(a.translucency, b.translucency);
+    m.specular = lerp(a.specular, b.specular);
+    m.exponent = lerp(a.exponent, b.exponent);
+    m.emission = lerp(a.emission, b.emission);
+    m.opacity = lerp(a.opacity, b.opacity);
+    return m;
+}
+
 Bsdf make_bsdf(const SurfaceMaterial& m, const Vec3f& diffuse)
 {
     float keep = 1 - std::clamp(max_component(m.specular), 0.0f, 1.0f);

@@ -36,6 +36,10 @@ struct SurfaceMaterial {
     float opacity = 1;       ///< 1 - transparency: probability a ray stops here
 };
 
+/// The material a fraction `w` of the way from `a` to `b`: every parameter linear in w
+/// (a generalized cylinder's colour blends so between its control points).
+SurfaceMaterial mix(const SurfaceMaterial& a, const SurfaceMaterial& b, float w);
+
 /// The BSDF of `m` with the (possibly textured) diffuse albedo `diffuse`. The glossy
 /// lobe takes its share first: the diffuse lobes keep (1 - max specular) of theirs.
 Bsdf make_bsdf(const SurfaceMaterial& m, const Vec3f& diffuse);

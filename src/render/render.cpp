@@ -137,17 +137,12 @@ struct Frame {
     bool primary = false;  // intersect the camera ray here too (AOVs, clipping)
 };
 
-const SurfaceMaterial& material_of(const PathContext& ctx, std::uint16_t m)
-{
-    static const SurfaceMaterial fallback;
-    return m < ctx.materials.size() ? ctx.materials[m] : fallback;
-}
-
 /// The albedo layer's colour: the (textured) diffuse albedo, or the flat colour of an
 /// unlit line.
 Vec3f first_hit_albedo(const PathContext& ctx, const SurfaceHit& hit, const Vec3f& dir)
 {
-    const SurfaceMaterial& m = material_of(ctx, hit.material);
+    SurfaceMaterial scratch;
+    const SurfaceMaterial& m = hit_material(ctx, hit, scratch);
     if (hit.unlit)
         return flat_colour(m);
     if (ctx.textures && ctx.textures->valid(hit.texture)) {

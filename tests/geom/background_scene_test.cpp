@@ -193,3 +193,27 @@ TEST(BackgroundSceneConformance, CorpusBackgroundsRead)
     BackgroundScene k = read_background_scene(knot.string(), "/", Material{}, FileLoc{"viewfile.v", 1, 1});
     EXPECT_GT(k.geometry.lines.segment_count(), 0u);
 }
+
+// Generalized cylinders whose colour changes carry end materials; appending keeps them
+// per segment (the other side's segments end in their start colour) and offsets them.
+TEST(BackgroundScene, AppendKeepsCurveEndMaterials)
+{
+    auto one_segment = [](std::uint16_t start, std::uint16_t end) {
+        Geometry g;
+        g.curves.points = {{0, 0, 0, 1}, {0, 1, 0, 1}};
+        g.curves.tangents = {{0, 1, 0, 0}, {0, 1, 0, 0}};
+        g.curves.segments = {0};
+        g.curves.material = {start};
+        if (start != end)
+            g.curves.end_material = {end};
+        return g;
+    };
+    Geometry a = one_segment(1, 1), b = one_segment(2, 3);
+    offset_materials(b, 10);
+    append_geometry(a, b);
+    ASSERT_EQ(a.curves.end_material.size(), 2u);
+    EXPECT_EQ(a.curves.end_material[0], 1);   // a's segment: one colour
+    EXPECT_EQ(a.curves.material[1], 12);
+    EXPECT_EQ(a.curves.end_material[1], 13);
+    EXPECT_EQ(a.curves.segments[1], 2u);
+}

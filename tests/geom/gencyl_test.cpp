@@ -301,6 +301,88 @@ TEST(GeneralizedCylinder, ConsecutiveMeshSegmentsShareTheirRing)
     EXPECT_EQ(scene.geometry.mesh.positions.size(), 5u * 9u);  // 3 + 3 rings, one shared
 }
 
+// cpfg (strip_to_mesh): the first strip of a control-point pair is in the start point's
+// colour, the others in the end point's; `render mode: interpolated` blends the first.
+TEST(GeneralizedCylinderColour, ColourChangeCutsTheSegmentAtTheFirstRing)
+{
+    Scene scene = run(";(1) @Gs f(1) ;(3) @Gc f(1) ;(5) @Ge");
+    const HermiteCurves& c = scene.geometry.curves;
+    ASSERT_EQ(c.segment_count(), 4u);  // each pair: its first strip, then the other three
+    EXPECT_EQ(c.material, (std::vector<std::uint16_t>{1, 3, 3, 5}));
+    EXPECT_TRUE(c.end_material.empty());  // flat colours
+    // The cut is on the same cubic: y(s) of the straight axis with tangents 1.2, and the
+    // tangents scaled by each piece's share of the parameter (1/4 and 3/4).
+    double y = scalar_hermite(0, 1, 1.2, 1.2, 0.25);
+    double dy = 6 * 0.25 * (1 - 0.25) + 1.2 * (3 * 0.0625 - 4 * 0.25 + 1) + 1.2 * (3 * 0.0625 - 2 * 0.25);
+    expect_key(c.points[c.segments[0]], 0, 0, 0, 0.5);
+    expect_key(c.tangents[c.segments[0]], 0, 1.2 * 0.25, 0, 0);
+    expect_key(c.points[c.segments[0] + 1], 0, y, 0, 0.5);
+    expect_key(c.tangents[c.segments[0] + 1], 0, dy * 0.25, 0, 0);
+    expect_key(c.points[c.segments[1]], 0, y, 0, 0.5);
+    expect_key(c.tangents[c.segments[1]], 0, dy * 0.75, 0, 0);
+    expect_key(c.points[c.segments[1] + 1], 0, 1, 0, 0.5);
+    expect_key(c.tangents[c.segments[1] + 1], 0, 1.2 * 0.75, 0, 0);
+}
+
+TEST(GeneralizedCylinderColour, InterpolatedRenderModeBlendsTheFirstStrip)
+{
+    Scene scene = run(";(1) @Gs f(1) ;(3) @Gc f(1) ;(5) @Ge",
+                      "line style: cylinder\nrender mode: interpolated\n");
+    const HermiteCurves& c = scene.geometry.curves;
+    ASSERT_EQ(c.segment_count(), 4u);
+    EXPECT_EQ(c.material, (std::vector<std::uint16_t>{1, 3, 3, 5}));
+    EXPECT_EQ(c.end_material, (std::vector<std::uint16_t>{3, 3, 5, 5}));
+}
+
+TEST(GeneralizedCylinderColour, OneStripIsOneSegment)
+{
+    Scene flat = run(";(1) @Gs f(1) ;(3) @Ge(1)");
+    EXPECT_EQ(flat.geometry.curves.material, (std::vector<std::uint16_t>{1}));
+    EXPECT_TRUE(flat.geometry.curves.end_material.empty());
+    Scene blended = run(";(1) @Gs f(1) ;(3) @Ge(1)", "line style: cylinder\nrender mode: interpolated\n");
+    EXPECT_EQ(blended.geometry.curves.material, (std::vector<std::uint16_t>{1}));
+    EXPECT_EQ(blended.geometry.curves.end_material, (std::vector<std::uint16_t>{3}));
+}
+
+TEST(GeneralizedCylinderColour, OneColourIsOneSegmentPerPairWithoutEndMaterials)
+{
+    Scene scene = run(";(2) @Gs f(1) @Gc f(1) @Ge");
+    EXPECT_EQ(scene.geometry.curves.segment_count(), 2u);
+    EXPECT_TRUE(scene.geometry.curves.end_material.empty());
+}
+
+TEST(GeneralizedCylinderColour, FirstBlendedSegmentPadsEarlierOnes)
+{
+    Scene scene = run(";(2) @Gs f(1) @Gc f(2) ;(4) @Ge(1)", "line style: cylinder\nrender mode: interpolated\n");
+    const HermiteCurves& c = scene.geometry.curves;
+    ASSERT_EQ(c.segment_count(), 2u);
+    EXPECT_EQ(c.end_material, (std::vector<std::uint16_t>{2, 4}));
+}
+
+TEST(GeneralizedCylinderColour, RadiusProfilePiecesAfterTheFirstTakeTheEndColour)
+{
+    Scene scene = run("!(0.4) ;(2) @Gs f(1) !(0.2) ;(6) @Gr(10,1.5,-20,1) @Ge(4)");
+    const HermiteCurves& c = scene.geometry.curves;
+    ASSERT_EQ(c.segment_count(), 4u);
+    EXPECT_EQ(c.material, (std::vector<std::uint16_t>{2, 6, 6, 6}));
+    EXPECT_EQ(c.points.size(), 5u);  // equal spans share their keys
+}
+
+TEST(GeneralizedCylinderColour, MeshStripsAfterTheFirstTakeTheEndColour)
+{
+    Scene scene = run(";(2) @#(1) @Gs f(2) ;(7) @Ge(4)", square_contour_view());
+    const TriangleMesh& m = scene.geometry.mesh;
+    ASSERT_EQ(m.size(), 4u * 8u * 2u);  // 4 strips of 8 sides, two triangles each
+    for (std::size_t t = 0; t < m.size(); ++t)
+        EXPECT_EQ(m.material[t], t < 8u * 2u ? 2 : 7) << "triangle " << t;
+}
+
+TEST(GeneralizedCylinderColour, AxisLinesAfterTheFirstTakeTheEndColour)
+{
+    Scene scene = run(";(2) @Gs f(1) ;(7) @Ge(4)", "line style: pixel\n");
+    EXPECT_EQ(scene.geometry.lines.material, (std::vector<std::uint16_t>{2, 7, 7, 7}));
+}
+
 TEST(GeneralizedCylinder, TwistIsMinimisedUnlessAskedFor)
 {
     // A roll of 90 degrees between the points: U turns from (0,0,-1) to (1,0,0).

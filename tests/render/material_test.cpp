@@ -168,5 +168,33 @@ TEST(Material, HighlightPeakIsOpenGLs)
     }
 }
 
+TEST(Material, MixIsLinearInEveryParameter)
+{
+    SurfaceMaterial a, b;
+    a.diffuse = {0.2f, 0.4f, 0.6f};
+    b.diffuse = {0.6f, 0.0f, 1.0f};
+    a.translucency = 0;
+    b.translucency = 0.8f;
+    a.specular = {0.1f, 0.1f, 0.1f};
+    b.specular = {0.3f, 0.5f, 0.1f};
+    a.exponent = 4;
+    b.exponent = 36;
+    b.emission = {2, 0, 0};
+    a.opacity = 1;
+    b.opacity = 0.5f;
+    SurfaceMaterial m = mix(a, b, 0.25f);
+    EXPECT_NEAR(m.diffuse.x, 0.3f, 1e-6f);
+    EXPECT_NEAR(m.diffuse.y, 0.3f, 1e-6f);
+    EXPECT_NEAR(m.diffuse.z, 0.7f, 1e-6f);
+    EXPECT_NEAR(m.translucency, 0.2f, 1e-6f);
+    EXPECT_NEAR(m.specular.y, 0.2f, 1e-6f);
+    EXPECT_NEAR(m.exponent, 12, 1e-5f);
+    EXPECT_NEAR(m.emission.x, 0.5f, 1e-6f);
+    EXPECT_NEAR(m.opacity, 0.875f, 1e-6f);
+    SurfaceMaterial end = mix(a, b, 1);
+    EXPECT_NEAR(end.diffuse.x, 0.6f, 1e-6f);
+    EXPECT_NEAR(end.opacity, 0.5f, 1e-6f);
+}
+
 }  // namespace
 }  // namespace cambium::render
