@@ -155,6 +155,23 @@ T at_or(const std::vector<T>& v, std::size_t i, T fallback)
 
 struct Lookup;
 
+/// Cylinders (F, G) as cpfg draws them: truncated cones with flat ends. Embree's round
+/// linear curves sweep a sphere, which turns a short wide segment (a lamp's base, a
+/// trunk's foot) into a ball; its cone curves are the exact frustums but leave the ends
+/// open and a wedge at each bend. So shaded lines are cone curves, each free end gets a
+/// disc and each bent joint a sphere of the joint's radius (the round joint cpfg's
+/// smooth tubes show).
+struct LineEnds {
+    std::vector<Key> caps;                   ///< disc centre and radius per free end
+    std::vector<geom::Float3> cap_normals;   ///< out of the cylinder
+    std::vector<std::uint32_t> cap_segment;  ///< the segment each cap closes
+    std::vector<std::uint8_t> cap_at_end;    ///< 1: at the segment's second key
+    std::vector<Key> joints;                 ///< sphere centre and radius per bent joint
+    std::vector<std::uint32_t> joint_segment;  ///< the segment a joint ends
+};
+
+LineEnds line_ends(const geom::LinearCurves& l, const Key* keys);
+
 /// One Embree geometry's source primitives.
 struct Part {
     Shape shape = Shape::line;
@@ -162,7 +179,18 @@ struct Part {
     const Key* line_keys = nullptr;  ///< lines: keys with world-unit radii
     bool unlit = false;
     const Lookup* owner = nullptr;
+    const LineEnds* ends = nullptr;  ///< caps and joints: the segments they belong to
 };
+
+/// The segment of the scene's lines whose hit this is (a cap's or joint's: its segment).
+std::uint32_t line_segment(const Part& part, std::uint32_t prim)
+{
+    switch (part.shape) {
+    case Shape::cap: return part.ends->cap_segment[prim];
+    case Shape::joint: return part.ends->joint_segment[prim];
+    default: return prim;
+    }
+}
 
 /// What hits are resolved with: parts by geometry id, instances' placements, textures
 /// (also read by the alpha filter during traversal).
@@ -195,6 +223,7 @@ struct EmbreeScene::Impl : Lookup {
     RTCScene scene = nullptr;
     std::vector<RTCScene> prototype_scenes;
     std::deque<Part> parts;  ///< stable addresses (Embree user data)
+    std::deque<LineEnds> line_ends;  ///< caps and joints of shaded lines (stable addresses)
     std::vector<Key> world_keys;  ///< line keys with pixel radii converted (else empty)
     /// Pixel-width lines of prototypes, placed by every instance in world space with
     /// their radii converted (a radius in pixels depends on each copy's depth).
@@ -241,6 +270,13 @@ std::array<float, 2> texture_coords(const Part& part, std::uint32_t prim, float 
 {
     const geom::Geometry& g = *part.geometry;
     switch (part.shape) {
+    case Shape::cap:
+    case Shape::joint: {
+        // the rim's t; s is the centre of the unrolled tube
+        std::uint32_t k = g.lines.segments[line_segment(part, prim)] +
+                          (part.shape == Shape::joint ? 1 : part.ends->cap_at_end[prim]);
+        return {0.5f, g.lines.v.size() == g.lines.keys.size() ? g.lines.v[k] : 0.0f};
+    }
     case Shape::line: {
         std::uint32_t k = g.lines.segments[prim];
         float t = g.lines.v.size() == g.lines.keys.size()
@@ -290,6 +326,8 @@ std::array<Vec3f, 2> texture_tangents(const Part& part, std::uint32_t prim, floa
         return dv_du != 0 ? dp_du * (1 / dv_du) : Vec3f();
     };
     switch (part.shape) {
+    case Shape::cap:
+    case Shape::joint: return {Vec3f(), Vec3f()};  // one texel across the end
     case Shape::line: {
         std::uint32_t k = g.lines.segments[prim];
         Vec3f axis = vec(part.line_keys[k + 1]) - vec(part.line_keys[k]);
@@ -443,6 +481,47 @@ void copy_buffer(RTCGeometry g, RTCBufferType type, RTCFormat format, const std:
         std::memcpy(dst, data.data(), sizeof(T) * data.size());
 }
 
+LineEnds line_ends(const geom::LinearCurves& l, const Key* keys)
+{
+    constexpr std::uint8_t left = 1, right = 2;  // RTC_CURVE_FLAG_NEIGHBOR_LEFT / _RIGHT
+    // Below this bend (about 0.8 degrees) the frustums meet without a visible wedge.
+    constexpr float straight = 0.9999f;
+    const std::size_t n = l.segments.size();
+    auto flags_of = [&](std::size_t i) -> std::uint8_t {
+        return l.flags.size() == n ? l.flags[i] : 0;
+    };
+    auto direction = [&](std::uint32_t k) {
+        Vec3f d = Vec3f(keys[k + 1][0], keys[k + 1][1], keys[k + 1][2]) -
+                  Vec3f(keys[k][0], keys[k][1], keys[k][2]);
+        float length = std::sqrt(dot(d, d));
+        return length > 0 ? d * (1 / length) : Vec3f();
+    };
+    LineEnds e;
+    auto add_cap = [&](const Key& at, const Vec3f& out, std::size_t segment, bool end) {
+        if (!(at[3] > 0) || dot(out, out) == 0)
+            return;  // tapered to nothing, or no direction: no end to close
+        e.caps.push_back(at);
+        e.cap_normals.push_back({out.x, out.y, out.z});
+        e.cap_segment.push_back(static_cast<std::uint32_t>(segment));
+        e.cap_at_end.push_back(end ? 1 : 0);
+    };
+    for (std::size_t i = 0; i < n; ++i) {
+        const std::uint32_t k = l.segments[i];
+        const std::uint8_t f = flags_of(i);
+        Vec3f dir = direction(k);
+        if (!(f & left))
+            add_cap(keys[k], -dir, i, false);
+        if (!(f & right)) {
+            add_cap(keys[k + 1], dir, i, true);
+        } else if (k + 2 < l.keys.size() && keys[k + 1][3] > 0 &&
+                   dot(dir, direction(k + 1)) < straight) {
+            e.joints.push_back(keys[k + 1]);
+            e.joint_segment.push_back(static_cast<std::uint32_t>(i));
+        }
+    }
+    return e;
+}
+
 void set_flags(RTCGeometry g, const std::vector<std::uint8_t>& flags, std::size_t segments)
 {
     // Neighbour flags close the joints of a polyline without caps or bulges.
@@ -470,7 +549,11 @@ int Lookup::texture_of(const Part& part, std::uint32_t prim, const Placement* p)
     const geom::Geometry& g = *part.geometry;
     std::int16_t t = geom::no_texture;
     switch (part.shape) {
-    case Shape::line: t = at_or(g.lines.texture, prim, geom::no_texture); break;
+    case Shape::line:
+    case Shape::cap:
+    case Shape::joint:
+        t = at_or(g.lines.texture, line_segment(part, prim), geom::no_texture);
+        break;
     case Shape::curve: t = at_or(g.curves.texture, prim, geom::no_texture); break;
     case Shape::sphere: t = at_or(g.spheres.texture, prim, geom::no_texture); break;
     case Shape::triangle: t = at_or(g.mesh.texture, prim, geom::no_texture); break;
@@ -508,15 +591,35 @@ void EmbreeScene::Impl::add_geometry(RTCScene s, const geom::Geometry& geo,
     if (lines && !l.segments.empty()) {
         check_segments(l.segments, l.keys.size(), "line");
         const Key* keys = line_keys ? line_keys : l.keys.data();
-        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
+        bool cut = alpha || any_texture(l.texture);
+        // cpfg's pixel lines are GL lines: Embree's round (swept-sphere) curves suit
+        // them; shaded cylinders are exact frustums (LineEnds).
+        RTCGeometry g = rtcNewGeometry(device, unlit ? RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE
+                                                     : RTC_GEOMETRY_TYPE_CONE_LINEAR_CURVE);
         rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, keys, 0,
                                    sizeof(Key), l.keys.size());
         rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
                                    l.segments.data(), 0, sizeof(std::uint32_t),
                                    l.segments.size());
-        set_flags(g, l.flags, l.segments.size());
-        attach(s, g, {Shape::line, &geo, keys, unlit, nullptr}, ids,
-               alpha || any_texture(l.texture));
+        if (unlit)
+            set_flags(g, l.flags, l.segments.size());
+        attach(s, g, {Shape::line, &geo, keys, unlit, nullptr}, ids, cut);
+        if (!unlit) {
+            const LineEnds& e = line_ends.emplace_back(render::line_ends(l, keys));
+            if (!e.caps.empty()) {
+                RTCGeometry d = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
+                rtcSetSharedGeometryBuffer(d, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                           e.caps.data(), 0, sizeof(Key), e.caps.size());
+                copy_buffer(d, RTC_BUFFER_TYPE_NORMAL, RTC_FORMAT_FLOAT3, e.cap_normals);
+                attach(s, d, {Shape::cap, &geo, keys, false, nullptr, &e}, ids, cut);
+            }
+            if (!e.joints.empty()) {
+                RTCGeometry j = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+                rtcSetSharedGeometryBuffer(j, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                           e.joints.data(), 0, sizeof(Key), e.joints.size());
+                attach(s, j, {Shape::joint, &geo, keys, false, nullptr, &e}, ids, cut);
+            }
+        }
     }
     const geom::HermiteCurves& c = geo.curves;
     if (!c.segments.empty()) {
@@ -694,6 +797,12 @@ LocalSurface local_surface(const Part& part, std::uint32_t prim, float u, float 
         break;
     }
     case Shape::sphere: s.radius = g.spheres.centres[prim][3]; break;
+    case Shape::cap:
+        // the solid cylinder's end: its normal points out, like the tube's
+        s.geometric = vec(part.ends->cap_normals[prim]);
+        s.radius = part.ends->caps[prim][3];
+        break;
+    case Shape::joint: s.radius = part.ends->joints[prim][3]; break;
     case Shape::disc:
         s.geometric = vec(g.discs.normals[prim]);
         s.two_sided = true;
@@ -770,7 +879,11 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     // Materials: the side hit, then the instance's for inherit_material.
     std::uint16_t material = 0;
     switch (part.shape) {
-    case Shape::line: material = at_or(g.lines.material, h.prim_id, std::uint16_t{0}); break;
+    case Shape::line:
+    case Shape::cap:
+    case Shape::joint:
+        material = at_or(g.lines.material, line_segment(part, h.prim_id), std::uint16_t{0});
+        break;
     case Shape::curve: material = at_or(g.curves.material, h.prim_id, std::uint16_t{0}); break;
     case Shape::sphere: material = at_or(g.spheres.material, h.prim_id, std::uint16_t{0}); break;
     case Shape::disc:
@@ -816,6 +929,8 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     // at curve joints; a small one guards against float error at large coordinates.
     switch (part.shape) {
     case Shape::line:
+    case Shape::cap:
+    case Shape::joint:
     case Shape::curve: h.spawn_offset = 1e-3f * h.radius + 1e-6f * scale; break;
     case Shape::sphere: h.spawn_offset = 1e-4f * h.radius + 1e-6f * scale; break;
     case Shape::disc:

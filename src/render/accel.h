@@ -25,7 +25,9 @@ struct PrimId {
 
 /// The kind of primitive hit: closed ones (curves, spheres) enclose a volume, flat ones
 /// (discs, triangles) have two sides with their own materials.
-enum class Shape : std::uint8_t { line, curve, sphere, disc, triangle };
+/// `cap`: the flat end of a cylinder (F, G) where no segment continues it; `joint`: the
+/// sphere that rounds a bend between two.
+enum class Shape : std::uint8_t { line, curve, sphere, disc, triangle, cap, joint };
 
 /// A ray's first hit, ready for shading. Everything is in world space.
 struct SurfaceHit {

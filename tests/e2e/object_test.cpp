@@ -44,8 +44,10 @@ Built build(const std::string& arrow, const std::string& line_style = "cylinder"
                                                 (arrow == "-o>" ? "o" : "i"));
     fs::create_directories(dir);
     std::ofstream(dir / "plant.l") << plant(arrow);
-    std::ofstream(dir / "plant.v") << "angle factor: 8\nline style: " << line_style
-                                   << "\ninitial line width: " << (line_style == "pixel" ? "3" : "0.2")
+    // `initial line width:` without a unit sets cpfg's polygon style: the style after it
+    std::ofstream(dir / "plant.v") << "angle factor: 8\ninitial line width: "
+                                   << (line_style == "pixel" ? "3" : "0.2")
+                                   << "\nline style: " << line_style
                                    << "\nlight: V: 0 0 1\nscale factor: 0.9\n";
     app::Options options;
     options.lsystem = dir / "plant.l";
@@ -89,6 +91,7 @@ TEST(Objects, PixelWideLinesInsideObjectsKeepTheirWidth)
     // lines N pixels wide are sized per placed copy, at its own depth
     Built instanced = build("-o>", "pixel");
     Built inline_ = build("-->", "pixel");
+    EXPECT_TRUE(inline_.scene.line_radius_in_pixels);
     EXPECT_EQ(instanced.scene.instances.size(), 3u);
     ASSERT_EQ(instanced.image.rgba.size(), inline_.image.rgba.size());
     EXPECT_LT(mean_difference(instanced.image, inline_.image), 1e-4);

@@ -30,10 +30,12 @@ TEST(Render, SegmentSilhouetteWhereCameraPutsIt)
         EXPECT_EQ(img.at(100, y, 3), 1.0f) << "row " << y;
     for (int y : {0, 20, 38, 61, 80, 99})
         EXPECT_EQ(img.at(100, y, 3), 0.0f) << "row " << y;
-    EXPECT_EQ(img.at(45, 50, 3), 1.0f);
-    EXPECT_EQ(img.at(155, 50, 3), 1.0f);
-    EXPECT_EQ(img.at(38, 50, 3), 0.0f);
-    EXPECT_EQ(img.at(161, 50, 3), 0.0f);
+    // 5 pixels per unit: the cylinder's flat ends at x = -10 and 10 are columns 50, 150
+    // (cpfg's cylinders end square; no half sphere beyond them)
+    EXPECT_EQ(img.at(51, 50, 3), 1.0f);
+    EXPECT_EQ(img.at(148, 50, 3), 1.0f);
+    EXPECT_EQ(img.at(48, 50, 3), 0.0f);
+    EXPECT_EQ(img.at(151, 50, 3), 0.0f);
     // Edge rows are partly covered.
     EXPECT_GT(img.at(100, 40, 3) + img.at(100, 59, 3), 0.0f);
 }
