@@ -264,6 +264,14 @@ struct EmbreeScene::Impl : Lookup {
 
 namespace {
 
+/// The direction of a Hermite segment's axis (its derivative) at u.
+Vec3f hermite_axis(const geom::HermiteCurves& c, std::uint32_t k, float u)
+{
+    auto d = hermite_derivative(u);
+    return vec(c.points[k]) * d[0] + vec(c.tangents[k]) * d[1] + vec(c.points[k + 1]) * d[2] +
+           vec(c.tangents[k + 1]) * d[3];
+}
+
 /// Texture coordinates (s, t) of a hit: Embree's (u, v) and object-space normal ng.
 std::array<float, 2> texture_coords(const Part& part, std::uint32_t prim, float u, float v,
                                     const Vec3f& ng)
@@ -287,9 +295,7 @@ std::array<float, 2> texture_coords(const Part& part, std::uint32_t prim, float 
     case Shape::curve: {
         const geom::HermiteCurves& c = g.curves;
         std::uint32_t k = c.segments[prim];
-        auto d = hermite_derivative(u);
-        Vec3f axis = vec(c.points[k]) * d[0] + vec(c.tangents[k]) * d[1] +
-                     vec(c.points[k + 1]) * d[2] + vec(c.tangents[k + 1]) * d[3];
+        Vec3f axis = hermite_axis(c, k, u);
         float t = c.v.size() == c.points.size() ? c.v[k] + (c.v[k + 1] - c.v[k]) * u : 0.0f;
         return {angle_around(axis, ng), t};
     }
@@ -338,9 +344,7 @@ std::array<Vec3f, 2> texture_tangents(const Part& part, std::uint32_t prim, floa
     case Shape::curve: {
         const geom::HermiteCurves& c = g.curves;
         std::uint32_t k = c.segments[prim];
-        auto d = hermite_derivative(u);
-        Vec3f axis = vec(c.points[k]) * d[0] + vec(c.tangents[k]) * d[1] +
-                     vec(c.points[k + 1]) * d[2] + vec(c.tangents[k + 1]) * d[3];
+        Vec3f axis = hermite_axis(c, k, u);
         float dv = c.v.size() == c.points.size() ? c.v[k + 1] - c.v[k] : 0;
         return {around(axis), along(axis, dv)};
     }
