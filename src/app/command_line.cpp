@@ -153,6 +153,11 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     cli.add_option("--max-modules", options.max_modules,
                    "Stop a derivation whose string grows past this many modules (default 1e8)")
         ->check(CLI::Range(std::size_t{1}, std::size_t{1'000'000'000}));
+    std::string max_memory;
+    cli.add_option("--max-memory", max_memory,
+                   "Memory budget for the derived strings, the scene's geometry and each "
+                   "texture, e.g. 8G or 512M (default: half the physical memory, " +
+                       byte_size_text(options.max_memory_bytes) + " here)");
     cli.add_option("--steps", options.steps,
                    "Derivation steps, instead of the L-system's derivation length")
         ->check(CLI::Range(0, 1'000'000));
@@ -195,6 +200,9 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
         ->check(CLI::Range(-3600.0f, 3600.0f));
     cli.add_flag("--allow-system-calls", options.allow_system_calls,
                  "Run the commands of @S modules (never done by default)");
+    cli.add_flag("--allow-file-access", options.allow_file_access,
+                 "Let the L-system's fopen read and write files outside the model's folder "
+                 "(never done by default)");
     cli.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
     std::vector<std::string> files;
     cli.add_option("files", files, "plant.l plant.v [plant.a]")->required()->expected(2, 3);
@@ -216,6 +224,13 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
         options.samples_per_pixel = 1 << 16;
     else if (cli.count("--spp") == 0 && options.noise_target > 0)
         options.samples_per_pixel = 4096;
+    if (!max_memory.empty()) {
+        std::optional<std::uint64_t> bytes = parse_byte_size(max_memory);
+        if (!bytes)
+            throw Error("--max-memory: '" + max_memory +
+                        "' is not a size such as 8G, 512M or 1000000 (bytes, at least 1)");
+        options.max_memory_bytes = *bytes;
+    }
     if (options.sky && options.environment_map)
         throw Error("--sky and --env both set what surrounds the plant; give one");
     if (cli.count("--turbidity") > 0 && !options.sky)

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "base/limits.h"
+
 namespace cambium::app {
 
 /// A colormap (-m[n]) or material file (-M[n]) for colour-table block n.
@@ -29,10 +31,13 @@ struct Options {
     // Language (cpfg options)
     std::string preprocessor = "cpp";          ///< -P
     std::size_t max_modules = 100'000'000;     ///< --max-modules
+    /// --max-memory: derivation, interpretation and each texture (base/limits.h)
+    std::uint64_t max_memory_bytes = default_max_memory_bytes();
     std::optional<int> steps;                  ///< --steps: derivation steps instead of the file's
     Verbosity verbosity = Verbosity::normal;
     bool environment_requested = false;        ///< -e: no environment program is connected
     bool allow_system_calls = false;           ///< @S runs commands only with this
+    bool allow_file_access = false;            ///< fopen outside the model's folder
 
     // Outputs besides images (cpfg options, file names may be format strings)
     std::optional<std::filesystem::path> string_text;    ///< -str

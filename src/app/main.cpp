@@ -56,6 +56,7 @@ render::RenderSettings render_settings(const Options& options,
     settings.max_depth = options.max_depth;
     settings.seed = options.seed;
     settings.threads = options.threads;
+    settings.max_memory_bytes = options.max_memory_bytes;
     settings.filter = pixel_filter(options.filter);
     settings.filter_radius = options.filter_radius;
     settings.noise_target = options.noise_target;

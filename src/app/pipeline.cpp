@@ -54,6 +54,8 @@ Model load_model(const Options& options)
 
     lsys::LoadOptions load;
     load.max_modules = options.max_modules;
+    load.max_memory_bytes = options.max_memory_bytes;
+    load.allow_file_access = options.allow_file_access;
     load.preprocessor = options.preprocessor;
     load.defines = functions->define_names();
     if (!functions->empty())
@@ -94,6 +96,7 @@ geom::Scene interpret(const Model& model, const lsys::ModuleString& derived,
 {
     geom::InterpretOptions interpret_options;
     interpret_options.strings = model.lsystem.program().strings;
+    interpret_options.max_memory_bytes = options.max_memory_bytes;
     // -o> objects become prototypes and instances (docs: manual 8.1); with -homo the
     // string already holds their expansions.
     std::vector<char> objects =

@@ -165,6 +165,34 @@ std::array<float, 12> object_transform(const Turtle& t)
 /// "node" (F f G g [ ] and the end of the string), so `F!F` tapers its first segment
 /// (`tapered lines: on`, cpfg's default). Consecutive segments share their joint key,
 /// which carries that width, and get Embree's neighbour flags.
+/// Modules between two checks of the Scene's size against the memory budget: the
+/// check sums a few dozen capacities, and the Scene grows by a few hundred bytes a module.
+constexpr std::size_t memory_check_interval = 4096;
+
+template <class T>
+std::size_t vector_bytes(const std::vector<T>& v)
+{
+    return v.capacity() * sizeof(T);
+}
+
+std::size_t geometry_bytes(const Geometry& g)
+{
+    return vector_bytes(g.lines.keys) + vector_bytes(g.lines.v) + vector_bytes(g.lines.segments) +
+           vector_bytes(g.lines.flags) + vector_bytes(g.lines.material) +
+           vector_bytes(g.lines.texture) + vector_bytes(g.curves.points) +
+           vector_bytes(g.curves.tangents) + vector_bytes(g.curves.v) +
+           vector_bytes(g.curves.segments) + vector_bytes(g.curves.flags) +
+           vector_bytes(g.curves.material) + vector_bytes(g.curves.texture) +
+           vector_bytes(g.curves.end_material) + vector_bytes(g.spheres.centres) +
+           vector_bytes(g.spheres.material) + vector_bytes(g.spheres.texture) +
+           vector_bytes(g.discs.centres) + vector_bytes(g.discs.normals) +
+           vector_bytes(g.discs.material) + vector_bytes(g.discs.back_material) +
+           vector_bytes(g.mesh.positions) + vector_bytes(g.mesh.normals) +
+           vector_bytes(g.mesh.uvs) + vector_bytes(g.mesh.triangles) +
+           vector_bytes(g.mesh.material) + vector_bytes(g.mesh.back_material) +
+           vector_bytes(g.mesh.texture);
+}
+
 class Interpreter {
     /// A polygon vertex: the turtle's position and the frame its texture axes use.
     struct PolygonCorner {
@@ -212,11 +240,29 @@ public:
         string.for_each([&](lsys::ModuleRef m) {
             interpret_module(m, m_root == this);
             ++m_module_index;
+            if (m_root == this && m_module_index % memory_check_interval == 0)
+                check_memory();
         });
         end_node();
         if (!m_polygons.empty())
             warn(std::to_string(m_polygons.size()) +
                  " polygon(s) left open at the end of the string are not drawn");
+    }
+
+    /// The Scene's arrays past the memory budget: an error rather than std::bad_alloc (or
+    /// the system's OOM killer) later, in Embree.
+    void check_memory() const
+    {
+        std::size_t bytes = geometry_bytes(m_scene.geometry);
+        for (const Prototype& p : m_scene.prototypes)
+            bytes += geometry_bytes(p.geometry);
+        bytes += m_scene.instances.capacity() * sizeof(Instance);
+        if (bytes > m_options.max_memory_bytes)
+            throw Error("the scene's geometry needs " + byte_size_text(bytes) + " after " +
+                        std::to_string(m_module_index) +
+                        " modules of the string, more than the memory budget of " +
+                        byte_size_text(m_options.max_memory_bytes) +
+                        " (--max-memory); reduce the derivation length or raise --max-memory");
     }
 
     /// Records the answers of query modules (?P ?H ?L ?U) while interpreting.

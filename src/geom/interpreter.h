@@ -6,6 +6,7 @@
 #include <span>
 #include <string>
 
+#include "base/limits.h"
 #include "geom/scene.h"
 #include "geom/view_file.h"
 #include "lsys/module_string.h"
@@ -37,6 +38,10 @@ struct InterpretOptions {
     /// expansion are never objects again. Unset: the string is interpreted as it is.
     std::function<bool(lsys::SymbolId)> is_object;
     std::function<lsys::ModuleString(lsys::ModuleRef)> expand_object;
+
+    /// What the Scene's primitive arrays may take (--max-memory): interpretation stops
+    /// with an error once they grow past it (checked every few thousand modules).
+    std::uint64_t max_memory_bytes = default_max_memory_bytes();
 };
 
 /// The view file's `rayshade objects: FORMAT [turtle considered]` (cpfg's

@@ -4,12 +4,19 @@
 
 #include <algorithm>
 #include <array>
+#include <climits>
+#include <cmath>
+#include <new>
 
 #include "base/diagnostics.h"
 
 namespace cambium::lsys {
 
 namespace {
+
+/// The largest `maximum depth:` accepted (decomposition passes; the homomorphism is cut
+/// to max_homomorphism_depth).
+constexpr long long max_depth_setting = 1'000'000;
 
 std::size_t predicted(std::size_t size, double growth)
 {
@@ -67,6 +74,7 @@ Deriver::Deriver(const Program& program, DeriveLimits limits)
     m_runtime.function = &m_limits.function;
     m_runtime.curve = &m_limits.curve;
     m_runtime.file_name = &program.file_name;
+    m_runtime.allow_file_access = m_limits.allow_file_access;
     m_warning = [this](const std::string& message, int site) {
         warn(location(site), message + ", " + context());
     };
@@ -79,6 +87,8 @@ Deriver::Deriver(const Program& program, DeriveLimits limits)
         start();
     } catch (const EvaluationError& e) {
         fail(e);
+    } catch (const std::bad_alloc&) {
+        out_of_memory(m_string.memory_bytes(), m_string);
     }
 }
 
@@ -87,8 +97,9 @@ void Deriver::start()
     const LSystemDefinition& main = m_program.lsystems.front();
     if (main.derivation_length) {
         in_block("'derivation length:'");
-        m_runtime.derivation_length =
-            static_cast<int>(evaluate(*main.derivation_length, m_frame, m_runtime));
+        m_runtime.derivation_length = static_cast<int>(
+            setting(*main.derivation_length, main.derivation_length_loc, "the derivation length",
+                    0, max_derivation_steps));
     }
     // seed: makes the L-system stochastic. The production choice draws from erand48 on
     // a state that starts at 0 and that cpfg (the build the corpus oracle comes from)
@@ -141,8 +152,9 @@ void Deriver::fail(const EvaluationError& e) const
 
 int Deriver::lsystem_index(double id) const
 {
+    // compared as numbers: converting an arbitrary parameter to int is undefined
     for (std::size_t i = 0; i < m_program.lsystems.size(); ++i)
-        if (m_program.lsystems[i].id == static_cast<int>(id))
+        if (static_cast<double>(m_program.lsystems[i].id) == std::trunc(id))
             return static_cast<int>(i);
     return -1;
 }
@@ -155,6 +167,7 @@ void Deriver::set_runtime(const Runtime& runtime)
     m_runtime.file_name = &m_program.file_name;
     m_runtime.strings = &m_program.strings;
     m_runtime.warning = &m_warning;
+    m_runtime.allow_file_access = m_limits.allow_file_access;
 }
 
 void Deriver::index(const ModuleString& s, Indexed& out, bool force) const
@@ -192,6 +205,9 @@ void Deriver::step()
         step_located();
     } catch (const EvaluationError& e) {
         fail(e);
+    } catch (const std::bad_alloc&) {
+        // the budget is checked as the string grows; this is the system running out first
+        out_of_memory(m_string.memory_bytes() + m_next.memory_bytes(), m_next);
     }
 }
 
@@ -203,8 +219,13 @@ void Deriver::step_located()
     m_next.clear();
     // Reserve what the last step's growth predicts, so the new string is not
     // reallocated (and briefly held twice) while it is built
-    m_next.reserve(predicted(m_string.size(), m_module_growth),
-                   predicted(m_string.param_total(), m_param_growth));
+    // (not past the memory budget: the prediction may be wrong, the budget is not)
+    std::size_t modules_ahead = predicted(m_string.size(), m_module_growth);
+    std::size_t params_ahead = predicted(m_string.param_total(), m_param_growth);
+    if (static_cast<double>(modules_ahead) * 3 + static_cast<double>(params_ahead) * 4 +
+            static_cast<double>(m_string.memory_bytes()) <
+        static_cast<double>(m_limits.max_memory_bytes))
+        m_next.reserve(modules_ahead, params_ahead);
     std::size_t modules = m_string.size(), params = m_string.param_total();
     rewrite(m_indexed, m_next, false);
     m_module_growth = growth(modules, m_next.size());
@@ -238,7 +259,11 @@ void Deriver::decompose()
     if (set.productions.empty())
         return;
     in_block("the decomposition's 'maximum depth:'");
-    int depth = set.max_depth ? static_cast<int>(evaluate(*set.max_depth, m_frame, m_runtime)) : 1;
+    int depth = set.max_depth
+                    ? static_cast<int>(setting(*set.max_depth, set.max_depth_loc,
+                                               "the decomposition's maximum depth", 0,
+                                               max_depth_setting))
+                    : 1;
     std::size_t applied = 0;
     for (int pass = 0; pass < depth; ++pass) {
         index(m_string, m_indexed);
@@ -266,6 +291,7 @@ void Deriver::decompose()
 std::size_t Deriver::rewrite(const Indexed& src, ModuleString& dst, bool decomposition)
 {
     const ModuleString& s = *src.string;
+    m_source = &s;
     m_lsystem_stack.assign(1, 0);
     std::size_t applied = 0;
     std::size_t offset = 0;  // first parameter of module i
@@ -341,8 +367,44 @@ void Deriver::check_size(const ModuleString& s) const
     if (s.size() > m_limits.max_modules)
         throw Error(FileLoc{m_program.file_name, 0, 0},
                     "the string grew past " + std::to_string(m_limits.max_modules) +
-                        " modules in step " + std::to_string(m_steps + 1) +
+                        " modules in " + phase() +
                         "; reduce the derivation length or raise the limit");
+    // What a step holds at once: the string it builds from, its context index and the
+    // string being built, at its next peak (when a full array grows, its old block and
+    // the new one, a quarter larger, are held at once)
+    std::size_t bytes = s.peak_bytes() +
+                        (m_source && m_source != &s ? m_source->memory_bytes() : 0) +
+                        (m_indexed.offsets.capacity() + m_indexed.partner.capacity()) *
+                            sizeof(std::uint32_t);
+    if (bytes > m_limits.max_memory_bytes)
+        out_of_memory(bytes, s);
+}
+
+std::string Deriver::phase() const
+{
+    return m_in_homomorphism ? std::string("the homomorphism")
+                             : "step " + std::to_string(m_steps + 1);
+}
+
+void Deriver::out_of_memory(std::size_t bytes, const ModuleString& s) const
+{
+    throw Error(FileLoc{m_program.file_name, 0, 0},
+                "the derivation needs " + byte_size_text(bytes) + " in " + phase() +
+                    ", more than the memory budget of " +
+                    byte_size_text(m_limits.max_memory_bytes) + " (--max-memory); the string " +
+                    "has " + std::to_string(s.size()) + " modules with " +
+                    std::to_string(s.param_total()) +
+                    " parameters so far; reduce the derivation length or raise --max-memory");
+}
+
+long long Deriver::setting(const Code& code, const FileLoc& loc, const std::string& what,
+                           long long lo, long long hi)
+{
+    double value = evaluate(code, m_frame, m_runtime);
+    if (std::optional<long long> whole = truncated_in(value, lo, hi))
+        return *whole;
+    throw Error(loc, what + " is " + number_text(value) + "; it must be a number from " +
+                         std::to_string(lo) + " to " + std::to_string(hi));
 }
 
 bool Deriver::apply_first_match(const ProductionSet& set, const LSystemDefinition& ls,
@@ -559,6 +621,8 @@ void Deriver::append_evaluated(const ModuleTemplate& m, ModuleString& dst)
 
 namespace {
 
+/// Homomorphism productions apply recursively, one stack frame per level: deeper
+/// `maximum depth:` values are cut here with a warning.
 constexpr int max_homomorphism_depth = 1000;
 
 ParamLink make_link(std::size_t from, std::size_t to, std::size_t count)
@@ -573,13 +637,18 @@ void Deriver::apply_homomorphism(const ModuleString& in, ModuleString& out,
                                  std::vector<ParamLink>* query_links, bool keep_objects)
 {
     m_keep_objects = keep_objects;
+    m_in_homomorphism = true;
+    m_source = &in;
     try {
         homomorphism_located(in, out, query_links);
     } catch (const EvaluationError& e) {
-        m_keep_objects = false;
+        m_keep_objects = m_in_homomorphism = false;
         fail(e);
+    } catch (const std::bad_alloc&) {
+        out_of_memory(in.memory_bytes() + out.memory_bytes(), out);
     }
-    m_keep_objects = false;
+    m_keep_objects = m_in_homomorphism = false;
+    m_source = nullptr;
 }
 
 void Deriver::homomorphism_located(const ModuleString& in, ModuleString& out,
@@ -608,12 +677,16 @@ void Deriver::homomorphism_located(const ModuleString& in, ModuleString& out,
     const ProductionSet& main_set = m_program.lsystems.front().homomorphism;
     in_block("the homomorphism's 'seed:' or 'maximum depth:'");
     m_homomorphism_random.seed(
-        main_set.seed ? static_cast<long>(evaluate(*main_set.seed, m_frame, m_runtime)) : 0);
+        main_set.seed ? static_cast<long>(setting(*main_set.seed, main_set.seed_loc,
+                                                  "the homomorphism's seed", LONG_MIN, LONG_MAX))
+                      : 0);
     std::vector<int> depth_of(m_program.lsystems.size(), 1);
     for (std::size_t l = 0; l < m_program.lsystems.size(); ++l) {
         const ProductionSet& set = m_program.lsystems[l].homomorphism;
         if (set.max_depth)
-            depth_of[l] = static_cast<int>(evaluate(*set.max_depth, m_frame, m_runtime));
+            depth_of[l] = static_cast<int>(setting(*set.max_depth, set.max_depth_loc,
+                                                   "the homomorphism's maximum depth", 0,
+                                                   max_depth_setting));
         if (depth_of[l] > max_homomorphism_depth) {
             warn(set.productions.empty() ? FileLoc{m_program.file_name, 0, 0}
                                          : set.productions.front().loc,

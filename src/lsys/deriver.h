@@ -7,12 +7,18 @@
 #include <functional>
 #include <vector>
 
+#include "base/limits.h"
 #include "lsys/program.h"
 
 namespace cambium::lsys {
 
 struct DeriveLimits {
     std::size_t max_modules = 100'000'000;  ///< string growth limit
+    /// What the string being built and the one it is built from may take together
+    /// (their modules and parameters, as allocated)
+    std::uint64_t max_memory_bytes = default_max_memory_bytes();
+    /// fopen may open files outside the model's folder
+    bool allow_file_access = false;
     /// func(id, x) of the view file's function set; unset: 0 with one warning
     std::function<double(int, double)> function;
     /// curveX/Y/Z(id, t) ('x' 'y' 'z') and curveGAL(id) ('l') of the view file's curves
@@ -126,6 +132,10 @@ private:
     std::size_t cut_end(const ModuleString& s, std::size_t i) const;
     void decompose();
     void check_size(const ModuleString& s) const;
+    [[noreturn]] void out_of_memory(std::size_t bytes, const ModuleString& building) const;
+    std::string phase() const;
+    long long setting(const Code& code, const FileLoc& loc, const std::string& what,
+                      long long lo, long long hi);
     int lsystem_index(double id) const;
 
     const Program& m_program;
@@ -134,6 +144,7 @@ private:
     Rand48 m_stochastic;
     ModuleString m_string, m_next;
     Indexed m_indexed;
+    const ModuleString* m_source = nullptr;  ///< the string being rewritten, for check_size
     std::vector<double> m_frame;
     /// Every production's variables between applications (Production::storage); the
     /// frame holds those of m_frame_owner and goes back there when another takes it.
@@ -147,6 +158,7 @@ private:
     int m_steps = 0;
     bool m_needs_index = false;          ///< some production has a context
     bool m_keep_objects = false;         ///< apply_homomorphism leaves objects as they are
+    bool m_in_homomorphism = false;      ///< apply_homomorphism is running (for messages)
     double m_module_growth = 1.0, m_param_growth = 1.0;  ///< last step's, for reserve()
     int m_bracket_open = -1, m_bracket_close = -1, m_cut = -1, m_sub_start = -1, m_sub_end = -1;
     int m_equals = -1;

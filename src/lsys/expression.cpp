@@ -7,10 +7,16 @@
 #include <cmath>
 #include <cctype>
 #include <cerrno>
+#include <climits>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <numbers>
+#include <optional>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "base/diagnostics.h"
 
@@ -20,6 +26,9 @@ namespace {
 
 constexpr double to_radians = std::numbers::pi / 180.0;
 constexpr int max_stack_depth = 256;
+/// printf widths and precisions: at most 99 (digits), so one conversion prints at most
+/// a few hundred characters
+constexpr std::size_t max_format_digits = 2;
 
 constexpr std::array<FunctionInfo, 31> functions = {{
     {"sin", Function::Sin, 1},     {"cos", Function::Cos, 1},
@@ -95,6 +104,22 @@ void warn_unbound(Runtime& rt, const std::string& what)
         warn(message);
 }
 
+constexpr long long max_biran_trials = 100'000'000;
+
+/// A function or curve id: out of int's range it names no function (0, which geom
+/// reports as undefined).
+int id_value(double id) { return static_cast<int>(truncated_in(id, INT_MIN, INT_MAX).value_or(0)); }
+
+/// A seed for srand48: a whole number within long's range.
+long seed_value(double seed, const char* what)
+{
+    std::optional<long long> whole = truncated_in(seed, LONG_MIN, LONG_MAX);
+    if (!whole)
+        throw EvaluationError(std::string(what) + ": the seed " + number_text(seed) +
+                              " is not a number within +-9.2e18");
+    return static_cast<long>(*whole);
+}
+
 double call(Function f, const double* a, Runtime& rt)
 {
     switch (f) {
@@ -119,14 +144,19 @@ double call(Function f, const double* a, Runtime& rt)
     case Function::Nran: return normal_random(rt, a[0], a[1]);
     case Function::Bran: return beta_random(rt.function_random, a[0], a[1]);
     case Function::Biran: {
-        int n = static_cast<int>(a[0]);
+        // one draw per trial: bound the trials so that a call cannot run for hours
+        std::optional<long long> trials = truncated_in(a[0], INT_MIN, max_biran_trials);
+        if (!trials)
+            throw EvaluationError("biran(" + number_text(a[0]) + ", p): the number of trials "
+                                  "must be at most " + number_text(max_biran_trials));
+        long long n = *trials;
         int count = 0;
-        for (int i = 0; i < n; ++i)
+        for (long long i = 0; i < n; ++i)
             count += rt.function_random.next_double() <= a[1] ? 1 : 0;
         return count;
     }
     case Function::Srand:
-        rt.function_random.seed(static_cast<long>(a[0]));
+        rt.function_random.seed(seed_value(a[0], "srand()"));
         rt.normal_cached = false;
         return 0;
     case Function::Stop:
@@ -135,18 +165,19 @@ double call(Function f, const double* a, Runtime& rt)
         return 0;
     case Function::GetDerivationLength: return rt.derivation_length;
     case Function::SetDerivationLength:
-        rt.derivation_length = static_cast<int>(a[0]);
+        rt.derivation_length = derivation_steps(a[0], "SetDerivationLength()");
         return 0;
     case Function::Fopen: {
         std::string l_file = rt.file_name ? *rt.file_name : std::string();
         auto text = [&](double index) -> std::string {
-            auto i = static_cast<std::size_t>(index);
-            if (!rt.strings || index < 0 || i >= rt.strings->size())
+            std::optional<long long> i =
+                truncated_in(index, 0, rt.strings ? static_cast<long long>(rt.strings->size()) - 1 : -1);
+            if (!i)
                 throw EvaluationError("fopen needs a file name and a mode in quotes");
-            return (*rt.strings)[i];
+            return (*rt.strings)[static_cast<std::size_t>(*i)];
         };
         std::string base = std::filesystem::path(l_file).parent_path().string();
-        return rt.files->open(base, text(a[0]), text(a[1]));
+        return rt.files->open(base, text(a[0]), text(a[1]), rt.allow_file_access);
     }
     case Function::Fclose:
         rt.files->close(a[0]);
@@ -157,7 +188,7 @@ double call(Function f, const double* a, Runtime& rt)
     case Function::Func:
         // function sets live in the view file (geom); the caller binds them
         if (rt.function && *rt.function)
-            return (*rt.function)(static_cast<int>(a[0]), a[1]);
+            return (*rt.function)(id_value(a[0]), a[1]);
         warn_unbound(rt, "func()");
         return 0;
     case Function::CurveX:
@@ -169,7 +200,7 @@ double call(Function f, const double* a, Runtime& rt)
                      : f == Function::CurveZ ? 'z'
                                              : 'l';
         if (rt.curve && *rt.curve)
-            return (*rt.curve)(which, static_cast<int>(a[0]), which == 'l' ? 0.0 : a[1]);
+            return (*rt.curve)(which, id_value(a[0]), which == 'l' ? 0.0 : a[1]);
         warn_unbound(rt, "curveX/curveY/curveZ/curveGAL()");
         return 0;
     }
@@ -177,34 +208,117 @@ double call(Function f, const double* a, Runtime& rt)
     return 0;
 }
 
-/// printf with only %f/%g/%e-style conversions, each given one double.
-std::string format_values(const std::string& format, const double* args, int count)
+/// One validated printf conversion, split into the parts format_values rebuilds.
+struct Conversion {
+    std::string_view flags;
+    std::string_view width;
+    std::string_view precision;  ///< with its '.', or empty
+    char type = 0;               ///< e E f F g G d i c, or '%'
+    std::size_t end = 0;         ///< index just past it in the format
+};
+
+bool is_digit_char(char c) { return c >= '0' && c <= '9'; }
+bool one_of(const char* set, char c) { return c != 0 && std::strchr(set, c) != nullptr; }
+
+/// The conversion starting at format[i] == '%' (see check_format), or a problem.
+std::optional<Conversion> read_conversion(std::string_view format, std::size_t i,
+                                          bool scanning, std::string& problem)
+{
+    Conversion c;
+    std::size_t j = i + 1;
+    auto span_while = [&](auto accept) {
+        std::size_t from = j;
+        while (j < format.size() && accept(format[j]))
+            ++j;
+        return format.substr(from, j - from);
+    };
+    if (!scanning)
+        c.flags = span_while([](char ch) { return one_of("-+ #0", ch); });
+    c.width = span_while(is_digit_char);
+    if (!scanning && j < format.size() && format[j] == '.') {
+        std::size_t dot = j++;
+        span_while(is_digit_char);
+        c.precision = format.substr(dot, j - dot);
+    }
+    if (c.width.size() > max_format_digits || c.precision.size() > max_format_digits + 1) {
+        problem = "width and precision may have at most " + std::to_string(max_format_digits) +
+                  " digits";
+        return std::nullopt;
+    }
+    // 'l' before a floating conversion changes nothing in C (the corpus writes %lf)
+    bool long_modifier = j < format.size() && format[j] == 'l';
+    if (long_modifier)
+        ++j;
+    if (j >= format.size()) {
+        problem = "the format ends inside a conversion";
+        return std::nullopt;
+    }
+    c.type = format[j];
+    c.end = j + 1;
+    bool floating = one_of("eEfFgG", c.type);
+    bool integer = one_of(scanning ? "di" : "dic", c.type);
+    bool percent = c.type == '%' && c.end == i + 2;
+    if (percent && !scanning)
+        return c;
+    if (c.type == '*' || (!floating && !integer) || (long_modifier && !floating)) {
+        problem = "conversion '" + std::string(format.substr(i, c.end - i)) +
+                  "' is not allowed; only " +
+                  (scanning ? "%[width][l](d i e E f F g G)"
+                            : "%[flags][width][.precision](e E f F g G d i c), %lf and %%") +
+                  " are";
+        return std::nullopt;
+    }
+    return c;
+}
+
+/// The int a %d %i %c conversion prints: C's conversion, saturated instead of undefined
+/// outside int's range (NaN prints 0).
+int saturated_int(double v)
+{
+    if (!(v == v))
+        return 0;
+    if (v >= 2147483647.0)
+        return 2147483647;
+    if (v <= -2147483648.0)
+        return -2147483647 - 1;
+    return static_cast<int>(v);
+}
+
+/// printf over a format that check_format accepted: each conversion is rebuilt from its
+/// validated parts and given one value (a value missing is 0), so no user text reaches
+/// libc as a format.
+std::string format_values(std::string_view format, const double* args, int count)
 {
     std::string out;
     int used = 0;
+    std::string problem;
     for (std::size_t i = 0; i < format.size(); ++i) {
-        if (format[i] != '%' || i + 1 >= format.size()) {
+        if (format[i] != '%') {
             out += format[i];
             continue;
         }
-        std::size_t j = i + 1;
-        while (j < format.size() && std::string_view("0123456789.-+ #l").find(format[j]) !=
-                                        std::string_view::npos)
-            ++j;
-        if (j >= format.size())
-            break;
-        std::string spec = format.substr(i, j - i + 1);
-        char buf[128];
-        if (format[j] == '%')
+        std::optional<Conversion> c = read_conversion(format, i, false, problem);
+        if (!c)
+            throw EvaluationError("printf format \"" + std::string(format) + "\": " + problem);
+        i = c->end - 1;
+        if (c->type == '%') {
             out += '%';
-        else if (std::string_view("dic").find(format[j]) != std::string_view::npos)
-            std::snprintf(buf, sizeof buf, (format.substr(i, j - i) + "d").c_str(),
-                          used < count ? static_cast<int>(args[used++]) : 0),
-                out += buf;
+            continue;
+        }
+        double value = used < count ? args[used++] : 0.0;
+        bool integer = one_of("dic", c->type);
+        std::string spec(1, '%');
+        spec.append(c->flags).append(c->width).append(c->precision).push_back(c->type);
+        int n = integer ? std::snprintf(nullptr, 0, spec.c_str(), saturated_int(value))
+                        : std::snprintf(nullptr, 0, spec.c_str(), value);
+        if (n <= 0)
+            continue;
+        std::string text(static_cast<std::size_t>(n) + 1, '\0');
+        if (integer)
+            std::snprintf(text.data(), text.size(), spec.c_str(), saturated_int(value));
         else
-            std::snprintf(buf, sizeof buf, spec.c_str(), used < count ? args[used++] : 0.0),
-                out += buf;
-        i = j;
+            std::snprintf(text.data(), text.size(), spec.c_str(), value);
+        out.append(text.data(), static_cast<std::size_t>(n));
     }
     return out;
 }
@@ -263,13 +377,6 @@ int scan_values(std::FILE* file, const std::string& format, double* values, int 
     return read;
 }
 
-std::string number_text(double v)
-{
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
-}
-
 double int_modulo(double a, double b)
 {
     // cpfg takes % on ints, and its int % 0 kills the process: say so instead
@@ -314,6 +421,52 @@ void warn_division_by_zero(Runtime& rt, int site)
 
 }  // namespace
 
+std::optional<long long> truncated_in(double value, long long lo, long long hi)
+{
+    // compare before converting: the conversion itself is undefined out of range
+    // (2^63 itself is a double within LLONG_MAX's rounding but not a long long)
+    constexpr double two_to_63 = 9223372036854775808.0;
+    double whole = std::trunc(value);
+    if (!(whole >= static_cast<double>(lo) && whole <= static_cast<double>(hi) &&
+          whole < two_to_63))
+        return std::nullopt;
+    return static_cast<long long>(whole);
+}
+
+int derivation_steps(double steps, const std::string& what)
+{
+    std::optional<long long> whole = truncated_in(steps, 0, max_derivation_steps);
+    if (!whole)
+        throw EvaluationError(what + " is " + number_text(steps) + "; it must be from 0 to " +
+                              std::to_string(max_derivation_steps) + " steps");
+    return static_cast<int>(*whole);
+}
+
+std::string number_text(double v)
+{
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+}
+
+FormatCheck check_format(std::string_view format, bool scanning)
+{
+    FormatCheck check;
+    for (std::size_t i = 0; i < format.size(); ++i) {
+        if (format[i] != '%')
+            continue;
+        std::optional<Conversion> c = read_conversion(format, i, scanning, check.problem);
+        if (!c) {
+            check.at = i;
+            return check;
+        }
+        if (c->type != '%')
+            ++check.conversions;
+        i = c->end - 1;
+    }
+    return check;
+}
+
 OpenFiles::~OpenFiles()
 {
     for (std::FILE* f : m_files)
@@ -321,8 +474,68 @@ OpenFiles::~OpenFiles()
             std::fclose(f);
 }
 
+namespace {
+
+/// Whether `path` is `folder` or lies below it (both canonical).
+bool is_within(const std::filesystem::path& folder, const std::filesystem::path& path)
+{
+    auto [f, p] = std::mismatch(folder.begin(), folder.end(), path.begin(), path.end());
+    return f == folder.end();
+}
+
+/// The file `name` names in the model's folder `base_dir`, links and ".." resolved,
+/// or an EvaluationError when it lies outside.
+std::filesystem::path confined_path(const std::string& base_dir, const std::string& name)
+{
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    fs::path folder = fs::canonical(base_dir.empty() ? fs::path(".") : fs::path(base_dir), ec);
+    if (ec)
+        throw EvaluationError("fopen(\"" + name + "\"): the model's folder '" + base_dir +
+                              "' cannot be resolved: " + ec.message());
+    fs::path path = fs::weakly_canonical(folder / name, ec);
+    // a link whose target does not exist yet stays unresolved: judge it by its target
+    // (open_regular does not follow it either way)
+    std::error_code link_ec;
+    if (!ec && fs::is_symlink(fs::symlink_status(path, link_ec))) {
+        fs::path target = fs::read_symlink(path, link_ec);
+        if (!link_ec)
+            path = fs::weakly_canonical(
+                target.is_absolute() ? target : path.parent_path() / target, ec);
+    }
+    if (ec || !is_within(folder, path) || path == folder)
+        throw EvaluationError("fopen(\"" + name + "\"): '" + (ec ? name : path.string()) +
+                              "' is outside the model's folder '" + folder.string() +
+                              "'; an L-system opens files only there and below "
+                              "(--allow-file-access lifts this)");
+    return path;
+}
+
+/// Opens a confined file without following a link in its last component (a link that
+/// points nowhere yet would create its target) and only if it is a regular file, so a
+/// device or a FIFO is neither read nor waited on.
+std::FILE* open_regular(const std::filesystem::path& path, const std::string& mode)
+{
+    int flags = mode == "r" ? O_RDONLY : O_WRONLY | O_CREAT | (mode == "a" ? O_APPEND : O_TRUNC);
+    int fd = ::open(path.c_str(), flags | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC, 0666);
+    if (fd < 0)
+        return nullptr;
+    struct stat st {};
+    if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        ::close(fd);
+        throw EvaluationError("fopen: '" + path.string() + "' is not a regular file");
+    }
+    ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+    std::FILE* f = ::fdopen(fd, mode.c_str());
+    if (!f)
+        ::close(fd);
+    return f;
+}
+
+}  // namespace
+
 int OpenFiles::open(const std::string& base_dir, const std::string& name,
-                    const std::string& mode)
+                    const std::string& mode, bool anywhere)
 {
     if (mode != "r" && mode != "w" && mode != "a")
         throw EvaluationError("fopen(\"" + name + "\", \"" + mode +
@@ -334,9 +547,15 @@ int OpenFiles::open(const std::string& base_dir, const std::string& name,
         throw EvaluationError("fopen(\"" + name + "\"): more than " +
                               std::to_string(max_open) + " files open at once");
     std::filesystem::path path(name);
-    if (path.is_relative() && !base_dir.empty())
-        path = std::filesystem::path(base_dir) / path;
-    std::FILE* f = std::fopen(path.string().c_str(), mode.c_str());
+    std::FILE* f = nullptr;
+    if (anywhere) {
+        if (path.is_relative() && !base_dir.empty())
+            path = std::filesystem::path(base_dir) / path;
+        f = std::fopen(path.string().c_str(), mode.c_str());
+    } else {
+        path = confined_path(base_dir, name);
+        f = open_regular(path, mode);
+    }
     if (!f)
         throw EvaluationError("fopen: cannot open '" + path.string() + "' for " +
                               (mode == "r" ? "reading" : "writing") + ": " +

@@ -6,9 +6,11 @@
 #include <cstdio>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "lsys/random.h"
@@ -78,9 +80,12 @@ public:
     OpenFiles(const OpenFiles&) = delete;
     OpenFiles& operator=(const OpenFiles&) = delete;
     ~OpenFiles();
-    /// Opens `name` (relative to `base_dir`) with mode "r", "w" or "a"; returns its index.
-    /// Failures throw EvaluationError.
-    int open(const std::string& base_dir, const std::string& name, const std::string& mode);
+    /// Opens `name` (relative to `base_dir`, the model's folder) with mode "r", "w" or
+    /// "a"; returns its index. Unless `anywhere`, the file must be a regular file (or a
+    /// new one) inside `base_dir` or below once symbolic links and ".." are resolved
+    /// (docs/security.md). Failures throw EvaluationError.
+    int open(const std::string& base_dir, const std::string& name, const std::string& mode,
+             bool anywhere = false);
     /// The open file with `index`, or throws EvaluationError.
     std::FILE* get(double index) const;
     void close(double index);
@@ -115,6 +120,8 @@ struct Runtime {
     /// unknown); the Deriver names the production. Unset: a plain warning.
     const std::function<void(const std::string& message, int site)>* warning = nullptr;
     std::shared_ptr<OpenFiles> files = std::make_shared<OpenFiles>();
+    /// fopen may open files outside the model's folder (--allow-file-access)
+    bool allow_file_access = false;
 };
 
 /// A failure while evaluating: an array subscript out of range, '%' by 0, a file
@@ -137,6 +144,32 @@ private:
 /// Runs `code` with the given local frame. Returns the value left on top of the stack
 /// (0 for statement code).
 double evaluate(const Code& code, std::span<double> frame, Runtime& runtime);
+
+/// A printf, fprintf or fscanf format checked when the L-system is compiled (formats are
+/// always literals). printf formats allow only %[flags][width][.precision] followed by
+/// e E f F g G (each takes a number), d i c (each takes a number converted to int), %lf
+/// and the like (C's 'l' changes nothing there), and %%; width and precision at most 99.
+/// fscanf formats (`scanning`) allow %[width][l] with d i e E f F g G.
+struct FormatCheck {
+    int conversions = 0;   ///< the values the format takes (%% takes none)
+    std::string problem;   ///< empty when the format is accepted
+    std::size_t at = 0;    ///< index in the format of the '%' that the problem is at
+};
+FormatCheck check_format(std::string_view format, bool scanning = false);
+
+/// `value` truncated toward zero (C's conversion to an integer) when that lies in
+/// [lo, hi]; nullopt when it is NaN or outside, where C's conversion is undefined. Every
+/// conversion of a user's number to an integer goes through here.
+std::optional<long long> truncated_in(double value, long long lo, long long hi);
+
+/// The most steps a derivation length (and --steps) may ask for.
+constexpr int max_derivation_steps = 1'000'000;
+/// `steps` as a derivation length (truncated as cpfg's int conversion), or an
+/// EvaluationError "`what` is ...; it must be from 0 to 1000000 steps".
+int derivation_steps(double steps, const std::string& what);
+
+/// A number for messages, as %g prints it.
+std::string number_text(double value);
 
 /// Function properties used by the compiler.
 struct FunctionInfo {

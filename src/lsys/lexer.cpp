@@ -100,7 +100,9 @@ bool Lexer::skip_line_marker()
         return false;
     std::size_t eol = m_text.find('\n', p);
     std::string_view line = m_text.substr(p, eol == std::string_view::npos ? eol : eol - p);
-    int number = std::atoi(std::string(line).c_str());
+    // (a line number past int's range, which cpp never writes, counts as unknown)
+    long long marked = std::strtoll(std::string(line).c_str(), nullptr, 10);
+    int number = marked > 0 && marked <= 1'000'000'000 ? static_cast<int>(marked) : 0;
     std::size_t open = line.find('"');
     std::size_t close = line.rfind('"');
     if (open != std::string_view::npos && close > open)

@@ -113,6 +113,8 @@ DeriveLimits limits_of(const LoadOptions& options)
 {
     DeriveLimits limits;
     limits.max_modules = options.max_modules;
+    limits.max_memory_bytes = options.max_memory_bytes;
+    limits.allow_file_access = options.allow_file_access;
     limits.function = options.function;
     limits.curve = options.curve;
     return limits;

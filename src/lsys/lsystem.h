@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "base/limits.h"
 #include "lsys/module_string.h"
 
 namespace cambium::lsys {
@@ -22,6 +23,10 @@ struct LoadOptions {
     std::vector<std::string> defines;      ///< extra -D NAME[=VALUE] for the preprocessor
     std::string preprocessor = "cpp";      ///< the system C preprocessor
     std::size_t max_modules = 100'000'000; ///< derivation fails past this string length
+    /// derivation fails when its strings take more (--max-memory; base/limits.h)
+    std::uint64_t max_memory_bytes = default_max_memory_bytes();
+    /// fopen may open files outside the model's folder (--allow-file-access)
+    bool allow_file_access = false;
     /// func(id, x): the view file's function set (geom's FunctionSet::evaluate, which
     /// owns the clamping). Unset: func() evaluates to 0 with one warning.
     std::function<double(int id, double x)> function;

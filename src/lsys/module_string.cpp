@@ -117,6 +117,15 @@ std::size_t ModuleString::memory_bytes() const
            m_counts.capacity() + m_params.capacity() * sizeof(float);
 }
 
+std::size_t ModuleString::peak_bytes() const
+{
+    auto next_block = [](const auto& v, std::size_t extra) -> std::size_t {
+        return v.size() + extra > v.capacity() ? grown_capacity(v, extra) * sizeof(v[0]) : 0;
+    };
+    return memory_bytes() + (m_wide ? next_block(m_symbols16, 1) : next_block(m_symbols8, 1)) +
+           next_block(m_counts, 1) + next_block(m_params, max_params);
+}
+
 ModuleRef ModuleString::Cursor::operator*() const
 {
     std::size_t n = m_string->m_counts[m_index];

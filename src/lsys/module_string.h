@@ -66,6 +66,9 @@ public:
     std::size_t param_count(std::size_t i) const { return m_counts[i]; }
     /// Bytes held by the string's arrays (for memory reports).
     std::size_t memory_bytes() const;
+    /// memory_bytes() plus the block that appending one more module would allocate
+    /// while the full one is still held: what the string takes at its next peak.
+    std::size_t peak_bytes() const;
 
     /// A position in the string that knows where its module's parameters start.
     class Cursor {
@@ -108,10 +111,15 @@ private:
     /// Grows `v` by a quarter instead of doubling, so that a string near the memory
     /// budget does not briefly need twice its size.
     template <class T>
+    static std::size_t grown_capacity(const std::vector<T>& v, std::size_t extra)
+    {
+        return std::max(v.size() + extra, v.capacity() + v.capacity() / 4 + 64);
+    }
+    template <class T>
     static void make_room(std::vector<T>& v, std::size_t extra)
     {
         if (v.size() + extra > v.capacity())
-            v.reserve(std::max(v.size() + extra, v.capacity() + v.capacity() / 4 + 64));
+            v.reserve(grown_capacity(v, extra));
     }
 
     bool m_wide = false;                   ///< symbols stored in m_symbols16

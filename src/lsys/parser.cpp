@@ -14,7 +14,11 @@ namespace cambium::lsys {
 
 namespace {
 
-constexpr int max_expression_nesting = 200;
+/// How deep expressions (parentheses, calls, subscripts, unary operators, conditional
+/// expressions in a then-branch) may nest, and, counted apart, blocks. The parser
+/// recurses once (a dozen frames at most) per level, so this bounds its stack use
+/// whatever the input; cpfg's models nest a few levels.
+constexpr int max_nesting = 200;
 constexpr int max_stack = 250;
 
 /// Appends instructions to a Code and tracks the evaluation stack depth.
@@ -137,6 +141,8 @@ private:
     void parse_primary(Emitter& e);
     void parse_call(Emitter& e, const Token& name);
     void parse_file_call(Emitter& e, const Token& name);
+    void check_format_literal(const std::string& function, const Token& format,
+                              std::string_view raw, int values) const;
     int parse_indices(Emitter& e);
     void emit_load(Emitter& e, const Token& name);
     void check_subscripts(const Token& name, const VariableRef& ref, int n) const;
@@ -146,12 +152,34 @@ private:
     double site(const FileLoc& loc);
     double constant_expression();
 
+    /// One level of a recursive construct while it lives (`depth`: m_nesting for
+    /// expressions, m_block_nesting for blocks; `what` names it): max_nesting levels
+    /// at most, else an error at the token that would open one more.
+    class Level {
+    public:
+        Level(Parser& parser, int& depth, const char* what) : m_depth(depth)
+        {
+            if (depth >= max_nesting)
+                throw Error(parser.peek(LexMode::Expression).loc,
+                            std::string(what) + " nested too deeply (more than " +
+                                std::to_string(max_nesting) + " levels)");
+            ++depth;
+        }
+        Level(const Level&) = delete;
+        Level& operator=(const Level&) = delete;
+        ~Level() { --m_depth; }
+
+    private:
+        int& m_depth;
+    };
+
     Lexer m_lexer;
     Program& m_program;
     Scope* m_scope = nullptr;
     std::string m_context;             ///< the global block or header item being compiled
     std::set<std::string> m_warned;    ///< undefined names already reported
-    int m_nesting = 0;
+    int m_nesting = 0;        ///< expressions being parsed inside each other
+    int m_block_nesting = 0;  ///< blocks being parsed inside each other
 };
 
 /// The source of a production on one line: line markers and comments dropped, blanks
@@ -293,7 +321,9 @@ void Parser::parse_label(LSystemDefinition& ls)
     std::string text = m_lexer.rest_of_line();
     std::size_t first = text.find_first_not_of(" \t");
     ls.label = first == std::string::npos ? "" : text.substr(first);
-    ls.id = std::atoi(ls.label.c_str());
+    // the label's leading number is the id ?(id) names; beyond int it names nothing
+    long long id = std::strtoll(ls.label.c_str(), nullptr, 10);
+    ls.id = id >= -2147483647 && id <= 2147483647 ? static_cast<int>(id) : 0;
 }
 
 bool Parser::parse_item(LSystemDefinition& ls)
@@ -309,6 +339,8 @@ bool Parser::parse_item(LSystemDefinition& ls)
         Scope scope = global_scope();
         m_scope = &scope;
         m_context = "'" + t.text + "'";
+        (t.text == "seed:" ? ls.seed_loc : ls.derivation_length_loc) =
+            peek(LexMode::Expression).loc;
         (t.text == "seed:" ? ls.seed : ls.derivation_length) = compile_expression();
         m_scope = nullptr;
         expect_eol(t.text.c_str());
@@ -382,9 +414,13 @@ void Parser::parse_array_definition()
     def.initial.name = name.text;
     std::size_t total = 1;
     while (accept_operator("[")) {
-        int dim = static_cast<int>(constant_expression());
-        if (dim <= 0 || dim > (1 << 24))
-            throw Error(name.loc, "array '" + name.text + "' has an invalid dimension");
+        FileLoc dim_loc = peek(LexMode::Expression).loc;
+        double size = constant_expression();
+        std::optional<long long> whole = truncated_in(size, 1, 1 << 24);
+        if (!whole)
+            throw Error(dim_loc, "array '" + name.text + "' has dimension " + number_text(size) +
+                                     "; dimensions go from 1 to " + std::to_string(1 << 24));
+        int dim = static_cast<int>(*whole);
         def.initial.dims.push_back(dim);
         total *= static_cast<std::size_t>(dim);
         expect_operator("]");
@@ -420,6 +456,7 @@ double Parser::constant_expression()
     for (const auto& a : m_program.arrays)
         rt.arrays.push_back(a.initial);
     rt.strings = &m_program.strings;
+    rt.file_name = &m_program.file_name;  // fopen's folder: the model's
     try {
         return evaluate(code, {}, rt);
     } catch (const EvaluationError& e) {
@@ -458,6 +495,7 @@ void Parser::parse_decomposition(LSystemDefinition& ls)
     if (at_keyword("maximum depth:")) {
         next(LexMode::Module);
         m_context = "the decomposition's 'maximum depth:'";
+        ls.decomposition.max_depth_loc = peek(LexMode::Expression).loc;
         ls.decomposition.max_depth = compile_expression();
         expect_eol("'maximum depth:'");
     }
@@ -473,11 +511,13 @@ void Parser::parse_homomorphism(LSystemDefinition& ls)
         if (at_keyword("maximum depth:")) {
             next(LexMode::Module);
             m_context = "the homomorphism's 'maximum depth:'";
+            ls.homomorphism.max_depth_loc = peek(LexMode::Expression).loc;
             ls.homomorphism.max_depth = compile_expression();
             expect_eol("'maximum depth:'");
         } else if (at_keyword("seed:")) {
             next(LexMode::Module);
             m_context = "the homomorphism's 'seed:'";
+            ls.homomorphism.seed_loc = peek(LexMode::Expression).loc;
             ls.homomorphism.seed = compile_expression();
             expect_eol("'seed:'");
         } else {
@@ -673,6 +713,7 @@ ModuleTemplate Parser::parse_module(const Token& symbol)
 
 void Parser::parse_block(Emitter& e)
 {
+    Level level(*this, m_block_nesting, "block");
     expect_operator("{");
     while (!accept_operator("}"))
         parse_statement(e);
@@ -793,26 +834,33 @@ Code Parser::compile_expression()
 
 void Parser::parse_expression(Emitter& e)
 {
-    if (++m_nesting > max_expression_nesting)
-        throw Error(peek(LexMode::Expression).loc, "expression nested too deeply");
-    parse_ternary(e);
-    --m_nesting;
+    {
+        Level level(*this, m_nesting, "expression");
+        parse_ternary(e);
+    }
     if (e.depth() > max_stack)
         throw Error(peek(LexMode::Expression).loc, "expression too complex");
 }
 
 void Parser::parse_ternary(Emitter& e)
 {
+    // `a ? b : c ? d : e` chains in the else branch as a loop, so a long chain needs no
+    // stack; a conditional in the then branch nests (and counts as a level).
     parse_or(e);
-    if (!accept_operator("?"))
-        return;
-    std::size_t to_else = e.emit(Op::JumpIfFalse, -1);
-    parse_ternary(e);
-    std::size_t to_end = e.emit(Op::Jump, -1);
-    expect(LexMode::Expression, TokenKind::Colon, "':' in a conditional expression");
-    e.patch(to_else, e.here());
-    parse_ternary(e);
-    e.patch(to_end, e.here());
+    std::vector<std::size_t> to_end;
+    while (accept_operator("?")) {
+        std::size_t to_else = e.emit(Op::JumpIfFalse, -1);
+        {
+            Level level(*this, m_nesting, "conditional expression");
+            parse_ternary(e);
+        }
+        to_end.push_back(e.emit(Op::Jump, -1));
+        expect(LexMode::Expression, TokenKind::Colon, "':' in a conditional expression");
+        e.patch(to_else, e.here());
+        parse_or(e);
+    }
+    for (std::size_t jump : to_end)
+        e.patch(jump, e.here());
 }
 
 void Parser::parse_or(Emitter& e)
@@ -912,20 +960,20 @@ void Parser::parse_power(Emitter& e)
 
 void Parser::parse_unary(Emitter& e)
 {
-    if (++m_nesting > max_expression_nesting)
-        throw Error(peek(LexMode::Expression).loc, "expression nested too deeply");
     if (accept_operator("-")) {
+        Level level(*this, m_nesting, "expression");
         parse_unary(e);
         e.emit(Op::Neg, 0);
     } else if (accept_operator("!")) {
+        Level level(*this, m_nesting, "expression");
         parse_unary(e);
         e.emit(Op::Not, 0);
     } else if (accept_operator("+")) {
+        Level level(*this, m_nesting, "expression");
         parse_unary(e);
     } else {
         parse_primary(e);
     }
-    --m_nesting;
 }
 
 void Parser::parse_primary(Emitter& e)
@@ -955,7 +1003,9 @@ void Parser::parse_call(Emitter& e, const Token& name)
 {
     next(LexMode::Expression);  // '('
     if (name.text == "printf") {
+        std::size_t raw_start = m_lexer.offset();
         Token format = expect(LexMode::Expression, TokenKind::String, "a format string");
+        std::string_view raw = m_lexer.source(raw_start, m_lexer.offset());
         m_program.strings.push_back(format.text);
         int n = 0;
         while (accept_operator(",")) {
@@ -963,6 +1013,7 @@ void Parser::parse_call(Emitter& e, const Token& name)
             ++n;
         }
         expect(LexMode::Expression, TokenKind::RParen, "')'");
+        check_format_literal(name.text, format, raw, n);
         e.emit(Op::Print, 1 - n, static_cast<std::int32_t>(m_program.strings.size() - 1),
                static_cast<std::uint8_t>(n));
         return;
@@ -998,7 +1049,9 @@ void Parser::parse_file_call(Emitter& e, const Token& name)
     // fprintf(file, "format", values...) and fscanf(file, "format", &var...) (5.1.5)
     parse_expression(e);
     expect_operator(",");
+    std::size_t raw_start = m_lexer.offset();
     Token format = expect(LexMode::Expression, TokenKind::String, "a format string");
+    std::string_view raw = m_lexer.source(raw_start, m_lexer.offset());
     m_program.strings.push_back(format.text);
     auto format_index = static_cast<std::int32_t>(m_program.strings.size() - 1);
     if (name.text == "fprintf") {
@@ -1010,6 +1063,7 @@ void Parser::parse_file_call(Emitter& e, const Token& name)
         expect(LexMode::Expression, TokenKind::RParen, "')'");
         if (n > max_stack)
             throw Error(name.loc, "too many arguments");
+        check_format_literal(name.text, format, raw, n);
         e.emit(Op::FilePrint, -n, format_index, static_cast<std::uint8_t>(n), site(name.loc));
         return;
     }
@@ -1026,10 +1080,42 @@ void Parser::parse_file_call(Emitter& e, const Token& name)
             throw Error(var.loc, "too many variables");
     }
     expect(LexMode::Expression, TokenKind::RParen, "')'");
+    check_format_literal(name.text, format, raw, static_cast<int>(targets.size()));
     e.emit(Op::FileScan, 0, format_index, static_cast<std::uint8_t>(targets.size()),
            site(name.loc));
     for (auto it = targets.rbegin(); it != targets.rend(); ++it)
         e.emit(it->kind == VariableRef::Local ? Op::StoreLocal : Op::StoreGlobal, -1, it->index);
+}
+
+/// Where the character at `index` of a string literal's value is in the source: `raw`
+/// holds the literal as written (blanks before it allowed); each escape is two
+/// characters there and one in the value.
+FileLoc string_char_loc(const Token& literal, std::string_view raw, std::size_t index)
+{
+    std::size_t quote = raw.find('"');
+    std::size_t at = quote == std::string_view::npos ? 0 : quote + 1;
+    for (std::size_t i = 0; i < index && at < raw.size(); ++i)
+        at += raw[at] == '\\' ? 2 : 1;
+    FileLoc loc = literal.loc;
+    if (quote != std::string_view::npos)
+        loc.column += static_cast<int>(at - quote);
+    return loc;
+}
+
+/// A format literal of printf, fprintf or fscanf: its conversions must be ones
+/// check_format allows and take exactly the values given, or loading stops here, so
+/// no format reaches libc unchecked and none runs short of values.
+void Parser::check_format_literal(const std::string& function, const Token& format,
+                                  std::string_view raw, int values) const
+{
+    FormatCheck check = lsys::check_format(format.text, function == "fscanf");
+    if (!check.problem.empty())
+        throw Error(string_char_loc(format, raw, check.at), function + " format: " + check.problem);
+    if (check.conversions != values)
+        throw Error(format.loc, function + " format has " + std::to_string(check.conversions) +
+                                    " conversion(s) but " + std::to_string(values) +
+                                    (function == "fscanf" ? " variable(s) to read into"
+                                                          : " value(s) to print"));
 }
 
 int Parser::parse_indices(Emitter& e)

@@ -61,6 +61,7 @@ struct ProductionSet {
     std::vector<std::vector<std::uint32_t>> by_symbol;  ///< indexed by SymbolId
     std::optional<Code> max_depth;
     std::optional<Code> seed;
+    FileLoc max_depth_loc, seed_loc;  ///< where their expressions start
     bool warnings = false;
 
     /// Rebuilds by_symbol for `symbol_count` symbols.
@@ -79,6 +80,7 @@ struct LSystemDefinition {
     FileLoc loc;
     std::optional<Code> seed;
     std::optional<Code> derivation_length;
+    FileLoc seed_loc, derivation_length_loc;  ///< where their expressions start
     std::vector<SymbolId> ignore;
     std::vector<SymbolId> consider;
     bool has_consider = false;

@@ -406,7 +406,8 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
     arena.execute([&] {
         std::unique_ptr<TextureSet> textures;
         if (!scene.textures.empty())
-            textures = std::make_unique<TextureSet>(scene.textures, settings.texture_folder);
+            textures = std::make_unique<TextureSet>(scene.textures, settings.texture_folder,
+                                                    settings.max_memory_bytes);
         // Embree builds with TBB too, so the build also stays within the arena.
         EmbreeScene accel(scene, camera, textures.get());
         PathContext ctx;

@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 
+#include "base/limits.h"
 #include "geom/scene.h"
 #include "render/camera.h"
 #include "render/environment.h"
@@ -50,6 +51,9 @@ struct RenderSettings {
     /// The folder that relative texture paths (Scene::textures) are taken from: the
     /// view file's folder.
     std::filesystem::path texture_folder;
+    /// What one decoded texture may take (--max-memory): larger ones are refused from
+    /// their header, before loading.
+    std::uint64_t max_memory_bytes = default_max_memory_bytes();
 
     /// Reconstruction filter and its radius in pixels (0 = the filter's default: 1.5 for
     /// gaussian, 1.0 for blackman_harris; box is always 0.5). Default box: the same image

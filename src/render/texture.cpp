@@ -2,9 +2,11 @@
 // The view file's textures, looked up through one OpenImageIO TextureSystem per render.
 #include "render/texture.h"
 
+#include <OpenImageIO/imageio.h>
 #include <OpenImageIO/texture.h>
 #include <tbb/enumerable_thread_specific.h>
 
+#include <algorithm>
 #include <string>
 
 #include "base/diagnostics.h"
@@ -54,8 +56,41 @@ struct TextureSet::Impl {
     }
 };
 
+namespace {
+
+/// Refuses, from its header alone, a texture too large to decode: a small file may
+/// declare 30000 x 30000 pixels, which OIIO would otherwise allocate when it builds the
+/// MIP levels. A header that cannot be read is left to the TextureSystem's warning.
+void check_texture_size(const std::filesystem::path& file, std::uint64_t max_memory_bytes)
+{
+    auto input = OIIO::ImageInput::open(file.string());
+    if (!input) {
+        (void)OIIO::geterror();  // the TextureSystem says why below
+        return;
+    }
+    const OIIO::ImageSpec& spec = input->spec();
+    if (spec.width > max_texture_side || spec.height > max_texture_side || spec.depth > 1)
+        throw Error(FileLoc{file.string()},
+                    "texture is " + std::to_string(spec.width) + " x " +
+                        std::to_string(spec.height) +
+                        (spec.depth > 1 ? " x " + std::to_string(spec.depth) : std::string()) +
+                        " pixels; textures may have at most " + std::to_string(max_texture_side) +
+                        " pixels on a side (and one layer)");
+    // the decoded pixels and their MIP levels (a third more)
+    std::uint64_t bytes = std::uint64_t(std::max(spec.width, 0)) *
+                          std::uint64_t(std::max(spec.height, 0)) *
+                          std::uint64_t(std::max(spec.nchannels, 0)) * spec.format.size() * 4 / 3;
+    if (bytes > max_memory_bytes)
+        throw Error(FileLoc{file.string()},
+                    "texture needs " + byte_size_text(bytes) +
+                        " decoded, more than the memory budget of " +
+                        byte_size_text(max_memory_bytes) + " (--max-memory)");
+}
+
+}  // namespace
+
 TextureSet::TextureSet(const std::vector<geom::TextureDef>& defs,
-                       const std::filesystem::path& base)
+                       const std::filesystem::path& base, std::uint64_t max_memory_bytes)
     : m_impl(std::make_unique<Impl>())
 {
     if (defs.empty())
@@ -79,6 +114,7 @@ TextureSet::TextureSet(const std::vector<geom::TextureDef>& defs,
             m_impl->entries.push_back(e);
             continue;
         }
+        check_texture_size(file, max_memory_bytes);
         e.handle = ts.get_texture_handle(OIIO::ustring(file.string()), m_impl->thread_info());
         const OIIO::ImageSpec* spec = e.handle ? ts.imagespec(e.handle, m_impl->thread_info()) : nullptr;
         if (!spec) {

@@ -6,6 +6,7 @@
 #include <memory>
 #include <vector>
 
+#include "base/limits.h"
 #include "geom/scene.h"
 #include "render/vecf.h"
 
@@ -29,13 +30,21 @@ struct TextureFootprint {
 /// Coordinates are OpenGL's: (s, t) in [0, 1]^2 with t = 0 the image's bottom row; both
 /// wrap (GL_REPEAT). 8-bit and 16-bit images hold display values and are decoded as sRGB
 /// after filtering; floating-point images are taken as linear (docs/materials.md).
+/// The largest texture side accepted: OpenGL's usual GL_MAX_TEXTURE_SIZE, beyond which
+/// cpfg could not have drawn the texture either.
+inline constexpr int max_texture_side = 16384;
+
 class TextureSet {
 public:
     /// Opens every texture; relative paths are taken relative to `base` (the view file's
     /// folder). A file that is missing or unreadable is a warning naming it, and its
-    /// index is not valid(): what it textures is drawn untextured, as cpfg does.
+    /// index is not valid(): what it textures is drawn untextured, as cpfg does. A file
+    /// whose header declares more than max_texture_side pixels on a side, or whose
+    /// decoded pixels (with MIP levels) would take more than `max_memory_bytes`, is an
+    /// error naming it, found before any pixel is read.
     explicit TextureSet(const std::vector<geom::TextureDef>& defs,
-                        const std::filesystem::path& base = {});
+                        const std::filesystem::path& base = {},
+                        std::uint64_t max_memory_bytes = default_max_memory_bytes());
     ~TextureSet();
     TextureSet(const TextureSet&) = delete;
     TextureSet& operator=(const TextureSet&) = delete;

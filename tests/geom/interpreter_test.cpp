@@ -4,6 +4,7 @@
 
 #include <string>
 
+#include "base/diagnostics.h"
 #include "geom/interpreter.h"
 #include "module_text.h"
 
@@ -139,4 +140,32 @@ TEST(Interpreter, UnbalancedPopIsIgnored)
     Scene scene = run("F]F", "");
     set_warnings_enabled(true);
     EXPECT_EQ(scene.geometry.lines.segment_count(), 2u);
+}
+
+TEST(Interpreter, SceneGeometryPastTheMemoryBudgetIsAnError)
+{
+    // a segment takes at least 16 (key) + 4 (segment) + 1 + 2 + 2 bytes: the first check,
+    // after 4096 modules, finds over 100 KiB, past a budget of 64 KiB
+    lsys::SymbolTable symbols;
+    std::string text;
+    for (int i = 0; i < 20000; ++i)
+        text += "F";
+    lsys::ModuleString s = text_modules(symbols, text);
+    InterpretOptions options;
+    options.max_memory_bytes = 64 << 10;
+    try {
+        interpret(s, symbols, parse_view_file("", "t.v"), options);
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        std::string message = e.what();
+        EXPECT_EQ(message.rfind("error: the scene's geometry needs ", 0), 0u) << message;
+        EXPECT_NE(message.find(" after 4096 modules of the string, more than the memory budget "
+                               "of 64.0 KiB (--max-memory)"),
+                  std::string::npos)
+            << message;
+    }
+    options.max_memory_bytes = 64 << 20;  // the same string within a larger budget
+    EXPECT_EQ(interpret(s, symbols, parse_view_file("", "t.v"), options)
+                  .geometry.lines.segment_count(),
+              20000u);
 }

@@ -338,3 +338,88 @@ TEST(Texture, DistantCheckerFiltersToTheMean)
 
 }  // namespace
 }  // namespace cambium::render
+
+namespace cambium::render {
+namespace {
+
+/// PNG's chunk checksum (CRC-32 of ISO 3309), which libpng verifies for IHDR.
+std::uint32_t png_crc(const std::string& bytes)
+{
+    std::uint32_t crc = 0xffffffffu;
+    for (unsigned char b : bytes) {
+        crc ^= b;
+        for (int k = 0; k < 8; ++k)
+            crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+    }
+    return crc ^ 0xffffffffu;
+}
+
+std::string big_endian(std::uint32_t v)
+{
+    return {static_cast<char>(v >> 24), static_cast<char>(v >> 16), static_cast<char>(v >> 8),
+            static_cast<char>(v)};
+}
+
+std::string png_chunk(const std::string& type, const std::string& data)
+{
+    return big_endian(static_cast<std::uint32_t>(data.size())) + type + data +
+           big_endian(png_crc(type + data));
+}
+
+/// A PNG of a few dozen bytes whose header declares `width` x `height` RGBA pixels; its
+/// image data is empty, so only the header can be read.
+void write_png_header(const fs::path& file, std::uint32_t width, std::uint32_t height)
+{
+    std::string ihdr = big_endian(width) + big_endian(height) + std::string("\x08\x06\0\0\0", 5);
+    std::ofstream(file, std::ios::binary)
+        << std::string("\x89PNG\r\n\x1a\n", 8) << png_chunk("IHDR", ihdr) << png_chunk("IDAT", "")
+        << png_chunk("IEND", "");
+}
+
+geom::TextureDef texture_file(const fs::path& file)
+{
+    geom::TextureDef def;
+    def.file = file;
+    return def;
+}
+
+TEST(TextureLimits, HugeDeclaredDimensionsAreRefusedFromTheHeader)
+{
+    // 30000 x 30000 RGBA would decode to 3.4 GiB (4.5 with MIP levels)
+    fs::path dir = temp_dir();
+    fs::path file = dir / "huge.png";
+    write_png_header(file, 30000, 30000);
+    try {
+        TextureSet set({texture_file(file)});
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  file.string() + ": error: texture is 30000 x 30000 pixels; textures may have "
+                                  "at most 16384 pixels on a side (and one layer)");
+    }
+    fs::remove_all(dir);
+}
+
+TEST(TextureLimits, DecodedSizePastTheBudgetIsRefused)
+{
+    // 4000 x 4000 RGBA bytes: 61 MiB, 81.4 MiB with MIP levels, past a 64 MiB budget
+    fs::path dir = temp_dir();
+    fs::path file = dir / "large.png";
+    write_png_header(file, 4000, 4000);
+    try {
+        TextureSet set({texture_file(file)}, {}, std::uint64_t{64} << 20);
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  file.string() + ": error: texture needs 81.4 MiB decoded, more than the "
+                                  "memory budget of 64.0 MiB (--max-memory)");
+    }
+    // a real small image within the budget still loads
+    write_image(dir / "small.png", 2, 2, 4, quadrants());
+    TextureSet small({texture_file(dir / "small.png")}, {}, std::uint64_t{64} << 20);
+    EXPECT_TRUE(small.valid(0));
+    fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace cambium::render
