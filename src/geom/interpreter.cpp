@@ -169,28 +169,26 @@ std::array<float, 12> object_transform(const Turtle& t)
 /// check sums a few dozen capacities, and the Scene grows by a few hundred bytes a module.
 constexpr std::size_t memory_check_interval = 4096;
 
-template <class T>
-std::size_t vector_bytes(const std::vector<T>& v)
+/// The bytes the vectors have allocated.
+template <class... Vectors>
+std::size_t vector_bytes(const Vectors&... v)
 {
-    return v.capacity() * sizeof(T);
+    return ((v.capacity() * sizeof(typename Vectors::value_type)) + ...);
 }
 
 std::size_t geometry_bytes(const Geometry& g)
 {
-    return vector_bytes(g.lines.keys) + vector_bytes(g.lines.v) + vector_bytes(g.lines.segments) +
-           vector_bytes(g.lines.flags) + vector_bytes(g.lines.material) +
-           vector_bytes(g.lines.texture) + vector_bytes(g.curves.points) +
-           vector_bytes(g.curves.tangents) + vector_bytes(g.curves.v) +
-           vector_bytes(g.curves.segments) + vector_bytes(g.curves.flags) +
-           vector_bytes(g.curves.material) + vector_bytes(g.curves.texture) +
-           vector_bytes(g.curves.end_material) + vector_bytes(g.spheres.centres) +
-           vector_bytes(g.spheres.material) + vector_bytes(g.spheres.texture) +
-           vector_bytes(g.discs.centres) + vector_bytes(g.discs.normals) +
-           vector_bytes(g.discs.material) + vector_bytes(g.discs.back_material) +
-           vector_bytes(g.mesh.positions) + vector_bytes(g.mesh.normals) +
-           vector_bytes(g.mesh.uvs) + vector_bytes(g.mesh.triangles) +
-           vector_bytes(g.mesh.material) + vector_bytes(g.mesh.back_material) +
-           vector_bytes(g.mesh.texture);
+    const LinearCurves& l = g.lines;
+    const HermiteCurves& c = g.curves;
+    const TriangleMesh& m = g.mesh;
+    return vector_bytes(l.keys, l.v, l.segments, l.flags, l.material, l.texture) +
+           vector_bytes(c.points, c.tangents, c.v, c.segments, c.flags, c.material, c.texture,
+                        c.end_material) +
+           vector_bytes(g.spheres.centres, g.spheres.material, g.spheres.texture) +
+           vector_bytes(g.discs.centres, g.discs.normals, g.discs.material,
+                        g.discs.back_material) +
+           vector_bytes(m.positions, m.normals, m.uvs, m.triangles, m.material,
+                        m.back_material, m.texture);
 }
 
 class Interpreter {
