@@ -37,6 +37,10 @@ struct InterpretOptions {
     /// expansion are never objects again. Unset: the string is interpreted as it is.
     std::function<bool(lsys::SymbolId)> is_object;
     std::function<lsys::ModuleString(lsys::ModuleRef)> expand_object;
+
+    /// `@S("command")`: called with the command, in string order, when set (the user
+    /// allowed system calls); unset, @S is ignored with a warning.
+    std::function<void(const std::string&)> system_call;
 };
 
 /// The view file's `rayshade objects: FORMAT [turtle considered]` (cpfg's
