@@ -4,6 +4,7 @@
 
 #include <sys/stat.h>
 
+#include <cctype>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -18,6 +19,19 @@ namespace {
 constexpr std::string_view tab_marker = "cambium_tab_";
 constexpr std::string_view hash_marker = "cambium_hash_";
 constexpr std::size_t max_scanned_includes = 1000;
+
+/// Calls `f` with each line of `text`, its '\n' included (the last one may lack it).
+template <class F>
+void for_each_line(std::string_view text, F f)
+{
+    std::size_t pos = 0;
+    while (pos < text.size()) {
+        std::size_t eol = text.find('\n', pos);
+        std::string_view line = text.substr(pos, eol == std::string_view::npos ? eol : eol - pos + 1);
+        pos += line.size();
+        f(line);
+    }
+}
 
 /// Replaces every occurrence of `from` in `text` by `to`.
 std::string replace_all(const std::string& text, std::string_view from, std::string_view to)
@@ -47,20 +61,20 @@ struct IncludeDirective {
 std::vector<IncludeDirective> scan_includes(std::string_view text, bool tab_lines_protected)
 {
     std::vector<IncludeDirective> found;
-    std::size_t pos = 0;
-    for (int line = 1; pos < text.size(); ++line) {
-        std::size_t eol = text.find('\n', pos);
-        std::string_view l = text.substr(pos, eol == std::string_view::npos ? eol : eol - pos);
-        pos = eol == std::string_view::npos ? text.size() : eol + 1;
+    int line = 0;
+    for_each_line(text, [&](std::string_view l) {
+        ++line;
+        if (!l.empty() && l.back() == '\n')
+            l.remove_suffix(1);
         if (tab_lines_protected && !l.empty() && l[0] == '\t')
-            continue;
+            return;
         std::size_t i = l.find_first_not_of(" \t");
         if (i == std::string_view::npos || l[i] != '#')
-            continue;
+            return;
         int column = int(i) + 1;
         i = l.find_first_not_of(" \t", i + 1);
         if (i == std::string_view::npos)
-            continue;
+            return;
         std::string_view rest = l.substr(i);
         std::size_t word = 0;
         for (std::string_view w : {"include_next", "include", "import"})
@@ -69,16 +83,16 @@ std::vector<IncludeDirective> scan_includes(std::string_view text, bool tab_line
                 break;
             }
         if (word == 0)
-            continue;
+            return;
         i = l.find_first_not_of(" \t", i + word);
         if (i == std::string_view::npos || (l[i] != '"' && l[i] != '<'))
-            continue;
+            return;
         char close = l[i] == '"' ? '"' : '>';
         std::size_t end = l.find(close, i + 1);
         if (end == std::string_view::npos)
-            continue;
+            return;
         found.push_back({std::string(l.substr(i + 1, end - i - 1)), close == '"', line, column});
-    }
+    });
     return found;
 }
 
@@ -191,6 +205,49 @@ std::string fmt_seconds(double seconds)
     return out.str();
 }
 
+/// cpp runs in the model's folder, so it names included files relative to it
+/// ("leaf.l"); the user named the model from their own folder. Prefixes `folder` (as
+/// the user gave it) to a relative file name at the start of each message line, after
+/// "included from ", and in line markers (`# 3 "leaf.l" 1`), so errors name the file
+/// the user can open. The main file (named by its marker) is left alone.
+std::string name_from_user_folder(const std::string& text, const std::filesystem::path& folder,
+                                  const std::string& main_name)
+{
+    if (folder.empty() || folder == ".")
+        return text;
+    auto rename = [&](std::string_view name) {
+        std::filesystem::path p(name);
+        std::error_code ec;
+        if (name.empty() || name == main_name || name.front() == '<' || p.is_absolute() ||
+            !std::filesystem::is_regular_file(folder / p, ec))  // not a file name ("cc1")
+            return std::string(name);
+        return (folder / p).string();
+    };
+    std::string out;
+    out.reserve(text.size());
+    for_each_line(text, [&](std::string_view view) {
+        std::string line(view);
+        std::size_t open = std::string::npos, close = std::string::npos;
+        if (line.size() > 2 && line[0] == '#' && line[1] == ' ' &&
+            std::isdigit(static_cast<unsigned char>(line[2]))) {  // a line marker
+            open = line.find('"');
+            close = open == std::string::npos ? open : line.find('"', open + 1);
+            if (close != std::string::npos)
+                ++open;
+        } else {
+            constexpr std::string_view from = "included from ";
+            std::size_t at = line.find(from);
+            open = at == std::string::npos ? 0 : at + from.size();
+            close = line.find(':', open);
+        }
+        if (open != std::string::npos && close != std::string::npos && close > open)
+            line = line.substr(0, open) + rename(std::string_view(line).substr(open, close - open)) +
+                   line.substr(close);
+        out += line;
+    });
+    return out;
+}
+
 std::string megabytes(std::size_t bytes) { return std::to_string(bytes >> 20) + " MiB"; }
 
 }  // namespace
@@ -199,11 +256,7 @@ std::string protect_cpfg_lines(std::string_view source)
 {
     std::string out;
     out.reserve(source.size() + source.size() / 8);
-    std::size_t pos = 0;
-    while (pos < source.size()) {
-        std::size_t eol = source.find('\n', pos);
-        std::string_view line = source.substr(pos, eol == std::string_view::npos ? eol : eol - pos + 1);
-        pos += line.size();
+    for_each_line(source, [&](std::string_view line) {
         std::size_t first = line.find_first_not_of(" \t");
         bool turtle_hash = first != std::string_view::npos && line.substr(first, 2) == "#(";
         if (!line.empty() && line[0] == '\t') {
@@ -220,7 +273,7 @@ std::string protect_cpfg_lines(std::string_view source)
         } else {
             out += line;
         }
-    }
+    });
     return out;
 }
 
@@ -228,11 +281,7 @@ std::string restore_cpfg_lines(std::string_view text)
 {
     std::string out;
     out.reserve(text.size());
-    std::size_t pos = 0;
-    while (pos < text.size()) {
-        std::size_t eol = text.find('\n', pos);
-        std::string_view line = text.substr(pos, eol == std::string_view::npos ? eol : eol - pos + 1);
-        pos += line.size();
+    for_each_line(text, [&](std::string_view line) {
         std::size_t first = line.find_first_not_of(" \t");
         std::string restored(line);
         if (first != std::string_view::npos && line.substr(first, tab_marker.size()) == tab_marker) {
@@ -244,7 +293,7 @@ std::string restore_cpfg_lines(std::string_view text)
         }
         restored = replace_all(std::move(restored), tab_marker, " ");
         out += replace_all(std::move(restored), hash_marker, "#");
-    }
+    });
     return out;
 }
 
@@ -272,7 +321,8 @@ std::string preprocess(std::string_view source, std::string_view file_name,
     ProcessIo io;
     io.input = input;
     ProcessResult r = run_process(cpp_command(options, folder), folder, io, limits);
-    std::string messages = replace_all(r.messages, "<stdin>", name);
+    std::string messages =
+        name_from_user_folder(replace_all(r.messages, "<stdin>", name), options.folder, name);
     while (!messages.empty() && (messages.back() == '\n' || messages.front() == '\n'))
         messages.erase(messages.back() == '\n' ? messages.size() - 1 : 0, 1);
     switch (r.end) {
@@ -297,7 +347,8 @@ std::string preprocess(std::string_view source, std::string_view file_name,
     if (r.exit_code != 0)
         throw Error(FileLoc{name, 0, 0}, "the C preprocessor failed:\n" + messages);
     forward_messages(messages);
-    return restore_cpfg_lines(replace_all(r.output, "\"<stdin>\"", quoted(file_name)));
+    std::string text = replace_all(r.output, "\"<stdin>\"", quoted(file_name));
+    return restore_cpfg_lines(name_from_user_folder(text, options.folder, name));
 }
 
 }  // namespace cambium::lsys

@@ -10,19 +10,14 @@
 #include <string>
 
 #include "base/diagnostics.h"
+#include "scratch.h"
 
 namespace cambium {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path scratch(const std::string& name)
-{
-    fs::path dir = fs::temp_directory_path() / ("cambium_atomic_" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
+using testing::scratch;
 
 std::string contents(const fs::path& file)
 {

@@ -13,18 +13,14 @@
 #include <thread>
 #include <vector>
 
+#include "scratch.h"
+
 namespace cambium {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path scratch(const std::string& name)
-{
-    fs::path dir = fs::temp_directory_path() / ("cambium_base_" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
+using testing::scratch;
 
 /// Whether `pid` is gone or a zombie within a few seconds (SIGKILL is asynchronous, and
 /// an orphan's zombie may wait for a reaper).

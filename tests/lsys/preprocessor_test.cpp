@@ -191,6 +191,25 @@ TEST(LsysPreprocessor, QuotedIncludesStartFromTheModelFolder)
     fs::remove(fs::temp_directory_path() / "cambium_planted.h");
 }
 
+// cpp runs in the model's folder; included files are still named as the user reaches
+// them (the folder they gave), in line markers and in cpp's messages.
+TEST(LsysPreprocessor, IncludedFilesAreNamedFromTheUsersFolder)
+{
+    fs::path dir = scratch("names");
+    std::ofstream(dir / "leaf.h") << "leaf_text\n";
+    std::ofstream(dir / "bad.h") << "\n#error in bad\n";
+    PreprocessOptions options;
+    options.folder = dir;
+    std::string main = (dir / "p.l").string();
+    std::string out = preprocess("#include \"leaf.h\"\n", main, options);
+    EXPECT_NE(out.find("\"" + (dir / "leaf.h").string() + "\""), std::string::npos) << out;
+    EXPECT_NE(out.find("\"" + main + "\""), std::string::npos) << out;
+    std::string message = preprocess_error("\n#include \"bad.h\"\n", main, options);
+    EXPECT_NE(message.find("included from " + main + ":2"), std::string::npos) << message;
+    EXPECT_NE(message.find((dir / "bad.h").string() + ":2:2: error: #error in bad"), std::string::npos)
+        << message;
+}
+
 // System headers are not searched: a model has no business with them.
 TEST(LsysPreprocessor, SystemHeadersAreNotSearched)
 {
