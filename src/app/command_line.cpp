@@ -3,11 +3,14 @@
 #include "app/command_line.h"
 
 #include <CLI/CLI.hpp>
+#include <charconv>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <regex>
 
 #include "base/diagnostics.h"
+#include "render/render.h"
 
 namespace cambium::app {
 namespace {
@@ -29,24 +32,26 @@ std::function<void(Options&, const std::vector<std::string>&)> unsupported_outpu
     };
 }
 
-/// `-w W H`: cpfg's window size, the image size here.
+/// A whole number from `low` to `high` spelled as `word`, or an Error naming `option`.
+int whole_number(const std::string& option, const std::string& word, int low, int high)
+{
+    int value = 0;
+    const char* end = word.data() + word.size();
+    auto [ptr, ec] = std::from_chars(word.data(), end, value);
+    if (word.empty() || ec != std::errc() || ptr != end || value < low || value > high)
+        throw Error(option + ": expected a whole number from " + std::to_string(low) + " to " +
+                    std::to_string(high) + ", not '" + word + "'");
+    return value;
+}
+
+/// `-w W H`: cpfg's window size, the image size here; checked before any work.
 void set_image_size(Options& options, const std::string& width, const std::string& height)
 {
-    auto pixels = [](const std::string& word) {
-        std::size_t used = 0;
-        int value = 0;
-        try {
-            value = std::stoi(word, &used);
-        } catch (const std::exception&) {
-            used = 0;
-        }
-        if (used != word.size() || value < 1 || value > 32768)
-            throw Error("-w: the image size must be two whole numbers from 1 to 32768, not '" +
-                        word + "'");
-        return value;
-    };
-    options.width = pixels(width);
-    options.height = pixels(height);
+    options.width = whole_number("-w", width, 1, max_image_side);
+    options.height = whole_number("-w", height, 1, max_image_side);
+    if (std::int64_t(options.width) * options.height > render::max_image_pixels)
+        throw Error("-w: " + width + " x " + height + " is more than " +
+                    std::to_string(render::max_image_pixels) + " pixels (8192 x 8192)");
 }
 
 const std::map<std::string, CpfgOption>& cpfg_options()
@@ -80,6 +85,12 @@ const std::map<std::string, CpfgOption>& cpfg_options()
     return table;
 }
 
+/// The n of -m<n>, -M<n>, -c<n>.
+int colour_map_number(const std::string& option, const std::string& digits)
+{
+    return whole_number("option " + option + ": the colour map number", digits, 0, 15);
+}
+
 /// Removes cpfg's own options (glued -m2 file, -M file, -c3, -s150000, and the
 /// single-dash words of cpfg_options) from `args`, recording them in `options`.
 std::vector<std::string> take_cpfg_options(const std::vector<std::string>& args, Options& options)
@@ -94,14 +105,10 @@ std::vector<std::string> take_cpfg_options(const std::vector<std::string>& args,
         if (std::regex_match(a, m, colour_file)) {
             if (i + 1 >= args.size())
                 throw Error("option " + a + " needs a file name");
-            int block = m[2].length() ? std::stoi(m[2]) : 1;
-            if (block > 15)
-                throw Error("option " + a + ": colour map numbers go from 0 to 15");
+            int block = m[2].length() ? colour_map_number(a, m[2]) : 1;
             options.colour_files.push_back({block, m[1] == "M", args[++i]});
         } else if (std::regex_match(a, m, colour_block)) {
-            options.colour_block = m[1].length() < 3 ? std::stoi(m[1]) : 99;
-            if (options.colour_block > 15)
-                throw Error("option " + a + ": colour map numbers go from 0 to 15");
+            options.colour_block = colour_map_number(a, m[1]);
         } else if (std::regex_match(a, m, string_size)) {
             // cpfg's initial string allocation; Cambium's strings grow as needed.
         } else if (a == "-pipestrb") {
@@ -149,7 +156,8 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
         ->check(CLI::Range(1, 64));
     cli.add_option("--threads", options.threads, "Render threads (default: all cores)")
         ->check(CLI::Range(0, 1024));
-    cli.add_option("--seed", options.seed, "Sampling seed (default 0)");
+    cli.add_option("--seed", options.seed, "Sampling seed (default 0)")
+        ->check(CLI::NonNegativeNumber);
     cli.add_option("--max-modules", options.max_modules,
                    "Stop a derivation whose string grows past this many modules (default 1e8)")
         ->check(CLI::Range(std::size_t{1}, std::size_t{1'000'000'000}));

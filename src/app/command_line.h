@@ -12,6 +12,10 @@
 
 namespace cambium::app {
 
+/// The largest image side -w accepts (the image also has at most
+/// render::max_image_pixels pixels).
+inline constexpr int max_image_side = 32768;
+
 /// A colormap (-m[n]) or material file (-M[n]) for colour-table block n.
 struct ColourFile {
     int block = 1;

@@ -13,7 +13,9 @@
 
 #include "app/command_line.h"
 #include "app/pipeline.h"
+#include "base/atomic_file.h"
 #include "base/diagnostics.h"
+#include "base/subprocess.h"
 #include "geom/view_volume.h"
 #include "lsys/string_io.h"
 #include "render/render.h"
@@ -89,29 +91,18 @@ render::RenderSettings render_settings(const Options& options,
     return settings;
 }
 
-/// Writes `text` to `file` through a temporary name, so a failure leaves nothing behind.
+/// Writes `file` through cambium::write_file_atomically, so a failure leaves nothing behind.
 template <typename Write>
 void write_atomically(const std::filesystem::path& file, Write write)
 {
-    std::filesystem::path temporary = file;
-    temporary += ".cambium-tmp";
-    {
+    write_file_atomically(file, [&](const std::filesystem::path& temporary) {
         std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
         if (out)
             write(out);
-        if (!out) {
-            out.close();
-            std::error_code ignored;
-            std::filesystem::remove(temporary, ignored);
+        out.close();
+        if (!out)
             throw Error(FileLoc{file.string()}, "cannot be written");
-        }
-    }
-    std::error_code ec;
-    std::filesystem::rename(temporary, file, ec);
-    if (ec) {
-        std::filesystem::remove(temporary, ec);
-        throw Error(FileLoc{file.string()}, "cannot be written: " + ec.message());
-    }
+    });
 }
 
 /// -str and -strb: the derived string in cpfg's formats; names may be format strings
@@ -199,7 +190,11 @@ int main(int argc, char** argv)
         auto options = cambium::app::parse_command_line(argc, argv);
         if (!options)
             return 0;
+        cambium::set_warnings_enabled(!options->quiet);  // -q: nothing but errors
         return cambium::app::run(*options);
+    } catch (const cambium::Interrupted& e) {
+        std::fprintf(stderr, "cambium: %s\n", e.what());
+        return 128 + e.signal();  // a helper program was running; it is stopped
     } catch (const cambium::Error& e) {
         std::fprintf(stderr, "cambium: %s\n", e.what());
         return 1;

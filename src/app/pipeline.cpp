@@ -4,6 +4,7 @@
 #include "app/pipeline.h"
 
 #include "base/diagnostics.h"
+#include "base/subprocess.h"
 #include "geom/background_scene.h"
 #include "geom/function.h"
 #include "geom/interpreter.h"
@@ -41,6 +42,29 @@ std::vector<char> object_symbols(const lsys::LSystem& lsystem)
     for (std::size_t s = 0; s < objects.size(); ++s)
         any |= (objects[s] = lsystem.is_object_symbol(static_cast<int>(s)) ? 1 : 0) != 0;
     return any ? objects : std::vector<char>{};
+}
+
+/// The longest an allowed @S command may run.
+constexpr double max_system_call_seconds = 300;
+
+/// Runs one allowed @S command with /bin/sh in the model's folder, its input from
+/// /dev/null and its output on cambium's; a failure is a warning, as under cpfg.
+void run_system_call(const std::string& command, const std::filesystem::path& folder)
+{
+    ProcessIo io;
+    io.capture = false;
+    ProcessLimits limits;
+    limits.wall_seconds = max_system_call_seconds;
+    limits.max_output_bytes = 0;
+    limits.max_memory_bytes = 0;
+    ProcessResult r = run_process({"/bin/sh", "-c", command}, folder, io, limits);
+    if (r.end == ProcessResult::End::timed_out)
+        warn("@S(\"" + command + "\") was stopped after " +
+             std::to_string(int(max_system_call_seconds)) + " s");
+    else if (r.end == ProcessResult::End::not_found)
+        throw Error("@S: cannot run /bin/sh: " + r.messages);
+    else if (r.exit_code != 0)
+        warn("@S(\"" + command + "\") ended with status " + std::to_string(r.exit_code));
 }
 
 }  // namespace
@@ -107,6 +131,12 @@ geom::Scene interpret(const Model& model, const lsys::ModuleString& derived,
             return s < objects.size() && objects[s] != 0;
         };
         interpret_options.expand_object = [&lsystem](lsys::ModuleRef m) { return lsystem.expand_object(m); };
+    }
+    if (options.allow_system_calls) {
+        std::filesystem::path folder = options.lsystem.parent_path();
+        interpret_options.system_call = [folder](const std::string& command) {
+            run_system_call(command, folder);
+        };
     }
     lsys::ModuleString string =
         options.homomorphism_in_string

@@ -463,11 +463,13 @@ BackgroundScene read_background_scene(std::string_view list, const std::filesyst
             file = base_dir / file;
         std::error_code ec;
         if (!std::filesystem::is_regular_file(file, ec))
-            throw Error(loc, "cannot open background scene file " + file.string());
+            throw Error(loc, "cannot read the background scene file " + file.string() +
+                                 (std::filesystem::exists(file, ec) ? ": not a regular file"
+                                                                    : ": no such file"));
         std::string text = read_text_file(file, "background scene file");
         if (has_directive(text)) {  // cpfg runs background files through cpp
             lsys::PreprocessOptions options;
-            options.include_dirs.push_back(file.parent_path());
+            options.folder = file.parent_path();  // "" (the current folder) is fine here
             text = lsys::preprocess(text, file.string(), options);
         }
         std::vector<BackgroundStatement> more = parse_background_text(text, file.string());

@@ -615,10 +615,7 @@ private:
         case TurtleOp::SubLsystem: enter_sub_lsystem(p); break;
         case TurtleOp::SubLsystemEnd: leave_sub_lsystem(); break;
         case TurtleOp::Label: at_command(); add_label(p); break;
-        case TurtleOp::SystemCall:
-            at_command();
-            warn_once(m_warned_system, "@S system calls are not run; use --allow-system-calls");
-            break;
+        case TurtleOp::SystemCall: at_command(); system_call(p); break;
         case TurtleOp::IncludeObject:
             at_command();
             warn_once(m_warned_include, "@I (rayshade object inclusion) is ignored");
@@ -874,6 +871,20 @@ private:
         m_turtle.scale = new_scale;
         if (old_scale != 0)
             m_turtle.line_width = m_turtle.line_width * new_scale / old_scale;
+    }
+
+    /// @S("command"): handed to InterpretOptions::system_call when the user allowed it.
+    void system_call(std::span<const float> p)
+    {
+        if (!m_options.system_call) {
+            warn_once(m_warned_system, "@S system calls are not run; use --allow-system-calls");
+            return;
+        }
+        if (p.empty() || !(p[0] >= 0) || static_cast<std::size_t>(p[0]) >= m_options.strings.size()) {
+            warn_once(m_warned_system, "@S without a command string (@S(\"command\")) is ignored");
+            return;
+        }
+        m_options.system_call(m_options.strings[static_cast<std::size_t>(p[0])]);
     }
 
     /// `@L(text [, values...])`: a label; the text's printf conversions take the values.

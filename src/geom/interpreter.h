@@ -42,6 +42,9 @@ struct InterpretOptions {
     /// What the Scene's primitive arrays may take (--max-memory): interpretation stops
     /// with an error once they grow past it (checked every few thousand modules).
     std::uint64_t max_memory_bytes = default_max_memory_bytes();
+    /// `@S("command")`: called with the command, in string order, when set (the user
+    /// allowed system calls); unset, @S is ignored with a warning.
+    std::function<void(const std::string&)> system_call;
 };
 
 /// The view file's `rayshade objects: FORMAT [turtle considered]` (cpfg's

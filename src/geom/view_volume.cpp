@@ -7,6 +7,7 @@
 #include <regex>
 #include <system_error>
 
+#include "base/atomic_file.h"
 #include "base/diagnostics.h"
 
 namespace cambium::geom {
@@ -24,20 +25,13 @@ std::string format_view_volume(const Bounds3& box)
 
 void write_view_volume(const Bounds3& box, const std::filesystem::path& file)
 {
-    std::filesystem::path temporary = file;
-    temporary += ".cambium-tmp";
-    {
+    write_file_atomically(file, [&](const std::filesystem::path& temporary) {
         std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
         out << format_view_volume(box) << '\n';
+        out.close();
         if (!out)
             throw Error(FileLoc{file.string()}, "cannot write the view volume file");
-    }
-    std::error_code ec;
-    std::filesystem::rename(temporary, file, ec);
-    if (ec) {
-        std::filesystem::remove(temporary, ec);
-        throw Error(FileLoc{file.string()}, "cannot write the view volume file");
-    }
+    });
 }
 
 Bounds3 parse_view_volume(std::string_view text, const std::string& file_name)

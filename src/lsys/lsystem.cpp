@@ -19,6 +19,9 @@ namespace {
 std::string read_source(const std::filesystem::path& file, std::size_t limit)
 {
     std::error_code ec;
+    if (std::filesystem::exists(file, ec) && !std::filesystem::is_regular_file(file, ec))
+        throw Error(FileLoc{file.string(), 0, 0},
+                    "cannot read the L-system file: not a regular file");
     auto size = std::filesystem::file_size(file, ec);
     if (ec)
         throw Error(FileLoc{file.string(), 0, 0}, "cannot read the L-system file: " + ec.message());
@@ -89,7 +92,7 @@ LSystem LSystem::load(const std::filesystem::path& file, const LoadOptions& opti
     PreprocessOptions pp;
     pp.defines = options.defines;
     pp.preprocessor = options.preprocessor;
-    pp.include_dirs.push_back(file.parent_path().empty() ? "." : file.parent_path());
+    pp.folder = file.parent_path();
     std::string source = read_source(file, pp.max_input_bytes);
     return LSystem(compile(source, file.string(), pp), options);
 }

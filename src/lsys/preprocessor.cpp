@@ -2,14 +2,15 @@
 // Runs an L-system file through the system C preprocessor, keeping cpfg's tab and `#(` lines.
 #include "lsys/preprocessor.h"
 
-#include <sys/wait.h>
-#include <unistd.h>
+#include <sys/stat.h>
 
-#include <cstdlib>
+#include <cctype>
 #include <fstream>
+#include <set>
 #include <sstream>
 
 #include "base/diagnostics.h"
+#include "base/subprocess.h"
 
 namespace cambium::lsys {
 
@@ -17,34 +18,19 @@ namespace {
 
 constexpr std::string_view tab_marker = "cambium_tab_";
 constexpr std::string_view hash_marker = "cambium_hash_";
+constexpr std::size_t max_scanned_includes = 1000;
 
-/// Quotes one word for /bin/sh.
-std::string shell_quote(std::string_view word)
+/// Calls `f` with each line of `text`, its '\n' included (the last one may lack it).
+template <class F>
+void for_each_line(std::string_view text, F f)
 {
-    std::string out = "'";
-    for (char c : word) {
-        if (c == '\'')
-            out += "'\\''";
-        else
-            out += c;
+    std::size_t pos = 0;
+    while (pos < text.size()) {
+        std::size_t eol = text.find('\n', pos);
+        std::string_view line = text.substr(pos, eol == std::string_view::npos ? eol : eol - pos + 1);
+        pos += line.size();
+        f(line);
     }
-    return out + "'";
-}
-
-std::string read_file(const std::filesystem::path& path)
-{
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-void write_file(const std::filesystem::path& path, std::string_view text)
-{
-    std::ofstream out(path, std::ios::binary);
-    out.write(text.data(), static_cast<std::streamsize>(text.size()));
-    if (!out)
-        throw Error("cannot write temporary file " + path.string());
 }
 
 /// Replaces every occurrence of `from` in `text` by `to`.
@@ -62,48 +48,147 @@ std::string replace_all(const std::string& text, std::string_view from, std::str
     return out;
 }
 
-/// A private temporary folder, removed with its contents on destruction.
-class TempDir {
-public:
-    TempDir()
-    {
-        std::string pattern = (std::filesystem::temp_directory_path() / "cambium-XXXXXX").string();
-        if (!mkdtemp(pattern.data()))
-            throw Error("cannot create a temporary folder in " + pattern);
-        m_path = pattern;
-    }
-    ~TempDir()
-    {
-        std::error_code ec;
-        std::filesystem::remove_all(m_path, ec);
-    }
-    TempDir(const TempDir&) = delete;
-    TempDir& operator=(const TempDir&) = delete;
-    const std::filesystem::path& path() const { return m_path; }
-
-private:
-    std::filesystem::path m_path;
+/// One `#include "name"` / `#include <name>` directive found by scan_includes.
+struct IncludeDirective {
+    std::string name;
+    bool quoted = true;
+    int line = 0, column = 0;
 };
 
-std::string build_command(const PreprocessOptions& options, const TempDir& dir)
+/// The include directives of `text` whose file name is written out (a computed
+/// `#include MACRO` is left to cpp and its limits). Lines starting with a tab are skipped
+/// when `tab_lines_protected`: they are production continuations, never directives.
+std::vector<IncludeDirective> scan_includes(std::string_view text, bool tab_lines_protected)
 {
-    std::string cmd = shell_quote(options.preprocessor);
-    cmd.append(" -undef -x c -fno-dollars-in-identifiers");
-    auto add = [&cmd](std::string_view flag, const std::string& value) {
-        cmd.append(flag);
-        cmd.append(shell_quote(value));
-    };
-    for (const auto& inc : options.include_dirs)
-        add(" -I", inc.string());
-    for (const auto& def : options.defines)
-        add(" -D", def);
-    add(" ", (dir.path() / "input.l").string());
-    add(" >", (dir.path() / "out").string());
-    add(" 2>", (dir.path() / "err").string());
-    return cmd;
+    std::vector<IncludeDirective> found;
+    int line = 0;
+    for_each_line(text, [&](std::string_view l) {
+        ++line;
+        if (!l.empty() && l.back() == '\n')
+            l.remove_suffix(1);
+        if (tab_lines_protected && !l.empty() && l[0] == '\t')
+            return;
+        std::size_t i = l.find_first_not_of(" \t");
+        if (i == std::string_view::npos || l[i] != '#')
+            return;
+        int column = int(i) + 1;
+        i = l.find_first_not_of(" \t", i + 1);
+        if (i == std::string_view::npos)
+            return;
+        std::string_view rest = l.substr(i);
+        std::size_t word = 0;
+        for (std::string_view w : {"include_next", "include", "import"})
+            if (rest.substr(0, w.size()) == w) {
+                word = w.size();
+                break;
+            }
+        if (word == 0)
+            return;
+        i = l.find_first_not_of(" \t", i + word);
+        if (i == std::string_view::npos || (l[i] != '"' && l[i] != '<'))
+            return;
+        char close = l[i] == '"' ? '"' : '>';
+        std::size_t end = l.find(close, i + 1);
+        if (end == std::string_view::npos)
+            return;
+        found.push_back({std::string(l.substr(i + 1, end - i - 1)), close == '"', line, column});
+    });
+    return found;
 }
 
-/// Forwards cpp's warnings (if any) with the temporary name replaced.
+/// Refuses, before cpp opens them, included names that are not regular files: reading
+/// /dev/zero, a FIFO or a terminal never ends. Follows the includes it can resolve
+/// (as cpp: the including file's folder for quoted names, then the -I folders).
+void check_includes(std::string_view source, const std::string& file_name,
+                    const std::filesystem::path& folder,
+                    const std::vector<std::filesystem::path>& include_dirs)
+{
+    struct Pending {
+        std::string text;
+        std::string name;
+        std::filesystem::path folder;
+        bool protected_tabs;
+    };
+    std::vector<Pending> queue{{std::string(source), file_name, folder, true}};
+    std::set<std::filesystem::path> seen;
+    while (!queue.empty()) {
+        Pending current = std::move(queue.back());
+        queue.pop_back();
+        for (const IncludeDirective& d : scan_includes(current.text, current.protected_tabs)) {
+            std::vector<std::filesystem::path> candidates;
+            std::filesystem::path named(d.name);
+            if (named.is_absolute()) {
+                candidates.push_back(named);
+            } else {
+                if (d.quoted)
+                    candidates.push_back(current.folder / named);
+                for (const auto& dir : include_dirs)
+                    candidates.push_back(dir / named);
+            }
+            for (const auto& candidate : candidates) {
+                struct stat st {};
+                if (::stat(candidate.c_str(), &st) != 0)
+                    continue;  // not there: the next folder, or cpp's own error
+                if (!S_ISREG(st.st_mode))
+                    throw Error(FileLoc{current.name, d.line, d.column},
+                                "#include names " + candidate.string() +
+                                    ", which is a device, FIFO or folder, not a file");
+                std::error_code ec;
+                auto canonical = std::filesystem::weakly_canonical(candidate, ec);
+                if (!seen.insert(ec ? candidate : canonical).second)
+                    break;
+                if (seen.size() > max_scanned_includes)
+                    throw Error(FileLoc{current.name, d.line, d.column},
+                                "more than " + std::to_string(max_scanned_includes) +
+                                    " files are included");
+                // Only the start of a huge file is scanned; cpp's output limit does the rest.
+                std::string text(std::min<std::size_t>(std::size_t(st.st_size), 16u << 20), '\0');
+                std::ifstream in(candidate, std::ios::binary);
+                in.read(text.data(), std::streamsize(text.size()));
+                text.resize(std::size_t(in.gcount()));
+                queue.push_back({std::move(text), candidate.string(), candidate.parent_path(), false});
+                break;
+            }
+        }
+    }
+}
+
+/// `name` as a C string literal for a line marker.
+std::string quoted(std::string_view name)
+{
+    std::string out = "\"";
+    for (char c : name) {
+        if (c == '"' || c == '\\')
+            out += '\\';
+        out += c == '\n' ? '?' : c;
+    }
+    return out + '"';
+}
+
+std::filesystem::path absolute_folder(const std::filesystem::path& folder)
+{
+    std::error_code ec;
+    auto absolute = std::filesystem::absolute(folder.empty() ? "." : folder, ec);
+    return ec ? folder : absolute.lexically_normal();
+}
+
+std::vector<std::string> cpp_command(const PreprocessOptions& options,
+                                     const std::filesystem::path& folder)
+{
+    // -nostdinc: a model has no business with the system's C headers.
+    std::vector<std::string> argv{options.preprocessor, "-undef", "-x", "c",
+                                  "-fno-dollars-in-identifiers", "-nostdinc",
+                                  "-I" + folder.string()};
+    for (const auto& dir : options.include_dirs)
+        if (!dir.empty())  // an empty -I would swallow the next word as a folder
+            argv.push_back("-I" + absolute_folder(dir).string());
+    for (const auto& def : options.defines)
+        argv.push_back("-D" + def);
+    argv.emplace_back("-");  // the protected text, on a pipe
+    return argv;
+}
+
+/// Relays cpp's warnings (if any).
 void forward_messages(const std::string& messages)
 {
     std::istringstream lines(messages);
@@ -113,17 +198,65 @@ void forward_messages(const std::string& messages)
             warn(line);
 }
 
+std::string fmt_seconds(double seconds)
+{
+    std::ostringstream out;
+    out << seconds;
+    return out.str();
+}
+
+/// cpp runs in the model's folder, so it names included files relative to it
+/// ("leaf.l"); the user named the model from their own folder. Prefixes `folder` (as
+/// the user gave it) to a relative file name at the start of each message line, after
+/// "included from ", and in line markers (`# 3 "leaf.l" 1`), so errors name the file
+/// the user can open. The main file (named by its marker) is left alone.
+std::string name_from_user_folder(const std::string& text, const std::filesystem::path& folder,
+                                  const std::string& main_name)
+{
+    if (folder.empty() || folder == ".")
+        return text;
+    auto rename = [&](std::string_view name) {
+        std::filesystem::path p(name);
+        std::error_code ec;
+        if (name.empty() || name == main_name || name.front() == '<' || p.is_absolute() ||
+            !std::filesystem::is_regular_file(folder / p, ec))  // not a file name ("cc1")
+            return std::string(name);
+        return (folder / p).string();
+    };
+    std::string out;
+    out.reserve(text.size());
+    for_each_line(text, [&](std::string_view view) {
+        std::string line(view);
+        std::size_t open = std::string::npos, close = std::string::npos;
+        if (line.size() > 2 && line[0] == '#' && line[1] == ' ' &&
+            std::isdigit(static_cast<unsigned char>(line[2]))) {  // a line marker
+            open = line.find('"');
+            close = open == std::string::npos ? open : line.find('"', open + 1);
+            if (close != std::string::npos)
+                ++open;
+        } else {
+            constexpr std::string_view from = "included from ";
+            std::size_t at = line.find(from);
+            open = at == std::string::npos ? 0 : at + from.size();
+            close = line.find(':', open);
+        }
+        if (open != std::string::npos && close != std::string::npos && close > open)
+            line = line.substr(0, open) + rename(std::string_view(line).substr(open, close - open)) +
+                   line.substr(close);
+        out += line;
+    });
+    return out;
+}
+
+std::string megabytes(std::size_t bytes) { return std::to_string(bytes >> 20) + " MiB"; }
+
 }  // namespace
 
 std::string protect_cpfg_lines(std::string_view source)
 {
     std::string out;
     out.reserve(source.size() + source.size() / 8);
-    std::size_t pos = 0;
-    while (pos < source.size()) {
-        std::size_t eol = source.find('\n', pos);
-        std::string_view line = source.substr(pos, eol == std::string_view::npos ? eol : eol - pos + 1);
-        pos += line.size();
+    for_each_line(source, [&](std::string_view line) {
         std::size_t first = line.find_first_not_of(" \t");
         bool turtle_hash = first != std::string_view::npos && line.substr(first, 2) == "#(";
         if (!line.empty() && line[0] == '\t') {
@@ -140,7 +273,7 @@ std::string protect_cpfg_lines(std::string_view source)
         } else {
             out += line;
         }
-    }
+    });
     return out;
 }
 
@@ -148,11 +281,7 @@ std::string restore_cpfg_lines(std::string_view text)
 {
     std::string out;
     out.reserve(text.size());
-    std::size_t pos = 0;
-    while (pos < text.size()) {
-        std::size_t eol = text.find('\n', pos);
-        std::string_view line = text.substr(pos, eol == std::string_view::npos ? eol : eol - pos + 1);
-        pos += line.size();
+    for_each_line(text, [&](std::string_view line) {
         std::size_t first = line.find_first_not_of(" \t");
         std::string restored(line);
         if (first != std::string_view::npos && line.substr(first, tab_marker.size()) == tab_marker) {
@@ -164,34 +293,62 @@ std::string restore_cpfg_lines(std::string_view text)
         }
         restored = replace_all(std::move(restored), tab_marker, " ");
         out += replace_all(std::move(restored), hash_marker, "#");
-    }
+    });
     return out;
 }
 
 std::string preprocess(std::string_view source, std::string_view file_name,
                        const PreprocessOptions& options)
 {
+    const std::string name(file_name);
     if (source.size() > options.max_input_bytes)
-        throw Error(FileLoc{std::string(file_name), 0, 0},
+        throw Error(FileLoc{name, 0, 0},
                     "the file is " + std::to_string(source.size()) + " bytes; at most " +
                         std::to_string(options.max_input_bytes) + " are accepted");
-    TempDir dir;
-    std::string input_path = (dir.path() / "input.l").string();
-    write_file(dir.path() / "input.l", protect_cpfg_lines(source));
-    int status = std::system(build_command(options, dir).c_str());
-    std::string messages = replace_all(read_file(dir.path() / "err"), input_path, file_name);
-    if (status == -1 || !WIFEXITED(status))
-        throw Error("cannot run the C preprocessor '" + options.preprocessor + "'");
-    int code = WEXITSTATUS(status);
-    if (code == 127)
-        throw Error("the C preprocessor '" + options.preprocessor +
-                    "' was not found; install cpp (e.g. apt-get install cpp) or pass another");
-    if (code != 0)
-        throw Error(FileLoc{std::string(file_name), 0, 0},
-                    "the C preprocessor failed:\n" + messages);
+    const std::filesystem::path folder = absolute_folder(options.folder);
+    std::vector<std::filesystem::path> include_dirs{folder};  // as cpp_command's -I list
+    for (const auto& dir : options.include_dirs)
+        if (!dir.empty())
+            include_dirs.push_back(absolute_folder(dir));
+    check_includes(source, name, folder, include_dirs);
+
+    // The line marker makes cpp's messages and markers name the model's file.
+    std::string input = "# 1 " + quoted(file_name) + "\n" + protect_cpfg_lines(source);
+    ProcessLimits limits;
+    limits.wall_seconds = options.max_seconds;
+    limits.max_output_bytes = options.max_output_bytes;
+    limits.max_memory_bytes = options.max_memory_bytes;
+    ProcessIo io;
+    io.input = input;
+    ProcessResult r = run_process(cpp_command(options, folder), folder, io, limits);
+    std::string messages =
+        name_from_user_folder(replace_all(r.messages, "<stdin>", name), options.folder, name);
+    while (!messages.empty() && (messages.back() == '\n' || messages.front() == '\n'))
+        messages.erase(messages.back() == '\n' ? messages.size() - 1 : 0, 1);
+    switch (r.end) {
+    case ProcessResult::End::not_found:
+        throw Error("the C preprocessor '" + options.preprocessor + "' was not found (" +
+                    r.messages + "); install cpp (e.g. apt-get install cpp) or pass another with -P");
+    case ProcessResult::End::timed_out:
+        throw Error(FileLoc{name, 0, 0},
+                    "the C preprocessor was stopped after " +
+                        fmt_seconds(options.max_seconds) +
+                        " s (does an #include read something endless?)");
+    case ProcessResult::End::output_too_large:
+        throw Error(FileLoc{name, 0, 0},
+                    "the preprocessed text grew past " + megabytes(options.max_output_bytes) +
+                        " and the C preprocessor was stopped (a macro that expands without bound?)");
+    case ProcessResult::End::signalled:
+        throw Error(FileLoc{name, 0, 0}, "the C preprocessor crashed (exit status " +
+                                             std::to_string(r.exit_code) + "):\n" + messages);
+    case ProcessResult::End::exited:
+        break;
+    }
+    if (r.exit_code != 0)
+        throw Error(FileLoc{name, 0, 0}, "the C preprocessor failed:\n" + messages);
     forward_messages(messages);
-    std::string text = read_file(dir.path() / "out");
-    return restore_cpfg_lines(replace_all(std::move(text), input_path, file_name));
+    std::string text = replace_all(r.output, "\"<stdin>\"", quoted(file_name));
+    return restore_cpfg_lines(name_from_user_folder(text, options.folder, name));
 }
 
 }  // namespace cambium::lsys

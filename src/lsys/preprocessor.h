@@ -10,18 +10,26 @@
 
 namespace cambium::lsys {
 
-/// How to run the preprocessor.
+/// How to run the preprocessor. cpp runs without a shell in the model's folder with
+/// the protected text on a pipe as its input (never a temporary file, never the
+/// user's standard input), so `#include "x"` is looked up from the model's folder,
+/// then in `include_dirs`; system folders are not searched (-nostdinc).
 struct PreprocessOptions {
     std::vector<std::string> defines;         ///< NAME or NAME=VALUE, passed as -D
-    std::vector<std::filesystem::path> include_dirs;  ///< passed as -I
+    std::filesystem::path folder;             ///< the model's folder ("" = the current one)
+    std::vector<std::filesystem::path> include_dirs;  ///< searched after `folder`; empty ones skipped
     std::string preprocessor = "cpp";         ///< the program to run
     std::size_t max_input_bytes = 16u << 20;  ///< larger inputs are refused
+    std::size_t max_output_bytes = 64u << 20;  ///< larger preprocessed text stops cpp
+    double max_seconds = 20;                  ///< cpp is stopped after this long
+    std::size_t max_memory_bytes = 1u << 30;  ///< cpp's address space
 };
 
 /// Preprocesses `source`, read from `file_name`. The result keeps cpp's line markers
 /// (`# 12 "plant.l"`) naming `file_name`, a leading tab on every line that had one, and
-/// every line whose first non-blank characters are `#(`. Throws cambium::Error when
-/// the preprocessor is missing or reports an error.
+/// every line whose first non-blank characters are `#(`. Throws cambium::Error (at the
+/// line of the directive where known) when the preprocessor is missing, reports an
+/// error, runs past a limit, or an `#include` names a device, FIFO or folder.
 std::string preprocess(std::string_view source, std::string_view file_name,
                        const PreprocessOptions& options);
 

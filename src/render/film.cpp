@@ -5,16 +5,13 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
-#include <system_error>
 #include <utility>
 
-#include <unistd.h>
-
+#include "base/atomic_file.h"
 #include "base/diagnostics.h"
 #include "render/color.h"
 
@@ -41,40 +38,38 @@ Format format_of(const std::filesystem::path& file)
                 "' (use .png, .exr, .tif or .jpg)");
 }
 
-/// A unique name beside `file`, keeping its extension so OIIO picks the same format.
-std::filesystem::path temporary_name(const std::filesystem::path& file)
-{
-    static std::atomic<unsigned> counter{0};
-    // Appended piece by piece: GCC 12 reports a false -Wrestrict on "." + std::string.
-    std::string name(1, '.');
-    name += file.stem().string();
-    name += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-    name += file.extension().string();
-    return file.parent_path() / name;
-}
+/// How a file with an alpha channel stores colour: straight (PNG's rule) or
+/// associated, i.e. premultiplied by alpha after encoding (TIFF's usual reading).
+enum class AlphaStorage { straight, associated };
 
-/// Display-referred pixels: exposure, straight (unassociated) colour for transparent
-/// images, sRGB-encoded, quantised to `Int` with `channels` channels (3: RGB, 4: RGBA).
+/// Display-referred pixels: exposure, sRGB-encoded, quantised to `Int` with `channels`
+/// channels (3: RGB, 4: RGBA with colour stored as `storage` says).
 template <class Int>
-std::vector<Int> encode_srgb(const Image& image, int channels, float exposure)
+std::vector<Int> encode_srgb(const Image& image, int channels, float exposure,
+                             AlphaStorage storage = AlphaStorage::straight)
 {
     constexpr float max = static_cast<float>(std::numeric_limits<Int>::max());
     float gain = std::exp2(exposure);
-    // A transparent image's colour is premultiplied; files with alpha want it straight.
+    // A transparent image's colour is premultiplied; it is encoded straight.
     bool unpremultiply = image.transparent && channels == 4;
+    bool associate = channels == 4 && storage == AlphaStorage::associated;
     std::size_t n = std::size_t(image.width) * image.height;
     std::vector<Int> out(n * channels);
     for (std::size_t i = 0; i < n; ++i) {
-        float alpha = image.rgba[i * 4 + 3];
-        float scale = unpremultiply && alpha > 0 ? gain / alpha : gain;
+        float alpha = std::clamp(image.rgba[i * 4 + 3], 0.0f, 1.0f);
+        float scale = unpremultiply && alpha > 0 ? gain / image.rgba[i * 4 + 3] : gain;
         for (int c = 0; c < channels; ++c) {
             float v = image.rgba[i * 4 + c];
-            float e = c < 3 ? linear_to_srgb(v * scale) : std::clamp(v, 0.0f, 1.0f);
+            float e = c < 3 ? linear_to_srgb(v * scale) * (associate ? alpha : 1.0f) : alpha;
             out[i * channels + c] = static_cast<Int>(std::lround(e * max));
         }
     }
     return out;
 }
+
+/// OpenImageIO stamps EXR (capDate) and TIFF files with the time of writing unless
+/// DateTime is set; an empty one writes none, so identical runs give identical files.
+void without_time_stamp(OIIO::ImageSpec& spec) { spec.attribute("DateTime", ""); }
 
 bool has_layer(const Image& image, const std::vector<float>& layer, int per_pixel)
 {
@@ -112,6 +107,7 @@ void write_exr(OIIO::ImageOutput& out, const Image& image, const std::filesystem
     }
     spec.attribute("oiio:ColorSpace", "Linear");
     spec.attribute("compression", "zip");
+    without_time_stamp(spec);
     std::size_t n = std::size_t(image.width) * image.height;
     std::vector<float> pixels(n * std::size_t(channels));
     for (std::size_t i = 0; i < n; ++i) {
@@ -128,25 +124,29 @@ void write_exr(OIIO::ImageOutput& out, const Image& image, const std::filesystem
 void write_with_oiio(const Image& image, const std::filesystem::path& temp, Format format,
                      const std::filesystem::path& file, const WriteOptions& options)
 {
-    auto out = OIIO::ImageOutput::create(temp.string());
+    auto out = OIIO::ImageOutput::create(file.string());  // the format from the real name
     if (!out)
         throw Error(file.string() + ": cannot write this format: " + OIIO::geterror());
     bool ok = false;
     if (format == Format::exr) {
         write_exr(*out, image, temp, ok);
     } else if (format == Format::tiff) {
-        OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::UINT16);
+        // Opaque renders have no alpha; transparent ones store associated alpha, which
+        // every TIFF reader shows right (unassociated alpha is premultiplied by some
+        // readers and left alone by others).
+        int channels = image.transparent ? 4 : 3;
+        OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::UINT16);
         spec.attribute("oiio:ColorSpace", "sRGB");
-        // Colour is composited over the background (or made straight when transparent);
-        // alpha is a coverage matte.
-        spec.attribute("oiio:UnassociatedAlpha", 1);
-        auto pixels = encode_srgb<std::uint16_t>(image, 4, options.exposure);
+        without_time_stamp(spec);
+        auto pixels = encode_srgb<std::uint16_t>(image, channels, options.exposure,
+                                                 AlphaStorage::associated);
         ok = out->open(temp.string(), spec) &&
              out->write_image(OIIO::TypeDesc::UINT16, pixels.data());
     } else {
         int channels = format == Format::png && image.transparent ? 4 : 3;
         OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::UINT8);
         spec.attribute("oiio:ColorSpace", "sRGB");
+        without_time_stamp(spec);
         if (channels == 4)
             spec.attribute("oiio:UnassociatedAlpha", 1);
         if (format == Format::jpeg)
@@ -178,18 +178,9 @@ void write_image(const Image& image, const std::filesystem::path& file,
         image.rgba.size() != std::size_t(image.width) * image.height * 4)
         throw Error(file.string() + ": cannot write an empty or malformed image");
     Format format = format_of(file);
-    std::filesystem::path temp = temporary_name(file);
-    try {
-        write_with_oiio(image, temp, format, file, options);
-        std::error_code ec;
-        std::filesystem::rename(temp, file, ec);
-        if (ec)
-            throw Error(file.string() + ": cannot write the image: " + ec.message());
-    } catch (...) {
-        std::error_code ignored;
-        std::filesystem::remove(temp, ignored);
-        throw;
-    }
+    write_file_atomically(file, [&](const std::filesystem::path& temporary) {
+        write_with_oiio(image, temporary, format, file, options);
+    });
 }
 
 }  // namespace cambium::render

@@ -45,7 +45,7 @@ void check_settings(const RenderSettings& s)
     if (s.width <= 0 || s.height <= 0)
         throw Error("render: image size " + std::to_string(s.width) + "x" +
                     std::to_string(s.height) + " is empty");
-    if (std::int64_t(s.width) * s.height > (std::int64_t{1} << 26))
+    if (std::int64_t(s.width) * s.height > max_image_pixels)
         throw Error("render: image size " + std::to_string(s.width) + "x" +
                     std::to_string(s.height) + " is larger than 2^26 pixels");
     if (s.samples_per_pixel <= 0)
@@ -226,6 +226,10 @@ std::vector<int> pass_targets(const RenderSettings& s)
                 break;
         }
     }
+    // With a time budget, a first pass of one sample per pixel is the quickest way to a
+    // complete image; the budget cannot stop it (see render()).
+    if (s.time_budget_s > 0)
+        targets.insert(targets.begin(), 1);
     targets.erase(std::unique(targets.begin(), targets.end()), targets.end());
     return targets;
 }
@@ -446,12 +450,15 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
         std::atomic<bool> stop{false}, cancelled{false}, out_of_time{false};
         double last_pass_s = 0;
         std::uint64_t last_pass_samples = 0;
+        // The time budget may stop a render only once every pixel has a sample: an
+        // image with unsampled (black) bands is never the result of a budget.
+        bool budget_applies = false;
         auto should_stop = [&] {
             if (settings.cancel && settings.cancel->load(std::memory_order_relaxed)) {
                 cancelled = true;
                 stop = true;
             }
-            if (settings.time_budget_s > 0 && elapsed() > settings.time_budget_s) {
+            if (budget_applies && settings.time_budget_s > 0 && elapsed() > settings.time_budget_s) {
                 out_of_time = true;
                 stop = true;
             }
@@ -477,6 +484,7 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
                     break;
                 }
             }
+            budget_applies = pass > 0;
             auto pass_start = Clock::now();
             // Each tile writes only its own pixels; no exception leaves a task.
             tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1),

@@ -26,6 +26,9 @@ enum class PixelFilter {
     blackman_harris,  ///< the 4-term Blackman-Harris window over [-radius, radius]
 };
 
+/// The largest image rendered: 2^26 pixels (8192 x 8192, about 5 GiB of pixel state).
+inline constexpr std::int64_t max_image_pixels = std::int64_t{1} << 26;
+
 /// How to render a frame.
 struct RenderSettings {
     int width = 640, height = 480;  ///< cpfg's default window
@@ -73,9 +76,10 @@ struct RenderSettings {
     /// its 8 neighbours (checked after each pass; 16 samples at least). e.g. 0.02.
     /// Deterministic: the same image for any thread count.
     float noise_target = 0;
-    /// Stop after about this many seconds (0 = no limit): no pass is started that is
-    /// predicted not to fit, and a pass still running at the limit stops at the next
-    /// tile row. The image then depends on the machine's speed (not bit-reproducible);
+    /// Stop after about this many seconds (0 = no limit): a first pass gives every
+    /// pixel one sample whatever the budget (never an image with unsampled bands); after
+    /// it, no pass is started that is predicted not to fit, and a pass still running at
+    /// the limit stops at the next tile row. The image then depends on the machine's speed (not bit-reproducible);
     /// `samples_per_pixel` still caps it, so set that high.
     double time_budget_s = 0;
 

@@ -2,11 +2,17 @@
 // The cambium command as a user runs it: exit status, messages, output files.
 #include <gtest/gtest.h>
 
+#include <OpenImageIO/imageio.h>
+#include <sys/stat.h>
+
 #include <array>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -17,9 +23,12 @@ struct Result {
     std::string output;  // stdout and stderr
 };
 
-Result run(const std::string& args)
+/// Runs cambium with `args` (in `folder` when given).
+Result run(const std::string& args, const fs::path& folder = {})
 {
     std::string command = std::string(CAMBIUM_EXE) + " " + args + " 2>&1";
+    if (!folder.empty())
+        command = "cd '" + folder.string() + "' && " + command;
     Result r{0, {}};
     FILE* pipe = popen(command.c_str(), "r");
     std::array<char, 512> buffer{};
@@ -110,4 +119,200 @@ TEST(Command, SkyTurbidityAndEnvironmentRotation)
     Result turn = run(out + "--env-rotate 90 " + files);
     EXPECT_NE(turn.status, 0);
     EXPECT_NE(turn.output.find("--env-rotate"), std::string::npos) << turn.output;
+}
+
+namespace {
+
+const char* plant_l = "lsystem: 1\nderivation length: 1\naxiom: F\nF --> F[+F]F\nendlsystem\n";
+const char* plant_v = "line style: cylinder\ninitial line width: 0.2\n";
+
+std::string bytes_of(const fs::path& file)
+{
+    std::ifstream in(file, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+fs::path corpus_model(const std::string& id)
+{
+    const char* env = std::getenv("CAMBIUM_CORPUS");
+    return fs::path(env ? env : CAMBIUM_CORPUS_DEFAULT) / "cpfg" / id;
+}
+
+}  // namespace
+
+// As cpfg users run it, inside the model's folder: the background scene (two spheres,
+// cylinders, a cone, polygons) is drawn (issue 14, item 2: it used to vanish).
+TEST(Command, BackgroundSceneFromInsideTheModelFolder)
+{
+    fs::path model = corpus_model("10-manuals/11-CPFG/BackgroundScene");
+    if (!fs::exists(model / "plant.v"))
+        GTEST_SKIP() << "corpus not found";
+    fs::path dir = scratch("background");
+    Result r = run("-M plant.mat plant.l plant.v -vv " + (dir / "p.vv").string() + " < /dev/null",
+                   model);
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("2 spheres"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
+}
+
+// Numbers out of range in options are clear errors before any work.
+TEST(Command, BadNumbersInOptionsAreClearErrors)
+{
+    fs::path dir = scratch("numbers");
+    write(dir / "p.l", plant_l);
+    write(dir / "p.v", plant_v);
+    std::string files = (dir / "p.l").string() + " " + (dir / "p.v").string();
+    Result big = run("-m99999999999 " + (dir / "p.map").string() + " " + files);
+    EXPECT_EQ(big.status, 1 << 8);
+    EXPECT_NE(big.output.find("option -m99999999999: the colour map number: expected a whole "
+                              "number from 0 to 15, not '99999999999'"),
+              std::string::npos)
+        << big.output;
+    EXPECT_EQ(big.output.find("stoi"), std::string::npos) << big.output;
+    Result block = run("-c123456789012 " + files);
+    EXPECT_NE(block.output.find("option -c123456789012: the colour map number"), std::string::npos)
+        << block.output;
+    Result huge = run("-w 32768 32768 " + files);
+    EXPECT_NE(huge.status, 0);
+    EXPECT_NE(huge.output.find("-w: 32768 x 32768 is more than 67108864 pixels"),
+              std::string::npos)
+        << huge.output;
+    EXPECT_EQ(huge.output.find("derived"), std::string::npos) << huge.output;  // before the work
+    Result word = run("-w 64 sixty " + files);
+    EXPECT_NE(word.output.find("-w: expected a whole number from 1 to 32768, not 'sixty'"),
+              std::string::npos)
+        << word.output;
+    Result spp = run("--spp lots " + files);
+    EXPECT_NE(spp.status, 0);
+    EXPECT_NE(spp.output.find("--spp"), std::string::npos) << spp.output;
+    Result seed = run("--seed -3 " + files);
+    EXPECT_NE(seed.status, 0);
+    EXPECT_NE(seed.output.find("--seed"), std::string::npos) << seed.output;
+    EXPECT_EQ(seed.output.find("derived"), std::string::npos) << seed.output;
+}
+
+// A FIFO (or device) given as the L-system file is refused, not read forever.
+TEST(Command, LsystemFileMustBeARegularFile)
+{
+    fs::path dir = scratch("fifo");
+    write(dir / "p.v", plant_v);
+    ASSERT_EQ(::mkfifo((dir / "p.l").c_str(), 0600), 0);
+    Result r = run((dir / "p.l").string() + " " + (dir / "p.v").string() + " < /dev/null");
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("p.l: error: cannot read the L-system file: not a regular file"),
+              std::string::npos)
+        << r.output;
+}
+
+// -q prints nothing but errors: warnings too.
+TEST(Command, QuietSilencesWarnings)
+{
+    fs::path dir = scratch("quiet");
+    write(dir / "p.l", "lsystem: 1\nderivation length: 0\naxiom: F@S(\"true\")\nendlsystem\n");
+    write(dir / "p.v", plant_v);
+    std::string files = (dir / "p.l").string() + " " + (dir / "p.v").string();
+    Result loud = run("-vv " + (dir / "p.vv").string() + " " + files);
+    EXPECT_NE(loud.output.find("warning: @S system calls are not run"), std::string::npos)
+        << loud.output;
+    Result quiet = run("-q -vv " + (dir / "p.vv").string() + " " + files);
+    EXPECT_EQ(quiet.status, 0);
+    EXPECT_EQ(quiet.output, "");
+}
+
+// @S runs its command only with --allow-system-calls, in the model's folder.
+TEST(Command, SystemCallsRunOnlyWhenAllowed)
+{
+    fs::path dir = scratch("system");
+    write(dir / "p.l",
+          "lsystem: 1\nderivation length: 0\naxiom: F@S(\"pwd > ran.txt\")\nendlsystem\n");
+    write(dir / "p.v", plant_v);
+    std::string files = (dir / "p.l").string() + " " + (dir / "p.v").string();
+    Result refused = run("-vv " + (dir / "p.vv").string() + " " + files);
+    EXPECT_EQ(refused.status, 0) << refused.output;
+    EXPECT_FALSE(fs::exists(dir / "ran.txt"));
+    EXPECT_NE(refused.output.find("use --allow-system-calls"), std::string::npos);
+    Result allowed = run("--allow-system-calls -vv " + (dir / "p.vv").string() + " " + files);
+    EXPECT_EQ(allowed.status, 0) << allowed.output;
+    EXPECT_EQ(bytes_of(dir / "ran.txt"), fs::canonical(dir).string() + "\n");
+}
+
+// Identical runs give identical files: no time stamps in EXR or TIFF headers.
+TEST(Command, IdenticalRunsGiveIdenticalFiles)
+{
+    fs::path dir = scratch("identical");
+    write(dir / "p.l", plant_l);
+    write(dir / "p.v", plant_v);
+    std::string files = (dir / "p.l").string() + " " + (dir / "p.v").string();
+    for (const char* run_name : {"a", "b"}) {
+        std::string outs;
+        for (const char* ext : {".exr", ".png", ".tif"})
+            outs += " -o " + (dir / (std::string(run_name) + ext)).string();
+        Result r = run("-q -w 24 16 --spp 2" + outs + " " + files);
+        ASSERT_EQ(r.status, 0) << r.output;
+    }
+    for (const char* ext : {".exr", ".png", ".tif"}) {
+        std::string a = bytes_of(dir / (std::string("a") + ext));
+        EXPECT_FALSE(a.empty());
+        EXPECT_TRUE(a == bytes_of(dir / (std::string("b") + ext))) << ext;
+        auto in = OIIO::ImageInput::open((dir / (std::string("a") + ext)).string());
+        ASSERT_TRUE(in);
+        EXPECT_EQ(in->spec().find_attribute("DateTime"), nullptr) << ext;
+        EXPECT_EQ(in->spec().find_attribute("capDate"), nullptr) << ext;
+    }
+}
+
+// TIFF: no alpha when opaque; associated alpha when transparent, so readers that
+// premultiply and readers that do not show the same picture.
+TEST(Command, TiffAlphaIsAssociatedOrAbsent)
+{
+    fs::path dir = scratch("tiff");
+    write(dir / "p.l", plant_l);
+    write(dir / "p.v", plant_v);
+    std::string files = (dir / "p.l").string() + " " + (dir / "p.v").string();
+    ASSERT_EQ(run("-q -w 24 16 --spp 2 -o " + (dir / "o.tif").string() + " " + files).status, 0);
+    auto opaque = OIIO::ImageInput::open((dir / "o.tif").string());
+    ASSERT_TRUE(opaque);
+    EXPECT_EQ(opaque->spec().nchannels, 3);
+
+    ASSERT_EQ(run("-q --transparent -w 24 16 --spp 2 -o " + (dir / "t.tif").string() + " -o " +
+                  (dir / "t.png").string() + " " + files)
+                  .status,
+              0);
+    auto tif = OIIO::ImageInput::open((dir / "t.tif").string());
+    auto png = OIIO::ImageInput::open((dir / "t.png").string());
+    ASSERT_TRUE(tif && png);
+    EXPECT_EQ(tif->spec().nchannels, 4);
+    EXPECT_EQ(tif->spec().get_int_attribute("oiio:UnassociatedAlpha", 0), 0);
+    std::vector<float> t(24 * 16 * 4), p(24 * 16 * 4);
+    ASSERT_TRUE(tif->read_image(0, 0, 0, 4, OIIO::TypeDesc::FLOAT, t.data()));
+    // The PNG's straight colour, read without OIIO premultiplying it.
+    OIIO::ImageSpec raw;
+    raw.attribute("oiio:UnassociatedAlpha", 1);
+    png = OIIO::ImageInput::open((dir / "t.png").string(), &raw);
+    ASSERT_TRUE(png->read_image(0, 0, 0, 4, OIIO::TypeDesc::FLOAT, p.data()));
+    int background = 0, plant = 0;
+    for (std::size_t i = 0; i < t.size(); i += 4) {
+        EXPECT_NEAR(t[i + 3], p[i + 3], 1.0 / 255);
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(t[i + c], p[i + c] * p[i + 3], 2.0 / 255) << i;
+        background += t[i + 3] == 0 && t[i] == 0;
+        plant += t[i + 3] == 1.0f;
+    }
+    EXPECT_GT(background, 0);
+    EXPECT_GT(plant, 0);
+}
+
+// A symlink planted at the temporary name earlier versions used is never followed.
+TEST(Command, PlantedSymlinkAtTemporaryNameIsNotFollowed)
+{
+    fs::path dir = scratch("symlink");
+    write(dir / "p.l", plant_l);
+    write(dir / "p.v", plant_v);
+    write(dir / "victim", "precious");
+    fs::create_symlink(dir / "victim", dir / "s.str.cambium-tmp");
+    Result r = run("-q -str " + (dir / "s.str").string() + " " + (dir / "p.l").string() + " " +
+                   (dir / "p.v").string());
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(bytes_of(dir / "victim"), "precious");
+    EXPECT_NE(bytes_of(dir / "s.str").find("F[+F]F"), std::string::npos);
 }

@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <fstream>
+
+#include <sys/stat.h>
 
 #include "geom/background_scene.h"
 
@@ -216,4 +219,80 @@ TEST(BackgroundScene, AppendKeepsCurveEndMaterials)
     EXPECT_EQ(a.curves.material[1], 12);
     EXPECT_EQ(a.curves.end_material[1], 13);
     EXPECT_EQ(a.curves.segments[1], 2u);
+}
+
+namespace {
+
+/// Runs `body` with the current folder set to `folder`, restoring it afterwards.
+template <class Body>
+void in_folder(const std::filesystem::path& folder, Body body)
+{
+    std::filesystem::path saved = std::filesystem::current_path();
+    std::filesystem::current_path(folder);
+    try {
+        body();
+    } catch (...) {
+        std::filesystem::current_path(saved);
+        throw;
+    }
+    std::filesystem::current_path(saved);
+}
+
+std::string error_of(const std::string& list, const std::filesystem::path& base)
+{
+    try {
+        read_background_scene(list, base, Material{}, FileLoc{"plant.v", 14, 1});
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "";
+}
+
+}  // namespace
+
+// Run inside the model's folder (`cambium plant.l plant.v`, view file named without a
+// folder), a preprocessed background file used to be lost: cpp got an empty -I and read
+// standard input instead (issue 14, item 2).
+TEST(BackgroundScene, RelativeFileInTheCurrentFolderIsPreprocessed)
+{
+    std::filesystem::path dir = std::filesystem::temp_directory_path() / "cambium_bg_relative";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "bg.dat") << "#define R 0.25\nsphere R\n";
+    in_folder(dir, [] {
+        BackgroundScene s = read_background_scene("bg.dat", "", Material{}, FileLoc{"plant.v", 1, 1});
+        ASSERT_EQ(s.geometry.spheres.size(), 1u);
+        EXPECT_EQ(s.geometry.spheres.centres[0], (Float4{0, 0, 0, 0.25f}));
+    });
+    const char* env = std::getenv("CAMBIUM_CORPUS");
+    std::filesystem::path plant = std::filesystem::path(env ? env : CAMBIUM_CORPUS_DEFAULT) /
+                                  "cpfg/10-manuals/11-CPFG/BackgroundScene";
+    if (!std::filesystem::exists(plant / "background.dat"))
+        return;
+    in_folder(plant, [] {
+        BackgroundScene s = read_background_scene("background.dat", "", Material{}, FileLoc{"plant.v", 14, 1});
+        EXPECT_EQ(s.geometry.spheres.size(), 2u);  // `sphere 0.5` and `sphere 1.0`
+        EXPECT_FLOAT_EQ(s.materials.at(0).transparency, 0.5f);
+    });
+}
+
+// A background file that cannot be read is an error naming it, never a warning.
+TEST(BackgroundScene, UnreadableFileIsAnErrorNamingIt)
+{
+    std::filesystem::path dir = std::filesystem::temp_directory_path() / "cambium_bg_unreadable";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    std::string message = error_of("missing.dat", dir);
+    EXPECT_NE(message.find("plant.v:14:1: error: cannot read the background scene file " +
+                           (dir / "missing.dat").string() + ": no such file"),
+              std::string::npos)
+        << message;
+    ASSERT_EQ(::mkfifo((dir / "fifo.dat").c_str(), 0600), 0);
+    message = error_of("fifo.dat", dir);
+    EXPECT_NE(message.find((dir / "fifo.dat").string() + ": not a regular file"), std::string::npos)
+        << message;
+    std::ofstream(dir / "bad.dat") << "#include \"nowhere.h\"\nsphere 1\n";
+    message = error_of("bad.dat", dir);
+    EXPECT_NE(message.find("bad.dat:1:10: fatal error: nowhere.h: No such file"), std::string::npos)
+        << message;
 }

@@ -1,6 +1,14 @@
 // SPDX-License-Identifier: Apache-2.0
 // The cpp step: tab continuations, `#(` turtle lines, defines, missing preprocessor.
 #include "lsys/preprocessor.h"
+
+#include <sys/stat.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+
 #include "test_util.h"
 
 namespace cambium::lsys {
@@ -70,6 +78,171 @@ TEST(LsysPreprocessor, RefusesHugeInput)
     PreprocessOptions options;
     options.max_input_bytes = 10;
     EXPECT_THROW(preprocess("lsystem: 1\naxiom: A\n", "big.l", options), Error);
+}
+
+namespace fs = std::filesystem;
+
+/// An empty scratch folder for one test.
+fs::path scratch(const std::string& name)
+{
+    fs::path dir = fs::temp_directory_path() / ("cambium_pp_" + name);
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+/// The message of the Error `preprocess` throws ("" if none).
+std::string preprocess_error(const std::string& source, const std::string& file,
+                             const PreprocessOptions& options = {})
+{
+    try {
+        preprocess(source, file, options);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "";
+}
+
+// cpp's own diagnostics are relayed naming the model's file at its line, never a
+// temporary path or <stdin>.
+TEST(LsysPreprocessor, CppMessagesNameTheModelFile)
+{
+    std::string message = preprocess_error("#define A 1\n\n#error no good\n", "dir/m.l");
+    EXPECT_NE(message.find("dir/m.l:3:2: error: #error no good"), std::string::npos) << message;
+    EXPECT_EQ(message.find("<stdin>"), std::string::npos) << message;
+    EXPECT_EQ(message.find(fs::temp_directory_path().string()), std::string::npos) << message;
+}
+
+// A macro that expands without bound hits the output limit with a message.
+TEST(LsysPreprocessor, MacroBombHitsTheOutputLimit)
+{
+    std::string bomb = "#define A0 x x x x x x x x x x x x x x x x\n";
+    for (int i = 1; i < 6; ++i)
+        bomb += "#define A" + std::to_string(i) + " A" + std::to_string(i - 1) + " A" +
+                std::to_string(i - 1) + " A" + std::to_string(i - 1) + " A" +
+                std::to_string(i - 1) + "\n";
+    for (int i = 0; i < 40; ++i)
+        bomb += "A5\n";  // 40 x 16 x 4^5 words: about 1.3 MB
+    PreprocessOptions options;
+    options.max_output_bytes = 256u << 10;
+    std::string message = preprocess_error(bomb, "bomb.l", options);
+    EXPECT_NE(message.find("bomb.l: error: the preprocessed text grew past"), std::string::npos)
+        << message;
+    EXPECT_NE(message.find("without bound"), std::string::npos) << message;
+}
+
+// Reading /dev/zero, a FIFO or a folder never ends (or makes no sense): refused at the
+// #include, before cpp runs.
+TEST(LsysPreprocessor, IncludeOfDeviceOrFifoIsRefused)
+{
+    auto start = std::chrono::steady_clock::now();
+    std::string message = preprocess_error("\n  #include \"/dev/zero\"\n", "z.l");
+    EXPECT_NE(message.find("z.l:2:3: error: #include names /dev/zero, which is a device"),
+              std::string::npos)
+        << message;
+    fs::path dir = scratch("fifo");
+    ASSERT_EQ(::mkfifo((dir / "pipe.h").c_str(), 0600), 0);
+    PreprocessOptions options;
+    options.folder = dir;
+    message = preprocess_error("#include \"pipe.h\"\n", "f.l", options);
+    EXPECT_NE(message.find("f.l:1:1: error: #include names"), std::string::npos) << message;
+    EXPECT_NE(message.find("pipe.h, which is a device, FIFO or folder"), std::string::npos)
+        << message;
+    // Also through an included file.
+    std::ofstream(dir / "inner.h") << "#include <pipe.h>\n";
+    message = preprocess_error("#include \"inner.h\"\n", "f.l", options);
+    EXPECT_NE(message.find("inner.h:1:1: error: #include names"), std::string::npos) << message;
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(10));
+}
+
+// An include whose name is computed is not seen before cpp runs: cpp's memory and
+// time limits stop it.
+TEST(LsysPreprocessor, ComputedIncludeOfDeviceIsStoppedByLimits)
+{
+    PreprocessOptions options;
+    options.max_seconds = 3;
+    options.max_memory_bytes = 256u << 20;
+    std::string message = preprocess_error("#define Z \"/dev/zero\"\n#include Z\n", "c.l", options);
+    EXPECT_NE(message.find("c.l"), std::string::npos) << message;
+    EXPECT_TRUE(message.find("memory") != std::string::npos ||
+                message.find("stopped after 3 s") != std::string::npos)
+        << message;
+}
+
+// `#include "../x"` is looked up from the model's folder, never from a temporary
+// folder's parent (the system's temporary directory), where anyone may plant a file.
+TEST(LsysPreprocessor, QuotedIncludesStartFromTheModelFolder)
+{
+    fs::path dir = scratch("hijack");
+    fs::create_directories(dir / "model");
+    std::ofstream(fs::temp_directory_path() / "cambium_planted.h") << "hijacked\n";
+    std::ofstream(dir / "model" / "own.h") << "own_text\n";
+    std::ofstream(dir / "shared.h") << "shared_text\n";
+    PreprocessOptions options;
+    options.folder = dir / "model";
+    std::string out = preprocess("#include \"own.h\"\n#include \"../shared.h\"\n", "p.l", options);
+    EXPECT_NE(out.find("own_text"), std::string::npos) << out;
+    EXPECT_NE(out.find("shared_text"), std::string::npos) << out;
+    std::string message = preprocess_error("#include \"../cambium_planted.h\"\n", "p.l", options);
+    EXPECT_NE(message.find("p.l:1:10: fatal error: ../cambium_planted.h: No such file"),
+              std::string::npos)
+        << message;
+    EXPECT_EQ(message.find("hijacked"), std::string::npos) << message;
+    fs::remove(fs::temp_directory_path() / "cambium_planted.h");
+}
+
+// cpp runs in the model's folder; included files are still named as the user reaches
+// them (the folder they gave), in line markers and in cpp's messages.
+TEST(LsysPreprocessor, IncludedFilesAreNamedFromTheUsersFolder)
+{
+    fs::path dir = scratch("names");
+    std::ofstream(dir / "leaf.h") << "leaf_text\n";
+    std::ofstream(dir / "bad.h") << "\n#error in bad\n";
+    PreprocessOptions options;
+    options.folder = dir;
+    std::string main = (dir / "p.l").string();
+    std::string out = preprocess("#include \"leaf.h\"\n", main, options);
+    EXPECT_NE(out.find("\"" + (dir / "leaf.h").string() + "\""), std::string::npos) << out;
+    EXPECT_NE(out.find("\"" + main + "\""), std::string::npos) << out;
+    std::string message = preprocess_error("\n#include \"bad.h\"\n", main, options);
+    EXPECT_NE(message.find("included from " + main + ":2"), std::string::npos) << message;
+    EXPECT_NE(message.find((dir / "bad.h").string() + ":2:2: error: #error in bad"), std::string::npos)
+        << message;
+}
+
+// System headers are not searched: a model has no business with them.
+TEST(LsysPreprocessor, SystemHeadersAreNotSearched)
+{
+    std::string message = preprocess_error("#include <stdio.h>\n", "s.l");
+    EXPECT_NE(message.find("s.l:1:10: fatal error: stdio.h: No such file"), std::string::npos)
+        << message;
+}
+
+// cpp never reads cambium's standard input and no empty -I is passed: an empty
+// include folder used to make cpp read its input from standard input.
+TEST(LsysPreprocessor, EmptyIncludeFolderIsSkipped)
+{
+    PreprocessOptions options;
+    options.include_dirs = {""};
+    std::string out = preprocess("#define N 7\nA(N)\n", "e.l", options);
+    EXPECT_NE(out.find("A(7)"), std::string::npos) << out;
+}
+
+// Nothing is left in the temporary directory, even after an error.
+TEST(LsysPreprocessor, NoTemporaryFilesEvenAfterAnError)
+{
+    fs::path dir = scratch("tmpdir");
+    const char* saved = std::getenv("TMPDIR");
+    std::string saved_value = saved ? saved : "";
+    ::setenv("TMPDIR", dir.c_str(), 1);
+    std::string message = preprocess_error("#error stop\n", "t.l");
+    std::string fine = preprocess("A\n", "t.l", {});
+    if (saved)
+        ::setenv("TMPDIR", saved_value.c_str(), 1);
+    else
+        ::unsetenv("TMPDIR");
+    EXPECT_NE(message.find("t.l:1:2: error: #error stop"), std::string::npos) << message;
+    EXPECT_TRUE(fs::is_empty(dir));
 }
 
 }  // namespace

@@ -1,0 +1,20 @@
+// SPDX-License-Identifier: Apache-2.0
+// Output files that appear whole or not at all, through a private temporary beside them.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+
+namespace cambium {
+
+/// Creates or replaces `file` atomically: `write` fills a fresh temporary in the same
+/// folder, which is then renamed over `file`. The temporary is made with mkstemps
+/// (O_CREAT|O_EXCL, a random name, never following a planted link) and `write` gets a
+/// path that reaches that very file (/proc/self/fd/N where available), so nothing at a
+/// predictable name is ever opened. `write` throws on failure; whatever goes wrong,
+/// the temporary is removed and `file` is left as it was. Throws cambium::Error naming
+/// `file`. The new file gets the usual permissions (0666 less the umask).
+void write_file_atomically(const std::filesystem::path& file,
+                           const std::function<void(const std::filesystem::path& temporary)>& write);
+
+}  // namespace cambium

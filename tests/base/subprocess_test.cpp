@@ -1,0 +1,133 @@
+// SPDX-License-Identifier: Apache-2.0
+// Helper programs: no shell, limits, standard input, interrupts, process groups.
+#include "base/subprocess.h"
+
+#include <gtest/gtest.h>
+
+#include <signal.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "scratch.h"
+
+namespace cambium {
+namespace {
+
+namespace fs = std::filesystem;
+
+using testing::scratch;
+
+/// Whether `pid` is gone or a zombie within a few seconds (SIGKILL is asynchronous, and
+/// an orphan's zombie may wait for a reaper).
+bool dies_soon(pid_t pid)
+{
+    auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+    while (std::chrono::steady_clock::now() < deadline) {
+        std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+        std::string id, name, state;
+        if (!(stat >> id >> name >> state) || state == "Z")
+            return true;
+        std::this_thread::yield();
+    }
+    return false;
+}
+
+TEST(Subprocess, RunsWithoutAShellInTheFolderGivenAndFeedsItsInput)
+{
+    fs::path dir = scratch("folder");
+    ProcessIo io;
+    io.input = "a;b $(x)\n";
+    // `cat` copies its input: no shell interprets the words.
+    ProcessResult r = run_process({"cat"}, dir, io, {});
+    EXPECT_EQ(r.end, ProcessResult::End::exited);
+    EXPECT_EQ(r.exit_code, 0);
+    EXPECT_EQ(r.output, "a;b $(x)\n");
+    r = run_process({"pwd"}, dir, {}, {});
+    EXPECT_EQ(r.output, fs::canonical(dir).string() + "\n");
+}
+
+TEST(Subprocess, StandardInputIsDevNullWithoutInput)
+{
+    ProcessResult r = run_process({"sh", "-c", "wc -c; readlink /proc/self/fd/0"}, ".", {}, {});
+    EXPECT_EQ(r.output, "0\n/dev/null\n");
+}
+
+TEST(Subprocess, MissingProgramIsReported)
+{
+    ProcessResult r = run_process({"/nonexistent/cambium-helper"}, ".", {}, {});
+    EXPECT_EQ(r.end, ProcessResult::End::not_found);
+    EXPECT_NE(r.messages.find("No such file"), std::string::npos) << r.messages;
+}
+
+TEST(Subprocess, WallTimeLimitKillsTheWholeGroup)
+{
+    fs::path dir = scratch("time");
+    ProcessLimits limits;
+    limits.wall_seconds = 0.3;
+    auto start = std::chrono::steady_clock::now();
+    // The grandchild `sleep` must die too (cpp leaves cc1 running otherwise).
+    ProcessResult r =
+        run_process({"sh", "-c", "sleep 60 & echo $! > grandchild; wait"}, dir, {}, limits);
+    EXPECT_EQ(r.end, ProcessResult::End::timed_out);
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(20));
+    pid_t grandchild = 0;
+    std::ifstream(dir / "grandchild") >> grandchild;
+    ASSERT_GT(grandchild, 0);
+    EXPECT_TRUE(dies_soon(grandchild));
+}
+
+TEST(Subprocess, OutputLimitStopsIt)
+{
+    ProcessLimits limits;
+    limits.max_output_bytes = 1u << 20;
+    ProcessResult r = run_process({"yes"}, ".", {}, limits);
+    EXPECT_EQ(r.end, ProcessResult::End::output_too_large);
+    EXPECT_LE(r.output.size(), limits.max_output_bytes);
+}
+
+TEST(Subprocess, MemoryLimitApplies)
+{
+    // awk builds a 32 MiB string: fine without a limit, impossible within 24 MiB.
+    std::vector<std::string> hungry{
+        "awk", "BEGIN { s = \"x\"; for (i = 0; i < 25; i++) s = s s; print length(s) }"};
+    ProcessLimits limits;
+    limits.max_memory_bytes = 0;
+    EXPECT_EQ(run_process(hungry, ".", {}, limits).output, "33554432\n");
+    limits.max_memory_bytes = 24u << 20;
+    ProcessResult r = run_process(hungry, ".", {}, limits);
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_EQ(r.output, "");
+    EXPECT_NE(r.messages.find("out of memory"), std::string::npos) << r.messages;
+}
+
+// Ctrl-C while a helper runs: it and its children are killed and reaped, and the
+// caller gets Interrupted (main exits 130) instead of dying with files left behind.
+TEST(Subprocess, InterruptKillsTheHelperAndThrows)
+{
+    fs::path dir = scratch("interrupt");
+    auto start = std::chrono::steady_clock::now();
+    try {
+        run_process({"sh", "-c", "echo $$ > helper; kill -INT $PPID; exec sleep 60"}, dir, {}, {});
+        FAIL() << "expected Interrupted";
+    } catch (const Interrupted& e) {
+        EXPECT_EQ(e.signal(), SIGINT);
+        EXPECT_NE(std::string(e.what()).find("interrupted"), std::string::npos);
+    }
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(20));
+    pid_t helper = 0;
+    std::ifstream(dir / "helper") >> helper;
+    ASSERT_GT(helper, 0);
+    EXPECT_NE(::kill(helper, 0), 0);
+    // The default disposition is back afterwards.
+    struct sigaction now {};
+    ::sigaction(SIGINT, nullptr, &now);
+    EXPECT_EQ(now.sa_handler, SIG_DFL);
+}
+
+}  // namespace
+}  // namespace cambium
