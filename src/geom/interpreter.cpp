@@ -747,7 +747,12 @@ private:
         outline.reserve(corners.size());
         for (const PolygonCorner& c : corners)
             outline.push_back(c.position);
-        auto triangles = triangulate_polygon(outline);
+        bool cut_short = false;
+        auto triangles = triangulate_polygon(outline, &cut_short);
+        if (cut_short)
+            warn("a polygon of " + std::to_string(outline.size()) +
+                 " vertices took too long to triangulate; the rest of it was cut in order "
+                 "(concave parts may be filled wrongly)");
         if (triangles.empty())
             return;
         Vec3 n = polygon_normal(outline);
