@@ -9,6 +9,7 @@
 #include "geom/function.h"
 #include "geom/interpreter.h"
 #include "geom/query.h"
+#include "geom/scene_limits.h"
 #include "lsys/program.h"
 
 namespace cambium::app {
@@ -159,6 +160,8 @@ geom::Scene interpret(const Model& model, const lsys::ModuleString& derived,
                                background.materials.end());
         geom::append_geometry(scene.geometry, background.geometry);
     }
+    // Non-finite or huge numbers would abort inside Embree: dropped here with a warning.
+    geom::drop_unrenderable(scene);
     return scene;
 }
 

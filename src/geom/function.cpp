@@ -345,6 +345,10 @@ double FunctionSet::evaluate(int id, double x) const
              std::to_string(m_functions.size()) + "); 0 used");
         return 0;
     }
+    if (std::isnan(x)) {  // no place on the curve; also no int to floor it to
+        warn("func(" + std::to_string(id) + ", x): x is not a number; 0 used");
+        x = 0;
+    }
     return m_functions[static_cast<std::size_t>(id - 1)].evaluate(x);
 }
 
@@ -796,6 +800,11 @@ double CurveSet::evaluate(char which, int id, double t) const
     const SpaceCurve& curve = m_curves[static_cast<std::size_t>(id - 1)];
     if (which == 'l')
         return curve.length();
+    if (std::isnan(t)) {
+        warn(std::string("curve") + static_cast<char>(std::toupper(which)) + "(" + std::to_string(id) +
+             ", t): t is not a number; 0 used");
+        t = 0;
+    }
     Vec3 p = curve.at_length_fraction(t);
     return which == 'x' ? p.x : which == 'y' ? p.y : p.z;
 }

@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <sstream>
 
+#include "geom/scene_limits.h"
 #include "geom/turtle.h"
 #include "geom/view_file.h"
 
@@ -16,6 +18,7 @@ namespace {
 constexpr double min_segment_length = 0.00001;  // cpfg draws nothing shorter
 constexpr int max_strips = 10000;
 constexpr int max_sides = 100000;
+constexpr long long max_segment_vertices = 1'000'000;
 
 Float3 f3(const Vec3& v) { return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)}; }
 Float4 f4(const Vec3& v, double w)
@@ -28,9 +31,9 @@ std::uint16_t material_index(int color) { return static_cast<std::uint16_t>(std:
 
 int strips_from(std::span<const float> p, int fallback)
 {
-    if (p.empty())
+    if (p.empty() || std::isnan(p[0]))
         return fallback;
-    return std::clamp(static_cast<int>(p[0]), 1, max_strips);  // cpfg: at least 1
+    return static_cast<int>(std::clamp(static_cast<double>(p[0]), 1.0, double(max_strips)));  // cpfg: at least 1
 }
 
 /// `up` made perpendicular to the unit `heading` (the turtle is not re-orthonormalised).
@@ -83,6 +86,25 @@ double parse_number(const std::string& text, double fallback)
     double value = fallback;
     in >> value;
     return in.fail() ? fallback : value;
+}
+
+/// A view-file count in [lo, hi]: beyond it (or not finite) clamped, with a warning.
+int parse_count(const ViewCommand& c, int fallback, int lo, int hi)
+{
+    double value = parse_number(c.value, fallback);
+    if (!(value >= lo && value <= hi)) {
+        warn(c.loc, "'" + c.name + ":' must be " + std::to_string(lo) + " to " + std::to_string(hi) +
+                        (std::isnan(value) ? std::string("; ") + std::to_string(fallback) + " used"
+                                           : "; clamped"));
+        value = std::isnan(value) ? fallback : std::clamp(value, double(lo), double(hi));
+    }
+    return static_cast<int>(value);
+}
+
+/// A cylinder module's parameter as an int clamped to [lo, hi] (NaN: `fallback`).
+int clamped_parameter(float v, int fallback, int lo, int hi)
+{
+    return std::isnan(v) ? fallback : static_cast<int>(std::clamp(static_cast<double>(v), double(lo), double(hi)));
 }
 
 }  // namespace
@@ -184,12 +206,10 @@ CylinderSettings cylinder_settings(const ViewFile& view)
     std::filesystem::path folder = view.path.parent_path();
     for (const ViewCommand& c : view.deferred) {
         if (c.name == "contour sides") {
-            int n = static_cast<int>(parse_number(c.value, 8));
-            s.sides = std::clamp(n, 3, max_sides);
+            s.sides = parse_count(c, 8, 3, max_sides);
         } else if (c.name == "polygonization level") {
             // cpfg: 2^(n+1) polygons around (manual 5.2.4), kept for old view files.
-            int level = std::clamp(static_cast<int>(parse_number(c.value, 2)), 1, 16);
-            s.sides = 1 << (level + 1);
+            s.sides = 1 << (parse_count(c, 2, 1, 16) + 1);
         } else if (c.name == "render mode") {
             std::istringstream in(c.value);
             std::string word;
@@ -275,9 +295,11 @@ void CylinderBuilder::end(Turtle& turtle, std::span<const float> p)
 
 void CylinderBuilder::open_curve(Turtle& turtle, std::span<const float> p)
 {
-    int type = p.empty() ? 0 : static_cast<int>(p[0]);
+    int type = p.empty() ? 0 : whole_number(p[0]).value_or(0);
     if (type <= 0 || type > 4) {
-        warn("'{(" + std::to_string(type) + ")': the cylinder type must be 1 to 4; ignored");
+        char shown[32];
+        std::snprintf(shown, sizeof shown, "%g", p.empty() ? 0.0 : static_cast<double>(p[0]));
+        warn(std::string("'{(") + shown + ")': the cylinder type must be 1 to 4; ignored");
         return;
     }
     CylinderState& c = turtle.cylinder;
@@ -285,7 +307,7 @@ void CylinderBuilder::open_curve(Turtle& turtle, std::span<const float> p)
     c.closed = type == 2 || type == 4;
     c.bspline = type >= 3;
     c.bspline_points.reset();
-    int rings = p.size() >= 2 ? static_cast<int>(p[1]) : 0;
+    int rings = p.size() >= 2 ? clamped_parameter(p[1], 0, 0, max_strips) : 0;
     c.default_strips = rings <= 0 ? default_cylinder_strips : std::min(rings, max_strips);
     c.points = 0;
 }
@@ -354,10 +376,13 @@ void CylinderBuilder::set_radius_tangents(Turtle& turtle, std::span<const float>
 
 void CylinderBuilder::set_contour(Turtle& turtle, std::span<const float> p)
 {
-    int id = p.empty() ? 0 : static_cast<int>(p[0]);
-    if (id != 0 && !m_settings.contours.contains(id)) {
+    std::optional<int> number = p.empty() ? std::optional<int>(0) : whole_number(p[0]);
+    int id = number.value_or(-1);
+    if (id != 0 && (!number || !m_settings.contours.contains(id))) {
+        char shown[32];
+        std::snprintf(shown, sizeof shown, "%g", p.empty() ? 0.0 : static_cast<double>(p[0]));
         if (!m_warned_unknown_contour)
-            warn("contour id " + std::to_string(id) + " is not defined in the view file; the circle is used");
+            warn(std::string("contour id ") + shown + " is not defined in the view file; the circle is used");
         m_warned_unknown_contour = true;
         id = 0;
     }
@@ -366,8 +391,7 @@ void CylinderBuilder::set_contour(Turtle& turtle, std::span<const float> p)
 
 void CylinderBuilder::set_sides(Turtle& turtle, std::span<const float> p)
 {
-    int sides = p.empty() ? 8 : static_cast<int>(p[0]);
-    turtle.cylinder.sides = std::clamp(sides, 3, max_sides);
+    turtle.cylinder.sides = p.empty() ? 8 : clamped_parameter(p[0], 8, 3, max_sides);
 }
 
 const ContourSamples& CylinderBuilder::samples(int contour, int sides)
@@ -482,6 +506,17 @@ void CylinderBuilder::draw_segment(const CylinderPoint& from, CylinderPoint& to,
     RadiusProfile profile = RadiusProfile::make(0.5 * from.line_width, 0.5 * to.line_width, from.radius_tangent_out,
                                                 to.radius_tangent_in, to.scale_radius_tangents, len);
 
+    // Each factor of a mesh segment's (strips + 1) x (sides + 1) vertices is bounded;
+    // their product is too, by fewer strips.
+    if (to.contour != 0 && (strips + 1LL) * (to.sides + 1LL) > max_segment_vertices) {
+        int fewer = std::max(1, static_cast<int>(max_segment_vertices / (to.sides + 1LL)) - 1);
+        if (!m_warned_segment_size)
+            warn("a generalized-cylinder segment of " + std::to_string(strips) + " strips and " +
+                 std::to_string(to.sides) + " sides is drawn with " + std::to_string(fewer) +
+                 " strips (at most " + std::to_string(max_segment_vertices) + " vertices a segment)");
+        m_warned_segment_size = true;
+        strips = fewer;
+    }
     // Rings at cpfg's strip boundaries; frames carried by double reflection.
     std::vector<SweepRing> rings(static_cast<std::size_t>(strips) + 1);
     for (int k = 0; k <= strips; ++k) {

@@ -195,6 +195,7 @@ private:
     Bounds3& m_bounds;
     std::map<std::pair<int, int>, ContourSamples> m_sample_cache;
     bool m_warned_unknown_contour = false;
+    bool m_warned_segment_size = false;
 };
 
 }  // namespace cambium::geom

@@ -17,6 +17,7 @@
 #include "geom/patch.h"
 #include "geom/polygon.h"
 #include "geom/query.h"
+#include "geom/scene_limits.h"
 #include "geom/surface.h"
 #include "geom/tropism.h"
 #include "geom/turtle.h"
@@ -675,9 +676,20 @@ private:
     /// `@Tx(i)`: texture i-1 of the view file; 0, none or an unknown index: none.
     void set_texture(std::span<const float> p)
     {
-        int index = p.empty() ? -1 : static_cast<int>(p[0]) - 1;
+        std::optional<int> number = p.empty() ? std::optional<int>(0) : whole_number(p[0]);
+        if (!number)
+            warn_once(m_warned_texture, "@Tx(" + text(p[0]) + "): no such texture; none used");
+        int index = number.value_or(0) - 1;
         bool known = index >= 0 && static_cast<std::size_t>(index) < m_view.textures.size();
         m_turtle.texture = known ? index : -1;
+    }
+
+    /// A parameter in messages, as the L-system would print it.
+    static std::string text(float v)
+    {
+        char buffer[32];
+        std::snprintf(buffer, sizeof buffer, "%g", static_cast<double>(v));
+        return buffer;
     }
 
     /// `@D(s)`, `@Di(f)`, `@Dd(f)`: set, multiply or divide the turtle scale.
@@ -788,7 +800,12 @@ private:
         outline.reserve(corners.size());
         for (const PolygonCorner& c : corners)
             outline.push_back(c.position);
-        auto triangles = triangulate_polygon(outline);
+        bool cut_short = false;
+        auto triangles = triangulate_polygon(outline, &cut_short);
+        if (cut_short)
+            warn("a polygon of " + std::to_string(outline.size()) +
+                 " vertices took too long to triangulate; the rest of it was cut in order "
+                 "(concave parts may be filled wrongly)");
         if (triangles.empty())
             return;
         Vec3 n = polygon_normal(outline);
@@ -825,7 +842,7 @@ private:
     /// the first). `@Ts(i)` sets 0; `@Ti`/`@Td` without d use the tropism's S: step.
     void change_elasticity(TurtleOp op, std::span<const float> p)
     {
-        int index = p.empty() ? 0 : static_cast<int>(p[0]) - 1;
+        int index = p.empty() ? 0 : whole_number(p[0]).value_or(0) - 1;
         if (index < 0 || static_cast<std::size_t>(index) >= m_movements.size()) {
             warn_once(m_warned_movement, "tropism index out of range in @Ts/@Ti/@Td ignored");
             return;
@@ -893,8 +910,9 @@ private:
         Label label;
         label.position = m_turtle.position;
         label.material = material(m_turtle.color);
-        if (!p.empty() && p[0] >= 0 && static_cast<std::size_t>(p[0]) < m_options.strings.size())
-            label.text = format_label(m_options.strings[static_cast<std::size_t>(p[0])], p.subspan(1));
+        std::optional<int> string = p.empty() ? std::nullopt : whole_number(p[0]);
+        if (string && *string >= 0 && static_cast<std::size_t>(*string) < m_options.strings.size())
+            label.text = format_label(m_options.strings[static_cast<std::size_t>(*string)], p.subspan(1));
         else if (!m_options.strings.empty() || !p.empty())
             warn_once(m_warned_label, "@L without a known string: label text left empty");
         m_scene.labels.push_back(std::move(label));
@@ -926,9 +944,13 @@ private:
             double value = next < values.size() ? static_cast<double>(values[next++]) : 0.0;
             char buffer[128];
             char conversion = format[end];
-            if (std::string_view("diouxX").find(conversion) != std::string_view::npos)
+            // an integer conversion of a value no long long holds prints it as %g
+            bool integral = std::abs(value) < 9e18;
+            if (std::string_view("diouxX").find(conversion) != std::string_view::npos && integral)
                 std::snprintf(buffer, sizeof buffer, (spec.substr(0, spec.size() - 1) + "lld").c_str(),
                               static_cast<long long>(value));
+            else if (!integral)
+                std::snprintf(buffer, sizeof buffer, (spec.substr(0, spec.size() - 1) + "g").c_str(), value);
             else
                 std::snprintf(buffer, sizeof buffer, spec.c_str(), value);
             out += buffer;
@@ -995,24 +1017,33 @@ private:
     {
         if (!m_view.separate_back_color)
             return;
-        int color = p.empty() ? m_turtle.back_color + sign * m_view.back_color_increment
-                              : static_cast<int>(p[0]);
+        std::optional<int> set = p.empty() ? std::nullopt : whole_number(p[0]);
+        if (!p.empty() && !set) {
+            warn_once(m_warned_color, "colour index " + text(p[0]) + " out of range in ;(n) ,(n) @;(n) @,(n) ignored");
+            return;
+        }
+        int color = set ? *set : m_turtle.back_color + sign * m_view.back_color_increment;
         if (color > 255)
             color -= 256;
         if (color < 0)
             color += 256;
-        m_turtle.back_color = color;
+        m_turtle.back_color = std::clamp(color, -1'000'000'000, 1'000'000'000);  // no int overflow next
     }
 
     /// `;` and `,`: by the increment (wrapping once around the 256 entries) or set.
     void change_color(std::span<const float> p, int sign)
     {
-        int color = p.empty() ? m_turtle.color + sign * m_view.color_increment : static_cast<int>(p[0]);
+        std::optional<int> set = p.empty() ? std::nullopt : whole_number(p[0]);
+        if (!p.empty() && !set) {
+            warn_once(m_warned_color, "colour index " + text(p[0]) + " out of range in ;(n) ,(n) @;(n) @,(n) ignored");
+            return;
+        }
+        int color = set ? *set : m_turtle.color + sign * m_view.color_increment;
         if (color > 255)
             color -= 256;
         if (color < 0)
             color += 256;
-        m_turtle.color = color;
+        m_turtle.color = std::clamp(color, -1'000'000'000, 1'000'000'000);  // no int overflow next
         // Manual 5.1.9: sides differ only when `initial color:` gives two indices.
         if (!m_view.separate_back_color)
             m_turtle.back_color = color;
@@ -1144,7 +1175,7 @@ private:
     bool m_warned_system = false, m_warned_include = false, m_warned_grid = false;
     bool m_warned_scale = false, m_warned_unmatched_polygon = false, m_warned_movement = false;
     bool m_warned_unmatched_sub = false, m_warned_label = false;
-    bool m_warned_patch = false;
+    bool m_warned_patch = false, m_warned_texture = false, m_warned_color = false;
     std::string m_warned_surface_letters;  ///< undefined `~x` letters already reported
     bool m_chain_open = false;  ///< the last key is at the turtle and may be shared
     bool m_taper_open = false;  ///< the last segment's top width may still change

@@ -18,7 +18,10 @@ Vec3 polygon_normal(std::span<const Vec3> outline);
 /// Triangles (indices into `outline`) covering a simple polygon, convex or concave,
 /// planar or nearly so: ear clipping in the plane of the Newell normal. Repeated and
 /// collinear vertices produce no triangle; every triangle keeps the outline's
-/// winding. A self-intersecting outline still gets triangles (never a hang).
-std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(std::span<const Vec3> outline);
+/// winding. A self-intersecting outline still gets triangles (never a hang). Near-linear
+/// for common outlines; an outline that would take quadratic work beyond a budget (about
+/// a second) has its rest cut in order, and `cut_short` (when given) says so.
+std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(std::span<const Vec3> outline,
+                                                              bool* cut_short = nullptr);
 
 }  // namespace cambium::geom

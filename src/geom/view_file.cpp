@@ -6,10 +6,12 @@
 #include <array>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 
+#include "geom/scene_limits.h"
 #include "geom/text_input.h"
 
 namespace cambium::geom {
@@ -39,6 +41,27 @@ bool parse_flag(ValueReader& in)
 Vec3 parse_vec3(ValueReader& in)
 {
     double x = in.number(), y = in.number(), z = in.number();
+    return {x, y, z};
+}
+
+/// A position, distance or direction of the camera or a light: within max_coordinate,
+/// so that no ray the renderer makes from it is beyond Embree's range.
+double parse_coordinate(ValueReader& in)
+{
+    FileLoc where = in.loc();
+    double v = in.number();
+    if (!in_range(v)) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%g", v);
+        throw Error(where, std::string("value ") + text +
+                               " is out of range: camera and light values must be within +-1e10");
+    }
+    return v;
+}
+
+Vec3 parse_position(ValueReader& in)
+{
+    double x = parse_coordinate(in), y = parse_coordinate(in), z = parse_coordinate(in);
     return {x, y, z};
 }
 
@@ -89,7 +112,7 @@ Bounds3 parse_box(ValueReader& in)
     Bounds3 box;
     for (char axis : {'x', 'y', 'z'}) {
         in.expect_label(std::string(1, axis));
-        double lo = in.number(), hi = in.number();
+        double lo = parse_coordinate(in), hi = parse_coordinate(in);
         int i = axis - 'x';
         (i == 0 ? box.lo.x : i == 1 ? box.lo.y : box.lo.z) = std::min(lo, hi);
         (i == 0 ? box.hi.x : i == 1 ? box.hi.y : box.hi.z) = std::max(lo, hi);
@@ -104,17 +127,17 @@ Light parse_light(ValueReader& in)
     while (!in.at_end()) {
         char sub = in.subcommand("a light subcommand (O: V: A: D: S: P: T:)");
         switch (sub) {
-        case 'O': light.position = parse_vec3(in); break;
+        case 'O': light.position = parse_position(in); break;
         case 'V':
             light.kind = Light::Kind::directional;
-            light.direction = parse_vec3(in);
+            light.direction = parse_position(in);
             break;
         case 'A': light.ambient = parse_rgb(in); break;
         case 'D': light.diffuse = parse_rgb(in); break;
         case 'S': light.specular = parse_rgb(in); break;
         case 'P':
             light.kind = Light::Kind::spot;
-            light.spot_direction = parse_vec3(in);
+            light.spot_direction = parse_position(in);
             light.spot_exponent = static_cast<float>(in.number());
             light.spot_cutoff_deg = static_cast<float>(in.number());
             break;
@@ -300,9 +323,9 @@ void apply_command(ViewFile& v, const std::string& name, ValueReader& in)
     } else if (name == "tapered lines" || name == "tappered lines") {
         v.tapered_lines = parse_flag(in);
     } else if (name == "viewpoint") {
-        v.view.viewpoint = parse_vec3(in);
+        v.view.viewpoint = parse_position(in);
     } else if (name == "view reference point") {
-        v.view.reference_point = parse_vec3(in);
+        v.view.reference_point = parse_position(in);
     } else if (name == "twist") {
         v.view.twist_deg = in.number() / 10.0;  // tenths of degrees
     } else if (name == "projection") {
@@ -313,9 +336,9 @@ void apply_command(ViewFile& v, const std::string& name, ValueReader& in)
     } else if (name == "viewing angle") {
         v.view.viewing_angle_deg = in.number();
     } else if (name == "front distance") {
-        v.view.front_distance = in.number();
+        v.view.front_distance = parse_coordinate(in);
     } else if (name == "back distance") {
-        v.view.back_distance = in.number();
+        v.view.back_distance = parse_coordinate(in);
     } else if (name == "scale factor") {
         v.view.scale_factor = in.number();
     } else if (name == "box") {
@@ -323,7 +346,7 @@ void apply_command(ViewFile& v, const std::string& name, ValueReader& in)
     } else if (name == "light") {
         v.lights.push_back(parse_light(in));
     } else if (name == "light direction") {
-        v.light_direction = parse_vec3(in);
+        v.light_direction = parse_position(in);
     } else if (name == "tropism") {
         v.movements.push_back(parse_movement(in, Movement::Kind::tropism));
     } else if (name == "torque") {

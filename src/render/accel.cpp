@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <deque>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "base/diagnostics.h"
+#include "geom/scene_limits.h"
 #include "render/texture.h"
 
 namespace cambium::render {
@@ -229,6 +231,7 @@ struct EmbreeScene::Impl : Lookup {
     /// their radii converted (a radius in pixels depends on each copy's depth).
     geom::Geometry placed_lines;
     std::size_t segments = 0;
+    mutable std::atomic<std::uint64_t> skipped_rays{0};
 
     ~Impl()
     {
@@ -752,7 +755,20 @@ EmbreeScene::~EmbreeScene() = default;
 
 std::size_t EmbreeScene::segment_count() const { return m_impl->segments; }
 
+std::uint64_t EmbreeScene::skipped_rays() const { return m_impl->skipped_rays.load(); }
+
 namespace {
+
+/// Whether Embree takes the ray (its traversal asserts this): finite, starting within
+/// geom::max_ray_start, so that instances' frames keep it in range too (scene_limits.h).
+bool traceable(const Vec3f& org, const Vec3f& dir, float tnear, float tfar)
+{
+    constexpr auto reach = static_cast<float>(geom::max_ray_start);
+    auto within = [](float v, float limit) { return v >= -limit && v <= limit; };
+    return within(org.x, reach) && within(org.y, reach) && within(org.z, reach) &&
+           std::isfinite(dir.x) && std::isfinite(dir.y) && std::isfinite(dir.z) && tnear >= 0 &&
+           !std::isnan(tfar);
+}
 
 RTCRay make_ray(const Vec3f& org, const Vec3f& dir, float tnear, float tfar)
 {
@@ -836,6 +852,10 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
                                                  float tfar, PrimId skip, bool coherent) const
 {
     const Impl& m = *m_impl;
+    if (!traceable(org, dir, tnear, tfar)) {
+        ++m.skipped_rays;
+        return std::nullopt;
+    }
     SkipContext context = make_context(skip, coherent);
     RTCRayHit rh;
     rh.ray = make_ray(org, dir, tnear, tfar);
@@ -946,6 +966,10 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
 bool EmbreeScene::occluded(const Vec3f& org, const Vec3f& dir, float tnear, float tfar,
                            PrimId skip) const
 {
+    if (!traceable(org, dir, tnear, tfar)) {
+        ++m_impl->skipped_rays;
+        return false;
+    }
     SkipContext context = make_context(skip, false);
     RTCRay r = make_ray(org, dir, tnear, tfar);
     rtcOccluded1(m_impl->scene, &context.context, &r);

@@ -97,6 +97,10 @@ public:
     bool occluded(const Vec3f& org, const Vec3f& dir, float tnear, float tfar,
                   PrimId skip = {}) const;
 
+    /// Rays that intersect() and occluded() skipped (a miss, not occluded) because
+    /// Embree would abort on them: not finite, or starting beyond geom::max_ray_start.
+    std::uint64_t skipped_rays() const;
+
     /// Number of curve segments (linear and Hermite) of the scene's own geometry.
     std::size_t segment_count() const;
 

@@ -18,9 +18,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <utility>
+
+#include "base/diagnostics.h"
+#include "geom/scene_limits.h"
 
 namespace cambium::render {
 
@@ -236,6 +240,33 @@ double Camera::pixel_size_at(const Vec3& p) const
         return m_pixel_size;
     double depth = geom::dot(p - m_origin, m_forward);
     return m_pixel_size * std::max(depth, 0.0) / m_focus_distance;
+}
+
+double Camera::farthest_ray_origin() const
+{
+    auto max_abs = [](const Vec3& v) { return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)}); };
+    double half_image = (m_width / 2.0 + 2) + (m_height / 2.0 + 2);
+    if (m_projection == Projection::parallel)
+        return max_abs(m_origin) + m_back_off + half_image * m_pixel_size;
+    return max_abs(m_origin) + std::sqrt(3.0) * m_aperture_radius;
+}
+
+void Camera::check_range(const std::string& what) const
+{
+    auto unit = [](const Vec3& v) { return std::abs(geom::length(v) - 1) < 1e-6; };
+    bool frame_ok = unit(m_forward) && unit(m_right) && unit(m_up);
+    bool scale_ok = m_pixel_size > 0 && std::isfinite(m_pixel_size) &&
+                    (m_projection == Projection::parallel || m_focus_distance > 1e-9);
+    double reach = farthest_ray_origin();
+    const char* advice = "; check the viewpoint, view reference point, scale factor and box";
+    if (!frame_ok || !scale_ok)
+        throw Error(what + ": the camera has no finite view direction or pixel size" + advice);
+    if (!(reach <= geom::max_ray_origin)) {
+        char text[96];
+        std::snprintf(text, sizeof text, "the camera's rays would start %g from the origin, beyond %g",
+                      reach, geom::max_ray_origin);
+        throw Error(what + ": " + text + advice);
+    }
 }
 
 namespace {

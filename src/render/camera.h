@@ -3,6 +3,7 @@
 #pragma once
 
 #include <limits>
+#include <string>
 
 #include "geom/scene.h"
 #include "geom/vec.h"
@@ -74,6 +75,15 @@ public:
     const geom::Vec3& up() const { return m_up; }
     /// Eye (perspective) or the focus point (parallel).
     const geom::Vec3& origin() const { return m_origin; }
+
+    /// An upper bound on how far from the world origin (max norm) a ray through the
+    /// image, up to two pixels outside it, starts (before clipping); NaN when some
+    /// number of the camera is not finite.
+    double farthest_ray_origin() const;
+    /// Throws Error unless every ray the camera makes is one Embree can take: finite,
+    /// a unit frame, a positive pixel size, and ray origins within geom::max_ray_origin.
+    /// `what` names where the camera came from in the message.
+    void check_range(const std::string& what) const;
 
 private:
     Camera() = default;

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -135,6 +136,7 @@ struct Frame {
     FilterTable filter;
     bool lens = false;
     bool primary = false;  // intersect the camera ray here too (AOVs, clipping)
+    std::atomic<std::uint64_t>* nonfinite = nullptr;  // samples whose radiance was NaN or infinite
 };
 
 /// The albedo layer's colour: the (textured) diffuse albedo, or the flat colour of an
@@ -203,6 +205,12 @@ void take_sample(const Frame& f, int x, int y, std::uint32_t i, PixelState& st)
         r = trace_path(f.ctx, org, dir, sampler);
     if (s.transparent_background && !r.hit)
         r.radiance = Vec3f();
+    // One NaN or infinite sample would spoil its pixel for good: it counts as black
+    // instead (pbrt does the same), and the render reports how many there were.
+    if (!std::isfinite(r.radiance.x + r.radiance.y + r.radiance.z)) {
+        r.radiance = Vec3f();
+        f.nonfinite->fetch_add(1, std::memory_order_relaxed);
+    }
     st.radiance += r.radiance;
     st.hits += r.hit ? 1 : 0;
     st.samples += 1;
@@ -400,6 +408,7 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
     check_settings(settings);
     if (camera.width() != settings.width || camera.height() != settings.height)
         throw Error("render: the camera's image size differs from the settings'");
+    camera.check_range("view");
     auto start = Clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
     tbb::task_arena arena(settings.threads > 0 ? settings.threads
@@ -407,6 +416,7 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
     const int w = settings.width, h = settings.height;
     std::vector<PixelState> pixels(std::size_t(w) * h);
     RenderReport rep;
+    std::atomic<std::uint64_t> nonfinite{0};
     arena.execute([&] {
         std::unique_ptr<TextureSet> textures;
         if (!scene.textures.empty())
@@ -441,7 +451,7 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
                     FilterTable(settings.filter, settings.filter_radius),
                     camera.aperture_radius() > 0 &&
                         camera.projection() == Camera::Projection::perspective,
-                    settings.aovs || clipping};
+                    settings.aovs || clipping, &nonfinite};
 
         const int tiles_x = (w + tile_size - 1) / tile_size;
         const int tiles_y = (h + tile_size - 1) / tile_size;
@@ -517,7 +527,15 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
         progress.finish();
         rep.cancelled = cancelled;
         rep.out_of_time = out_of_time;
+        rep.skipped_rays = accel.skipped_rays();
     });
+    rep.nonfinite_samples = nonfinite.load();
+    if (rep.nonfinite_samples > 0)
+        warn("render: " + std::to_string(rep.nonfinite_samples) +
+             " sample(s) with a radiance that is not finite were counted as black");
+    if (rep.skipped_rays > 0)
+        warn("render: " + std::to_string(rep.skipped_rays) +
+             " ray(s) not finite or starting too far from the origin were skipped");
     for (const PixelState& st : pixels)
         rep.samples += st.samples;
     Image image = resolve(pixels, settings);

@@ -112,6 +112,8 @@ struct RenderReport {
     int passes = 0;             ///< passes completed
     bool cancelled = false;     ///< stopped by `cancel`
     bool out_of_time = false;   ///< stopped by the time budget
+    std::uint64_t nonfinite_samples = 0;  ///< samples with NaN or infinite radiance, counted as black
+    std::uint64_t skipped_rays = 0;  ///< rays Embree could not take (EmbreeScene::skipped_rays)
     double seconds = 0;         ///< wall time, including the Embree build
 };
 

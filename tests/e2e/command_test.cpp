@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include <sys/wait.h>
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -315,4 +317,47 @@ TEST(Command, PlantedSymlinkAtTemporaryNameIsNotFollowed)
     EXPECT_EQ(r.status, 0) << r.output;
     EXPECT_EQ(bytes_of(dir / "victim"), "precious");
     EXPECT_NE(bytes_of(dir / "s.str").find("F[+F]F"), std::string::npos);
+TEST(Command, HugeGeometryIsRefusedWithAMessageNeverAnEmbreeAbort)
+{
+    // F(1e38) used to end in Embree's assertion `ray.valid()` (exit 134)
+    fs::path dir = scratch("huge");
+    write(dir / "h.l", "lsystem: 1\nderivation length: 1\naxiom: F(1e38)F(-1e38)@O(sqrt(-1))\nendlsystem\n");
+    write(dir / "h.v", "line style: cylinder\n");
+    Result r = run("-w 16 12 --spp 1 -o " + (dir / "out.png").string() + " " + (dir / "h.l").string() + " " +
+                   (dir / "h.v").string());
+    ASSERT_TRUE(WIFEXITED(r.status)) << r.output;
+    EXPECT_EQ(WEXITSTATUS(r.status), 1) << r.output;
+    EXPECT_NE(r.output.find("warning: 2 line segment(s) with coordinates or widths not finite or beyond 1e+10 "
+                            "dropped"),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("warning: 1 sphere(s) with a centre or diameter"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("error: the view volume reaches 1e+38"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "out.png"));
+}
+
+TEST(Command, NotANumberGeometryIsDroppedAndTheRestRenders)
+{
+    fs::path dir = scratch("nan");
+    write(dir / "n.l", "lsystem: 1\nderivation length: 1\naxiom: F@O(sqrt(-1))F\nendlsystem\n");
+    write(dir / "n.v", "line style: cylinder\n");
+    Result r = run("-w 16 12 --spp 1 -o " + (dir / "out.png").string() + " " + (dir / "n.l").string() + " " +
+                   (dir / "n.v").string());
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("warning: 1 sphere(s) with a centre or diameter not finite or beyond 1e+10 dropped"),
+              std::string::npos)
+        << r.output;
+    EXPECT_TRUE(fs::exists(dir / "out.png"));
+}
+
+TEST(Command, ViewFileCameraOutOfRangeIsAnErrorAtItsColumn)
+{
+    fs::path dir = scratch("camera");
+    write(dir / "p.l", "lsystem: 1\nderivation length: 1\naxiom: F\nendlsystem\n");
+    write(dir / "p.v", "line style: cylinder\nviewpoint: 0 0 1e30\n");
+    Result r = run("-w 16 12 --spp 1 -o " + (dir / "out.png").string() + " " + (dir / "p.l").string() + " " +
+                   (dir / "p.v").string());
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("p.v:2:16: error: value 1e+30 is out of range"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "out.png"));
 }

@@ -609,3 +609,44 @@ TEST(GeneralizedCylinderCorpus, LilyLeafTrianglesAreCpfgs)
     // Smooth normals within 45 degrees of cpfg's (measured: all but the 6 at the tip).
     EXPECT_GE(normals_agree, matched * 99 / 100);
 }
+
+TEST(GencylHostileNumbers, ParametersNoIntHoldsAreIgnoredOrClampedWithAMessage)
+{
+    testing::internal::CaptureStderr();
+    Scene scene = run("{(1e30) f @#(1e30) @#(nan) @!(nan) @Gs F @Ge(nan)");
+    std::string err = testing::internal::GetCapturedStderr();
+    EXPECT_NE(err.find("'{(1e+30)': the cylinder type must be 1 to 4; ignored"), std::string::npos) << err;
+    EXPECT_NE(err.find("contour id 1e+30 is not defined in the view file; the circle is used"),
+              std::string::npos)
+        << err;
+    // @Ge(nan) falls back to the default strips: one round cylinder piece
+    EXPECT_EQ(scene.geometry.curves.segment_count(), 1u);
+}
+
+TEST(GencylHostileNumbers, ViewFileCountsBeyondTheirRangeAreClamped)
+{
+    testing::internal::CaptureStderr();
+    std::filesystem::path dir = temp_dir();
+    ViewFile view = parse_view_file("contour sides: 1e30\npolygonization level: -1e30\n", (dir / "t.v").string());
+    CylinderSettings s = cylinder_settings(view);
+    std::string err = testing::internal::GetCapturedStderr();
+    EXPECT_EQ(s.sides, 4);  // the level's 2^(1 + 1) came last
+    EXPECT_NE(err.find("t.v:1:1: warning: 'contour sides:' must be 3 to 100000; clamped"), std::string::npos)
+        << err;
+    EXPECT_NE(err.find("t.v:2:1: warning: 'polygonization level:' must be 1 to 16; clamped"), std::string::npos)
+        << err;
+}
+
+TEST(GencylHostileNumbers, OversizedMeshSegmentsGetFewerStrips)
+{
+    // 10 000 strips of a 20 000-sided contour would be 2e8 vertices in one segment
+    testing::internal::CaptureStderr();
+    Scene scene = run("@#(1) @!(20000) @Gs f(1) @Ge(1e30)", square_contour_view());
+    std::string err = testing::internal::GetCapturedStderr();
+    EXPECT_NE(err.find("a generalized-cylinder segment of 10000 strips and 20000 sides is drawn with 48 strips "
+                       "(at most 1000000 vertices a segment)"),
+              std::string::npos)
+        << err;
+    EXPECT_LE(scene.geometry.mesh.positions.size(), 1'000'000u);
+    EXPECT_GT(scene.geometry.mesh.positions.size(), 900'000u);
+}

@@ -159,3 +159,50 @@ TEST(Polygon, ManyVerticesFinishQuickly)
         total += 0.5 * cross(o[t[1]] - o[t[0]], o[t[2]] - o[t[0]]).z;
     EXPECT_NEAR(total, shoelace(p), 1e-9);
 }
+
+TEST(Polygon, OutlineTouchingItselfAtAVertex)
+{
+    // two squares joined at the corner (1,1), walked as one outline through it twice
+    check_xy({{0, 0}, {1, 0}, {1, 1}, {2, 1}, {2, 2}, {1, 2}, {1, 1}, {0, 1}}, 6);
+}
+
+TEST(Polygon, LargeZigzagIsExactAndNotCutShort)
+{
+    // 20 000 vertices (the old clipper took seconds here; 300 000 are in
+    // benchmarks/polygon.cpp): every triangle inside, the areas add up
+    std::vector<std::array<double, 2>> p;
+    const int n = 20000;
+    for (int i = 0; i < n; ++i) {
+        double a = 2 * 3.141592653589793 * i / n;
+        double r = i % 2 ? 1.0 : 0.9;
+        p.push_back({r * std::cos(a), r * std::sin(a)});
+    }
+    Outline o = lift(p);
+    bool cut_short = true;
+    auto tris = triangulate_polygon(o, &cut_short);
+    EXPECT_FALSE(cut_short);
+    EXPECT_EQ(tris.size(), static_cast<std::size_t>(n - 2));
+    double total = 0;
+    for (const auto& t : tris) {
+        double area = 0.5 * cross(o[t[1]] - o[t[0]], o[t[2]] - o[t[0]]).z;
+        EXPECT_GT(area, 0);
+        total += area;
+    }
+    EXPECT_NEAR(total, shoelace(p), 1e-9);
+}
+
+TEST(Polygon, LongCombWithDeepTeeth)
+{
+    // 500 teeth 10 high: every ear of the base is spoiled by tooth vertices nearby
+    std::vector<std::array<double, 2>> p;
+    for (int t = 499; t >= 0; --t) {
+        double x = 2.0 * t;
+        p.push_back({x + 1, 0});
+        p.push_back({x + 1, 10});
+        p.push_back({x, 10});
+        p.push_back({x, 0});
+    }
+    p.insert(p.begin(), {{0, -1}, {1000, -1}});
+    // counter-clockwise from (0,-1): base, then the teeth from the right
+    check_xy(p, p.size() - 2);
+}

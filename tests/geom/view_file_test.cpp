@@ -2,6 +2,9 @@
 // Tests of the view-file reader: values, defaults, line styles, lights and error locations.
 #include <gtest/gtest.h>
 
+#include <string>
+#include <utility>
+
 #include "geom/view_file.h"
 
 using namespace cambium;
@@ -188,4 +191,31 @@ TEST(ViewFile, TranslucencyRanges)
     EXPECT_THROW(parse_view_file("translucency: 7 3 0.5\n", "t.v"), cambium::Error);
     EXPECT_THROW(parse_view_file("translucency: 0.5\n", "t.v"), cambium::Error);
     EXPECT_THROW(parse_view_file("translucency: 1.5 0.5\n", "t.v"), cambium::Error);
+}
+
+TEST(ViewFileRanges, CameraAndLightValuesBeyondTheLimitAreErrorsAtTheirColumn)
+{
+    const std::pair<const char*, const char*> cases[] = {
+        {"viewpoint: 0 1e300 0\n", "t.v:1:14: error: value 1e+300 is out of range"},
+        {"view reference point: 1e11 0 0\n", "t.v:1:23: error: value 1e+11 is out of range"},
+        {"front distance: -1e30\n", "t.v:1:17: error: value -1e+30 is out of range"},
+        {"back distance: 1e30\n", "t.v:1:16: error"},
+        {"box: x: 0,1 y: 0,2e10 z: 0,1\n", "t.v:1:18: error: value 2e+10 is out of range"},
+        {"light: O: 0 0 1e99\n", "t.v:1:15: error"},
+        {"light: V: 1e99 0 0\n", "t.v:1:11: error"},
+        {"light: P: 1e99 0 0 1 2\n", "t.v:1:11: error"},
+        {"light direction: 0 0 -1e20\n", "t.v:1:22: error: value -1e+20 is out of range: camera and light values "
+                                         "must be within +-1e10"},
+        {"viewpoint: nan 0 0\n", "t.v:1:12: error: expected a number, found 'nan'"},
+    };
+    for (const auto& [text, message] : cases) {
+        try {
+            parse_view_file(text, "t.v");
+            ADD_FAILURE() << "no error for " << text;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+        }
+    }
+    // at the limit still fine
+    EXPECT_NO_THROW(parse_view_file("viewpoint: 1e10 -1e10 0\n", "t.v"));
 }

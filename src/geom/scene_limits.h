@@ -1,0 +1,65 @@
+// SPDX-License-Identifier: Apache-2.0
+// The numbers a Scene may hold: what Embree's float BVH and rays can take.
+//
+// Embree asserts (and aborts the process) on a ray whose origin or direction is beyond
+// 1.844e18 or not finite, also for the rays it moves into an instance's frame, and a BVH
+// over non-finite bounds is garbage. The limits below keep every ray within that:
+// geometry within max_coordinate of the origin, camera rays starting within
+// max_ray_origin (a ray moved to a front clipping plane may start farther: beyond
+// max_ray_start it has passed all geometry and render skips it), instances scaling by at
+// least min_instance_scale (an instance's inverse grows a world ray by at most
+// 1 / min_instance_scale: 1e6 x (4e11 + 1e10) < 1.8e18).
+#pragma once
+
+#include <cstddef>
+#include <optional>
+
+#include "geom/scene.h"
+
+namespace cambium::geom {
+
+/// Largest coordinate, radius or tangent kept in a scene (docs/security.md).
+inline constexpr double max_coordinate = 1e10;
+/// Farthest from the origin that a camera ray may start (render checks its camera).
+inline constexpr double max_ray_origin = 1e11;
+/// Farthest from the origin that any traced ray starts; rays beyond are skipped.
+inline constexpr double max_ray_start = 4 * max_ray_origin;
+/// Smallest and largest scale of an instance's placement.
+inline constexpr double min_instance_scale = 1e-6;
+inline constexpr double max_instance_scale = 1e6;
+
+/// Whether |v| <= max_coordinate (false for NaN and infinities).
+inline bool in_range(double v) { return v >= -max_coordinate && v <= max_coordinate; }
+
+/// The integer a module parameter or a file's number stands for, truncated toward zero
+/// as cpfg's C casts do; nothing when it is not finite or beyond +-1e9 (where a cast to
+/// int would be undefined behaviour). Every float-to-int of user data goes through it.
+inline std::optional<int> whole_number(double v)
+{
+    if (!(v >= -1e9 && v <= 1e9))
+        return std::nullopt;
+    return static_cast<int>(v);
+}
+
+/// What drop_unrenderable removed or repaired, per kind.
+struct DroppedGeometry {
+    std::size_t line_segments = 0, curve_segments = 0, spheres = 0, discs = 0, triangles = 0;
+    std::size_t instances = 0;
+    std::size_t attributes = 0;  ///< normals, texture coordinates set to 0
+
+    std::size_t total() const
+    {
+        return line_segments + curve_segments + spheres + discs + triangles + instances + attributes;
+    }
+};
+
+/// Drops every primitive (of the scene and of its prototypes) with a position, radius,
+/// tangent or normal that is not finite or beyond max_coordinate, and every instance
+/// whose placement is not finite, scales beyond [min_instance_scale,
+/// max_instance_scale] or puts its prototype beyond max_coordinate; non-finite normals
+/// and texture coordinates become 0. One warning per kind names the count. Throws Error
+/// when the view volume (Scene::bounds: turtle positions, surfaces) reaches beyond
+/// max_coordinate, since no camera could frame it.
+DroppedGeometry drop_unrenderable(Scene& scene);
+
+}  // namespace cambium::geom

@@ -1,0 +1,94 @@
+// SPDX-License-Identifier: Apache-2.0
+// Hostile numbers at the renderer: cameras that would make invalid rays are refused,
+// rays Embree cannot take are skipped (never an abort), NaN samples are counted.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "base/diagnostics.h"
+#include "render/accel.h"
+#include "render/camera.h"
+#include "test_scenes.h"
+
+namespace cambium::render {
+namespace {
+
+using testing::add_segment;
+using testing::empty_scene;
+using testing::small;
+
+constexpr float inf = std::numeric_limits<float>::infinity();
+constexpr float nan_value = std::numeric_limits<float>::quiet_NaN();
+
+std::string error_of(const geom::Scene& s, const RenderSettings& settings)
+{
+    try {
+        render(s, settings);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+TEST(RenderLimits, CamerasWhoseRaysWouldStartOutOfRangeAreRefused)
+{
+    geom::Scene s = empty_scene({-1, -1, -1}, {1, 1, 1});
+    add_segment(s, {0, -1, 0}, {0, 1, 0}, 0.1f);
+    // parallel: a tiny scale factor widens the window to 1e300 units
+    s.view.scale_factor = 1e-300;
+    EXPECT_NE(error_of(s, small(8, 8, 1)).find("view: the camera's rays would start"), std::string::npos);
+    // perspective: the eye goes to reference + (viewpoint - reference) / scale factor
+    s.view.perspective = true;
+    s.view.scale_factor = 1e-12;
+    std::string err = error_of(s, small(8, 8, 1));
+    EXPECT_NE(err.find("beyond 1e+11; check the viewpoint, view reference point, scale factor and box"),
+              std::string::npos)
+        << err;
+    // and within range the same scene renders
+    s.view.scale_factor = 1;
+    EXPECT_EQ(error_of(s, small(8, 8, 1)), "no error");
+}
+
+TEST(RenderLimits, RaysEmbreeWouldAbortOnAreSkippedAndCounted)
+{
+    geom::Scene s = empty_scene({-1, -1, -1}, {1, 1, 1});
+    add_segment(s, {-1, 0, 0}, {1, 0, 0}, 0.5f);
+    EmbreeScene accel(s, make_camera(s.view, s.bounds, 16, 16));
+    EXPECT_FALSE(accel.intersect({0, 0, 5}, {nan_value, 0, -1}, 0, inf));
+    EXPECT_FALSE(accel.intersect({0, 0, 1e30f}, {0, 0, -1}, 0, inf));
+    EXPECT_FALSE(accel.occluded({0, 0, 5}, {0, 0, -1}, nan_value, inf));
+    EXPECT_FALSE(accel.occluded({inf, 0, 5}, {0, 0, -1}, 0, inf));
+    EXPECT_EQ(accel.skipped_rays(), 4u);
+    // a good ray still hits
+    EXPECT_TRUE(accel.intersect({0, 0, 5}, {0, 0, -1}, 0, inf));
+    EXPECT_EQ(accel.skipped_rays(), 4u);
+}
+
+TEST(RenderLimits, NotFiniteSamplesCountAsBlackAndAreReported)
+{
+    geom::Scene s = empty_scene({-2, -2, -2}, {2, 2, 2});
+    add_segment(s, {-2, 0, 0}, {2, 0, 0}, 1.0f, 3);
+    // a light no view file could give (display colours are clamped, so NaN must come
+    // from a direction): its shadow rays are skipped, its radiance is NaN
+    s.lights.push_back(testing::directional({nan_value, 0, 1}));
+    RenderReport report;
+    ::testing::internal::CaptureStderr();
+    Image img = render(s, small(8, 8, 2), &report);
+    std::string err = ::testing::internal::GetCapturedStderr();
+    EXPECT_GT(report.nonfinite_samples, 0u);
+    EXPECT_LT(report.nonfinite_samples, report.samples);  // the background ones are fine
+    for (float v : img.rgba)
+        EXPECT_TRUE(std::isfinite(v));
+    EXPECT_GT(report.skipped_rays, 0u);
+    EXPECT_NE(err.find("ray(s) not finite or starting too far from the origin were skipped"), std::string::npos)
+        << err;
+    EXPECT_NE(err.find("render: " + std::to_string(report.nonfinite_samples) +
+                       " sample(s) with a radiance that is not finite were counted as black"),
+              std::string::npos)
+        << err;
+}
+
+}  // namespace
+}  // namespace cambium::render
