@@ -30,10 +30,12 @@ test: build
 # The quick tests under AddressSanitizer and UndefinedBehaviorSanitizer, in their own
 # build folder (docs/security.md). OpenImageIO 2.4 frees some objects with a sized
 # delete of a different size than it allocated (in the library itself, not in Cambium):
-# ASan's new_delete_type_mismatch check is off for that reason only.
+# ASan's new_delete_type_mismatch check is off for that reason only; leaks inside the
+# third-party libraries are suppressed (scripts/lsan-suppressions.txt).
 ASAN_BUILD ?= build-asan
 sanitize: export ASAN_OPTIONS = new_delete_type_mismatch=0:detect_leaks=1:abort_on_error=0
 sanitize: export UBSAN_OPTIONS = print_stacktrace=1:halt_on_error=1
+sanitize: export LSAN_OPTIONS = suppressions=$(CURDIR)/scripts/lsan-suppressions.txt
 sanitize:
 	@echo "sanitize: configuring $(ASAN_BUILD) (address,undefined)"
 	@cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCAMBIUM_SANITIZE=address,undefined \
