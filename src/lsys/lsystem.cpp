@@ -106,6 +106,14 @@ LSystem LSystem::from_source(std::string_view source, std::string_view file_name
     return LSystem(compile(source, std::string(file_name), pp), options);
 }
 
+LSystem LSystem::from_preprocessed(std::string_view text, std::string_view file_name,
+                                   const LoadOptions& options)
+{
+    auto program = std::make_unique<Program>();
+    parse_program(text, std::string(file_name), *program);
+    return LSystem(std::move(program), options);
+}
+
 const SymbolTable& LSystem::symbols() const { return m_program->symbols; }
 SymbolTable& LSystem::symbols() { return m_program->symbols; }
 const Program& LSystem::program() const { return *m_program; }

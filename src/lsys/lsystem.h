@@ -59,6 +59,10 @@ public:
     /// Compiles source text (still preprocessed); for tests.
     static LSystem from_source(std::string_view source, std::string_view file_name = "<string>",
                                const LoadOptions& = {});
+    /// Compiles text that is already preprocessed (cpp's output, line markers allowed):
+    /// no preprocessor runs. For the fuzz targets and tools that preprocess themselves.
+    static LSystem from_preprocessed(std::string_view text, std::string_view file_name,
+                                     const LoadOptions& = {});
 
     LSystem(LSystem&&) noexcept;
     LSystem& operator=(LSystem&&) noexcept;
