@@ -599,6 +599,17 @@ double run(const Code& code, std::span<double> frame, Runtime& rt, std::size_t& 
     int sp = 0;
     const Instr* instrs = code.instrs.data();
     const std::size_t count = code.instrs.size();
+    std::uint64_t loop_iterations = 0;
+    // A jump back is one more iteration of a while or do loop: bounded, never a hang.
+    auto jump_to = [&](const Instr& in) {
+        std::size_t target = static_cast<std::size_t>(in.arg);
+        if (target <= pc && ++loop_iterations > max_loop_iterations)
+            throw EvaluationError("a loop repeated more than " +
+                                      std::to_string(max_loop_iterations) +
+                                      " times (a loop that never ends?)",
+                                  static_cast<int>(in.value));
+        pc = target - 1;
+    };
     for (pc = 0; pc < count; ++pc) {
         const Instr& in = instrs[pc];
         switch (in.op) {
@@ -667,10 +678,10 @@ double run(const Code& code, std::span<double> frame, Runtime& rt, std::size_t& 
                 --sp;
             }
             break;
-        case Op::Jump: pc = static_cast<std::size_t>(in.arg) - 1; break;
+        case Op::Jump: jump_to(in); break;
         case Op::JumpIfFalse:
             if (stack[--sp] == 0)
-                pc = static_cast<std::size_t>(in.arg) - 1;
+                jump_to(in);
             break;
         case Op::Pop: --sp; break;
         case Op::Call:

@@ -47,8 +47,12 @@ enum class Function : std::uint8_t {
     CurveX, CurveY, CurveZ, CurveLength, Fopen, Fclose, Fflush,
 };
 
+/// A `while` or `do` loop may repeat at most this many times in one evaluation: a model
+/// must not hang the renderer (`while (1) {}`); the limit is far above any real model.
+inline constexpr std::uint64_t max_loop_iterations = 100'000'000;
+
 /// Instructions that can fail or warn at run time (LoadElement, StoreElement, Div, Mod,
-/// Call, FilePrint, FileScan) keep in `value` the index of their source position in
+/// Call, FilePrint, FileScan, and a loop's backward jump) keep in `value` the index of their source position in
 /// Program::sites, so a runtime error names the column, not only the production.
 struct Instr {
     Op op;

@@ -756,20 +756,20 @@ void Parser::parse_if(Emitter& e)
 
 void Parser::parse_while(Emitter& e)
 {
-    next(LexMode::Expression);
+    Token loop = next(LexMode::Expression);
     std::int32_t top = e.here();
     expect(LexMode::Expression, TokenKind::LParen, "'(' after 'while'");
     parse_expression(e);
     expect(LexMode::Expression, TokenKind::RParen, "')'");
     std::size_t exit = e.emit(Op::JumpIfFalse, -1);
     parse_block(e);
-    e.emit(Op::Jump, 0, top);
+    e.emit(Op::Jump, 0, top, 0, site(loop.loc));  // the loop's site: its iteration limit
     e.patch(exit, e.here());
 }
 
 void Parser::parse_do(Emitter& e)
 {
-    next(LexMode::Expression);
+    Token loop = next(LexMode::Expression);
     std::int32_t top = e.here();
     parse_block(e);
     Token w = next(LexMode::Expression);
@@ -779,7 +779,7 @@ void Parser::parse_do(Emitter& e)
     parse_expression(e);
     expect(LexMode::Expression, TokenKind::RParen, "')'");
     e.emit(Op::Not, 0);
-    e.emit(Op::JumpIfFalse, -1, top);
+    e.emit(Op::JumpIfFalse, -1, top, 0, site(loop.loc));
     expect_operator(";");
 }
 

@@ -38,7 +38,7 @@ std::string error_of(Run&& run)
 // Issue 11, row 6 (float to int conversions of user values): `derivation length: 2^56`
 // was converted to int unchecked (UBSan: "7.20576e+16 is outside the range of
 // representable values of type 'int'", src/lsys/deriver.cpp Deriver::start).
-TEST(FuzzRegression, DISABLED_DerivationLengthOutOfIntRange)
+TEST(FuzzRegression, DerivationLengthOutOfIntRange)
 {
     std::string message = error_of([] {
         derive_preprocessed("Lsystem: 1\nderivation length: 2^56\nAxiom: F\nendlsystem\n");

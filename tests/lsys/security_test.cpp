@@ -387,6 +387,25 @@ TEST(NumericSettings, FunctionArgumentsOutOfRangeAreErrorsNamingTheBlock)
               "in the Start block");
 }
 
+// ---------------------------------------------------------------- loops
+
+TEST(Loops, ALoopThatNeverEndsIsAnErrorAtItsKeyword)
+{
+    // `while (1) {}` would hang the renderer; 'while' is column 9, 'do' column 16
+    EXPECT_EQ(derive_error(with_start("while (1) {}")),
+              "test.l:2:9: error: a loop repeated more than 100000000 times (a loop that never "
+              "ends?), in the Start block");
+    EXPECT_EQ(derive_error(with_start("x = 0; do { x = x + 1; } while (x > 0);")),
+              "test.l:2:16: error: a loop repeated more than 100000000 times (a loop that never "
+              "ends?), in the Start block");
+}
+
+TEST(Loops, LongFiniteLoopsRunToTheirEnd)
+{
+    EXPECT_EQ(printed(with_start("i = 0; while (i < 100000) { i = i + 1; } printf(\"%g\\n\", i);")),
+              "100000\n");
+}
+
 TEST(NumericSettings, ArrayDimensionOutOfRangeIsALoadError)
 {
     EXPECT_EQ(load_error("lsystem: 1\ndefine: { array a[1e30]; }\naxiom: A\nendlsystem\n"),
