@@ -134,24 +134,7 @@ struct Frame {
     const RenderSettings& settings;
     FilterTable filter;
     bool lens = false;
-    bool primary = false;  // intersect the camera ray here too (AOVs, clipping)
 };
-
-/// The albedo layer's colour: the (textured) diffuse albedo, or the flat colour of an
-/// unlit line.
-Vec3f first_hit_albedo(const PathContext& ctx, const SurfaceHit& hit, const Vec3f& dir)
-{
-    SurfaceMaterial scratch;
-    const SurfaceMaterial& m = hit_material(ctx, hit, scratch);
-    if (hit.unlit)
-        return flat_colour(m);
-    if (ctx.textures && ctx.textures->valid(hit.texture)) {
-        float width = ctx.camera_cone.width + ctx.camera_cone.spread * hit.t;
-        return ctx.textures->apply(hit.texture, m.diffuse, hit.u, hit.v,
-                                   texture_footprint(hit, dir, width));
-    }
-    return m.diffuse;
-}
 
 /// A camera ray's cone: a parallel camera's rays are a pixel wide; a perspective one's
 /// start at a point and widen by a pixel's angle.
@@ -181,26 +164,16 @@ void take_sample(const Frame& f, int x, int y, std::uint32_t i, PixelState& st)
     Vec3f org(ray.org), dir(ray.dir);
     if (ray.tnear > 0)
         org = Vec3f(ray.org + ray.dir * ray.tnear);  // front clipping: start at the plane
-    bool clipped_far = std::isfinite(ray.tfar);
+    // Far clipping: geometry beyond the back plane must not show.
+    float tfar = std::isfinite(ray.tfar) ? static_cast<float>(ray.tfar - ray.tnear) : infinity;
 
-    PathResult r;
-    bool trace = true;
-    if (f.primary) {
-        float tfar = clipped_far ? static_cast<float>(ray.tfar - ray.tnear) : infinity;
-        std::optional<SurfaceHit> hit = f.accel.intersect(org, dir, 0, tfar, {}, true);
-        if (hit) {
-            // The path's first hit is this one: nothing nearer, and it is in range.
-            st.albedo += first_hit_albedo(f.ctx, *hit, dir);
-            st.normal += hit->normal;
-            st.depth = std::min(st.depth, static_cast<float>(hit->t + ray.tnear));
-        } else if (clipped_far) {
-            // Geometry beyond the back plane must not show: the camera ray missed.
-            r.radiance = f.ctx.background;
-            trace = false;
-        }
+    VisibleSurface first;
+    PathResult r = trace_path(f.ctx, org, dir, sampler, tfar, s.aovs ? &first : nullptr);
+    if (first.hit) {
+        st.albedo += first.albedo;
+        st.normal += first.normal;
+        st.depth = std::min(st.depth, static_cast<float>(first.t + ray.tnear));
     }
-    if (trace)
-        r = trace_path(f.ctx, org, dir, sampler);
     if (s.transparent_background && !r.hit)
         r.radiance = Vec3f();
     st.radiance += r.radiance;
@@ -429,14 +402,15 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
         ctx.max_depth = settings.max_depth;
         ctx.roulette_depth = settings.roulette_depth;
         ctx.camera_cone = camera_cone(camera);
+        if (!scene.bounds.empty())
+            ctx.scene_radius =
+                static_cast<float>(0.5 * geom::length(scene.bounds.hi - scene.bounds.lo));
         prepare_path_context(ctx);
 
-        const bool clipping = std::isfinite(camera.clip_near()) || std::isfinite(camera.clip_far());
         Frame frame{ctx, accel, camera, settings,
                     FilterTable(settings.filter, settings.filter_radius),
                     camera.aperture_radius() > 0 &&
-                        camera.projection() == Camera::Projection::perspective,
-                    settings.aovs || clipping};
+                        camera.projection() == Camera::Projection::perspective};
 
         const int tiles_x = (w + tile_size - 1) / tile_size;
         const int tiles_y = (h + tile_size - 1) / tile_size;

@@ -46,6 +46,7 @@ float furnace(const geom::Scene& s, const Camera& camera, int x0, int y0, int x1
     ctx.environment = env ? env : uniform.get();
     ctx.background = Vec3f(1);
     ctx.roulette_depth = roulette_depth;
+    prepare_path_context(ctx);
     BlockMean m = trace_block(ctx, camera, x0, y0, x1, y1, spp);
     EXPECT_EQ(m.coverage, 1.0);
     return m.radiance.y;
@@ -123,7 +124,7 @@ TEST(Physics, GlossyFurnace)
         s.materials[1].shininess = shininess;
         add_quad(s.geometry, -10, -10, 10, 10, 0, 1, 1);
         Camera c = top_camera(0, 0, 8, 16, 16);
-        float plane = furnace(s, c, 4, 4, 12, 12, 16, 1000);
+        float plane = furnace(s, c, 4, 4, 12, 12, 256, 1000);
         EXPECT_NEAR(plane, albedo, 0.02f * albedo) << shininess;
         geom::Scene ball = s;
         ball.geometry = {};
@@ -144,6 +145,7 @@ float radiance_at(const geom::Scene& s, float x, float y, int depth = 1, int spp
                           : top_camera(x, y, 0.2, 20, 20);
     EmbreeScene accel(s, c);
     PathContext ctx = context(s, accel, 0, depth);
+    prepare_path_context(ctx);
     return trace_block(ctx, c, 9, 9, 11, 11, spp).radiance.y;
 }
 
@@ -325,6 +327,7 @@ TEST(Physics, EnvironmentSamplingWithMis)
     PathContext ctx = context(s, accel, 0, 1);
     ctx.environment = &sky;
     ctx.max_depth = 2;
+    prepare_path_context(ctx);
     float got = trace_block(ctx, c, 9, 9, 11, 11, 512).radiance.y;
     float expect = srgb_to_linear(0.5f) * 2;
     EXPECT_NEAR(got, expect, 0.01f * expect);
