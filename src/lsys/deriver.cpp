@@ -430,21 +430,9 @@ bool Deriver::bind(const FormalModule& f, const ModuleString& s, std::size_t k,
 bool Deriver::match(const Production& p, const LSystemDefinition& ls, const Indexed& src,
                     std::size_t i, std::size_t offset)
 {
-    const ModuleString& s = *src.string;
-    if (i + p.predecessor.size() > s.size())
-        return false;
-    in_production(p);
-    use_frame_of(p);
-    for (std::size_t k = 0; k < p.predecessor.size(); ++k) {
-        if (!bind(p.predecessor[k], s, i + k, offset))
-            return false;
-        offset += s.param_count(i + k);
-    }
-    if (p.left_context.empty() && p.right_context.empty())
-        return true;
-    const auto& ignored = m_ignored[static_cast<std::size_t>(&ls - m_program.lsystems.data())];
-    return match_left(p, ignored, src, i) &&
-           match_right(p, ignored, src, i + p.predecessor.size());
+    // The string matched is the one context is read from (indexed whenever some
+    // production has context).
+    return match_at(p, ls, *src.string, i, offset, src, i, i + p.predecessor.size());
 }
 
 bool Deriver::match_left(const Production& p, const std::vector<char>& ignored,
