@@ -127,7 +127,7 @@ struct PixelState {
 float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 /// Everything one sample needs, shared read-only by all threads.
-struct Frame {
+struct RenderState {
     const PathContext& ctx;
     const EmbreeScene& accel;
     const Camera& camera;
@@ -146,7 +146,7 @@ RayCone camera_cone(const Camera& camera)
 }
 
 /// Sample i of pixel (x, y), added to its sums.
-void take_sample(const Frame& f, int x, int y, std::uint32_t i, PixelState& st)
+void take_sample(const RenderState& f, int x, int y, std::uint32_t i, PixelState& st)
 {
     const RenderSettings& s = f.settings;
     Sampler sampler(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), i, s.seed);
@@ -407,7 +407,7 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
                 static_cast<float>(0.5 * geom::length(scene.bounds.hi - scene.bounds.lo));
         prepare_path_context(ctx);
 
-        Frame frame{ctx, accel, camera, settings,
+        RenderState state{ctx, accel, camera, settings,
                     FilterTable(settings.filter, settings.filter_radius),
                     camera.aperture_radius() > 0 &&
                         camera.projection() == Camera::Projection::perspective};
@@ -464,7 +464,7 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
                             if (st.done)
                                 continue;
                             for (std::uint32_t i = st.samples; i < target; ++i, ++taken)
-                                take_sample(frame, x, y, i, st);
+                                take_sample(state, x, y, i, st);
                         }
                     progress.add(taken);
                 }
