@@ -154,20 +154,20 @@ T at_or(const std::vector<T>& v, std::size_t i, T fallback)
     return i < v.size() ? v[i] : fallback;
 }
 
-struct Lookup;
+struct HitResolver;
 
 /// One Embree geometry's source primitives.
-struct Part {
+struct GeometrySource {
     Shape shape = Shape::line;
     const geom::Geometry* geometry = nullptr;
     const Key* line_keys = nullptr;  ///< lines: keys with world-unit radii
     bool unlit = false;
-    const Lookup* owner = nullptr;
+    const HitResolver* owner = nullptr;
     const LineEnds* ends = nullptr;  ///< caps and joints: the segments they belong to
 };
 
 /// The segment of the scene's lines whose hit this is (a cap's or joint's: its segment).
-std::uint32_t line_segment(const Part& part, std::uint32_t prim)
+std::uint32_t line_segment(const GeometrySource& part, std::uint32_t prim)
 {
     switch (part.shape) {
     case Shape::cap: return part.ends->cap_segment[prim];
@@ -178,11 +178,11 @@ std::uint32_t line_segment(const Part& part, std::uint32_t prim)
 
 /// What hits are resolved with: parts by geometry id, instances' placements, textures
 /// (also read by the alpha filter during traversal).
-struct Lookup {
+struct HitResolver {
     const TextureSet* textures = nullptr;
-    std::vector<const Part*> top_parts;                ///< by top-level geometry id
-    std::vector<std::vector<const Part*>> proto_parts;  ///< by prototype, geometry id
-    std::vector<Placement> placements;                 ///< by top-level geometry id
+    std::vector<const GeometrySource*> top_parts;  ///< by top-level geometry id
+    std::vector<std::vector<const GeometrySource*>> proto_parts;  ///< by prototype, geometry id
+    std::vector<Placement> placements;  ///< by top-level geometry id
 
     const Placement* placement(std::uint32_t inst_id) const
     {
@@ -190,23 +190,23 @@ struct Lookup {
                    ? &placements[inst_id]
                    : nullptr;
     }
-    const Part* part(std::uint32_t inst_id, std::uint32_t geom_id) const
+    const GeometrySource* part(std::uint32_t inst_id, std::uint32_t geom_id) const
     {
         if (const Placement* p = placement(inst_id))
             return proto_parts[p->instance->prototype][geom_id];
         return top_parts[geom_id];
     }
-    int texture_of(const Part& part, std::uint32_t prim, const Placement* p) const;
+    int texture_of(const GeometrySource& part, std::uint32_t prim, const Placement* p) const;
 };
 
 }  // namespace
 
-struct EmbreeScene::Impl : Lookup {
+struct EmbreeScene::Impl : HitResolver {
     ErrorSink errors;
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     std::vector<RTCScene> prototype_scenes;
-    std::deque<Part> parts;  ///< stable addresses (Embree user data)
+    std::deque<GeometrySource> parts;  ///< stable addresses (Embree user data)
     std::deque<LineEnds> line_ends;  ///< caps and joints of shaded lines (stable addresses)
     std::vector<Key> world_keys;  ///< line keys with pixel radii converted (else empty)
     /// Pixel-width lines of prototypes, placed by every instance in world space with
@@ -239,10 +239,11 @@ struct EmbreeScene::Impl : Lookup {
         return s;
     }
 
-    /// Adds every non-empty part of g to s; ids[geomID] = its Part.
-    void add_geometry(RTCScene s, const geom::Geometry& g, std::vector<const Part*>& ids,
+    /// Adds every non-empty part of g to s; ids[geomID] = its GeometrySource.
+    void add_geometry(RTCScene s, const geom::Geometry& g, std::vector<const GeometrySource*>& ids,
                       const Key* line_keys, bool unlit, bool alpha, bool lines = true);
-    void attach(RTCScene s, RTCGeometry g, Part part, std::vector<const Part*>& ids, bool alpha);
+    void attach(RTCScene s, RTCGeometry g, GeometrySource part,
+                std::vector<const GeometrySource*>& ids, bool alpha);
 
 };
 
@@ -257,8 +258,8 @@ Vec3f hermite_axis(const geom::HermiteCurves& c, std::uint32_t k, float u)
 }
 
 /// Texture coordinates (s, t) of a hit: Embree's (u, v) and object-space normal ng.
-std::array<float, 2> texture_coords(const Part& part, std::uint32_t prim, float u, float v,
-                                    const Vec3f& ng)
+std::array<float, 2> texture_coords(const GeometrySource& part, std::uint32_t prim, float u,
+                                    float v, const Vec3f& ng)
 {
     const geom::Geometry& g = *part.geometry;
     switch (part.shape) {
@@ -304,7 +305,7 @@ std::array<float, 2> texture_coords(const Part& part, std::uint32_t prim, float 
 
 /// dP/ds and dP/dt in object space at a hit (texture_coords' derivatives); zero where a
 /// coordinate does not change.
-std::array<Vec3f, 2> texture_tangents(const Part& part, std::uint32_t prim, float u,
+std::array<Vec3f, 2> texture_tangents(const GeometrySource& part, std::uint32_t prim, float u,
                                       const Vec3f& ng, float radius)
 {
     const geom::Geometry& g = *part.geometry;
@@ -365,8 +366,8 @@ std::array<Vec3f, 2> texture_tangents(const Part& part, std::uint32_t prim, floa
 /// Rejects hits where the primitive's texture is cut out (alpha < 0.5).
 void alpha_filter(const RTCFilterFunctionNArguments* args)
 {
-    const auto* part = static_cast<const Part*>(args->geometryUserPtr);
-    const Lookup& owner = *part->owner;
+    const auto* part = static_cast<const GeometrySource*>(args->geometryUserPtr);
+    const HitResolver& owner = *part->owner;
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] == 0)
             continue;
@@ -433,7 +434,8 @@ bool any_texture(const std::vector<T>& textures)
 
 }  // namespace
 
-int Lookup::texture_of(const Part& part, std::uint32_t prim, const Placement* p) const
+int HitResolver::texture_of(const GeometrySource& part, std::uint32_t prim,
+                            const Placement* p) const
 {
     const geom::Geometry& g = *part.geometry;
     std::int16_t t = geom::no_texture;
@@ -454,8 +456,8 @@ int Lookup::texture_of(const Part& part, std::uint32_t prim, const Placement* p)
     return t;
 }
 
-void EmbreeScene::Impl::attach(RTCScene s, RTCGeometry g, Part part,
-                               std::vector<const Part*>& ids, bool alpha)
+void EmbreeScene::Impl::attach(RTCScene s, RTCGeometry g, GeometrySource part,
+                               std::vector<const GeometrySource*>& ids, bool alpha)
 {
     part.owner = this;
     parts.push_back(part);
@@ -473,7 +475,7 @@ void EmbreeScene::Impl::attach(RTCScene s, RTCGeometry g, Part part,
 }
 
 void EmbreeScene::Impl::add_geometry(RTCScene s, const geom::Geometry& geo,
-                                     std::vector<const Part*>& ids, const Key* line_keys,
+                                     std::vector<const GeometrySource*>& ids, const Key* line_keys,
                                      bool unlit, bool alpha, bool lines)
 {
     const geom::LinearCurves& l = geo.lines;
@@ -665,7 +667,7 @@ struct LocalSurface {
     bool two_sided = false;
 };
 
-LocalSurface local_surface(const Part& part, std::uint32_t prim, float u, float v,
+LocalSurface local_surface(const GeometrySource& part, std::uint32_t prim, float u, float v,
                            const Vec3f& ng)
 {
     const geom::Geometry& g = *part.geometry;
@@ -739,7 +741,7 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     const Placement* placement = m.placement(h.inst_id);
     if (placement)
         h.instance = placement->index;
-    const Part& part = *m.part(h.inst_id, h.geom_id);
+    const GeometrySource& part = *m.part(h.inst_id, h.geom_id);
     h.shape = part.shape;
     h.unlit = part.unlit;
     const geom::Geometry& g = *part.geometry;
