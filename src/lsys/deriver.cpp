@@ -277,7 +277,7 @@ std::size_t Deriver::rewrite(const Indexed& src, ModuleString& dst, bool decompo
         // Copy a run of modules that nothing can rewrite in one go
         std::size_t run = i;
         std::size_t run_params = 0;
-        while (run < s.size() && is_plain(set, s.symbol(run), decomposition)) {
+        while (run < s.size() && never_rewritten(set, s.symbol(run), decomposition)) {
             run_params += s.param_count(run);
             ++run;
         }
@@ -316,7 +316,7 @@ std::size_t Deriver::rewrite(const Indexed& src, ModuleString& dst, bool decompo
     return applied;
 }
 
-bool Deriver::is_plain(const ProductionSet& set, int sym, bool decomposition) const
+bool Deriver::never_rewritten(const ProductionSet& set, int sym, bool decomposition) const
 {
     return !set.candidates(static_cast<SymbolId>(sym)) && sym != m_sub_start &&
            sym != m_sub_end && (decomposition || sym != m_cut);
