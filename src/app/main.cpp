@@ -130,6 +130,10 @@ void write_strings(const Model& model, const lsys::ModuleString& string, const O
 
 int run(const Options& options)
 {
+    // One sink for the whole command, render threads included; -q keeps warnings quiet.
+    Diagnostics diagnostics(options.quiet ? Diagnostics::Output::quiet
+                                          : Diagnostics::Output::print);
+    ScopedDiagnostics install(diagnostics, ScopedDiagnostics::Reach::process);
     auto say = [&](const std::string& text) {
         if (!options.quiet)
             std::printf("%s\n", text.c_str());

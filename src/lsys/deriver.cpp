@@ -303,7 +303,7 @@ std::size_t Deriver::rewrite(const Indexed& src, ModuleString& dst, bool decompo
         // Copy a run of modules that nothing can rewrite in one go
         std::size_t run = i;
         std::size_t run_params = 0;
-        while (run < s.size() && is_plain(set, s.symbol(run), decomposition)) {
+        while (run < s.size() && never_rewritten(set, s.symbol(run), decomposition)) {
             run_params += s.param_count(run);
             ++run;
         }
@@ -342,7 +342,7 @@ std::size_t Deriver::rewrite(const Indexed& src, ModuleString& dst, bool decompo
     return applied;
 }
 
-bool Deriver::is_plain(const ProductionSet& set, int sym, bool decomposition) const
+bool Deriver::never_rewritten(const ProductionSet& set, int sym, bool decomposition) const
 {
     return !set.candidates(static_cast<SymbolId>(sym)) && sym != m_sub_start &&
            sym != m_sub_end && (decomposition || sym != m_cut);
@@ -492,21 +492,9 @@ bool Deriver::bind(const FormalModule& f, const ModuleString& s, std::size_t k,
 bool Deriver::match(const Production& p, const LSystemDefinition& ls, const Indexed& src,
                     std::size_t i, std::size_t offset)
 {
-    const ModuleString& s = *src.string;
-    if (i + p.predecessor.size() > s.size())
-        return false;
-    in_production(p);
-    use_frame_of(p);
-    for (std::size_t k = 0; k < p.predecessor.size(); ++k) {
-        if (!bind(p.predecessor[k], s, i + k, offset))
-            return false;
-        offset += s.param_count(i + k);
-    }
-    if (p.left_context.empty() && p.right_context.empty())
-        return true;
-    const auto& ignored = m_ignored[static_cast<std::size_t>(&ls - m_program.lsystems.data())];
-    return match_left(p, ignored, src, i) &&
-           match_right(p, ignored, src, i + p.predecessor.size());
+    // The string matched is the one context is read from (indexed whenever some
+    // production has context).
+    return match_at(p, ls, *src.string, i, offset, src, i, i + p.predecessor.size());
 }
 
 bool Deriver::match_left(const Production& p, const std::vector<char>& ignored,

@@ -102,7 +102,9 @@ private:
     bool apply_first_match(const ProductionSet& set, const LSystemDefinition& ls,
                            const Indexed& src, std::size_t i, std::size_t offset,
                            ModuleString& dst, std::size_t& consumed);
-    bool is_plain(const ProductionSet& set, int sym, bool decomposition) const;
+    /// Whether no production of `set` can rewrite `sym` (runs of such modules are copied
+    /// in bulk).
+    bool never_rewritten(const ProductionSet& set, int sym, bool decomposition) const;
     const Production* find_homomorphism(const ProductionSet& set, const LSystemDefinition& ls,
                                         const ModuleString& s, std::size_t k,
                                         std::size_t offset, const Indexed& ctx,

@@ -18,6 +18,7 @@
 
 #include "base/diagnostics.h"
 #include "geom/scene_limits.h"
+#include "render/line_geometry.h"
 #include "render/texture.h"
 
 namespace cambium::render {
@@ -155,37 +156,20 @@ T at_or(const std::vector<T>& v, std::size_t i, T fallback)
     return i < v.size() ? v[i] : fallback;
 }
 
-struct Lookup;
-
-/// Cylinders (F, G) as cpfg draws them: truncated cones with flat ends. Embree's round
-/// linear curves sweep a sphere, which turns a short wide segment (a lamp's base, a
-/// trunk's foot) into a ball; its cone curves are the exact frustums but leave the ends
-/// open and a wedge at each bend. So shaded lines are cone curves, each free end gets a
-/// disc and each bent joint a sphere of the joint's radius (the round joint cpfg's
-/// smooth tubes show).
-struct LineEnds {
-    std::vector<Key> caps;                   ///< disc centre and radius per free end
-    std::vector<geom::Float3> cap_normals;   ///< out of the cylinder
-    std::vector<std::uint32_t> cap_segment;  ///< the segment each cap closes
-    std::vector<std::uint8_t> cap_at_end;    ///< 1: at the segment's second key
-    std::vector<Key> joints;                 ///< sphere centre and radius per bent joint
-    std::vector<std::uint32_t> joint_segment;  ///< the segment a joint ends
-};
-
-LineEnds line_ends(const geom::LinearCurves& l, const Key* keys);
+struct HitResolver;
 
 /// One Embree geometry's source primitives.
-struct Part {
+struct GeometrySource {
     Shape shape = Shape::line;
     const geom::Geometry* geometry = nullptr;
     const Key* line_keys = nullptr;  ///< lines: keys with world-unit radii
     bool unlit = false;
-    const Lookup* owner = nullptr;
+    const HitResolver* owner = nullptr;
     const LineEnds* ends = nullptr;  ///< caps and joints: the segments they belong to
 };
 
 /// The segment of the scene's lines whose hit this is (a cap's or joint's: its segment).
-std::uint32_t line_segment(const Part& part, std::uint32_t prim)
+std::uint32_t line_segment(const GeometrySource& part, std::uint32_t prim)
 {
     switch (part.shape) {
     case Shape::cap: return part.ends->cap_segment[prim];
@@ -196,11 +180,11 @@ std::uint32_t line_segment(const Part& part, std::uint32_t prim)
 
 /// What hits are resolved with: parts by geometry id, instances' placements, textures
 /// (also read by the alpha filter during traversal).
-struct Lookup {
+struct HitResolver {
     const TextureSet* textures = nullptr;
-    std::vector<const Part*> top_parts;                ///< by top-level geometry id
-    std::vector<std::vector<const Part*>> proto_parts;  ///< by prototype, geometry id
-    std::vector<Placement> placements;                 ///< by top-level geometry id
+    std::vector<const GeometrySource*> top_parts;  ///< by top-level geometry id
+    std::vector<std::vector<const GeometrySource*>> proto_parts;  ///< by prototype, geometry id
+    std::vector<Placement> placements;  ///< by top-level geometry id
 
     const Placement* placement(std::uint32_t inst_id) const
     {
@@ -208,23 +192,23 @@ struct Lookup {
                    ? &placements[inst_id]
                    : nullptr;
     }
-    const Part* part(std::uint32_t inst_id, std::uint32_t geom_id) const
+    const GeometrySource* part(std::uint32_t inst_id, std::uint32_t geom_id) const
     {
         if (const Placement* p = placement(inst_id))
             return proto_parts[p->instance->prototype][geom_id];
         return top_parts[geom_id];
     }
-    int texture_of(const Part& part, std::uint32_t prim, const Placement* p) const;
+    int texture_of(const GeometrySource& part, std::uint32_t prim, const Placement* p) const;
 };
 
 }  // namespace
 
-struct EmbreeScene::Impl : Lookup {
+struct EmbreeScene::Impl : HitResolver {
     ErrorSink errors;
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     std::vector<RTCScene> prototype_scenes;
-    std::deque<Part> parts;  ///< stable addresses (Embree user data)
+    std::deque<GeometrySource> parts;  ///< stable addresses (Embree user data)
     std::deque<LineEnds> line_ends;  ///< caps and joints of shaded lines (stable addresses)
     std::vector<Key> world_keys;  ///< line keys with pixel radii converted (else empty)
     /// Pixel-width lines of prototypes, placed by every instance in world space with
@@ -258,10 +242,11 @@ struct EmbreeScene::Impl : Lookup {
         return s;
     }
 
-    /// Adds every non-empty part of g to s; ids[geomID] = its Part.
-    void add_geometry(RTCScene s, const geom::Geometry& g, std::vector<const Part*>& ids,
+    /// Adds every non-empty part of g to s; ids[geomID] = its GeometrySource.
+    void add_geometry(RTCScene s, const geom::Geometry& g, std::vector<const GeometrySource*>& ids,
                       const Key* line_keys, bool unlit, bool alpha, bool lines = true);
-    void attach(RTCScene s, RTCGeometry g, Part part, std::vector<const Part*>& ids, bool alpha);
+    void attach(RTCScene s, RTCGeometry g, GeometrySource part,
+                std::vector<const GeometrySource*>& ids, bool alpha);
 
 };
 
@@ -276,8 +261,8 @@ Vec3f hermite_axis(const geom::HermiteCurves& c, std::uint32_t k, float u)
 }
 
 /// Texture coordinates (s, t) of a hit: Embree's (u, v) and object-space normal ng.
-std::array<float, 2> texture_coords(const Part& part, std::uint32_t prim, float u, float v,
-                                    const Vec3f& ng)
+std::array<float, 2> texture_coords(const GeometrySource& part, std::uint32_t prim, float u,
+                                    float v, const Vec3f& ng)
 {
     const geom::Geometry& g = *part.geometry;
     switch (part.shape) {
@@ -323,7 +308,7 @@ std::array<float, 2> texture_coords(const Part& part, std::uint32_t prim, float 
 
 /// dP/ds and dP/dt in object space at a hit (texture_coords' derivatives); zero where a
 /// coordinate does not change.
-std::array<Vec3f, 2> texture_tangents(const Part& part, std::uint32_t prim, float u,
+std::array<Vec3f, 2> texture_tangents(const GeometrySource& part, std::uint32_t prim, float u,
                                       const Vec3f& ng, float radius)
 {
     const geom::Geometry& g = *part.geometry;
@@ -384,8 +369,8 @@ std::array<Vec3f, 2> texture_tangents(const Part& part, std::uint32_t prim, floa
 /// Rejects hits where the primitive's texture is cut out (alpha < 0.5).
 void alpha_filter(const RTCFilterFunctionNArguments* args)
 {
-    const auto* part = static_cast<const Part*>(args->geometryUserPtr);
-    const Lookup& owner = *part->owner;
+    const auto* part = static_cast<const GeometrySource*>(args->geometryUserPtr);
+    const HitResolver& owner = *part->owner;
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] == 0)
             continue;
@@ -401,64 +386,6 @@ void alpha_filter(const RTCFilterFunctionNArguments* args)
         if (owner.textures->lookup(texture, st[0], st[1]).alpha < 0.5f)
             args->valid[i] = 0;
     }
-}
-
-/// Most line keys that placing pixel-width prototype lines may create.
-constexpr std::size_t max_placed_keys = std::size_t{1} << 27;
-
-/// The pixel-width lines of every instance's prototype in world space: keys transformed,
-/// radii converted at each key's depth, materials and textures resolved.
-geom::LinearCurves place_pixel_lines(const geom::Scene& scene, const Camera& camera)
-{
-    geom::LinearCurves out;
-    std::size_t total = 0;
-    for (const geom::Instance& inst : scene.instances)
-        if (inst.prototype < scene.prototypes.size())
-            total += scene.prototypes[inst.prototype].geometry.lines.keys.size();
-    if (total > max_placed_keys)
-        throw Error("scene: placing pixel-width lines of prototypes would make " +
-                    std::to_string(total) + " keys (at most " +
-                    std::to_string(max_placed_keys) + ")");
-    for (const geom::Instance& inst : scene.instances) {
-        if (inst.prototype >= scene.prototypes.size())
-            continue;
-        const geom::LinearCurves& l = scene.prototypes[inst.prototype].geometry.lines;
-        if (l.segments.empty())
-            continue;
-        for (std::uint32_t k : l.segments)
-            if (k + 1 >= l.keys.size())
-                throw Error("scene: line segment starts at key " + std::to_string(k) + " of " +
-                            std::to_string(l.keys.size()));
-        const auto& m = inst.transform;
-        auto first = static_cast<std::uint32_t>(out.keys.size());
-        for (const Key& k : l.keys) {
-            geom::Vec3 p{m[0] * k[0] + m[3] * k[1] + m[6] * k[2] + m[9],
-                         m[1] * k[0] + m[4] * k[1] + m[7] * k[2] + m[10],
-                         m[2] * k[0] + m[5] * k[1] + m[8] * k[2] + m[11]};
-            out.keys.push_back({float(p.x), float(p.y), float(p.z),
-                                static_cast<float>(k[3] * camera.pixel_size_at(p))});
-        }
-        for (std::size_t k = 0; k < l.keys.size(); ++k)
-            out.v.push_back(l.v.size() == l.keys.size() ? l.v[k] : 0.0f);
-        for (std::size_t i = 0; i < l.segments.size(); ++i) {
-            out.segments.push_back(first + l.segments[i]);
-            out.flags.push_back(l.flags.size() == l.segments.size() ? l.flags[i] : 0);
-            std::uint16_t mat = at_or(l.material, i, std::uint16_t{0});
-            out.material.push_back(mat == geom::inherit_material ? inst.material : mat);
-            std::int16_t tex = at_or(l.texture, i, geom::no_texture);
-            out.texture.push_back(tex == geom::no_texture ? inst.texture : tex);
-        }
-    }
-    return out;
-}
-
-/// The keys with radii converted from pixels to world units at each key's depth.
-std::vector<Key> keys_in_world_units(const geom::LinearCurves& lines, const Camera& camera)
-{
-    std::vector<Key> keys(lines.keys);
-    for (Key& k : keys)
-        k[3] = static_cast<float>(k[3] * camera.pixel_size_at({k[0], k[1], k[2]}));
-    return keys;
 }
 
 void check_segments(const std::vector<std::uint32_t>& segments, std::size_t keys,
@@ -488,47 +415,6 @@ void copy_buffer(RTCGeometry g, RTCBufferType type, RTCFormat format, const std:
         std::memcpy(dst, data.data(), sizeof(T) * data.size());
 }
 
-LineEnds line_ends(const geom::LinearCurves& l, const Key* keys)
-{
-    constexpr std::uint8_t left = 1, right = 2;  // RTC_CURVE_FLAG_NEIGHBOR_LEFT / _RIGHT
-    // Below this bend (about 0.8 degrees) the frustums meet without a visible wedge.
-    constexpr float straight = 0.9999f;
-    const std::size_t n = l.segments.size();
-    auto flags_of = [&](std::size_t i) -> std::uint8_t {
-        return l.flags.size() == n ? l.flags[i] : 0;
-    };
-    auto direction = [&](std::uint32_t k) {
-        Vec3f d = Vec3f(keys[k + 1][0], keys[k + 1][1], keys[k + 1][2]) -
-                  Vec3f(keys[k][0], keys[k][1], keys[k][2]);
-        float length = std::sqrt(dot(d, d));
-        return length > 0 ? d * (1 / length) : Vec3f();
-    };
-    LineEnds e;
-    auto add_cap = [&](const Key& at, const Vec3f& out, std::size_t segment, bool end) {
-        if (!(at[3] > 0) || dot(out, out) == 0)
-            return;  // tapered to nothing, or no direction: no end to close
-        e.caps.push_back(at);
-        e.cap_normals.push_back({out.x, out.y, out.z});
-        e.cap_segment.push_back(static_cast<std::uint32_t>(segment));
-        e.cap_at_end.push_back(end ? 1 : 0);
-    };
-    for (std::size_t i = 0; i < n; ++i) {
-        const std::uint32_t k = l.segments[i];
-        const std::uint8_t f = flags_of(i);
-        Vec3f dir = direction(k);
-        if (!(f & left))
-            add_cap(keys[k], -dir, i, false);
-        if (!(f & right)) {
-            add_cap(keys[k + 1], dir, i, true);
-        } else if (k + 2 < l.keys.size() && keys[k + 1][3] > 0 &&
-                   dot(dir, direction(k + 1)) < straight) {
-            e.joints.push_back(keys[k + 1]);
-            e.joint_segment.push_back(static_cast<std::uint32_t>(i));
-        }
-    }
-    return e;
-}
-
 void set_flags(RTCGeometry g, const std::vector<std::uint8_t>& flags, std::size_t segments)
 {
     // Neighbour flags close the joints of a polyline without caps or bulges.
@@ -551,7 +437,8 @@ bool any_texture(const std::vector<T>& textures)
 
 }  // namespace
 
-int Lookup::texture_of(const Part& part, std::uint32_t prim, const Placement* p) const
+int HitResolver::texture_of(const GeometrySource& part, std::uint32_t prim,
+                            const Placement* p) const
 {
     const geom::Geometry& g = *part.geometry;
     std::int16_t t = geom::no_texture;
@@ -572,8 +459,8 @@ int Lookup::texture_of(const Part& part, std::uint32_t prim, const Placement* p)
     return t;
 }
 
-void EmbreeScene::Impl::attach(RTCScene s, RTCGeometry g, Part part,
-                               std::vector<const Part*>& ids, bool alpha)
+void EmbreeScene::Impl::attach(RTCScene s, RTCGeometry g, GeometrySource part,
+                               std::vector<const GeometrySource*>& ids, bool alpha)
 {
     part.owner = this;
     parts.push_back(part);
@@ -591,7 +478,7 @@ void EmbreeScene::Impl::attach(RTCScene s, RTCGeometry g, Part part,
 }
 
 void EmbreeScene::Impl::add_geometry(RTCScene s, const geom::Geometry& geo,
-                                     std::vector<const Part*>& ids, const Key* line_keys,
+                                     std::vector<const GeometrySource*>& ids, const Key* line_keys,
                                      bool unlit, bool alpha, bool lines)
 {
     const geom::LinearCurves& l = geo.lines;
@@ -796,7 +683,7 @@ struct LocalSurface {
     bool two_sided = false;
 };
 
-LocalSurface local_surface(const Part& part, std::uint32_t prim, float u, float v,
+LocalSurface local_surface(const GeometrySource& part, std::uint32_t prim, float u, float v,
                            const Vec3f& ng)
 {
     const geom::Geometry& g = *part.geometry;
@@ -874,7 +761,7 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     const Placement* placement = m.placement(h.inst_id);
     if (placement)
         h.instance = placement->index;
-    const Part& part = *m.part(h.inst_id, h.geom_id);
+    const GeometrySource& part = *m.part(h.inst_id, h.geom_id);
     h.shape = part.shape;
     h.unlit = part.unlit;
     const geom::Geometry& g = *part.geometry;

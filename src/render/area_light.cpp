@@ -237,6 +237,7 @@ AreaLights::AreaLights(const geom::Scene& scene, const std::vector<SurfaceMateri
         m_cdf[i + 1] = m_cdf[i] + std::max(power, 0.0);
     }
     double total = m_cdf.back();
+    m_power = total;
     for (std::size_t i = 1; i <= m_lights.size(); ++i)
         m_cdf[i] = total > 0 ? m_cdf[i] / total : double(i) / double(m_lights.size());
 }

@@ -45,6 +45,8 @@ public:
 
     bool empty() const { return m_lights.empty(); }
     std::size_t size() const { return m_lights.size(); }
+    /// The summed area times luminance of the lights' sides: their emitted power over pi.
+    double power() const { return m_power; }
 
     /// A point on a light for the shading point p, from three uniforms; nullopt if the
     /// point sends nothing toward p.
@@ -79,6 +81,7 @@ private:
     std::vector<double> m_cdf;  ///< m_lights.size() + 1 entries, last 1
     std::unordered_map<std::uint64_t, std::uint32_t> m_index;  ///< key() -> light
     std::size_t m_max = 0;
+    double m_power = 0;
     bool m_full = false;
 };
 

@@ -1,12 +1,17 @@
 // SPDX-License-Identifier: Apache-2.0
-// The unidirectional path tracer: next-event estimation toward the view file's lights, the
-// environment and emissive primitives (MIS against BSDF sampling), transmission, opacity,
-// Russian roulette, ray cones for texture filtering.
+// The unidirectional path tracer: next-event estimation toward one light per vertex, chosen
+// by power from the view file's lights, the environment and emissive primitives (MIS
+// against BSDF sampling), transmission, opacity, Russian roulette, ray cones for texture
+// filtering.
+//
+// Sampler dimensions per vertex: [opacity, only on a material with opacity < 1], then a
+// fixed budget of 4 for the light (choice + 3) and 3 for the BSDF ray and roulette.
 #include "render/integrator.h"
 
 #include <array>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace cambium::render {
 
@@ -138,69 +143,34 @@ struct Vertex {
     Vec3f wo;
 };
 
-/// Direct light from every delta light, each with one shadow ray.
-Vec3f light_delta(const PathContext& ctx, bool transparent, const Vertex& v)
-{
-    Vec3f sum;
-    for (const RenderLight& light : ctx.lights) {
-        LightSample ls = sample_light(light, v.hit.position);
-        if (is_black(ls.irradiance))
-            continue;
-        Vec3f f = bsdf_eval(v.bsdf, v.hit.normal, v.wo, ls.wi);
-        float cos = std::fabs(dot(v.hit.normal, ls.wi));
-        if (is_black(f) || cos <= 0 || !same_side(v.hit, ls.wi))
-            continue;
-        // The offset origin is a little closer to the light; stop just short of it.
-        float tfar = std::isinf(ls.distance) ? infinity : ls.distance * (1 - 1e-4f);
-        float through = transmittance(ctx, transparent, spawn(v.hit, ls.wi), ls.wi, tfar);
-        if (through > 0)
-            sum += f * ls.irradiance * (cos * through);
-    }
-    return sum;
-}
+/// The four uniforms a vertex spends on next-event estimation.
+struct LightUniforms {
+    float choose, u0, u1, u2;
+};
 
-/// One point on an emissive primitive, weighted against BSDF sampling of the same
-/// direction (weight 1 at the path's last vertex, where no BSDF ray follows).
-Vec3f light_area(const PathContext& ctx, bool transparent, const Vertex& v, bool last,
-                 float u0, float u1, float u2)
+/// Direct light from one light chosen by power (pbrt's SampleLd): a delta light at full
+/// weight, the others weighted against BSDF sampling of the same direction by the power
+/// heuristic (full weight at the path's last vertex, where no BSDF ray follows).
+Vec3f sample_ld(const PathContext& ctx, const LightSet& lights, bool transparent,
+                const Vertex& v, bool last, const LightUniforms& u)
 {
-    std::optional<AreaLightSample> ls = ctx.area_lights->sample(v.hit.position, u0, u1, u2);
-    if (!ls)
+    std::optional<ChosenLight> chosen = lights.choose(u.choose);
+    if (!chosen || !(chosen->probability > 0))
         return {};
-    Vec3f f = bsdf_eval(v.bsdf, v.hit.normal, v.wo, ls->wi);
-    float cos = std::fabs(dot(v.hit.normal, ls->wi));
-    if (is_black(f) || cos <= 0 || !same_side(v.hit, ls->wi))
+    LightLiSample ls = lights.sample_li(chosen->index, v.hit.position, u.u0, u.u1, u.u2);
+    if (!(ls.pdf > 0) || is_black(ls.li))
         return {};
-    // Stop just short of the light, whose own surface must not block the ray.
-    float through = transmittance(ctx, transparent, spawn(v.hit, ls->wi), ls->wi,
-                                  ls->distance - ls->margin);
+    Vec3f f = bsdf_eval(v.bsdf, v.hit.normal, v.wo, ls.wi);
+    float cos = std::fabs(dot(v.hit.normal, ls.wi));
+    if (is_black(f) || cos <= 0 || !same_side(v.hit, ls.wi))
+        return {};
+    float through = transmittance(ctx, transparent, spawn(v.hit, ls.wi), ls.wi, ls.tfar);
     if (through <= 0)
         return {};
-    float w = last ? 1.0f
-                   : power_heuristic(ls->pdf, bsdf_pdf(v.bsdf, v.hit.normal, v.wo, ls->wi));
-    return f * ls->radiance * (cos * through * w / ls->pdf);
-}
-
-/// One environment sample, weighted against BSDF sampling of the same direction
-/// (weight 1 at the path's last vertex, where no BSDF ray follows).
-Vec3f light_environment(const PathContext& ctx, const Environment& env, bool transparent,
-                        const Vertex& v, bool last, float u1, float u2)
-{
-    EnvironmentSample es = env.sample(u1, u2);
-    if (es.pdf <= 0 || is_black(es.radiance))
-        return {};
-    Vec3f f = bsdf_eval(v.bsdf, v.hit.normal, v.wo, es.direction);
-    float cos = std::fabs(dot(v.hit.normal, es.direction));
-    if (is_black(f) || cos <= 0 || !same_side(v.hit, es.direction))
-        return {};
-    float through = transmittance(ctx, transparent, spawn(v.hit, es.direction), es.direction,
-                                  infinity);
-    if (through <= 0)
-        return {};
-    float w = last ? 1.0f
-                   : power_heuristic(es.pdf,
-                                     bsdf_pdf(v.bsdf, v.hit.normal, v.wo, es.direction));
-    return f * es.radiance * (cos * through * w / es.pdf);
+    float pdf = chosen->probability * ls.pdf;
+    float w = ls.delta || last ? 1.0f
+                               : power_heuristic(pdf, bsdf_pdf(v.bsdf, v.hit.normal, v.wo, ls.wi));
+    return f * ls.li * (cos * through * w / pdf);
 }
 
 }  // namespace
@@ -233,17 +203,13 @@ TextureFootprint texture_footprint(const SurfaceHit& hit, const Vec3f& dir, floa
     return {dsdx, dtdx, dsdy, dtdy};
 }
 
-namespace {
-
-PathContext::Prepared scene_facts(const PathContext& ctx)
+void prepare_path_context(PathContext& ctx)
 {
     const EnvironmentView env(ctx);
-    return {any_transparent(ctx), env.black(), env.nee()};
+    ctx.prepared = PathContext::SceneFlags{
+        any_transparent(ctx), env.black(), env.nee(),
+        LightSet(ctx.lights, ctx.area_lights, ctx.environment, env.nee(), ctx.scene_radius)};
 }
-
-}  // namespace
-
-void prepare_path_context(PathContext& ctx) { ctx.prepared = scene_facts(ctx); }
 
 const SurfaceMaterial& hit_material(const PathContext& ctx, const SurfaceHit& hit,
                                     SurfaceMaterial& scratch)
@@ -255,37 +221,47 @@ const SurfaceMaterial& hit_material(const PathContext& ctx, const SurfaceHit& hi
     return scratch;
 }
 
-PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec3f& camera_dir,
-                      Sampler& sampler)
+namespace {
+
+/// The camera ray's first hit as the image's layers show it.
+VisibleSurface visible_surface(const SurfaceHit& hit, const SurfaceMaterial& material,
+                               const Vec3f& diffuse)
 {
-    const PathContext::Prepared facts = ctx.prepared ? *ctx.prepared : scene_facts(ctx);
-    const bool env_nee = facts.environment_nee;
-    const bool env_black = facts.environment_black;
-    const bool transparent = facts.transparent;
+    return {true, hit.unlit ? flat_colour(material) : diffuse, hit.normal, hit.t};
+}
+
+}  // namespace
+
+PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec3f& camera_dir,
+                      Sampler& sampler, float camera_tfar, VisibleSurface* first)
+{
+    if (!ctx.prepared)
+        throw std::logic_error("trace_path: prepare_path_context() was not called");
+    const PathContext::SceneFlags& facts = *ctx.prepared;
+    const LightSet& lights = facts.lights;
     auto env_radiance = [&](const Vec3f& d) {
         return ctx.environment ? ctx.environment->radiance(d) : ctx.ambient;
     };
-    const bool area_nee = ctx.area_lights && !ctx.area_lights->empty();
 
     PathResult result;
     Vec3f beta(1.0f);
     Vec3f org = camera_org, dir = camera_dir;
+    float tfar = camera_tfar;  // the camera ray's range left (far clipping); later rays: none
     PrimId leaving;        // the primitive the current ray leaves (none for the camera ray)
     float bsdf_pdf_prev = 0;  // pdf the current ray's direction was drawn with
     Vec3f scatter_prev;       // where it was drawn (the last scattering vertex)
     int passes = 0;
     float travelled = 0;  // along the path, for the ray cone
     for (int depth = 0; depth < ctx.max_depth;) {
-        std::optional<SurfaceHit> hit =
-            ctx.accel->intersect(org, dir, 0, infinity, leaving, depth == 0);
+        std::optional<SurfaceHit> hit = ctx.accel->intersect(org, dir, 0, tfar, leaving, depth == 0);
         if (!hit) {
             if (depth == 0 && ctx.environment_visible) {
                 result.radiance += beta * env_radiance(dir);
             } else if (depth == 0) {
                 result.radiance += beta * ctx.background;
-            } else if (!env_black) {
-                float w = env_nee
-                              ? power_heuristic(bsdf_pdf_prev, ctx.environment->pdf(dir))
+            } else if (!facts.environment_black) {
+                float w = facts.environment_nee
+                              ? power_heuristic(bsdf_pdf_prev, lights.pdf_li(dir))
                               : 1.0f;
                 result.radiance += beta * env_radiance(dir) * w;
             }
@@ -294,22 +270,32 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         travelled += hit->t;
         SurfaceMaterial blended;
         const SurfaceMaterial& material = hit_material(ctx, *hit, blended);
+        auto textured_diffuse = [&] {
+            if (!ctx.textures || hit->texture == geom::no_texture)
+                return material.diffuse;
+            return ctx.textures->apply(
+                hit->texture, material.diffuse, hit->u, hit->v,
+                texture_footprint(*hit, dir,
+                                  ctx.camera_cone.width + ctx.camera_cone.spread * travelled));
+        };
+        std::optional<Vec3f> diffuse_seen;  // looked up once per vertex at most
+        if (first && depth == 0 && passes == 0) {
+            diffuse_seen = textured_diffuse();
+            *first = visible_surface(*hit, material, *diffuse_seen);
+        }
         // Opacity: the ray stops here with probability opacity, else passes on unchanged.
         if (material.opacity < 1 && sampler.next() >= material.opacity) {
             if (++passes > max_pass_throughs)
                 break;
             org = hit->position;
             leaving = hit->prim();
+            if (depth == 0)
+                tfar = std::isinf(tfar) ? tfar : tfar - hit->t;
             continue;
         }
         if (depth == 0)
             result.hit = true;
-        Vec3f diffuse = material.diffuse;
-        if (ctx.textures && hit->texture != geom::no_texture)
-            diffuse = ctx.textures->apply(
-                hit->texture, diffuse, hit->u, hit->v,
-                texture_footprint(*hit, dir,
-                                  ctx.camera_cone.width + ctx.camera_cone.spread * travelled));
+        Vec3f diffuse = diffuse_seen ? *diffuse_seen : textured_diffuse();
         if (hit->unlit) {
             result.radiance += beta * (diffuse + material.emission);
             break;
@@ -317,8 +303,8 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         if (!is_black(material.emission)) {
             // A BSDF-sampled hit on a listed light: weighted against sampling the light.
             float w = 1;
-            if (depth > 0 && area_nee) {
-                float light_pdf = ctx.area_lights->pdf(scatter_prev, *hit);
+            if (depth > 0) {
+                float light_pdf = lights.pdf_li(scatter_prev, *hit);
                 if (light_pdf > 0)
                     w = power_heuristic(bsdf_pdf_prev, light_pdf);
             }
@@ -327,15 +313,8 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         Bsdf bsdf = make_bsdf(material, diffuse);
         Vertex vertex{*hit, bsdf, -dir};
         const bool last = depth + 1 == ctx.max_depth;
-        result.radiance += beta * light_delta(ctx, transparent, vertex);
-        float e1 = sampler.next(), e2 = sampler.next();
-        if (env_nee)
-            result.radiance += beta * light_environment(ctx, *ctx.environment, transparent,
-                                                        vertex, last, e1, e2);
-        if (area_nee) {
-            float a0 = sampler.next(), a1 = sampler.next(), a2 = sampler.next();
-            result.radiance += beta * light_area(ctx, transparent, vertex, last, a0, a1, a2);
-        }
+        LightUniforms lu{sampler.next(), sampler.next(), sampler.next(), sampler.next()};
+        result.radiance += beta * sample_ld(ctx, lights, facts.transparent, vertex, last, lu);
         if (++depth == ctx.max_depth)
             break;
 
@@ -356,6 +335,7 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         Spawn s = spawn(*hit, bs.wi);
         org = s.origin;
         dir = bs.wi;
+        tfar = infinity;
         leaving = s.skip;
         bsdf_pdf_prev = bs.pdf;
         scatter_prev = hit->position;

@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
-// The unidirectional path tracer: next-event estimation toward the view file's lights, the
-// environment and emissive primitives (MIS against BSDF sampling), transmission, opacity,
-// Russian roulette, ray cones for texture filtering.
+// The unidirectional path tracer: next-event estimation toward one light per vertex, chosen
+// by power from the view file's lights, the environment and emissive primitives (MIS
+// against BSDF sampling), transmission, opacity, Russian roulette, ray cones for texture
+// filtering.
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -47,15 +49,19 @@ struct PathContext {
     int roulette_depth = 3;
     /// The camera rays' cone (zero: textures are looked up at their finest level).
     RayCone camera_cone;
+    /// Half the scene's diagonal: how far area lights' power is taken to reach when lights
+    /// are chosen (variance only; 0 counts as 1).
+    float scene_radius = 0;
 
-    /// Scene-wide facts trace_path needs, found once by prepare_path_context() (else
-    /// worked out again for every path, which costs a scan of the materials each time).
-    struct Prepared {
+    /// Scene-wide facts and the light set trace_path needs, made once by
+    /// prepare_path_context() after everything above is set.
+    struct SceneFlags {
         bool transparent = false;      ///< some material lets light through
         bool environment_black = true; ///< escaping rays see nothing
         bool environment_nee = false;  ///< the environment is sampled for NEE
+        LightSet lights;               ///< what next-event estimation samples
     };
-    std::optional<Prepared> prepared;
+    std::optional<SceneFlags> prepared;
 };
 
 /// The material at `hit`: ctx.materials[hit.material], or, where a generalized
@@ -64,7 +70,8 @@ struct PathContext {
 const SurfaceMaterial& hit_material(const PathContext& ctx, const SurfaceHit& hit,
                                     SurfaceMaterial& scratch);
 
-/// Fills ctx.prepared; call after setting the materials and the environment.
+/// Fills ctx.prepared; call after setting the materials, lights and environment (again
+/// after changing them). trace_path throws std::logic_error without it.
 void prepare_path_context(PathContext& ctx);
 
 /// The texture footprint of `hit` seen along `dir` through a cone `width` wide there: an
@@ -78,8 +85,20 @@ struct PathResult {
     bool hit = false;
 };
 
-/// Traces the camera ray (org, dir) with the sampler's dimensions. Allocates nothing.
+/// What the camera ray meets first (transparent or not), for the image's albedo, normal
+/// and depth layers (pbrt's VisibleSurface).
+struct VisibleSurface {
+    bool hit = false;
+    Vec3f albedo;  ///< the (textured) diffuse albedo, or an unlit line's flat colour
+    Vec3f normal;  ///< unit shading normal, facing the camera
+    float t = 0;   ///< distance along the camera ray
+};
+
+/// Traces the camera ray (org, dir), which ends at tfar (far clipping), with the sampler's
+/// dimensions; fills `first` when given. Allocates nothing.
 PathResult trace_path(const PathContext& ctx, const Vec3f& org, const Vec3f& dir,
-                      Sampler& sampler);
+                      Sampler& sampler,
+                      float tfar = std::numeric_limits<float>::infinity(),
+                      VisibleSurface* first = nullptr);
 
 }  // namespace cambium::render

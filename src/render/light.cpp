@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
-// The view file's lights (point, directional, spot) as delta lights for next-event estimation.
+// The scene's lights as one closed set for next-event estimation: the view file's point,
+// spot and directional lights (delta lights), the emissive primitives (one area-light
+// group) and the environment, chosen by power.
 #include "render/light.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -10,6 +13,10 @@
 namespace cambium::render {
 
 namespace {
+
+constexpr float pi = std::numbers::pi_v<float>;
+
+float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 float attenuation(const RenderLight& l, float d)
 {
@@ -30,7 +37,6 @@ float spot_factor(const RenderLight& l, const Vec3f& from_light)
 
 LightSample sample_light(const RenderLight& light, const Vec3f& p)
 {
-    constexpr float pi = std::numbers::pi_v<float>;
     if (light.kind == RenderLight::Kind::directional)
         return {light.toward_light, std::numeric_limits<float>::infinity(), light.colour * pi};
     Vec3f to = light.position - p;
@@ -72,6 +78,135 @@ std::vector<RenderLight> make_lights(const std::vector<geom::Light>& lights)
         out.push_back(r);
     }
     return out;
+}
+
+}  // namespace cambium::render
+
+namespace cambium::render {
+
+namespace {
+
+/// The integral of the environment's luminance over the sphere, estimated from its own
+/// importance sampling on a fixed 16 x 16 grid of uniforms (the same for every render, so
+/// images stay a function of the seed).
+double environment_luminance(const Environment& env)
+{
+    constexpr int n = 16;
+    double sum = 0;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            EnvironmentSample s = env.sample((i + 0.5f) / n, (j + 0.5f) / n);
+            if (s.pdf > 0)
+                sum += luminance(s.radiance) / s.pdf;
+        }
+    return sum / (n * n);
+}
+
+LightKind kind_of(const RenderLight& l)
+{
+    switch (l.kind) {
+    case RenderLight::Kind::point: return LightKind::point;
+    case RenderLight::Kind::spot: return LightKind::spot;
+    case RenderLight::Kind::directional: return LightKind::directional;
+    }
+    return LightKind::point;
+}
+
+}  // namespace
+
+LightSet::LightSet(const std::vector<RenderLight>& lights, const AreaLights* area_lights,
+                   const Environment* environment, bool environment_nee, float scene_radius)
+{
+    for (const RenderLight& l : lights) {
+        float falloff = attenuation(l, 0);
+        add({kind_of(l), l}, pi * luminance(l.colour) * (falloff > 0 ? falloff : 1.0f));
+    }
+    if (area_lights && !area_lights->empty()) {
+        m_area = area_lights;
+        float r = scene_radius > 0 ? scene_radius : 1.0f;
+        add({LightKind::area, {}}, area_lights->power() / (double(r) * r));
+    }
+    if (environment && environment_nee) {
+        m_environment = environment;
+        add({LightKind::environment, {}}, environment_luminance(*environment) / 4);
+    }
+    // Every light keeps a chance: a weight of 0 (black, or a failed estimate) would make
+    // its light unreachable, which is bias, not just variance.
+    double total = 0, floor = 0;
+    for (double w : m_weights)
+        total += std::isfinite(w) ? std::max(w, 0.0) : 0.0;
+    floor = total > 0 ? total * 1e-3 / double(m_weights.size()) : 1;
+    m_cdf.assign(m_lights.size() + 1, 0.0);
+    for (std::size_t i = 0; i < m_lights.size(); ++i) {
+        double w = std::isfinite(m_weights[i]) ? std::max(m_weights[i], floor) : floor;
+        m_cdf[i + 1] = m_cdf[i] + w;
+    }
+    for (double& c : m_cdf)
+        c /= m_cdf.back();
+    m_weights.clear();
+    for (std::size_t i = 0; i < m_lights.size(); ++i) {
+        float p = static_cast<float>(m_cdf[i + 1] - m_cdf[i]);
+        if (m_lights[i].kind == LightKind::area)
+            m_area_probability = p;
+        if (m_lights[i].kind == LightKind::environment)
+            m_environment_probability = p;
+    }
+}
+
+void LightSet::add(const Entry& entry, double weight)
+{
+    m_lights.push_back(entry);
+    m_weights.push_back(weight);
+}
+
+std::optional<ChosenLight> LightSet::choose(float u) const
+{
+    if (m_lights.empty())
+        return std::nullopt;
+    auto it = std::upper_bound(m_cdf.begin(), m_cdf.end(), double(u));
+    std::size_t i = std::min<std::size_t>(
+        std::size_t(std::max<std::ptrdiff_t>(it - m_cdf.begin() - 1, 0)), m_lights.size() - 1);
+    return ChosenLight{static_cast<std::uint32_t>(i),
+                       static_cast<float>(m_cdf[i + 1] - m_cdf[i])};
+}
+
+LightLiSample LightSet::sample_li(std::uint32_t index, const Vec3f& p, float u0, float u1,
+                                  float u2) const
+{
+    const Entry& e = m_lights[index];
+    switch (e.kind) {
+    case LightKind::point:
+    case LightKind::spot:
+    case LightKind::directional: {
+        LightSample ls = sample_light(e.delta, p);
+        // The offset origin is a little closer to the light; stop just short of it.
+        float tfar = std::isinf(ls.distance) ? ls.distance : ls.distance * (1 - 1e-4f);
+        return {ls.wi, ls.irradiance, is_black(ls.irradiance) ? 0.0f : 1.0f, tfar, true};
+    }
+    case LightKind::area: {
+        std::optional<AreaLightSample> ls = m_area->sample(p, u0, u1, u2);
+        if (!ls)
+            return {};
+        // Stop just short of the light, whose own surface must not block the ray.
+        return {ls->wi, ls->radiance, ls->pdf, ls->distance - ls->margin, false};
+    }
+    case LightKind::environment: {
+        EnvironmentSample es = m_environment->sample(u0, u1);
+        return {es.direction, es.radiance, es.pdf, std::numeric_limits<float>::infinity(),
+                false};
+    }
+    }
+    return {};
+}
+
+float LightSet::pdf_li(const Vec3f& p, const SurfaceHit& hit) const
+{
+    return m_area ? m_area_probability * m_area->pdf(p, hit) : 0.0f;
+}
+
+float LightSet::pdf_li(const Vec3f& wi) const
+{
+    return m_environment ? m_environment_probability * m_environment->pdf(wi) : 0.0f;
 }
 
 }  // namespace cambium::render

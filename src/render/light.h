@@ -1,11 +1,17 @@
 // SPDX-License-Identifier: Apache-2.0
-// The view file's lights (point, directional, spot) as delta lights for next-event estimation.
+// The scene's lights as one closed set for next-event estimation: the view file's point,
+// spot and directional lights (delta lights), the emissive primitives (one area-light
+// group) and the environment, chosen by power.
 #pragma once
 
+#include <cstdint>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "geom/scene.h"
+#include "render/area_light.h"
+#include "render/environment.h"
 #include "render/vecf.h"
 
 namespace cambium::render {
@@ -42,5 +48,73 @@ LightSample sample_light(const RenderLight& light, const Vec3f& p);
 
 /// Converts the view file's lights; colours are decoded from display values.
 std::vector<RenderLight> make_lights(const std::vector<geom::Light>& lights);
+
+/// The kinds of light next-event estimation knows: a closed set, dispatched by switch.
+enum class LightKind : std::uint8_t { point, spot, directional, area, environment };
+
+/// Light arriving at a shading point from one light: the unit direction toward it, the
+/// radiance along -wi (a delta light: the irradiance on a surface facing it), the
+/// solid-angle density wi was drawn with (a delta light: 1; the light's choice not
+/// included) and where a shadow ray toward it stops (just short of the light).
+struct LightLiSample {
+    Vec3f wi;
+    Vec3f li;
+    float pdf = 0;
+    float tfar = std::numeric_limits<float>::infinity();
+    bool delta = false;  ///< no BSDF ray can find this light (no MIS weight)
+};
+
+/// One light of a LightSet, chosen with `probability`.
+struct ChosenLight {
+    std::uint32_t index = 0;
+    float probability = 0;
+};
+
+/// Every light next-event estimation samples, one at a time, chosen in proportion to its
+/// power (pbrt's power light sampler): a delta light by the irradiance pi |colour| it gives
+/// a surface facing it (attenuation at distance 0, the spot cone ignored), the
+/// environment by the integral of its luminance over the sphere (a quarter of it reaches an
+/// average surface, as a quarter of a delta light's does), the emissive primitives by
+/// their power over pi r^2, r the scene's radius (the irradiance they give a surface that
+/// far away). The weights only steer variance: every light keeps a non-zero chance.
+/// Holds pointers to the area lights and the environment, which must outlive it.
+class LightSet {
+public:
+    LightSet() = default;
+    /// `environment` is sampled only if `environment_nee` (a uniform one is left to BSDF
+    /// sampling, which is perfect for it).
+    LightSet(const std::vector<RenderLight>& lights, const AreaLights* area_lights,
+             const Environment* environment, bool environment_nee, float scene_radius);
+
+    bool empty() const { return m_lights.empty(); }
+    std::size_t size() const { return m_lights.size(); }
+    LightKind kind(std::uint32_t index) const { return m_lights[index].kind; }
+
+    /// The light for the uniform u; nullopt when the set is empty.
+    std::optional<ChosenLight> choose(float u) const;
+    /// Light from light `index` at p, from three uniforms; pdf 0 when it sends none.
+    LightLiSample sample_li(std::uint32_t index, const Vec3f& p, float u0, float u1,
+                            float u2) const;
+    /// The density (choice included) with which sampling the set finds the emissive
+    /// point `hit` seen from p; 0 when it is not a sampled area light.
+    float pdf_li(const Vec3f& p, const SurfaceHit& hit) const;
+    /// The density (choice included) with which sampling the set finds the environment
+    /// along wi; 0 when the environment is not sampled.
+    float pdf_li(const Vec3f& wi) const;
+
+private:
+    struct Entry {
+        LightKind kind = LightKind::point;
+        RenderLight delta;  ///< point, spot, directional
+    };
+    void add(const Entry& entry, double weight);
+
+    std::vector<Entry> m_lights;
+    std::vector<double> m_cdf;      ///< m_lights.size() + 1 entries, last 1
+    std::vector<double> m_weights;  ///< unnormalised, while adding
+    const AreaLights* m_area = nullptr;
+    const Environment* m_environment = nullptr;
+    float m_area_probability = 0, m_environment_probability = 0;
+};
 
 }  // namespace cambium::render

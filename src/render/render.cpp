@@ -128,32 +128,15 @@ struct PixelState {
 float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 /// Everything one sample needs, shared read-only by all threads.
-struct Frame {
+struct RenderState {
     const PathContext& ctx;
     const EmbreeScene& accel;
     const Camera& camera;
     const RenderSettings& settings;
     FilterTable filter;
     bool lens = false;
-    bool primary = false;  // intersect the camera ray here too (AOVs, clipping)
     std::atomic<std::uint64_t>* nonfinite = nullptr;  // samples whose radiance was NaN or infinite
 };
-
-/// The albedo layer's colour: the (textured) diffuse albedo, or the flat colour of an
-/// unlit line.
-Vec3f first_hit_albedo(const PathContext& ctx, const SurfaceHit& hit, const Vec3f& dir)
-{
-    SurfaceMaterial scratch;
-    const SurfaceMaterial& m = hit_material(ctx, hit, scratch);
-    if (hit.unlit)
-        return flat_colour(m);
-    if (ctx.textures && ctx.textures->valid(hit.texture)) {
-        float width = ctx.camera_cone.width + ctx.camera_cone.spread * hit.t;
-        return ctx.textures->apply(hit.texture, m.diffuse, hit.u, hit.v,
-                                   texture_footprint(hit, dir, width));
-    }
-    return m.diffuse;
-}
 
 /// A camera ray's cone: a parallel camera's rays are a pixel wide; a perspective one's
 /// start at a point and widen by a pixel's angle.
@@ -165,7 +148,7 @@ RayCone camera_cone(const Camera& camera)
 }
 
 /// Sample i of pixel (x, y), added to its sums.
-void take_sample(const Frame& f, int x, int y, std::uint32_t i, PixelState& st)
+void take_sample(const RenderState& f, int x, int y, std::uint32_t i, PixelState& st)
 {
     const RenderSettings& s = f.settings;
     Sampler sampler(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), i, s.seed);
@@ -183,26 +166,16 @@ void take_sample(const Frame& f, int x, int y, std::uint32_t i, PixelState& st)
     Vec3f org(ray.org), dir(ray.dir);
     if (ray.tnear > 0)
         org = Vec3f(ray.org + ray.dir * ray.tnear);  // front clipping: start at the plane
-    bool clipped_far = std::isfinite(ray.tfar);
+    // Far clipping: geometry beyond the back plane must not show.
+    float tfar = std::isfinite(ray.tfar) ? static_cast<float>(ray.tfar - ray.tnear) : infinity;
 
-    PathResult r;
-    bool trace = true;
-    if (f.primary) {
-        float tfar = clipped_far ? static_cast<float>(ray.tfar - ray.tnear) : infinity;
-        std::optional<SurfaceHit> hit = f.accel.intersect(org, dir, 0, tfar, {}, true);
-        if (hit) {
-            // The path's first hit is this one: nothing nearer, and it is in range.
-            st.albedo += first_hit_albedo(f.ctx, *hit, dir);
-            st.normal += hit->normal;
-            st.depth = std::min(st.depth, static_cast<float>(hit->t + ray.tnear));
-        } else if (clipped_far) {
-            // Geometry beyond the back plane must not show: the camera ray missed.
-            r.radiance = f.ctx.background;
-            trace = false;
-        }
+    VisibleSurface first;
+    PathResult r = trace_path(f.ctx, org, dir, sampler, tfar, s.aovs ? &first : nullptr);
+    if (first.hit) {
+        st.albedo += first.albedo;
+        st.normal += first.normal;
+        st.depth = std::min(st.depth, static_cast<float>(first.t + ray.tnear));
     }
-    if (trace)
-        r = trace_path(f.ctx, org, dir, sampler);
     if (s.transparent_background && !r.hit)
         r.radiance = Vec3f();
     // One NaN or infinite sample would spoil its pixel for good: it counts as black
@@ -444,14 +417,16 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
         ctx.max_depth = settings.max_depth;
         ctx.roulette_depth = settings.roulette_depth;
         ctx.camera_cone = camera_cone(camera);
+        if (!scene.bounds.empty())
+            ctx.scene_radius =
+                static_cast<float>(0.5 * geom::length(scene.bounds.hi - scene.bounds.lo));
         prepare_path_context(ctx);
 
-        const bool clipping = std::isfinite(camera.clip_near()) || std::isfinite(camera.clip_far());
-        Frame frame{ctx, accel, camera, settings,
+        RenderState state{ctx, accel, camera, settings,
                     FilterTable(settings.filter, settings.filter_radius),
                     camera.aperture_radius() > 0 &&
                         camera.projection() == Camera::Projection::perspective,
-                    settings.aovs || clipping, &nonfinite};
+                    &nonfinite};
 
         const int tiles_x = (w + tile_size - 1) / tile_size;
         const int tiles_y = (h + tile_size - 1) / tile_size;
@@ -509,7 +484,7 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
                             if (st.done)
                                 continue;
                             for (std::uint32_t i = st.samples; i < target; ++i, ++taken)
-                                take_sample(frame, x, y, i, st);
+                                take_sample(state, x, y, i, st);
                         }
                     progress.add(taken);
                 }

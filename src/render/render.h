@@ -13,7 +13,7 @@
 #include "geom/scene.h"
 #include "render/camera.h"
 #include "render/environment.h"
-#include "render/film.h"
+#include "render/image_io.h"
 
 namespace cambium::render {
 

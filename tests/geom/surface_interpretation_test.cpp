@@ -245,9 +245,11 @@ TEST(SurfaceInterpretation, LsystemPatchStepsAndUnfinishedPatch)
 
 TEST(ViewFileLenientNumbers, NotANumberWarnsAndKeepsTheDefault)
 {
-    testing::internal::CaptureStderr();
+    Diagnostics sink(Diagnostics::Output::quiet);
+    ScopedDiagnostics install(sink);
     ViewFile v = parse_view_file("angle increment: ?\ninitial scale: 2\n", "lenient.v");
-    std::string err = testing::internal::GetCapturedStderr();
+    std::string err = sink.text();
+    EXPECT_EQ(sink.count(Severity::warning), 1u) << err;
     EXPECT_DOUBLE_EQ(v.angle_increment_deg, 45);  // cpfg's default
     EXPECT_DOUBLE_EQ(v.initial_scale, 2);         // the next line still read
     EXPECT_NE(err.find("lenient.v:1:18"), std::string::npos) << err;

@@ -3,6 +3,7 @@
 // through the homomorphism.
 #include <initializer_list>
 #include <string>
+#include <thread>
 
 #include "test_util.h"
 
@@ -35,14 +36,15 @@ void expect_parts(const std::string& text, std::initializer_list<const char*> pa
         EXPECT_TRUE(contains(text, part)) << "missing \"" << part << "\" in: " << text;
 }
 
-/// What deriving `source` writes to stderr (warnings).
+/// The warnings deriving `source` reports (collected by a sink of its own, one a line).
 std::string derive_warnings(const std::string& source, std::string* derived = nullptr)
 {
-    ::testing::internal::CaptureStderr();
+    Diagnostics sink(Diagnostics::Output::quiet);
+    ScopedDiagnostics install(sink);
     std::string text = derive_text(source);
     if (derived)
         *derived = text;
-    return ::testing::internal::GetCapturedStderr();
+    return sink.text();
 }
 
 // ---------------------------------------------------------------- arrays
@@ -361,6 +363,65 @@ TEST(QueryPass, QueryRewrittenByHomomorphismKeepsItsValues)
     // the homomorphism replaces ?P itself: no module of the expansion answers for it
     EXPECT_EQ(derive_with_positions(query_model("9,9", "?P(x, y) --> F ?P(x, y) F")),
               "A?P(9,9)B");
+}
+
+}  // namespace
+}  // namespace cambium::lsys
+
+// ---------------------------------------------------------------- diagnostics sinks
+
+namespace cambium::lsys {
+namespace {
+
+const char* division_by_zero = R"(lsystem: 1
+derivation length: 1
+axiom: A(6)
+A(x) --> B(x / (x - 6))
+endlsystem
+)";
+
+TEST(DiagnosticsSink, EachRunHearsItsOwnWarnings)
+{
+    // Deduplication is per sink (per run): a second run is told again.
+    for (int run = 0; run < 2; ++run) {
+        Diagnostics sink(Diagnostics::Output::quiet);
+        ScopedDiagnostics install(sink);
+        derive_text(division_by_zero);
+        ASSERT_EQ(sink.count(Severity::warning), 1u) << "run " << run << ": " << sink.text();
+        const Diagnostic d = sink.collected().at(0);
+        EXPECT_EQ(d.loc.file, "test.l");
+        EXPECT_EQ(d.loc.line, 4);
+        EXPECT_EQ(d.loc.column, 14);
+        EXPECT_TRUE(contains(d.message, "division by 0")) << d.message;
+    }
+}
+
+TEST(DiagnosticsSink, InnerSinkTakesWarningsThenTheOuterOneAgain)
+{
+    Diagnostics outer(Diagnostics::Output::quiet), inner(Diagnostics::Output::quiet);
+    ScopedDiagnostics install_outer(outer);
+    {
+        ScopedDiagnostics install_inner(inner);
+        warn(FileLoc{"a.l", 1, 2}, "first");
+        warn(FileLoc{"a.l", 1, 2}, "first");  // the same text: once
+    }
+    warn("second");
+    EXPECT_EQ(inner.text(), "a.l:1:2: warning: first\n");
+    EXPECT_EQ(outer.text(), "warning: second\n");
+}
+
+TEST(DiagnosticsSink, OtherThreadsKeepTheirOwnSink)
+{
+    Diagnostics mine(Diagnostics::Output::quiet), theirs(Diagnostics::Output::quiet);
+    ScopedDiagnostics install(mine);
+    std::thread other([&] {
+        ScopedDiagnostics install_theirs(theirs);
+        warn("from the other thread");
+    });
+    other.join();
+    warn("from this thread");
+    EXPECT_EQ(mine.text(), "warning: from this thread\n");
+    EXPECT_EQ(theirs.text(), "warning: from the other thread\n");
 }
 
 }  // namespace

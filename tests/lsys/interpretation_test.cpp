@@ -49,12 +49,14 @@ endlsystem
               "C");
 }
 
+/// The warnings loading, deriving and interpreting `source` reports, one a line.
 std::string stderr_of(const std::string& source, const char* file_name)
 {
-    ::testing::internal::CaptureStderr();
+    Diagnostics sink(Diagnostics::Output::quiet);
+    ScopedDiagnostics install(sink);
     LSystem ls = LSystem::from_source(source, file_name);
     ls.interpretation_string(ls.derive());
-    return ::testing::internal::GetCapturedStderr();
+    return sink.text();
 }
 
 TEST(Interpretation, WarningsSayWhenTheDepthStopsRewriting)

@@ -57,6 +57,7 @@ std::vector<double> pixels(const geom::Scene& s, const Camera& c, int depth, int
     AreaLights lights(s, ctx.materials);
     ctx.area_lights = nee ? &lights : nullptr;
     ctx.max_depth = depth;
+    prepare_path_context(ctx);
     std::vector<double> out;
     for (int y = 0; y < c.height(); ++y)
         for (int x = 0; x < c.width(); ++x) {

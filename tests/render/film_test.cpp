@@ -10,7 +10,7 @@
 
 #include "base/diagnostics.h"
 #include "render/color.h"
-#include "render/film.h"
+#include "render/image_io.h"
 #include "render/render.h"
 #include "test_scenes.h"
 

@@ -3,7 +3,9 @@
 // path-tracing loop for the render_geom_test physics tests.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <numbers>
 
@@ -121,12 +123,15 @@ inline Camera top_camera(double cx, double cy, double size, int w, int h)
 struct BlockMean {
     Vec3f radiance;
     double coverage = 0;
+    /// The standard error of radiance.y (from the paths' own variance): tolerances of
+    /// Monte Carlo tests are a few of these, not a fixed percentage.
+    double standard_error = 0;
 };
 
 inline BlockMean trace_block(const PathContext& ctx, const Camera& camera, int x0, int y0, int x1,
                              int y1, int spp)
 {
-    double r = 0, g = 0, b = 0, hits = 0, n = 0;
+    double r = 0, g = 0, b = 0, g2 = 0, hits = 0, n = 0;
     for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x)
             for (int i = 0; i < spp; ++i) {
@@ -137,11 +142,14 @@ inline BlockMean trace_block(const PathContext& ctx, const Camera& camera, int x
                 PathResult p = trace_path(ctx, Vec3f(ray.org), Vec3f(ray.dir), s);
                 r += p.radiance.x;
                 g += p.radiance.y;
+                g2 += double(p.radiance.y) * p.radiance.y;
                 b += p.radiance.z;
                 hits += p.hit ? 1 : 0;
                 n += 1;
             }
-    return {Vec3f(float(r / n), float(g / n), float(b / n)), hits / n};
+    double variance = n > 1 ? std::max(0.0, (g2 - g * g / n) / (n - 1)) : 0.0;
+    return {Vec3f(float(r / n), float(g / n), float(b / n)), hits / n,
+            std::sqrt(variance / n)};
 }
 
 }  // namespace cambium::render::testing

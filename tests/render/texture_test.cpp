@@ -217,6 +217,7 @@ TEST(Texture, TexturedQuadRendersTheTexture)
         ctx.lights = make_lights(s.lights);
         ctx.background = Vec3f(0.25f);
         ctx.max_depth = 1;
+        prepare_path_context(ctx);
         return trace_block(ctx, c, 9, 9, 11, 11, 1).radiance;
     };
     Vec3f red = at(2, 6), blue = at(2, 2), grey = at(6, 2), cut = at(6, 6);
@@ -267,6 +268,7 @@ std::vector<float> checker_pixels(const geom::Scene& s, const TextureSet& set, c
     ctx.materials = make_materials(s.materials);
     ctx.lights = make_lights(s.lights);
     ctx.max_depth = 1;
+    prepare_path_context(ctx);
     if (filtered)
         ctx.camera_cone = {float(c.pixel_size()), 0};
     std::vector<float> out;

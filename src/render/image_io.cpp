@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // The rendered image and its output through OpenImageIO (PNG, EXR, TIFF, JPEG).
-#include "render/film.h"
+#include "render/image_io.h"
 
 #include <OpenImageIO/imageio.h>
 
