@@ -111,12 +111,6 @@ void ModuleString::append_range(const ModuleString& other, std::size_t first, st
     }
 }
 
-std::size_t ModuleString::memory_bytes() const
-{
-    return m_symbols8.capacity() + m_symbols16.capacity() * sizeof(SymbolId) +
-           m_counts.capacity() + m_params.capacity() * sizeof(float);
-}
-
 ModuleRef ModuleString::Cursor::operator*() const
 {
     std::size_t n = m_string->m_counts[m_index];

@@ -64,8 +64,6 @@ public:
     /// The same, writable (a query pass fills ?P ?H ?L ?U values in place).
     std::span<float> mutable_params() { return m_params; }
     std::size_t param_count(std::size_t i) const { return m_counts[i]; }
-    /// Bytes held by the string's arrays (for memory reports).
-    std::size_t memory_bytes() const;
 
     /// A position in the string that knows where its module's parameters start.
     class Cursor {
