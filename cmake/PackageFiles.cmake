@@ -11,22 +11,13 @@
 # in numpy and Boost.Python).
 set(CAMBIUM_UNUSED_IMPORTED_TARGETS "^Imath::PyImath")
 
-function(_cambium_imported_targets dir out)
-  get_property(targets DIRECTORY "${dir}" PROPERTY IMPORTED_TARGETS)
+# The targets of `dir` and the folders below it: `property` is IMPORTED_TARGETS (those the
+# packages found there define) or BUILDSYSTEM_TARGETS (the project's own).
+function(_cambium_directory_targets dir property out)
+  get_property(targets DIRECTORY "${dir}" PROPERTY ${property})
   get_property(subdirs DIRECTORY "${dir}" PROPERTY SUBDIRECTORIES)
   foreach(sub IN LISTS subdirs)
-    _cambium_imported_targets("${sub}" more)
-    list(APPEND targets ${more})
-  endforeach()
-  set(${out} ${targets} PARENT_SCOPE)
-endfunction()
-
-# The project's own targets, in `dir` and below.
-function(_cambium_project_targets dir out)
-  get_property(targets DIRECTORY "${dir}" PROPERTY BUILDSYSTEM_TARGETS)
-  get_property(subdirs DIRECTORY "${dir}" PROPERTY SUBDIRECTORIES)
-  foreach(sub IN LISTS subdirs)
-    _cambium_project_targets("${sub}" more)
+    _cambium_directory_targets("${sub}" ${property} more)
     list(APPEND targets ${more})
   endforeach()
   set(${out} ${targets} PARENT_SCOPE)
@@ -34,7 +25,7 @@ endfunction()
 
 # The imported targets the project links, directly or through other targets.
 function(_cambium_linked_targets out)
-  _cambium_project_targets("${PROJECT_SOURCE_DIR}" queue)
+  _cambium_directory_targets("${PROJECT_SOURCE_DIR}" BUILDSYSTEM_TARGETS queue)
   set(seen "")
   list(LENGTH queue left)
   while(left GREATER 0)
@@ -109,7 +100,7 @@ function(cambium_write_package_files)
   # Files of the targets the build links are used; those of the other targets a package
   # defines need only exist, since Debian's *Targets.cmake stop the configure otherwise.
   _cambium_linked_targets(linked)
-  _cambium_imported_targets("${PROJECT_SOURCE_DIR}" targets)
+  _cambium_directory_targets("${PROJECT_SOURCE_DIR}" IMPORTED_TARGETS targets)
   foreach(target IN LISTS targets)
     if(target MATCHES "${CAMBIUM_UNUSED_IMPORTED_TARGETS}")
       continue()
