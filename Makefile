@@ -6,18 +6,24 @@ CAMBIUM = $(BUILD)/src/app/cambium
 MAKEFLAGS += --no-print-directory
 DEFAULT = scenes/default
 
-.PHONY: setup build render test sanitize clean
+.PHONY: setup configure build render test sanitize clean
 
 setup:
 	@bash scripts/setup.sh
 
-build:
+configure:
 	@echo "build: configuring $(BUILD) (Release)"
 	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release > $(BUILD).configure.log 2>&1 || { cat $(BUILD).configure.log; exit 1; }
+
+# Everything: the command, the tests and the benchmarks.
+build: configure
 	@echo "build: compiling with $(JOBS) jobs"
 	@cmake --build $(BUILD) --parallel $(JOBS)
 
-render: build
+# Only what the first image needs: the cambium command.
+render: configure
+	@echo "build: compiling the cambium command with $(JOBS) jobs"
+	@cmake --build $(BUILD) --parallel $(JOBS) --target cambium
 	@mkdir -p out
 	@echo "render: $(DEFAULT) -> out/default.png, out/default.exr"
 	@cd $(DEFAULT) && $(CURDIR)/$(CAMBIUM) -M plant.mat -o $(CURDIR)/out/default.png \

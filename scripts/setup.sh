@@ -1,13 +1,32 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # Installs the Debian packages Cambium needs that are missing (idempotent).
+# `scripts/setup.sh --list` prints the list instead; scripts/check-packages.sh (a ctest)
+# fails when the build or the tests read a file from a package that is not in it.
 set -euo pipefail
 
+# Every Debian (bookworm) package the build, the tests and the benchmarks use, in one place.
+# Packages these pull in through a hard Depends need no line; Recommends are never installed.
 packages=(
+  # tools: build, test runner, and the C preprocessor cambium runs on .l files
   cmake make g++ cpp
-  libembree-dev libopenimageio-dev libopenexr-dev libtbb-dev
-  libgtest-dev libbenchmark-dev libcli11-dev libfmt-dev nlohmann-json3-dev
+  # libraries of the renderer and the command
+  libembree-dev libtbb-dev libcli11-dev libfmt-dev
+  libopenimageio-dev libopenexr-dev
+  # OpenImageIO's CMake package requires its command-line tools (iconvert, oiiotool, ...)
+  # to exist; Debian has them only as a Recommends of libopenimageio-dev.
+  openimageio-tools
+  # tests and benchmarks
+  libgtest-dev libbenchmark-dev nlohmann-json3-dev
 )
+# Not installed on purpose: python3-imath. Imath's CMake package names its Python binding,
+# which Cambium does not use (CMakeLists.txt keeps the resulting notice quiet).
+# Optional for developers: clang-format (.clang-format), ccache.
+
+if [ "${1:-}" = "--list" ]; then
+  printf '%s\n' "${packages[@]}"
+  exit 0
+fi
 
 missing=()
 for p in "${packages[@]}"; do

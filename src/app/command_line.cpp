@@ -145,7 +145,7 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
                  "cpfg options: -w W H (image size, default 640 480), -m[n] file.map, -M[n] file.mat, -c<n>, -w W H, -str file,\n"
                  "-strb file, -homo, -vv file, -rgb file, -tga file, -v, -V, -P cpp, -e file;\n"
                  "window options (-g -a -wp -wt -mb -pm -sb -s<n>) are accepted and ignored."};
-    cli.set_version_flag("--version", "cambium 0.1.0");
+    cli.set_version_flag("--version", "cambium " CAMBIUM_VERSION);
     cli.add_option("-o", options.outputs,
                    "Output image (.png .exr .tif .jpg); may be given more than once")
         ->take_all()
@@ -222,7 +222,7 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
         std::printf("%s", cli.help().c_str());
         return std::nullopt;
     } catch (const CLI::CallForVersion&) {
-        std::printf("cambium 0.1.0\n");
+        std::printf("cambium %s\n", CAMBIUM_VERSION);
         return std::nullopt;
     } catch (const CLI::ParseError& e) {
         throw Error(std::string(e.what()) + " (see cambium --help)");

@@ -431,11 +431,6 @@ std::vector<Contour> parse_contour_gallery(std::string_view text, const std::str
     return contours;
 }
 
-std::vector<Contour> read_contour_gallery(const std::filesystem::path& file)
-{
-    return parse_contour_gallery(read_text_file(file, "contour gallery"), file.string());
-}
-
 std::vector<Contour> parse_contours(std::string_view text, const std::string& file_name)
 {
     std::size_t start = text.find_first_not_of(" \t\r\n");

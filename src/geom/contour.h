@@ -61,7 +61,6 @@ Contour read_contour(const std::filesystem::path& file);
 /// A contour gallery (`contourgalleryver 1 1`): its items, numbered from 1 in the file,
 /// at index item - 1 here.
 std::vector<Contour> parse_contour_gallery(std::string_view text, const std::string& file_name);
-std::vector<Contour> read_contour_gallery(const std::filesystem::path& file);
 
 /// What `contour: id file` reads: one contour from a contour file, or every item of a
 /// gallery (a file starting with `contourgalleryver`), in order. cpfg itself reads only

@@ -35,7 +35,8 @@ struct CurveFlags {
     static constexpr std::uint8_t neighbour_right = 2;
 };
 
-/// Round linear curve segments (cylinders drawn by F and G): keys (x, y, z, radius) and
+/// Linear curve segments (cylinders drawn by F and G; render draws them as Embree cone
+/// curves, exact frustums with discs and joint spheres): keys (x, y, z, radius) and
 /// one first-key index per segment; segment i spans keys[segments[i]] .. keys[segments[i]+1].
 struct LinearCurves {
     static constexpr std::uint8_t neighbour_left = CurveFlags::neighbour_left;

@@ -47,10 +47,10 @@ struct LoadOptions {
     std::function<void(int step, const ModuleString&)> on_step;
 };
 
-/// A parsed and compiled .l file.
 /// What interpretation_string does with object productions (-o>).
 enum class ObjectHandling { expand, keep };
 
+/// A parsed and compiled .l file.
 class LSystem {
 public:
     /// Reads, preprocesses (with -I the file's folder) and compiles `file`.

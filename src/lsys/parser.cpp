@@ -37,7 +37,6 @@ public:
     std::int32_t here() const { return static_cast<std::int32_t>(m_code.instrs.size()); }
     void patch(std::size_t at, std::int32_t target) { m_code.instrs[at].arg = target; }
     int depth() const { return m_depth; }
-    void set_depth(int d) { m_depth = d; }
 
 private:
     Code& m_code;

@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
+# Fails when a file in src/ includes what its layer may not see (a quick ctest):
+#   base    the standard library (and POSIX headers) only
+#   lsys    + base
+#   geom    + lsys; never Embree, TBB, OpenImageIO or render
+#   render  + geom/scene.h and geom/vec.h (the Scene contract), Embree, TBB, OpenImageIO
+#   app     everything
+# Standard and POSIX headers are <name>, <name.h> and <sys/name.h>; any other <dir/...> is a
+# third-party library; "layer/file.h" is the project's own.
+#   scripts/check-layers.sh [SRC]   (default: the src/ beside this script)
+set -euo pipefail
+src=${1:-$(cd "$(dirname "$0")/.." && pwd)/src}
+cd "$src"
+find . -type f \( -name '*.h' -o -name '*.cpp' -o -name '*.def' \) | sort \
+    | xargs awk '
+BEGIN {
+    project["base"] = "^base/"
+    project["lsys"] = "^(base|lsys)/"
+    project["geom"] = "^(base|lsys|geom)/"
+    project["render"] = "^(base|render)/|^geom/(scene|vec)\\.h$"
+    project["app"] = "."
+    library["render"] = "^(embree3|tbb|OpenImageIO)/"
+    library["app"] = "."
+    rule["base"] = "the standard library only"
+    rule["lsys"] = "the standard library and base only"
+    rule["geom"] = "the standard library, base and lsys only"
+    rule["render"] = "base, geom/scene.h, geom/vec.h, Embree, TBB and OpenImageIO only"
+    rule["app"] = "anything"
+}
+FNR == 1 {
+    file = FILENAME; sub(/^\.\//, "", file)
+    layer = file; sub(/\/.*/, "", layer)
+    if (!(layer in rule) && !(layer in unknown)) {
+        printf "src/%s: no include rule for layer %s: add one to scripts/check-layers.sh\n", file, layer
+        unknown[layer] = 1; bad = 1
+    }
+}
+/^[ \t]*#[ \t]*include/ {
+    line = $0
+    sub(/^[ \t]*#[ \t]*include[ \t]*/, "", line)
+    if (line ~ /^"/) {
+        name = substr(line, 2); sub(/".*/, "", name)
+        ok = name ~ project[layer]
+    } else {
+        name = substr(line, 2); sub(/>.*/, "", name)
+        ok = name ~ /^[A-Za-z0-9_]+(\.h)?$/ || name ~ /^sys\/[A-Za-z0-9_]+\.h$/ \
+             || (layer in library && name ~ library[layer])
+    }
+    if (!ok) {
+        printf "src/%s:%d: %s may include %s; not %s\n", file, FNR, layer, rule[layer], name
+        bad = 1
+    }
+}
+END {
+    if (bad) exit 1
+    print "check-layers: every layer includes only what it may"
+}'
