@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   cmake make g++ cpp
   libembree-dev libopenimageio-dev libopenexr-dev libtbb-dev
-  libgtest-dev libbenchmark-dev libcli11-dev libfmt-dev nlohmann-json3-dev
+  libgtest-dev libbenchmark-dev libcli11-dev libfmt-dev nlohmann-json3-dev zlib1g-dev
 )
 
 missing=()
