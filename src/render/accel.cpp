@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "base/diagnostics.h"
+#include "render/pixel_lines.h"
 #include "render/texture.h"
 
 namespace cambium::render {
@@ -196,6 +197,7 @@ std::uint32_t line_segment(const Part& part, std::uint32_t prim)
 /// (also read by the alpha filter during traversal).
 struct Lookup {
     const TextureSet* textures = nullptr;
+    std::unique_ptr<const Camera> camera;  ///< pixel-width lines are drawn for its pixels
     std::vector<const Part*> top_parts;                ///< by top-level geometry id
     std::vector<std::vector<const Part*>> proto_parts;  ///< by prototype, geometry id
     std::vector<Placement> placements;                 ///< by top-level geometry id
@@ -433,7 +435,7 @@ geom::LinearCurves place_pixel_lines(const geom::Scene& scene, const Camera& cam
                          m[1] * k[0] + m[4] * k[1] + m[7] * k[2] + m[10],
                          m[2] * k[0] + m[5] * k[1] + m[8] * k[2] + m[11]};
             out.keys.push_back({float(p.x), float(p.y), float(p.z),
-                                static_cast<float>(k[3] * camera.pixel_size_at(p))});
+                                static_cast<float>(pixel_line_world_radius(k[3], camera, p))});
         }
         for (std::size_t k = 0; k < l.keys.size(); ++k)
             out.v.push_back(l.v.size() == l.keys.size() ? l.v[k] : 0.0f);
@@ -454,7 +456,7 @@ std::vector<Key> keys_in_world_units(const geom::LinearCurves& lines, const Came
 {
     std::vector<Key> keys(lines.keys);
     for (Key& k : keys)
-        k[3] = static_cast<float>(k[3] * camera.pixel_size_at({k[0], k[1], k[2]}));
+        k[3] = static_cast<float>(pixel_line_world_radius(k[3], camera, {k[0], k[1], k[2]}));
     return keys;
 }
 
@@ -569,13 +571,39 @@ int Lookup::texture_of(const Part& part, std::uint32_t prim, const Placement* p)
     return t;
 }
 
+/// Keeps a hit on a pixel-width line only in the pixels OpenGL draws (pixel_lines.h),
+/// then applies the alpha cut-out where the line is textured.
+void pixel_line_filter(const RTCFilterFunctionNArguments* args)
+{
+    const auto* part = static_cast<const Part*>(args->geometryUserPtr);
+    const geom::LinearCurves& lines = part->geometry->lines;
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0)
+            continue;
+        std::uint32_t first = lines.segments[RTCHitN_primID(args->hit, args->N, i)];
+        const Key& a = part->line_keys[first];
+        const Key& b = part->line_keys[first + 1];
+        float t = RTCRayN_tfar(args->ray, args->N, i);  // the candidate hit's distance
+        geom::Vec3 hit{RTCRayN_org_x(args->ray, args->N, i) + t * RTCRayN_dir_x(args->ray, args->N, i),
+                       RTCRayN_org_y(args->ray, args->N, i) + t * RTCRayN_dir_y(args->ray, args->N, i),
+                       RTCRayN_org_z(args->ray, args->N, i) + t * RTCRayN_dir_z(args->ray, args->N, i)};
+        if (!pixel_line_draws(*part->owner->camera, {a[0], a[1], a[2]}, {b[0], b[1], b[2]}, a[3], hit))
+            args->valid[i] = 0;
+    }
+    if (part->owner->textures)
+        alpha_filter(args);
+}
+
 void EmbreeScene::Impl::attach(RTCScene s, RTCGeometry g, Part part,
                                std::vector<const Part*>& ids, bool alpha)
 {
     part.owner = this;
     parts.push_back(part);
     rtcSetGeometryUserData(g, &parts.back());
-    if (alpha && textures) {
+    if (part.shape == Shape::line && part.unlit) {
+        rtcSetGeometryIntersectFilterFunction(g, &pixel_line_filter);
+        rtcSetGeometryOccludedFilterFunction(g, &pixel_line_filter);
+    } else if (alpha && textures) {
         rtcSetGeometryIntersectFilterFunction(g, &alpha_filter);
         rtcSetGeometryOccludedFilterFunction(g, &alpha_filter);
     }
@@ -680,6 +708,7 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
 {
     Impl& m = *m_impl;
     m.textures = textures;
+    m.camera = std::make_unique<const Camera>(camera);
     m.device = rtcNewDevice(nullptr);
     if (!m.device)
         throw Error(std::string("Embree: cannot create a device: ") +
