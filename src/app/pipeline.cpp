@@ -114,6 +114,11 @@ geom::Scene interpret(const Model& model, const lsys::ModuleString& derived,
         geom::interpret(string, model.lsystem.symbols(), *model.view, interpret_options);
     scene.materials = model.palette.entries(options.colour_block);
     scene.background = model.palette.background(options.colour_block);
+    // cpfg's window draws every object of the L-system opaque (manual 9.4); only the
+    // background scene keeps its transparency.
+    if (!options.material_transparency)
+        for (geom::Material& m : scene.materials)
+            m.transparency = 0;
     for (const geom::TranslucencySetting& t : model.view->translucency)
         for (int i = t.first; i <= t.last; ++i)
             scene.materials.at(static_cast<std::size_t>(i)).translucency = t.amount;
