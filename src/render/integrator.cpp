@@ -292,6 +292,8 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             break;
         }
         travelled += hit->t;
+        if (ctx.facet_normals)
+            hit->normal = hit->geometric_normal;
         SurfaceMaterial blended;
         const SurfaceMaterial& material = hit_material(ctx, *hit, blended);
         // Opacity: the ray stops here with probability opacity, else passes on unchanged.
@@ -310,7 +312,7 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
                 hit->texture, diffuse, hit->u, hit->v,
                 texture_footprint(*hit, dir,
                                   ctx.camera_cone.width + ctx.camera_cone.spread * travelled));
-        if (hit->unlit) {
+        if (hit->unlit || ctx.unlit) {
             result.radiance += beta * (diffuse + material.emission);
             break;
         }

@@ -106,6 +106,27 @@ TEST(Render, LitSideIsBrighterThanUnlitSide)
     EXPECT_LE(img.at(100, 41, 1), albedo * 1.001f);
 }
 
+// `render mode: filled`: the same cylinder shows its flat colour on both sides, unlit;
+// `flat`: lit by the facet normal (a round tube's is its smooth normal: still shaded).
+TEST(Render, FilledRenderModeShowsFlatColours)
+{
+    geom::Scene s = empty_scene({-20, -5, 0}, {20, 5, 0});
+    add_segment(s, {-10, 0, 0}, {10, 0, 0}, 2.0f);
+    s.materials[1].diffuse = {0.8f, 0.4f, 0.2f};
+    s.lights.push_back(directional({0, 1, 0}));
+    s.shading = geom::Shading::filled;
+    Image img = render(s, small(200, 100, 4));
+    const geom::Rgb& d = s.materials[1].diffuse;
+    for (int y : {43, 50, 57}) {
+        EXPECT_NEAR(img.at(100, y, 0), srgb_to_linear(d.r), 1e-5f) << y;
+        EXPECT_NEAR(img.at(100, y, 1), srgb_to_linear(d.g), 1e-5f) << y;
+        EXPECT_NEAR(img.at(100, y, 2), srgb_to_linear(d.b), 1e-5f) << y;
+    }
+    s.shading = geom::Shading::flat;
+    Image flat = render(s, small(200, 100, 4));
+    EXPECT_LT(flat.at(100, 55, 0), 0.5f * flat.at(100, 45, 0));
+}
+
 // A white light straight onto a white-ish Lambertian surface gives exactly its albedo
 // (cpfg/OpenGL convention, light.h) where the normal faces the light.
 TEST(Render, LightIntensityConventionMatchesAlbedoAtNormalIncidence)
