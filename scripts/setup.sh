@@ -18,6 +18,8 @@ packages=(
   openimageio-tools
   # tests and benchmarks
   libgtest-dev libbenchmark-dev nlohmann-json3-dev
+  # zlib: the conformance tests read cpfg's gzipped rayshade exports (scene.ray.gz)
+  zlib1g-dev
 )
 # Not installed on purpose: python3-imath. Imath's CMake package names its Python binding,
 # which Cambium does not use (CMakeLists.txt keeps the resulting notice quiet).

@@ -190,6 +190,8 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
         ->check(CLI::Range(-20.0f, 20.0f));
     cli.add_flag("--transparent", options.transparent,
                  "Transparent background: alpha is the plant's coverage");
+    cli.add_flag("--material-transparency", options.material_transparency,
+                 "Keep the materials' transparency on the plant (cpfg's window draws it opaque)");
     cli.add_option("--ambient", options.ambient,
                    "Radiance of the uniform environment (default 0.05)")
         ->check(CLI::Range(0.0f, 1e6f));

@@ -65,6 +65,9 @@ struct Options {
     double focus_distance = 0;         ///< --focus-distance (0 = view reference point)
     float exposure = 0;                ///< --exposure stops, for PNG/TIFF/JPEG
     bool transparent = false;          ///< --transparent: no background, alpha = coverage
+    /// --material-transparency: the L-system's materials keep their transparency (as in
+    /// cpfg's rayshade output); by default they are opaque, as cpfg's window draws them.
+    bool material_transparency = false;
     float ambient = 0.05f;             ///< --ambient: uniform environment radiance
     bool sky = false;                  ///< --sky: analytic sun and sky
     std::vector<float> sun_direction;  ///< --sun X Y Z (with --sky)

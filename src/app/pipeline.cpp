@@ -3,6 +3,8 @@
 // interpreted.
 #include "app/pipeline.h"
 
+#include <sstream>
+
 #include "base/diagnostics.h"
 #include "base/subprocess.h"
 #include "geom/background_scene.h"
@@ -116,6 +118,28 @@ lsys::ModuleString derive(const Model& model, const Options& options)
     return derived;
 }
 
+namespace {
+/// The view file's `render mode:` (the last one given). `fast` is filled (manual 5.2:
+/// filled with wireframe spheres); `interpolated` and `shadows` are shaded (the former's
+/// colour blending is the generalized cylinders' concern).
+geom::Shading render_mode(const geom::ViewFile& view)
+{
+    geom::Shading mode = geom::Shading::shaded;
+    for (const geom::ViewCommand& c : view.deferred) {
+        if (c.name != "render mode")
+            continue;
+        std::istringstream in(c.value);
+        std::string word;
+        in >> word;
+        mode = word == "flat"        ? geom::Shading::flat
+               : word == "filled" || word == "fast" ? geom::Shading::filled
+               : word == "wireframe" ? geom::Shading::wireframe
+                                     : geom::Shading::shaded;
+    }
+    return mode;
+}
+}  // namespace
+
 geom::Scene interpret(const Model& model, const lsys::ModuleString& derived,
                       const Options& options)
 {
@@ -146,8 +170,14 @@ geom::Scene interpret(const Model& model, const lsys::ModuleString& derived,
                   derived, objects.empty() ? lsys::ObjectHandling::expand : lsys::ObjectHandling::keep);
     geom::Scene scene =
         geom::interpret(string, model.lsystem.symbols(), *model.view, interpret_options);
+    scene.shading = render_mode(*model.view);
     scene.materials = model.palette.entries(options.colour_block);
     scene.background = model.palette.background(options.colour_block);
+    // cpfg's window draws every object of the L-system opaque (manual 9.4); only the
+    // background scene keeps its transparency.
+    if (!options.material_transparency)
+        for (geom::Material& m : scene.materials)
+            m.transparency = 0;
     for (const geom::TranslucencySetting& t : model.view->translucency)
         for (int i = t.first; i <= t.last; ++i)
             scene.materials.at(static_cast<std::size_t>(i)).translucency = t.amount;

@@ -165,6 +165,7 @@ private:
     void mesh(const std::vector<double>& n);
     void box(double a, double b, double c);
     void sphere(double r);
+    void ellipsoid(double r);
     void cylinder(double r1, double r2, double h);
 
     Material m_initial;
@@ -307,15 +308,56 @@ void Builder::box(double a, double b, double c)
     rectangle(P(0, 1, 0), P(1, 1, 0), P(1, 1, 1), P(0, 1, 1));
 }
 
-// cpfg draws the sphere with the turtle at the transformed origin: not scaled.
+// cpfg's window draws the sphere under the current matrix (manual 5.4.10: a sphere under
+// `scale 1 0.7 0.7` is an ellipsoid; only its rayshade output writes a plain sphere).
+// A matrix that keeps shapes (rotation and uniform scale) gives a sphere primitive,
+// any other an ellipsoid of triangles.
 void Builder::sphere(double r)
 {
     Vec3 c = m_matrix.point({0, 0, 0});
-    Spheres& s = m_scene.geometry.spheres;
-    s.centres.push_back({static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z),
-                         static_cast<float>(r)});
-    s.material.push_back(material());
-    s.texture.push_back(no_texture);
+    Vec3 a = m_matrix.vector({1, 0, 0}), b = m_matrix.vector({0, 1, 0}), z = m_matrix.vector({0, 0, 1});
+    double s = length(a);
+    double tolerance = 1e-9 * std::max(s, 1.0);
+    bool keeps_shape = std::fabs(length(b) - s) <= tolerance && std::fabs(length(z) - s) <= tolerance &&
+                       std::fabs(dot(a, b)) <= tolerance * s && std::fabs(dot(b, z)) <= tolerance * s &&
+                       std::fabs(dot(a, z)) <= tolerance * s;
+    if (!keeps_shape) {
+        ellipsoid(r);
+        return;
+    }
+    Spheres& spheres = m_scene.geometry.spheres;
+    spheres.centres.push_back({static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z),
+                               static_cast<float>(r * s)});
+    spheres.material.push_back(material());
+    spheres.texture.push_back(no_texture);
+}
+
+// The sphere of radius r as latitude-longitude triangles through the current matrix;
+// normals by the inverse transpose (columns b x c, c x a, a x b of the linear part).
+void Builder::ellipsoid(double r)
+{
+    constexpr int slices = 32, stacks = 16;
+    Vec3 a = m_matrix.vector({1, 0, 0}), b = m_matrix.vector({0, 1, 0}), c = m_matrix.vector({0, 0, 1});
+    Vec3 na = cross(b, c), nb = cross(c, a), nc = cross(a, b);
+    if (dot(a, na) < 0) {  // a mirroring matrix: keep normals outward
+        na = na * -1.0;
+        nb = nb * -1.0;
+        nc = nc * -1.0;
+    }
+    auto unit = [](int i, int j) {
+        double theta = std::numbers::pi * j / stacks, phi = 2 * std::numbers::pi * i / slices;
+        return Vec3{std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi)};
+    };
+    auto point = [&](const Vec3& u) { return m_matrix.point(u * r); };
+    auto normal = [&](const Vec3& u) { return na * u.x + nb * u.y + nc * u.z; };
+    for (int j = 0; j < stacks; ++j)
+        for (int i = 0; i < slices; ++i) {
+            Vec3 u00 = unit(i, j), u10 = unit(i + 1, j), u01 = unit(i, j + 1), u11 = unit(i + 1, j + 1);
+            if (j > 0)
+                triangle({point(u00), point(u10), point(u11)}, {normal(u00), normal(u10), normal(u11)});
+            if (j < stacks - 1)
+                triangle({point(u00), point(u11), point(u01)}, {normal(u00), normal(u11), normal(u01)});
+        }
 }
 
 // A turtle segment from the transformed origin to the transformed (0, h, 0) with radii

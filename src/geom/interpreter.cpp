@@ -611,6 +611,9 @@ private:
         case TurtleOp::ElasticitySet:
         case TurtleOp::ElasticityUp:
         case TurtleOp::ElasticityDown: at_command(); change_elasticity(op, p); break;
+        case TurtleOp::LegacyElasticity:
+            change_legacy_elasticity(m_turtle, p, m_view.legacy_elasticity_increment);
+            break;
         case TurtleOp::PreventTwist: at_command(); m_turtle.adjust_up_and_left(); break;
         case TurtleOp::ForceTwist: at_command(); m_turtle.remember_frame(); break;
         case TurtleOp::SubLsystem: enter_sub_lsystem(p); break;

@@ -198,6 +198,11 @@ struct Label {
     std::uint16_t material = 0;
 };
 
+/// `render mode:` (manual 5.2) read by a path tracer: shaded (lit with smooth normals),
+/// flat (lit with each facet's own normal), filled (unlit: every surface in its flat
+/// colour, as OpenGL without lighting), wireframe (drawn as filled: edges are not drawn).
+enum class Shading { shaded, flat, filled, wireframe };
+
 /// Everything render needs to draw one frame of a plant.
 struct Scene {
     Geometry geometry;
@@ -208,6 +213,7 @@ struct Scene {
     /// true when line radii are in pixels (`line style: pixel`): render converts
     /// them with its camera's pixel footprint.
     bool line_radius_in_pixels = false;
+    Shading shading = Shading::shaded;  ///< the view file's `render mode:`
 
     std::vector<Material> materials = std::vector<Material>(256);  ///< by colour index
     std::vector<TextureDef> textures;

@@ -90,4 +90,12 @@ void apply_movements(Turtle& turtle, std::span<const Movement> movements)
     twist(turtle, movements);
 }
 
+void change_legacy_elasticity(Turtle& turtle, std::span<const float> p, double increment)
+{
+    if (p.empty())
+        turtle.legacy_elasticity += increment;
+    else
+        turtle.legacy_elasticity = static_cast<double>(p[0]);
+}
+
 }  // namespace cambium::geom

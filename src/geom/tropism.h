@@ -31,4 +31,8 @@ double tropism_bending_angle(const Vec3& h, const Vec3& t, double e, double gamm
 /// toward the torques' direction. Elasticities are the turtle's, one per movement.
 void apply_movements(Turtle& turtle, std::span<const Movement> movements);
 
+/// `_` and `_(e)` (manual 5.2.7): sets the pre-3.0 tropism's elasticity to e, or adds
+/// the view file's `elasticity increment:` (negative increments decrease it).
+void change_legacy_elasticity(Turtle& turtle, std::span<const float> p, double increment);
+
 }  // namespace cambium::geom

@@ -502,10 +502,15 @@ bool Deriver::match_left(const Production& p, const std::vector<char>& ignored,
 {
     const ModuleString& s = *src.string;
     std::size_t k = i;
+    bool wrapped = false;
     for (auto f = p.left_context.rbegin(); f != p.left_context.rend(); ++f) {
         for (;;) {
-            if (k == 0)
-                return false;
+            if (k == 0) {
+                if (!m_ring || wrapped)
+                    return false;
+                wrapped = true;  // a ring: the string's last module precedes its first
+                k = s.size();
+            }
             --k;
             int sym = s.symbol(k);
             if (sym == m_bracket_close)
@@ -530,14 +535,19 @@ bool Deriver::match_right(const Production& p, const std::vector<char>& ignored,
     // leaves out is stepped into rather than skipped.
     const ModuleString& s = *src.string;
     std::size_t k = i;
+    bool wrapped = false;
     for (const FormalModule& f : p.right_context) {
         if (f.symbol == m_equals) {
             k = branch_end(src, k);
             continue;
         }
         for (;;) {
-            if (k >= s.size())
-                return false;
+            if (k >= s.size()) {
+                if (!m_ring || wrapped || s.size() == 0)
+                    return false;
+                wrapped = true;  // a ring: the first module follows the last
+                k = 0;
+            }
             int sym = s.symbol(k);
             if (sym < static_cast<int>(ignored.size()) && ignored[static_cast<std::size_t>(sym)])
                 ++k;
@@ -742,6 +752,7 @@ bool Deriver::match_at(const Production& p, const LSystemDefinition& ls, const M
     if (ctx.offsets.empty())
         return false;  // no original string to take context from (an object expansion)
     const auto& ignored = m_ignored[static_cast<std::size_t>(&ls - m_program.lsystems.data())];
+    m_ring = ls.ring;
     return match_left(p, ignored, ctx, left) && match_right(p, ignored, ctx, right);
 }
 

@@ -164,6 +164,8 @@ private:
     double m_module_growth = 1.0, m_param_growth = 1.0;  ///< last step's, for reserve()
     int m_bracket_open = -1, m_bracket_close = -1, m_cut = -1, m_sub_start = -1, m_sub_end = -1;
     int m_equals = -1;
+    /// The L-system being matched is a `ring lsystem`: contexts wrap around once.
+    bool m_ring = false;
     std::vector<ModuleString> m_homomorphism_stack;  ///< successor buffers, by depth
     Rand48 m_homomorphism_random;
     std::vector<char> m_query_symbol;                ///< by symbol: ?P ?H ?L ?U

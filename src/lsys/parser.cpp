@@ -364,7 +364,7 @@ bool Parser::parse_item(LSystemDefinition& ls)
         target.instrs.insert(target.instrs.end(), block.instrs.begin(), block.instrs.end());
         target.max_stack = std::max(target.max_stack, block.max_stack);
     } else if (t.text == "ring lsystem") {
-        warn(t.loc, "ring L-systems are not supported; treated as an ordinary L-system");
+        ls.ring = true;
     } else {
         fail(t, "a header item or 'axiom:'");
     }

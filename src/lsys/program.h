@@ -84,6 +84,9 @@ struct LSystemDefinition {
     std::vector<SymbolId> ignore;
     std::vector<SymbolId> consider;
     bool has_consider = false;
+    /// `ring lsystem`: contexts wrap around the ends of the string (a closed ring of
+    /// cells, as cpfg's Ring example).
+    bool ring = false;
     std::vector<ModuleTemplate> axiom;
     ProductionSet productions;
     ProductionSet decomposition;

@@ -19,6 +19,7 @@
 #include "base/diagnostics.h"
 #include "geom/scene_limits.h"
 #include "render/line_geometry.h"
+#include "render/pixel_lines.h"
 #include "render/texture.h"
 
 namespace cambium::render {
@@ -182,6 +183,7 @@ std::uint32_t line_segment(const GeometrySource& part, std::uint32_t prim)
 /// (also read by the alpha filter during traversal).
 struct HitResolver {
     const TextureSet* textures = nullptr;
+    std::unique_ptr<const Camera> camera;  ///< pixel-width lines are drawn for its pixels
     std::vector<const GeometrySource*> top_parts;  ///< by top-level geometry id
     std::vector<std::vector<const GeometrySource*>> proto_parts;  ///< by prototype, geometry id
     std::vector<Placement> placements;  ///< by top-level geometry id
@@ -459,13 +461,39 @@ int HitResolver::texture_of(const GeometrySource& part, std::uint32_t prim,
     return t;
 }
 
+/// Keeps a hit on a pixel-width line only in the pixels OpenGL draws (pixel_lines.h),
+/// then applies the alpha cut-out where the line is textured.
+void pixel_line_filter(const RTCFilterFunctionNArguments* args)
+{
+    const auto* part = static_cast<const GeometrySource*>(args->geometryUserPtr);
+    const geom::LinearCurves& lines = part->geometry->lines;
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0)
+            continue;
+        std::uint32_t first = lines.segments[RTCHitN_primID(args->hit, args->N, i)];
+        const Key& a = part->line_keys[first];
+        const Key& b = part->line_keys[first + 1];
+        float t = RTCRayN_tfar(args->ray, args->N, i);  // the candidate hit's distance
+        geom::Vec3 hit{RTCRayN_org_x(args->ray, args->N, i) + t * RTCRayN_dir_x(args->ray, args->N, i),
+                       RTCRayN_org_y(args->ray, args->N, i) + t * RTCRayN_dir_y(args->ray, args->N, i),
+                       RTCRayN_org_z(args->ray, args->N, i) + t * RTCRayN_dir_z(args->ray, args->N, i)};
+        if (!pixel_line_draws(*part->owner->camera, {a[0], a[1], a[2]}, {b[0], b[1], b[2]}, a[3], hit))
+            args->valid[i] = 0;
+    }
+    if (part->owner->textures)
+        alpha_filter(args);
+}
+
 void EmbreeScene::Impl::attach(RTCScene s, RTCGeometry g, GeometrySource part,
                                std::vector<const GeometrySource*>& ids, bool alpha)
 {
     part.owner = this;
     parts.push_back(part);
     rtcSetGeometryUserData(g, &parts.back());
-    if (alpha && textures) {
+    if (part.shape == Shape::line && part.unlit) {
+        rtcSetGeometryIntersectFilterFunction(g, &pixel_line_filter);
+        rtcSetGeometryOccludedFilterFunction(g, &pixel_line_filter);
+    } else if (alpha && textures) {
         rtcSetGeometryIntersectFilterFunction(g, &alpha_filter);
         rtcSetGeometryOccludedFilterFunction(g, &alpha_filter);
     }
@@ -570,6 +598,7 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
 {
     Impl& m = *m_impl;
     m.textures = textures;
+    m.camera = std::make_unique<const Camera>(camera);
     m.device = rtcNewDevice(nullptr);
     if (!m.device)
         throw Error(std::string("Embree: cannot create a device: ") +

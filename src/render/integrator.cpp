@@ -268,6 +268,8 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             break;
         }
         travelled += hit->t;
+        if (ctx.facet_normals)
+            hit->normal = hit->geometric_normal;
         SurfaceMaterial blended;
         const SurfaceMaterial& material = hit_material(ctx, *hit, blended);
         auto textured_diffuse = [&] {
@@ -296,7 +298,7 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         if (depth == 0)
             result.hit = true;
         Vec3f diffuse = diffuse_seen ? *diffuse_seen : textured_diffuse();
-        if (hit->unlit) {
+        if (hit->unlit || ctx.unlit) {
             result.radiance += beta * (diffuse + material.emission);
             break;
         }

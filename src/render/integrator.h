@@ -47,6 +47,10 @@ struct PathContext {
     bool environment_visible = false;
     int max_depth = 6;
     int roulette_depth = 3;
+    /// `render mode: filled` / `wireframe`: every surface shows its flat colour, unlit.
+    bool unlit = false;
+    /// `render mode: flat`: shading uses each facet's own normal.
+    bool facet_normals = false;
     /// The camera rays' cone (zero: textures are looked up at their finest level).
     RayCone camera_cone;
     /// Half the scene's diagonal: how far area lights' power is taken to reach when lights

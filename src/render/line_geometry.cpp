@@ -8,6 +8,7 @@
 #include <string>
 
 #include "base/diagnostics.h"
+#include "render/pixel_lines.h"
 #include "render/vecf.h"
 
 namespace cambium::render {
@@ -53,7 +54,7 @@ geom::LinearCurves place_pixel_lines(const geom::Scene& scene, const Camera& cam
                          m[1] * k[0] + m[4] * k[1] + m[7] * k[2] + m[10],
                          m[2] * k[0] + m[5] * k[1] + m[8] * k[2] + m[11]};
             out.keys.push_back({float(p.x), float(p.y), float(p.z),
-                                static_cast<float>(k[3] * camera.pixel_size_at(p))});
+                                static_cast<float>(pixel_line_world_radius(k[3], camera, p))});
         }
         for (std::size_t k = 0; k < l.keys.size(); ++k)
             out.v.push_back(l.v.size() == l.keys.size() ? l.v[k] : 0.0f);
@@ -73,7 +74,7 @@ std::vector<geom::Float4> keys_in_world_units(const geom::LinearCurves& lines, c
 {
     std::vector<geom::Float4> keys(lines.keys);
     for (geom::Float4& k : keys)
-        k[3] = static_cast<float>(k[3] * camera.pixel_size_at({k[0], k[1], k[2]}));
+        k[3] = static_cast<float>(pixel_line_world_radius(k[3], camera, {k[0], k[1], k[2]}));
     return keys;
 }
 

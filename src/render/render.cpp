@@ -415,6 +415,8 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
                                   camera.projection() == Camera::Projection::perspective;
         ctx.ambient = {settings.ambient.r, settings.ambient.g, settings.ambient.b};
         ctx.max_depth = settings.max_depth;
+        ctx.unlit = scene.shading == geom::Shading::filled || scene.shading == geom::Shading::wireframe;
+        ctx.facet_normals = scene.shading == geom::Shading::flat;
         ctx.roulette_depth = settings.roulette_depth;
         ctx.camera_cone = camera_cone(camera);
         if (!scene.bounds.empty())

@@ -62,9 +62,23 @@ TEST(BackgroundScene, ManualExample)
     EXPECT_EQ(s.materials[0].ambient, (Rgb{0.1f, 0.1f, 0.1f}));
     EXPECT_FLOAT_EQ(s.materials[0].transparency, 0);
 
-    // cpfg draws the sphere at the transformed origin, unscaled.
-    ASSERT_EQ(s.geometry.spheres.size(), 1u);
-    EXPECT_EQ(s.geometry.spheres.centres[0], (Float4{3, -20, -3, 15}));
+    // The sphere under `scale 1 0.7 0.7` is the manual's ellipsoid: semi-axes 15, 10.5,
+    // 10.5 about (3, -20, -3), as cpfg's window draws it.
+    EXPECT_EQ(s.geometry.spheres.size(), 0u);
+    const std::size_t ellipsoid = 960;  // 32 slices x 16 stacks, one triangle at the poles
+    ASSERT_EQ(s.geometry.mesh.size(), ellipsoid + 12);
+    double x_lo = 1e9, x_hi = -1e9, y_lo = 1e9, y_hi = -1e9;
+    for (std::size_t i = 0; i < 3 * ellipsoid; ++i) {
+        const Float3& p = s.geometry.mesh.positions[i];
+        Vec3 q{(p[0] - 3) / 15, (p[1] + 20) / 10.5, (p[2] + 3) / 10.5};
+        EXPECT_NEAR(dot(q, q), 1, 1e-5);
+        x_lo = std::min(x_lo, double(p[0]));
+        x_hi = std::max(x_hi, double(p[0]));
+        y_lo = std::min(y_lo, double(p[1]));
+        y_hi = std::max(y_hi, double(p[1]));
+    }
+    EXPECT_NEAR(x_hi - x_lo, 30, 1e-4);
+    EXPECT_NEAR(y_hi - y_lo, 21, 1e-4);
 
     // The cone: a segment from (-14,-55,8) radius 15 to (-14,-41,8) radius 2, two discs.
     ASSERT_EQ(s.geometry.lines.segment_count(), 1u);
@@ -76,15 +90,24 @@ TEST(BackgroundScene, ManualExample)
 
     // The box: 6 faces, 12 triangles over [-10,20] x [-65,-60] x [0,30].
     const TriangleMesh& m = s.geometry.mesh;
-    ASSERT_EQ(m.size(), 12u);
     Vec3 lo{1e9, 1e9, 1e9}, hi{-1e9, -1e9, -1e9};
-    for (const Float3& p : m.positions) {
+    for (std::size_t i = 3 * ellipsoid; i < m.positions.size(); ++i) {
+        const Float3& p = m.positions[i];
         lo = {std::min(lo.x, double(p[0])), std::min(lo.y, double(p[1])), std::min(lo.z, double(p[2]))};
         hi = {std::max(hi.x, double(p[0])), std::max(hi.y, double(p[1])), std::max(hi.z, double(p[2]))};
     }
     expect_near(lo, {-10, -65, 0}, 1e-5);
     expect_near(hi, {20, -60, 30}, 1e-5);
     EXPECT_TRUE(std::all_of(m.material.begin(), m.material.end(), [](auto k) { return k == 0; }));
+}
+
+// A rotation with a uniform scale keeps a sphere a sphere, its radius scaled.
+TEST(BackgroundScene, UniformScaleScalesTheSphere)
+{
+    BackgroundScene s = build("translate 1 2 3\nrotate 30 0 0 1\nscale 2 2 2\nsphere 1.5\n");
+    ASSERT_EQ(s.geometry.spheres.size(), 1u);
+    EXPECT_EQ(s.geometry.mesh.size(), 0u);
+    EXPECT_EQ(s.geometry.spheres.centres[0], (Float4{1, 2, 3, 3}));
 }
 
 TEST(BackgroundScene, RotationFollowsOpenGL)
@@ -186,11 +209,21 @@ TEST(BackgroundSceneConformance, CorpusBackgroundsRead)
     ASSERT_FALSE(s.materials.empty());
     EXPECT_FLOAT_EQ(s.materials[0].transparency, 0.5f);
     EXPECT_EQ(s.materials[0].diffuse, (Rgb{0.5f, 0.2f, 0.2f}));
-    // The first sphere: translate 2 2 0, then rotate and scale leave the origin there.
-    ASSERT_GE(s.geometry.spheres.size(), 1u);
-    EXPECT_EQ(s.geometry.spheres.centres[0], (Float4{2, 2, 0, 0.5f}));
+    // The first sphere (0.5 under translate 2 2 0, rotate, scale 2 1 1) is an ellipsoid
+    // about (2, 2, 0) with semi-axes 1, 0.5, 0.5: the first 960 triangles.
+    ASSERT_GE(s.geometry.mesh.size(), 960u + 2u);
+    double nearest = 1e9, farthest = 0;
+    for (std::size_t i = 0; i < 3 * 960; ++i) {
+        const Float3& p = s.geometry.mesh.positions[i];
+        double d = length(Vec3{p[0] - 2.0, p[1] - 2.0, p[2]});
+        nearest = std::min(nearest, d);
+        farthest = std::max(farthest, d);
+    }
+    EXPECT_NEAR(farthest, 1.0, 1e-3);
+    EXPECT_NEAR(nearest, 0.5, 1e-2);
+    // The last, `sphere 1.0` under no scale, stays a sphere.
+    EXPECT_EQ(s.geometry.spheres.size(), 1u);
     EXPECT_GE(s.geometry.lines.segment_count(), 2u);
-    EXPECT_GE(s.geometry.mesh.size(), 2u);
 
     std::filesystem::path knot = root / "10-manuals/20-EnviroPgms/CPFG-CelticKnot/background.dat";
     BackgroundScene k = read_background_scene(knot.string(), "/", Material{}, FileLoc{"viewfile.v", 1, 1});

@@ -152,3 +152,16 @@ TEST(TurtleFrame, PreventTwistCarriesTheLastSegmentsUp)
     EXPECT_NEAR(dot(t.up, k), t.heading.x, 1e-12);
     EXPECT_NEAR(t.heading.x, s40 * 0.5, 1e-12);
 }
+
+TEST(LegacyTropism, UnderscoreSetsOrAddsTheIncrement)
+{
+    // WeepingBirch: `initial elasticity: 0.4`, `elasticity increment: -0.06`, `_` at
+    // every branching: each order is stiffer, then bends away from the tropism.
+    Turtle t;
+    t.legacy_elasticity = 0.4;
+    change_legacy_elasticity(t, {}, -0.06);
+    EXPECT_NEAR(t.legacy_elasticity, 0.34, 1e-12);
+    const float set[] = {-0.1f};
+    change_legacy_elasticity(t, set, -0.06);  // Sedge: `_(0-.1)` sets
+    EXPECT_FLOAT_EQ(static_cast<float>(t.legacy_elasticity), -0.1f);
+}

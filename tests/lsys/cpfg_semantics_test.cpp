@@ -86,6 +86,33 @@ endlsystem
     EXPECT_EQ(derive_text(src), "B(2,2)");
 }
 
+// 10-manuals/11-CPFG/Ring: in a `ring lsystem` the first module's left neighbour is the
+// last and the last's right neighbour the first; an ordinary L-system has none there.
+TEST(CpfgSemantics, RingLsystemContextsWrapAround)
+{
+    const char* ring = R"(lsystem: 1
+ring lsystem
+derivation length: 1
+axiom: A B B C
+B > A --> X
+C > A --> Y
+B < A --> Z
+endlsystem
+)";
+    EXPECT_EQ(derive_text(ring), "ABBY");
+    const char* left = R"(lsystem: 1
+ring lsystem
+derivation length: 1
+axiom: A B C
+C < A --> Z
+endlsystem
+)";
+    EXPECT_EQ(derive_text(left), "ZBC");
+    std::string open = left;
+    open.erase(open.find("ring lsystem\n"), 13);
+    EXPECT_EQ(derive_text(open.c_str()), "ABC");
+}
+
 TEST(CpfgSemantics, RightContextEqualsSkipsToBranchEnd)
 {
     // '=' jumps to the end of the current branch; ']' then matches literally

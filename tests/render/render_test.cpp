@@ -40,6 +40,41 @@ TEST(Render, SegmentSilhouetteWhereCameraPutsIt)
     EXPECT_GT(img.at(100, 40, 3) + img.at(100, 59, 3), 0.0f);
 }
 
+/// How many of the first n pixels of column `at` (or row, when `rows`) the image covers,
+/// and whether each is covered fully (coverage 0 or 1 only).
+std::pair<int, bool> covered_pixels(const Image& img, int at, bool rows, int n)
+{
+    int count = 0;
+    bool crisp = true;
+    for (int i = 0; i < n; ++i) {
+        float a = rows ? img.at(i, at, 3) : img.at(at, i, 3);
+        count += a > 0;
+        crisp = crisp && (a == 0 || a == 1);
+    }
+    return {count, crisp};
+}
+
+// cpfg's pixel lines are aliased GL lines: a line N pixels wide covers exactly N pixels of
+// every column it crosses (x-major) or row (y-major), fully. A tube N pixels across would
+// cover parts of N + 1 (and look wider once anti-aliased). 5 px per unit, centre (100, 50).
+TEST(Render, PixelLineOfWidthNCoversNPixelsPerColumn)
+{
+    for (float width : {1.0f, 3.0f}) {
+        geom::Scene s = empty_scene({-20, -5, 0}, {20, 5, 0});
+        s.line_radius_in_pixels = true;
+        add_segment(s, {-15, -3.1, 0}, {15, 2.3, 0}, width / 2);  // x-major: columns 25..175
+        add_segment(s, {-18.3, -4, 0}, {-17.1, 4.5, 0}, width / 2);  // y-major: rows 28..70
+        Image img = render(s, small(200, 100, 16));
+        for (int x = 30; x <= 170; ++x) {
+            auto [count, crisp] = covered_pixels(img, x, false, img.height);
+            EXPECT_EQ(count, int(width)) << "column " << x << ", width " << width;
+            EXPECT_TRUE(crisp) << "column " << x << ", width " << width;
+        }
+        for (int y = 32; y <= 66; ++y)  // left of column 24, where the x-major line starts
+            EXPECT_EQ(covered_pixels(img, y, true, 24).first, int(width)) << "row " << y << ", width " << width;
+    }
+}
+
 // Camera rays that miss see the background: the PNG must hold cpfg's exact bytes.
 TEST(Render, MissedPixelsAreTheDecodedBackground)
 {
@@ -69,6 +104,27 @@ TEST(Render, LitSideIsBrighterThanUnlitSide)
     // Near row 41 the normal is ~ (0, 0.9, 0.44): expect albedo * cos within tolerance.
     float albedo = srgb_to_linear(0.8f);
     EXPECT_LE(img.at(100, 41, 1), albedo * 1.001f);
+}
+
+// `render mode: filled`: the same cylinder shows its flat colour on both sides, unlit;
+// `flat`: lit by the facet normal (a round tube's is its smooth normal: still shaded).
+TEST(Render, FilledRenderModeShowsFlatColours)
+{
+    geom::Scene s = empty_scene({-20, -5, 0}, {20, 5, 0});
+    add_segment(s, {-10, 0, 0}, {10, 0, 0}, 2.0f);
+    s.materials[1].diffuse = {0.8f, 0.4f, 0.2f};
+    s.lights.push_back(directional({0, 1, 0}));
+    s.shading = geom::Shading::filled;
+    Image img = render(s, small(200, 100, 4));
+    const geom::Rgb& d = s.materials[1].diffuse;
+    for (int y : {43, 50, 57}) {
+        EXPECT_NEAR(img.at(100, y, 0), srgb_to_linear(d.r), 1e-5f) << y;
+        EXPECT_NEAR(img.at(100, y, 1), srgb_to_linear(d.g), 1e-5f) << y;
+        EXPECT_NEAR(img.at(100, y, 2), srgb_to_linear(d.b), 1e-5f) << y;
+    }
+    s.shading = geom::Shading::flat;
+    Image flat = render(s, small(200, 100, 4));
+    EXPECT_LT(flat.at(100, 55, 0), 0.5f * flat.at(100, 45, 0));
 }
 
 // A white light straight onto a white-ish Lambertian surface gives exactly its albedo

@@ -1,0 +1,157 @@
+// SPDX-License-Identifier: Apache-2.0
+// Comparing a render with cpfg's window image: silhouettes and colours.
+#include "image_compare.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+namespace cambium::test {
+namespace {
+
+/// The square dilation of `mask` by `radius` pixels (separable: rows, then columns).
+std::vector<bool> dilate(const std::vector<bool>& mask, int width, int height, int radius)
+{
+    std::vector<bool> rows(mask.size()), out(mask.size());
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            bool any = false;
+            for (int d = std::max(0, x - radius); d <= std::min(width - 1, x + radius) && !any; ++d)
+                any = mask[std::size_t(y) * width + d];
+            rows[std::size_t(y) * width + x] = any;
+        }
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            bool any = false;
+            for (int d = std::max(0, y - radius); d <= std::min(height - 1, y + radius) && !any; ++d)
+                any = rows[std::size_t(d) * width + x];
+            out[std::size_t(y) * width + x] = any;
+        }
+    return out;
+}
+
+/// The fraction of `of`'s pixels inside `within`.
+double fraction_inside(const std::vector<bool>& of, const std::vector<bool>& within)
+{
+    std::size_t n = 0, inside = 0;
+    for (std::size_t i = 0; i < of.size(); ++i)
+        if (of[i]) {
+            ++n;
+            inside += within[i];
+        }
+    return n == 0 ? 1.0 : double(inside) / double(n);
+}
+
+struct Hsv {
+    double h = 0, s = 0, v = 0;
+};
+
+Hsv hsv(const float* c)
+{
+    double mx = std::max({c[0], c[1], c[2]}), mn = std::min({c[0], c[1], c[2]});
+    Hsv r;
+    r.v = mx;
+    r.s = mx > 0 ? (mx - mn) / mx : 0;
+    if (mx == mn)
+        return r;
+    double d = mx - mn;
+    if (mx == c[0])
+        r.h = 60 * std::fmod((c[1] - c[2]) / d + 6, 6.0);
+    else if (mx == c[1])
+        r.h = 60 * ((c[2] - c[0]) / d + 2);
+    else
+        r.h = 60 * ((c[0] - c[1]) / d + 4);
+    return r;
+}
+
+double median(std::vector<double> v)
+{
+    if (v.empty())
+        return 0;
+    auto mid = v.begin() + std::ptrdiff_t(v.size() / 2);
+    std::nth_element(v.begin(), mid, v.end());
+    return *mid;
+}
+
+}  // namespace
+
+PlantImage read_cpfg_image(const std::string& file)
+{
+    auto in = OIIO::ImageInput::open(file);
+    if (!in)
+        throw std::runtime_error("cannot read " + file);
+    const OIIO::ImageSpec& spec = in->spec();
+    PlantImage img;
+    img.width = spec.width;
+    img.height = spec.height;
+    std::vector<unsigned char> bytes(std::size_t(img.width) * img.height * 3);
+    if (!in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, bytes.data()))
+        throw std::runtime_error("cannot read " + file);
+    auto colour = [&](int x, int y) {
+        const unsigned char* p = &bytes[(std::size_t(y) * img.width + x) * 3];
+        return (p[0] << 16) | (p[1] << 8) | p[2];
+    };
+    std::map<int, int> border;
+    for (int x = 0; x < img.width; ++x) {
+        ++border[colour(x, 0)];
+        ++border[colour(x, img.height - 1)];
+    }
+    for (int y = 0; y < img.height; ++y) {
+        ++border[colour(0, y)];
+        ++border[colour(img.width - 1, y)];
+    }
+    int background = std::max_element(border.begin(), border.end(), [](auto& a, auto& b) {
+                         return a.second < b.second;
+                     })->first;
+    img.rgb.resize(bytes.size());
+    img.plant.resize(bytes.size() / 3);
+    for (std::size_t i = 0; i < img.plant.size(); ++i) {
+        bool differs = false;
+        for (int c = 0; c < 3; ++c) {
+            img.rgb[3 * i + c] = bytes[3 * i + c] / 255.0f;
+            int bg = (background >> (16 - 8 * c)) & 0xff;
+            differs = differs || std::abs(int(bytes[3 * i + c]) - bg) > 3;
+        }
+        img.plant[i] = differs;
+    }
+    return img;
+}
+
+ImageAgreement compare_images(const PlantImage& ours, const PlantImage& cpfg, int tolerance_px)
+{
+    if (ours.width != cpfg.width || ours.height != cpfg.height)
+        throw std::runtime_error(fmt::format("image sizes differ: {}x{} and cpfg's {}x{}", ours.width,
+                                             ours.height, cpfg.width, cpfg.height));
+    ImageAgreement a;
+    a.precision = fraction_inside(ours.plant, dilate(cpfg.plant, cpfg.width, cpfg.height, tolerance_px));
+    a.recall = fraction_inside(cpfg.plant, dilate(ours.plant, ours.width, ours.height, tolerance_px));
+    std::vector<double> hue, value;
+    for (std::size_t i = 0; i < ours.plant.size(); ++i) {
+        if (!ours.plant[i] || !cpfg.plant[i])
+            continue;
+        Hsv o = hsv(&ours.rgb[3 * i]), c = hsv(&cpfg.rgb[3 * i]);
+        if (c.v > 0.02)
+            value.push_back(o.v / c.v);
+        if (o.s > 0.15 && c.s > 0.15 && o.v > 0.15 && c.v > 0.15) {
+            double d = std::fabs(o.h - c.h);
+            hue.push_back(std::min(d, 360 - d));
+        }
+    }
+    a.hue_pixels = hue.size();
+    a.median_hue_difference = median(hue);
+    a.median_value_ratio = value.empty() ? 1 : median(value);
+    return a;
+}
+
+std::string ImageAgreement::describe() const
+{
+    return fmt::format("precision {:.3f} recall {:.3f} hue {:.1f} deg ({} px) value x{:.2f}", precision,
+                       recall, median_hue_difference, hue_pixels, median_value_ratio);
+}
+
+}  // namespace cambium::test
