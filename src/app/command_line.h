@@ -20,6 +20,21 @@ struct ColourFile {
 /// How much cpfg-style tracing to print (-v warnings, -V verbose).
 enum class Verbosity { normal, warnings, verbose };
 
+/// Sequences and the camera (src/app/shot_options.cpp): cpfg's animation mode,
+/// turntables, camera changes over the view file, and which frames to render.
+struct ShotOptions {
+    bool animate = false;                      ///< -a: the frames the animation selects
+    int turntable = 0;                         ///< --turntable N frames (0 = none)
+    std::optional<double> turntable_elevation; ///< --turntable-elevation DEG
+    std::vector<double> orbit;                 ///< --orbit AZ EL (degrees)
+    double zoom = 1;                           ///< --zoom K
+    bool fit = false;                          ///< --fit
+    std::optional<double> fov;                 ///< --fov DEG
+    bool perspective = false, parallel = false;  ///< --perspective / --parallel
+    std::optional<std::string> frames;         ///< --frames A-B (frame numbers)
+    bool resume = false;                       ///< --resume: skip frames already written
+};
+
 struct Options {
     std::filesystem::path lsystem, view;
     std::optional<std::filesystem::path> animation;
@@ -63,6 +78,8 @@ struct Options {
     std::optional<std::filesystem::path> environment_map;  ///< --env file.exr|.hdr
     float environment_scale = 1;       ///< --env-scale
     float environment_rotation = 0;    ///< --env-rotate DEG about +y (with --env or --sky)
+
+    ShotOptions shot;
 
     /// Whether an image is to be rendered: an -o was given, or no other output was.
     bool renders() const

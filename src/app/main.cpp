@@ -13,6 +13,7 @@
 
 #include "app/command_line.h"
 #include "app/pipeline.h"
+#include "app/sequence.h"
 #include "base/diagnostics.h"
 #include "geom/view_volume.h"
 #include "lsys/string_io.h"
@@ -116,9 +117,8 @@ void write_atomically(const std::filesystem::path& file, Write write)
 /// -str and -strb: the derived string in cpfg's formats; names may be format strings
 /// (plant%03d.str) that receive the derivation step.
 void write_strings(const Model& model, const lsys::ModuleString& string, const Options& options,
-                   const std::function<void(const std::string&)>& say)
+                   int step, const std::function<void(const std::string&)>& say)
 {
-    int step = options.steps.value_or(model.lsystem.derivation_length());
     if (options.string_text) {
         std::filesystem::path file = lsys::format_frame_name(options.string_text->string(), step);
         write_atomically(file, [&](std::ostream& out) {
@@ -145,17 +145,22 @@ int run(const Options& options)
     std::vector<std::filesystem::path> images = image_outputs(options);
     for (const auto& out : images)
         render::check_output_format(out);  // fail before the work, not after
-    if (options.animation)
-        warn(FileLoc{options.animation->string()},
-             "animation files are not interpreted yet; rendering the last derivation step");
     if (options.environment_requested)
         warn("-e: no environmental program is connected; ?E modules keep their parameters");
+    if (is_sequence(options)) {
+        SequenceOutputs outputs{images, render_settings(options, images), {}, say};
+        outputs.write_strings = [&](const Model& model, const lsys::ModuleString& s, int step) {
+            write_strings(model, s, options, step, say);
+        };
+        return run_sequence(options, outputs);
+    }
 
     auto start = Clock::now();
     Model model = load_model(options);
     lsys::ModuleString string = derive(model, options);
     say(fmt::format("derived {} modules in {:.3f} s", string.size(), seconds_since(start)));
-    write_strings(model, string, options, say);
+    write_strings(model, string, options,
+                  options.steps.value_or(model.lsystem.derivation_length()), say);
 
     geom::Scene scene = interpret(model, string, options);
     const geom::Geometry& g = scene.geometry;
@@ -172,6 +177,7 @@ int run(const Options& options)
         return 0;
 
     render::RenderSettings settings = render_settings(options, images);
+    apply_camera_options(scene, options);
     render::RenderReport report;
     render::Image image = render::render(scene, settings, &report);
     say(fmt::format("rendered {}x{}, {:.1f} samples per pixel on average, in {:.2f} s{}",

@@ -92,12 +92,36 @@ lsys::ModuleString derive(const Model& model, const Options& options)
 geom::Scene interpret(const Model& model, const lsys::ModuleString& derived,
                       const Options& options)
 {
+    return interpret_turtle_string(model, turtle_string(model, derived, options), options);
+}
+
+namespace {
+
+/// -o> objects become prototypes and instances (docs: manual 8.1); with -homo the
+/// string already holds their expansions.
+std::vector<char> instanced_objects(const Model& model, const Options& options)
+{
+    return options.homomorphism_in_string ? std::vector<char>{} : object_symbols(model.lsystem);
+}
+
+}  // namespace
+
+lsys::ModuleString turtle_string(const Model& model, const lsys::ModuleString& derived,
+                                 const Options& options)
+{
+    if (options.homomorphism_in_string)
+        return derived;
+    return model.lsystem.interpretation_string(derived, instanced_objects(model, options).empty()
+                                                            ? lsys::ObjectHandling::expand
+                                                            : lsys::ObjectHandling::keep);
+}
+
+geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString& string,
+                                    const Options& options)
+{
     geom::InterpretOptions interpret_options;
     interpret_options.strings = model.lsystem.program().strings;
-    // -o> objects become prototypes and instances (docs: manual 8.1); with -homo the
-    // string already holds their expansions.
-    std::vector<char> objects =
-        options.homomorphism_in_string ? std::vector<char>{} : object_symbols(model.lsystem);
+    std::vector<char> objects = instanced_objects(model, options);
     if (!objects.empty()) {
         const lsys::LSystem& lsystem = model.lsystem;
         interpret_options.is_object = [objects](lsys::SymbolId s) {
@@ -105,11 +129,6 @@ geom::Scene interpret(const Model& model, const lsys::ModuleString& derived,
         };
         interpret_options.expand_object = [&lsystem](lsys::ModuleRef m) { return lsystem.expand_object(m); };
     }
-    lsys::ModuleString string =
-        options.homomorphism_in_string
-            ? derived
-            : model.lsystem.interpretation_string(
-                  derived, objects.empty() ? lsys::ObjectHandling::expand : lsys::ObjectHandling::keep);
     geom::Scene scene =
         geom::interpret(string, model.lsystem.symbols(), *model.view, interpret_options);
     scene.materials = model.palette.entries(options.colour_block);

@@ -393,22 +393,38 @@ Image render(const geom::Scene& scene, const RenderSettings& settings, RenderRep
 Image render(const geom::Scene& scene, const Camera& camera, const RenderSettings& settings,
              RenderReport* report)
 {
+    Image image;
+    render_views(scene, std::span<const Camera>(&camera, 1), settings,
+                 [&](std::size_t, Image& frame, const RenderReport& rep) {
+        image = std::move(frame);
+        if (report)
+            *report = rep;
+        return true;
+    });
+    return image;
+}
+
+void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
+                  const RenderSettings& settings, const ViewCallback& on_view)
+{
     check_settings(settings);
-    if (camera.width() != settings.width || camera.height() != settings.height)
-        throw Error("render: the camera's image size differs from the settings'");
+    for (const Camera& camera : cameras)
+        if (camera.width() != settings.width || camera.height() != settings.height)
+            throw Error("render: the camera's image size differs from the settings'");
+    if (cameras.empty())
+        return;
     auto start = Clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
     tbb::task_arena arena(settings.threads > 0 ? settings.threads
                                                : tbb::task_arena::automatic);
     const int w = settings.width, h = settings.height;
-    std::vector<PixelState> pixels(std::size_t(w) * h);
-    RenderReport rep;
     arena.execute([&] {
         std::unique_ptr<TextureSet> textures;
         if (!scene.textures.empty())
             textures = std::make_unique<TextureSet>(scene.textures, settings.texture_folder);
-        // Embree builds with TBB too, so the build also stays within the arena.
-        EmbreeScene accel(scene, camera, textures.get());
+        // Embree builds with TBB too, so the build also stays within the arena. One
+        // build serves every view (pixel-wide lines take the first view's pixel size).
+        EmbreeScene accel(scene, cameras.front(), textures.get());
         PathContext ctx;
         ctx.accel = &accel;
         ctx.textures = textures.get();
@@ -421,16 +437,20 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
         }
         ctx.background = decode_display(scene.background);
         ctx.environment = settings.environment.get();
+        ctx.ambient = {settings.ambient.r, settings.ambient.g, settings.ambient.b};
+        ctx.max_depth = settings.max_depth;
+        ctx.roulette_depth = settings.roulette_depth;
+        prepare_path_context(ctx);
+
+        for (std::size_t view = 0; view < cameras.size(); ++view) {
+        const Camera& camera = cameras[view];
         // A parallel camera looks along one direction: its misses would all see the same
         // environment radiance, so they keep cpfg's background there.
         ctx.environment_visible = settings.environment != nullptr &&
                                   camera.projection() == Camera::Projection::perspective;
-        ctx.ambient = {settings.ambient.r, settings.ambient.g, settings.ambient.b};
-        ctx.max_depth = settings.max_depth;
-        ctx.roulette_depth = settings.roulette_depth;
         ctx.camera_cone = camera_cone(camera);
-        prepare_path_context(ctx);
-
+        std::vector<PixelState> pixels(std::size_t(w) * h);
+        RenderReport rep;
         const bool clipping = std::isfinite(camera.clip_near()) || std::isfinite(camera.clip_far());
         Frame frame{ctx, accel, camera, settings,
                     FilterTable(settings.filter, settings.filter_radius),
@@ -508,14 +528,15 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
         progress.finish();
         rep.cancelled = cancelled;
         rep.out_of_time = out_of_time;
+        for (const PixelState& st : pixels)
+            rep.samples += st.samples;
+        Image image = resolve(pixels, settings);
+        rep.seconds = elapsed();
+        if (!on_view(view, image, rep) || rep.cancelled)
+            break;
+        start = Clock::now();  // the next view's time budget and seconds
+        }
     });
-    for (const PixelState& st : pixels)
-        rep.samples += st.samples;
-    Image image = resolve(pixels, settings);
-    rep.seconds = elapsed();
-    if (report)
-        *report = rep;
-    return image;
 }
 
 }  // namespace cambium::render

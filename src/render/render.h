@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "geom/scene.h"
@@ -117,6 +118,18 @@ Image render(const geom::Scene& scene, const RenderSettings& settings,
 /// Renders with an explicit camera (tests, turntables); the settings' lens is not applied.
 Image render(const geom::Scene& scene, const Camera& camera, const RenderSettings& settings,
              RenderReport* report = nullptr);
+
+/// Called after each view of render_views() with its index, its image (which may be
+/// moved from) and its report; returning false stops the sequence.
+using ViewCallback = std::function<bool(std::size_t view, Image& image, const RenderReport&)>;
+
+/// Renders one scene from several cameras (a turntable), loading its textures and
+/// building its BVH once. Every view uses the same sampling pattern (random numbers
+/// hashed from pixel, sample and seed), so noise does not move between frames; the
+/// time budget applies to each view; a cancel ends the sequence after the view it
+/// interrupted. The first view's report counts the build.
+void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
+                  const RenderSettings& settings, const ViewCallback& on_view);
 
 /// Installs a SIGINT handler that sets the returned flag (pass it as
 /// RenderSettings::cancel); a second Ctrl-C kills the process as usual. Idempotent.

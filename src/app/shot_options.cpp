@@ -1,0 +1,70 @@
+// SPDX-License-Identifier: Apache-2.0
+// The command-line options of sequences and of the camera (ShotOptions).
+#include "app/shot_options.h"
+
+#include <charconv>
+
+#include "base/diagnostics.h"
+
+namespace cambium::app {
+
+void add_shot_options(CLI::App& cli, ShotOptions& shot)
+{
+    cli.add_option("--turntable", shot.turntable,
+                   "Render N frames orbiting the plant about the vertical axis, framed once")
+        ->check(CLI::Range(1, 100000));
+    cli.add_option("--turntable-elevation", shot.turntable_elevation,
+                   "Angle of the turntable's view above the horizontal, degrees")
+        ->check(CLI::Range(-89.0, 89.0));
+    cli.add_option("--orbit", shot.orbit,
+                   "Turn the viewpoint AZ degrees about the vertical and EL degrees up, "
+                   "about the view reference point")
+        ->expected(2);
+    cli.add_option("--zoom", shot.zoom, "Multiply the view's scale factor by K")
+        ->check(CLI::Range(1e-6, 1e6));
+    cli.add_flag("--fit", shot.fit, "Frame the plant's bounds (ignores box: and scale factor:)");
+    cli.add_option("--fov", shot.fov, "Vertical field of view in degrees (perspective)")
+        ->check(CLI::Range(0.1, 179.0));
+    cli.add_flag("--perspective", shot.perspective, "Perspective projection");
+    cli.add_flag("--parallel", shot.parallel, "Parallel projection");
+    cli.add_option("--frames", shot.frames,
+                   "Render only frames A-B of a sequence (frame numbers as in the file names)");
+    cli.add_flag("--resume", shot.resume, "Skip frames whose output files exist already");
+}
+
+std::pair<int, int> frame_range(const std::string& text)
+{
+    auto number = [&](std::string_view word) {
+        int value = 0;
+        auto [end, ec] = std::from_chars(word.data(), word.data() + word.size(), value);
+        if (ec != std::errc() || end != word.data() + word.size() || value < 0)
+            throw Error("--frames: expected A-B with frame numbers A <= B, not '" + text + "'");
+        return value;
+    };
+    std::string_view all = text;
+    std::size_t dash = all.find('-');
+    int first = number(all.substr(0, dash));
+    int last = dash == std::string_view::npos ? first : number(all.substr(dash + 1));
+    if (last < first)
+        throw Error("--frames: expected A-B with frame numbers A <= B, not '" + text + "'");
+    return {first, last};
+}
+
+void check_shot_options(const Options& options)
+{
+    const ShotOptions& shot = options.shot;
+    if (shot.perspective && shot.parallel)
+        throw Error("--perspective and --parallel contradict each other; give one");
+    if (shot.turntable > 0 && shot.animate)
+        throw Error("--turntable and -a (animation) are two kinds of sequence; give one");
+    if (shot.turntable_elevation && shot.turntable == 0)
+        throw Error("--turntable-elevation tilts a --turntable; give --turntable N too");
+    if (shot.turntable > 0 && (!shot.orbit.empty() || shot.fit))
+        throw Error("--turntable frames the plant itself; --orbit and --fit do not apply");
+    if ((shot.frames || shot.resume) && shot.turntable == 0 && !shot.animate)
+        throw Error("--frames and --resume select frames of a sequence (-a or --turntable)");
+    if (shot.frames)
+        frame_range(*shot.frames);
+}
+
+}  // namespace cambium::app
