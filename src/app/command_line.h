@@ -33,6 +33,8 @@ struct ShotOptions {
     bool perspective = false, parallel = false;  ///< --perspective / --parallel
     std::optional<std::string> frames;         ///< --frames A-B (frame numbers)
     bool resume = false;                       ///< --resume: skip frames already written
+    bool video = false;                        ///< --video: also <plant>.mp4
+    int fps = 24;                              ///< --fps of video outputs
 };
 
 struct Options {

@@ -14,6 +14,7 @@
 #include "app/command_line.h"
 #include "app/pipeline.h"
 #include "app/sequence.h"
+#include "app/video.h"
 #include "base/diagnostics.h"
 #include "geom/view_volume.h"
 #include "lsys/string_io.h"
@@ -144,7 +145,8 @@ int run(const Options& options)
     };
     std::vector<std::filesystem::path> images = image_outputs(options);
     for (const auto& out : images)
-        render::check_output_format(out);  // fail before the work, not after
+        if (!is_video(out))
+            render::check_output_format(out);  // fail before the work, not after
     if (options.environment_requested)
         warn("-e: no environmental program is connected; ?E modules keep their parameters");
     if (is_sequence(options)) {

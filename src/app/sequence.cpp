@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 
 #include "app/shot_options.h"
+#include "app/video.h"
 #include "base/diagnostics.h"
 #include "geom/view_file.h"
 #include "geom/view_volume.h"
@@ -333,9 +334,33 @@ void apply_camera_options(geom::Scene& scene, const Options& options)
 
 int run_sequence(const Options& options, const SequenceOutputs& outputs)
 {
-    if (options.shot.turntable > 0)
-        return run_turntable(options, outputs);
-    return run_animation(options, outputs);
+    // Videos: frames go to a folder per video first, then ffmpeg encodes them.
+    SequenceOutputs frames = outputs;
+    std::vector<fs::path> videos;
+    frames.images.clear();
+    for (const fs::path& out : outputs.images)
+        (is_video(out) ? videos : frames.images).push_back(out);
+    if (options.shot.video && videos.empty()) {
+        videos.push_back(options.lsystem.stem().string() + ".mp4");
+        if (options.outputs.empty())
+            frames.images.clear();  // not the default still's name
+    }
+    fs::path ffmpeg;
+    if (!videos.empty())
+        ffmpeg = require_ffmpeg(videos.front());  // before any work
+    for (const fs::path& video : videos) {
+        fs::create_directories(video_frames_folder(video));
+        frames.images.push_back(video_frames_folder(video) / "%06d.png");
+    }
+    int status = options.shot.turntable > 0 ? run_turntable(options, frames)
+                                            : run_animation(options, frames);
+    if (status != 0)
+        return status;
+    for (const fs::path& video : videos) {
+        encode_video(ffmpeg, video_frames_folder(video), options.shot.fps, video);
+        outputs.say("wrote " + video.string());
+    }
+    return 0;
 }
 
 }  // namespace cambium::app

@@ -2,8 +2,10 @@
 // The command-line options of sequences and of the camera (ShotOptions).
 #include "app/shot_options.h"
 
+#include <algorithm>
 #include <charconv>
 
+#include "app/video.h"
 #include "base/diagnostics.h"
 
 namespace cambium::app {
@@ -30,6 +32,10 @@ void add_shot_options(CLI::App& cli, ShotOptions& shot)
     cli.add_option("--frames", shot.frames,
                    "Render only frames A-B of a sequence (frame numbers as in the file names)");
     cli.add_flag("--resume", shot.resume, "Skip frames whose output files exist already");
+    cli.add_flag("--video", shot.video,
+                 "Encode the sequence as <plant>.mp4 with ffmpeg (or give -o name.mp4)");
+    cli.add_option("--fps", shot.fps, "Frames per second of video outputs (default 24)")
+        ->check(CLI::Range(1, 240));
 }
 
 std::pair<int, int> frame_range(const std::string& text)
@@ -65,6 +71,13 @@ void check_shot_options(const Options& options)
         throw Error("--frames and --resume select frames of a sequence (-a or --turntable)");
     if (shot.frames)
         frame_range(*shot.frames);
+    bool video = shot.video || std::any_of(options.outputs.begin(), options.outputs.end(),
+                                           [](const auto& f) { return is_video(f); });
+    if (video && shot.turntable == 0 && !shot.animate)
+        throw Error("a video needs a sequence: give -a or --turntable N");
+    if (video && shot.frames)
+        throw Error("--frames renders part of a sequence and a video needs all of it; write "
+                    "frames with -o frame%03d.png and encode them yourself");
 }
 
 }  // namespace cambium::app
