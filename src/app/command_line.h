@@ -35,6 +35,8 @@ struct ShotOptions {
     bool resume = false;                       ///< --resume: skip frames already written
     bool video = false;                        ///< --video: also <plant>.mp4
     int fps = 24;                              ///< --fps of video outputs
+    std::string tonemap = "none";              ///< --tonemap none|filmic (display outputs)
+    std::optional<std::string> background;     ///< --background COLOUR|sky|env
 };
 
 struct Options {

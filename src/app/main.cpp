@@ -87,6 +87,7 @@ render::RenderSettings render_settings(const Options& options,
         return ext == ".exr" || ext == ".EXR";
     });
     settings.cancel = render::install_interrupt_handler();
+    apply_staging(settings, options);
     return settings;
 }
 
@@ -186,8 +187,7 @@ int run(const Options& options)
                     options.width, options.height,
                     double(report.samples) / (double(options.width) * options.height),
                     report.seconds, report.cancelled ? " (interrupted)" : ""));
-    render::WriteOptions write;
-    write.exposure = options.exposure;
+    render::WriteOptions write = write_options(options);
     for (const auto& out : images) {
         render::write_image(image, out, write);
         say("wrote " + out.string());

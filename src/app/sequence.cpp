@@ -138,8 +138,7 @@ private:
 void write_frame_images(render::Image& image, int number, const Options& options,
                         const SequenceOutputs& out)
 {
-    render::WriteOptions write;
-    write.exposure = options.exposure;
+    render::WriteOptions write = write_options(options);
     for (const fs::path& pattern : out.images) {
         fs::path file = frame_file(pattern, number);
         render::write_image(image, file, write);
@@ -325,6 +324,29 @@ int derive_frames(const Model& model, const std::vector<geom::AnimationFrame>& f
             break;  // stop() ends the animation (manual 5.1)
     }
     return derivation.steps_done();
+}
+
+void apply_staging(render::RenderSettings& settings, const Options& options)
+{
+    const std::optional<std::string>& background = options.shot.background;
+    if (!background)
+        return;
+    if (*background == "sky" || *background == "env") {
+        settings.backdrop = render::RenderSettings::Backdrop::environment;
+        return;
+    }
+    auto rgb = background_colour(*background);
+    settings.backdrop = render::RenderSettings::Backdrop::colour;
+    settings.backdrop_colour = {rgb[0], rgb[1], rgb[2]};
+}
+
+render::WriteOptions write_options(const Options& options)
+{
+    render::WriteOptions write;
+    write.exposure = options.exposure;
+    write.tonemap =
+        options.shot.tonemap == "filmic" ? render::ToneMap::filmic : render::ToneMap::none;
+    return write;
 }
 
 void apply_camera_options(geom::Scene& scene, const Options& options)

@@ -41,6 +41,12 @@ int derive_frames(const Model& model, const std::vector<geom::AnimationFrame>& f
                   const std::function<void(const geom::AnimationFrame&,
                                            const lsys::ModuleString&)>& on_frame);
 
+/// The staging options' part of the render settings: --background.
+void apply_staging(render::RenderSettings& settings, const Options& options);
+
+/// How images are written: --exposure and --tonemap.
+render::WriteOptions write_options(const Options& options);
+
 /// The scene's view with --orbit, --zoom, --fit, --fov, --perspective / --parallel.
 void apply_camera_options(geom::Scene& scene, const Options& options);
 

@@ -34,6 +34,12 @@ void add_shot_options(CLI::App& cli, ShotOptions& shot)
     cli.add_flag("--resume", shot.resume, "Skip frames whose output files exist already");
     cli.add_flag("--video", shot.video,
                  "Encode the sequence as <plant>.mp4 with ffmpeg (or give -o name.mp4)");
+    cli.add_option("--tonemap", shot.tonemap,
+                   "Tone curve of PNG/TIFF/JPEG: none (clip, default) or filmic (ACES fit)")
+        ->check(CLI::IsMember({"none", "filmic"}));
+    cli.add_option("--background", shot.background,
+                   "What the camera sees behind the plant: a colour (#rrggbb or R,G,B in 0..1), "
+                   "sky (with --sky) or env (with --env), in both projections");
     cli.add_option("--fps", shot.fps, "Frames per second of video outputs (default 24)")
         ->check(CLI::Range(1, 240));
 }
@@ -56,6 +62,39 @@ std::pair<int, int> frame_range(const std::string& text)
     return {first, last};
 }
 
+std::array<float, 3> background_colour(const std::string& text)
+{
+    std::array<float, 3> rgb{};
+    auto fail = [&]() -> std::array<float, 3> {
+        throw Error("--background: expected sky, env, #rrggbb or R,G,B (0 to 1), not '" + text +
+                    "'");
+    };
+    if (text.size() == 7 && text[0] == '#') {
+        for (int c = 0; c < 3; ++c) {
+            unsigned value = 0;
+            auto [end, ec] = std::from_chars(text.data() + 1 + 2 * c, text.data() + 3 + 2 * c,
+                                             value, 16);
+            if (ec != std::errc() || end != text.data() + 3 + 2 * c)
+                return fail();
+            rgb[std::size_t(c)] = static_cast<float>(value) / 255.0f;
+        }
+        return rgb;
+    }
+    std::size_t start = 0;
+    for (int c = 0; c < 3; ++c) {
+        std::size_t end = c < 2 ? text.find(',', start) : text.size();
+        if (end == std::string::npos)
+            return fail();
+        float value = -1;
+        auto [ptr, ec] = std::from_chars(text.data() + start, text.data() + end, value);
+        if (ec != std::errc() || ptr != text.data() + end || !(value >= 0 && value <= 1))
+            return fail();
+        rgb[std::size_t(c)] = value;
+        start = end + 1;
+    }
+    return rgb;
+}
+
 void check_shot_options(const Options& options)
 {
     const ShotOptions& shot = options.shot;
@@ -71,6 +110,12 @@ void check_shot_options(const Options& options)
         throw Error("--frames and --resume select frames of a sequence (-a or --turntable)");
     if (shot.frames)
         frame_range(*shot.frames);
+    if (shot.background == "sky" && !options.sky)
+        throw Error("--background sky shows the --sky behind the plant; give --sky too");
+    if (shot.background == "env" && !options.environment_map)
+        throw Error("--background env shows the --env map behind the plant; give --env too");
+    if (shot.background && *shot.background != "sky" && *shot.background != "env")
+        background_colour(*shot.background);
     bool video = shot.video || std::any_of(options.outputs.begin(), options.outputs.end(),
                                            [](const auto& f) { return is_video(f); });
     if (video && shot.turntable == 0 && !shot.animate)

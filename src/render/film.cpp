@@ -56,10 +56,10 @@ std::filesystem::path temporary_name(const std::filesystem::path& file)
 /// Display-referred pixels: exposure, straight (unassociated) colour for transparent
 /// images, sRGB-encoded, quantised to `Int` with `channels` channels (3: RGB, 4: RGBA).
 template <class Int>
-std::vector<Int> encode_srgb(const Image& image, int channels, float exposure)
+std::vector<Int> encode_srgb(const Image& image, int channels, const WriteOptions& options)
 {
     constexpr float max = static_cast<float>(std::numeric_limits<Int>::max());
-    float gain = std::exp2(exposure);
+    float gain = std::exp2(options.exposure);
     // A transparent image's colour is premultiplied; files with alpha want it straight.
     bool unpremultiply = image.transparent && channels == 4;
     std::size_t n = std::size_t(image.width) * image.height;
@@ -69,7 +69,8 @@ std::vector<Int> encode_srgb(const Image& image, int channels, float exposure)
         float scale = unpremultiply && alpha > 0 ? gain / alpha : gain;
         for (int c = 0; c < channels; ++c) {
             float v = image.rgba[i * 4 + c];
-            float e = c < 3 ? linear_to_srgb(v * scale) : std::clamp(v, 0.0f, 1.0f);
+            float e = c < 3 ? linear_to_srgb(tone_map(options.tonemap, v * scale))
+                            : std::clamp(v, 0.0f, 1.0f);
             out[i * channels + c] = static_cast<Int>(std::lround(e * max));
         }
     }
@@ -140,7 +141,7 @@ void write_with_oiio(const Image& image, const std::filesystem::path& temp, Form
         // Colour is composited over the background (or made straight when transparent);
         // alpha is a coverage matte.
         spec.attribute("oiio:UnassociatedAlpha", 1);
-        auto pixels = encode_srgb<std::uint16_t>(image, 4, options.exposure);
+        auto pixels = encode_srgb<std::uint16_t>(image, 4, options);
         ok = out->open(temp.string(), spec) &&
              out->write_image(OIIO::TypeDesc::UINT16, pixels.data());
     } else {
@@ -151,7 +152,7 @@ void write_with_oiio(const Image& image, const std::filesystem::path& temp, Form
             spec.attribute("oiio:UnassociatedAlpha", 1);
         if (format == Format::jpeg)
             spec.attribute("Compression", "jpeg:95");
-        auto pixels = encode_srgb<std::uint8_t>(image, channels, options.exposure);
+        auto pixels = encode_srgb<std::uint8_t>(image, channels, options);
         ok = out->open(temp.string(), spec) &&
              out->write_image(OIIO::TypeDesc::UINT8, pixels.data());
     }

@@ -435,7 +435,9 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
             area_lights = std::make_unique<AreaLights>(scene, ctx.materials);
             ctx.area_lights = area_lights.get();
         }
-        ctx.background = decode_display(scene.background);
+        ctx.background = decode_display(settings.backdrop == RenderSettings::Backdrop::colour
+                                            ? settings.backdrop_colour
+                                            : scene.background);
         ctx.environment = settings.environment.get();
         ctx.ambient = {settings.ambient.r, settings.ambient.g, settings.ambient.b};
         ctx.max_depth = settings.max_depth;
@@ -446,8 +448,11 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         const Camera& camera = cameras[view];
         // A parallel camera looks along one direction: its misses would all see the same
         // environment radiance, so they keep cpfg's background there.
-        ctx.environment_visible = settings.environment != nullptr &&
-                                  camera.projection() == Camera::Projection::perspective;
+        ctx.environment_visible =
+            settings.environment != nullptr &&
+            (settings.backdrop == RenderSettings::Backdrop::environment ||
+             (settings.backdrop == RenderSettings::Backdrop::view &&
+              camera.projection() == Camera::Projection::perspective));
         ctx.camera_cone = camera_cone(camera);
         std::vector<PixelState> pixels(std::size_t(w) * h);
         RenderReport rep;

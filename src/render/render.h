@@ -84,6 +84,13 @@ struct RenderSettings {
     /// Camera rays that miss contribute nothing instead of the background: RGB is
     /// premultiplied by the coverage alpha (Image::transparent) for PNG/TIFF/EXR output.
     bool transparent_background = false;
+    /// What camera rays that miss see (--background): the view's background colour
+    /// (cpfg's window; the environment shows there in perspective views), a colour of
+    /// its own (display values, decoded from sRGB), or the environment in both
+    /// projections (a parallel view sees the environment's radiance along its direction).
+    enum class Backdrop { view, colour, environment };
+    Backdrop backdrop = Backdrop::view;
+    geom::Rgb backdrop_colour{0, 0, 0};
     /// Compute the albedo, normal and depth layers (Image::albedo/normal/depth): one
     /// extra camera-ray intersection per sample.
     bool aovs = true;

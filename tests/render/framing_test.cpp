@@ -194,3 +194,30 @@ TEST(RenderViews, EveryViewEqualsASeparateRender)
 
 }  // namespace
 }  // namespace cambium::render
+
+#include "render/tonemap.h"
+
+namespace cambium::render {
+namespace {
+
+TEST(ToneMap, FilmicRollsHighlightsOffInsteadOfClipping)
+{
+    EXPECT_FLOAT_EQ(tone_map(ToneMap::none, 3.0f), 3.0f);  // clipped later by the encoder
+    EXPECT_FLOAT_EQ(filmic(0.0f), 0.0f);
+    EXPECT_FLOAT_EQ(filmic(-1.0f), 0.0f);
+    float previous = 0;
+    for (float x : {0.05f, 0.18f, 0.5f, 1.0f, 2.0f, 4.0f}) {
+        float y = filmic(x);
+        EXPECT_GT(y, previous) << x;  // strictly increasing: highlights keep detail
+        EXPECT_LE(y, 1.0f) << x;
+        previous = y;
+    }
+    EXPECT_LT(filmic(2.0f), 0.95f);   // a value twice white is not clipped yet
+    EXPECT_GT(filmic(16.0f), 0.99f);  // very bright values reach white
+    EXPECT_LE(filmic(100.0f), 1.0f);
+    // Narkowicz's fit at mid-grey: 0.18 -> about 0.14 after his 0.6 exposure match
+    EXPECT_NEAR(filmic(0.18f), 0.140f, 0.002f);
+}
+
+}  // namespace
+}  // namespace cambium::render
