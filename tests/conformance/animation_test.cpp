@@ -12,13 +12,6 @@
 namespace cambium::test {
 namespace {
 
-std::string without_newlines(std::string s)
-{
-    std::erase(s, '\n');
-    std::erase(s, '\r');
-    return s;
-}
-
 app::Options animated(const CorpusModel& model)
 {
     app::Options options = model_options(model);
@@ -37,14 +30,7 @@ TEST(AnimationConformance, LastFrameStringsMatchCpfg)
                            [&](const geom::AnimationFrame&, const lsys::ModuleString& s) {
             last = lsys::to_text(s, loaded.lsystem.symbols());
         });
-        std::string ref = without_newlines(reference);
-        if (last == ref)
-            return std::string();
-        std::size_t at = 0;
-        while (at < last.size() && at < ref.size() && last[at] == ref[at])
-            ++at;
-        return "at character " + std::to_string(at) + ": ours '" + last.substr(at, 40) +
-               "' cpfg '" + ref.substr(at, 40) + "'";
+        return string_difference(last, without_newlines(reference));
     });
 }
 
