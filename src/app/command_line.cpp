@@ -9,6 +9,7 @@
 #include <map>
 #include <regex>
 
+#include "app/shot_options.h"
 #include "base/diagnostics.h"
 #include "render/render.h"
 
@@ -76,8 +77,10 @@ const std::map<std::string, CpfgOption>& cpfg_options()
         {"-iv", {1, unsupported_output("Inventor")}},
         {"-gls", {1, unsupported_output("gls")}},
         {"-glsl", {1, unsupported_output("gls")}},
+        // cpfg's animate mode: every frame of the animation file (or its defaults).
+        {"-a", {0, [](Options& o, auto&) { o.shot.animate = true; }}},
         // Window-system and interactive options of cpfg: meaningless offline.
-        {"-g", {0, ignore}},  {"-a", {0, ignore}},  {"-d", {0, ignore}},
+        {"-g", {0, ignore}},  {"-d", {0, ignore}},
         {"-mb", {0, ignore}}, {"-pm", {0, ignore}}, {"-sb", {0, ignore}},
         {"-wt", {1, ignore}}, {"-S", {1, ignore}},  {"-C", {1, ignore}},
         {"-f", {1, ignore}},  {"-wp", {2, ignore}},
@@ -143,8 +146,9 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
 
     CLI::App cli{"cambium: renders cpfg plant models physically.\n"
                  "cpfg options: -w W H (image size, default 640 480), -m[n] file.map, -M[n] file.mat, -c<n>, -w W H, -str file,\n"
-                 "-strb file, -homo, -vv file, -rgb file, -tga file, -v, -V, -P cpp, -e file;\n"
-                 "window options (-g -a -wp -wt -mb -pm -sb -s<n>) are accepted and ignored."};
+                 "-strb file, -homo, -vv file, -rgb file, -tga file, -v, -V, -P cpp, -e file,\n"
+                 "-a (every frame of the animation file); window options (-g -wp -wt -mb -pm -sb -s<n>)\n"
+                 "are accepted and ignored."};
     cli.set_version_flag("--version", "cambium " CAMBIUM_VERSION);
     cli.add_option("-o", options.outputs,
                    "Output image (.png .exr .tif .jpg); may be given more than once")
@@ -214,6 +218,7 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
                  "Let the L-system's fopen read and write files outside the model's folder "
                  "(never done by default)");
     cli.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
+    add_shot_options(cli, options.shot);
     std::vector<std::string> files;
     cli.add_option("files", files, "plant.l plant.v [plant.a]")->required()->expected(2, 3);
 
@@ -247,6 +252,7 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
         throw Error("--turbidity sets the haze of the --sky; give --sky too");
     if (cli.count("--env-rotate") > 0 && !options.sky && !options.environment_map)
         throw Error("--env-rotate turns the --env map or the --sky; give one of them");
+    check_shot_options(options);
     options.lsystem = files[0];
     options.view = files[1];
     if (files.size() == 3)

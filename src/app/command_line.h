@@ -26,6 +26,25 @@ struct ColourFile {
 /// How much cpfg-style tracing to print (-v warnings, -V verbose).
 enum class Verbosity { normal, warnings, verbose };
 
+/// Sequences and the camera (src/app/shot_options.cpp): cpfg's animation mode,
+/// turntables, camera changes over the view file, and which frames to render.
+struct ShotOptions {
+    bool animate = false;                      ///< -a: the frames the animation selects
+    int turntable = 0;                         ///< --turntable N frames (0 = none)
+    std::optional<double> turntable_elevation; ///< --turntable-elevation DEG
+    std::vector<double> orbit;                 ///< --orbit AZ EL (degrees)
+    double zoom = 1;                           ///< --zoom K
+    bool fit = false;                          ///< --fit
+    std::optional<double> fov;                 ///< --fov DEG
+    bool perspective = false, parallel = false;  ///< --perspective / --parallel
+    std::optional<std::string> frames;         ///< --frames A-B (frame numbers)
+    bool resume = false;                       ///< --resume: skip frames already written
+    bool video = false;                        ///< --video: also <plant>.mp4
+    int fps = 24;                              ///< --fps of video outputs
+    std::string tonemap = "none";              ///< --tonemap none|filmic (display outputs)
+    std::optional<std::string> background;     ///< --background COLOUR|sky|env
+};
+
 struct Options {
     std::filesystem::path lsystem, view;
     std::optional<std::filesystem::path> animation;
@@ -75,6 +94,8 @@ struct Options {
     std::optional<std::filesystem::path> environment_map;  ///< --env file.exr|.hdr
     float environment_scale = 1;       ///< --env-scale
     float environment_rotation = 0;    ///< --env-rotate DEG about +y (with --env or --sky)
+
+    ShotOptions shot;
 
     /// Whether an image is to be rendered: an -o was given, or no other output was.
     bool renders() const

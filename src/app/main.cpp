@@ -14,6 +14,8 @@
 #include "app/command_line.h"
 #include "app/pipeline.h"
 #include "base/atomic_file.h"
+#include "app/sequence.h"
+#include "app/video.h"
 #include "base/diagnostics.h"
 #include "base/subprocess.h"
 #include "geom/view_volume.h"
@@ -88,6 +90,7 @@ render::RenderSettings render_settings(const Options& options,
         return ext == ".exr" || ext == ".EXR";
     });
     settings.cancel = render::install_interrupt_handler();
+    apply_staging(settings, options);
     return settings;
 }
 
@@ -108,9 +111,8 @@ void write_atomically(const std::filesystem::path& file, Write write)
 /// -str and -strb: the derived string in cpfg's formats; names may be format strings
 /// (plant%03d.str) that receive the derivation step.
 void write_strings(const Model& model, const lsys::ModuleString& string, const Options& options,
-                   const std::function<void(const std::string&)>& say)
+                   int step, const std::function<void(const std::string&)>& say)
 {
-    int step = options.steps.value_or(model.lsystem.derivation_length());
     if (options.string_text) {
         std::filesystem::path file = lsys::format_frame_name(options.string_text->string(), step);
         write_atomically(file, [&](std::ostream& out) {
@@ -140,18 +142,24 @@ int run(const Options& options)
     };
     std::vector<std::filesystem::path> images = image_outputs(options);
     for (const auto& out : images)
-        render::check_output_format(out);  // fail before the work, not after
-    if (options.animation)
-        warn(FileLoc{options.animation->string()},
-             "animation files are not interpreted yet; rendering the last derivation step");
+        if (!is_video(out))
+            render::check_output_format(out);  // fail before the work, not after
     if (options.environment_requested)
         warn("-e: no environmental program is connected; ?E modules keep their parameters");
+    if (is_sequence(options)) {
+        SequenceOutputs outputs{images, render_settings(options, images), {}, say};
+        outputs.write_strings = [&](const Model& model, const lsys::ModuleString& s, int step) {
+            write_strings(model, s, options, step, say);
+        };
+        return run_sequence(options, outputs);
+    }
 
     auto start = Clock::now();
     Model model = load_model(options);
     lsys::ModuleString string = derive(model, options);
     say(fmt::format("derived {} modules in {:.3f} s", string.size(), seconds_since(start)));
-    write_strings(model, string, options, say);
+    write_strings(model, string, options,
+                  options.steps.value_or(model.lsystem.derivation_length()), say);
 
     geom::Scene scene = interpret(model, string, options);
     const geom::Geometry& g = scene.geometry;
@@ -168,14 +176,14 @@ int run(const Options& options)
         return 0;
 
     render::RenderSettings settings = render_settings(options, images);
+    apply_camera_options(scene, options);
     render::RenderReport report;
     render::Image image = render::render(scene, settings, &report);
     say(fmt::format("rendered {}x{}, {:.1f} samples per pixel on average, in {:.2f} s{}",
                     options.width, options.height,
                     double(report.samples) / (double(options.width) * options.height),
                     report.seconds, report.cancelled ? " (interrupted)" : ""));
-    render::WriteOptions write;
-    write.exposure = options.exposure;
+    render::WriteOptions write = write_options(options);
     for (const auto& out : images) {
         render::write_image(image, out, write);
         say("wrote " + out.string());

@@ -143,13 +143,37 @@ geom::Shading render_mode(const geom::ViewFile& view)
 geom::Scene interpret(const Model& model, const lsys::ModuleString& derived,
                       const Options& options)
 {
+    return interpret_turtle_string(model, turtle_string(model, derived, options), options);
+}
+
+namespace {
+
+/// -o> objects become prototypes and instances (docs: manual 8.1); with -homo the
+/// string already holds their expansions.
+std::vector<char> instanced_objects(const Model& model, const Options& options)
+{
+    return options.homomorphism_in_string ? std::vector<char>{} : object_symbols(model.lsystem);
+}
+
+}  // namespace
+
+lsys::ModuleString turtle_string(const Model& model, const lsys::ModuleString& derived,
+                                 const Options& options)
+{
+    if (options.homomorphism_in_string)
+        return derived;
+    return model.lsystem.interpretation_string(derived, instanced_objects(model, options).empty()
+                                                            ? lsys::ObjectHandling::expand
+                                                            : lsys::ObjectHandling::keep);
+}
+
+geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString& string,
+                                    const Options& options)
+{
     geom::InterpretOptions interpret_options;
     interpret_options.strings = model.lsystem.program().strings;
     interpret_options.max_memory_bytes = options.max_memory_bytes;
-    // -o> objects become prototypes and instances (docs: manual 8.1); with -homo the
-    // string already holds their expansions.
-    std::vector<char> objects =
-        options.homomorphism_in_string ? std::vector<char>{} : object_symbols(model.lsystem);
+    std::vector<char> objects = instanced_objects(model, options);
     if (!objects.empty()) {
         const lsys::LSystem& lsystem = model.lsystem;
         interpret_options.is_object = [objects](lsys::SymbolId s) {
@@ -163,11 +187,6 @@ geom::Scene interpret(const Model& model, const lsys::ModuleString& derived,
             run_system_call(command, folder);
         };
     }
-    lsys::ModuleString string =
-        options.homomorphism_in_string
-            ? derived
-            : model.lsystem.interpretation_string(
-                  derived, objects.empty() ? lsys::ObjectHandling::expand : lsys::ObjectHandling::keep);
     geom::Scene scene =
         geom::interpret(string, model.lsystem.symbols(), *model.view, interpret_options);
     scene.shading = render_mode(*model.view);

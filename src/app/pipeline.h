@@ -39,4 +39,12 @@ lsys::ModuleString derive(const Model& model, const Options& options);
 geom::Scene interpret(const Model& model, const lsys::ModuleString& derived,
                       const Options& options);
 
+/// The two halves of interpret(): the string the turtle reads (homomorphism applied
+/// with the globals of the last derivation; instanceable objects kept whole) ...
+lsys::ModuleString turtle_string(const Model& model, const lsys::ModuleString& derived,
+                                 const Options& options);
+/// ... and its interpretation into a Scene.
+geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString& string,
+                                    const Options& options);
+
 }  // namespace cambium::app

@@ -149,28 +149,62 @@ bool LSystem::has_queries() const { return m_has_queries; }
 
 ModuleString LSystem::derive(std::optional<int> steps) const
 {
-    Deriver deriver(*m_program, limits_of(m_options));
+    Derivation derivation = start();
+    int n = steps.value_or(derivation.derivation_length());
+    derivation.advance(n);
+    bool stopped_early = derivation.stopped() && derivation.steps_done() < n;
+    if (!stopped_early || derivation.stop_runs_end())
+        derivation.finish();
+    return derivation.take_string();
+}
+
+Derivation LSystem::start() const
+{
+    auto deriver = std::make_unique<Deriver>(*m_program, limits_of(m_options));
     if (m_options.on_step)
-        m_options.on_step(0, deriver.string());
-    int n = steps.value_or(deriver.derivation_length());
-    for (int i = 0; i < n; ++i) {
+        m_options.on_step(0, deriver->string());
+    m_last_runtime = std::make_shared<Runtime>(deriver->runtime());
+    return Derivation(*this, std::move(deriver));
+}
+
+Derivation::Derivation(const LSystem& lsystem, std::unique_ptr<Deriver> deriver)
+    : m_lsystem(&lsystem), m_deriver(std::move(deriver))
+{
+}
+Derivation::Derivation(Derivation&&) noexcept = default;
+Derivation& Derivation::operator=(Derivation&&) noexcept = default;
+Derivation::~Derivation() = default;
+
+void Derivation::advance(int steps)
+{
+    const LoadOptions& options = m_lsystem->m_options;
+    for (int i = 0; i < steps && !m_deriver->stop_requested(); ++i) {
         // cpfg (with its default "environment display" off) answers queries while
         // interpreting the string before each step, not after the last one
-        if (m_has_queries && m_options.query)
-            run_query(deriver);
-        deriver.step();
-        if (m_options.on_step)
-            m_options.on_step(deriver.steps_done(), deriver.string());
-        // stop() ends the derivation once the step that called it is complete
-        if (deriver.stop_requested())
-            break;
+        if (m_lsystem->m_has_queries && options.query)
+            m_lsystem->run_query(*m_deriver);
+        m_deriver->step();
+        if (options.on_step)
+            options.on_step(m_deriver->steps_done(), m_deriver->string());
     }
-    bool stopped_early = deriver.stop_requested() && deriver.steps_done() < n;
-    if (!stopped_early || deriver.stop_runs_end())
-        deriver.finish();
-    m_last_runtime = std::make_shared<Runtime>(deriver.runtime());
-    return deriver.take_string();
+    m_lsystem->m_last_runtime = std::make_shared<Runtime>(m_deriver->runtime());
 }
+
+void Derivation::finish()
+{
+    if (m_finished)
+        return;
+    m_finished = true;
+    m_deriver->finish();
+    m_lsystem->m_last_runtime = std::make_shared<Runtime>(m_deriver->runtime());
+}
+
+const ModuleString& Derivation::string() const { return m_deriver->string(); }
+int Derivation::steps_done() const { return m_deriver->steps_done(); }
+int Derivation::derivation_length() const { return m_deriver->derivation_length(); }
+bool Derivation::stopped() const { return m_deriver->stop_requested(); }
+bool Derivation::stop_runs_end() const { return m_deriver->stop_runs_end(); }
+ModuleString Derivation::take_string() { return m_deriver->take_string(); }
 
 void LSystem::run_query(Deriver& deriver) const
 {

@@ -50,6 +50,44 @@ struct LoadOptions {
 /// What interpretation_string does with object productions (-o>).
 enum class ObjectHandling { expand, keep };
 
+class LSystem;
+
+/// A derivation that advances step by step, as cpfg's animation mode derives: each
+/// frame continues from the previous one's string (never re-derived from the axiom).
+/// Made by LSystem::start(); it refers to its LSystem, which must outlive it. Every
+/// advance() leaves its globals where LSystem::interpretation_string() reads them.
+class Derivation {
+public:
+    Derivation(Derivation&&) noexcept;
+    Derivation& operator=(Derivation&&) noexcept;
+    ~Derivation();
+
+    /// Derives up to `steps` more steps (the query pass before each, as derive() does),
+    /// past the derivation length if asked. stop() called in a step ends the advance
+    /// after that step; stopped() then stays true.
+    void advance(int steps);
+    /// Runs the End block once (later calls do nothing).
+    void finish();
+    const ModuleString& string() const;
+    /// Steps derived since the axiom.
+    int steps_done() const;
+    /// The derivation length the Start block left (the file's, unless it sets one).
+    int derivation_length() const;
+    /// stop() was called in a step.
+    bool stopped() const;
+    /// ... with an argument other than 1: the End block runs anyway (cpfg).
+    bool stop_runs_end() const;
+    /// Moves the string out; the Derivation is spent afterwards.
+    ModuleString take_string();
+
+private:
+    friend class LSystem;
+    Derivation(const LSystem& lsystem, std::unique_ptr<Deriver> deriver);
+    const LSystem* m_lsystem;
+    std::unique_ptr<Deriver> m_deriver;
+    bool m_finished = false;
+};
+
 /// A parsed and compiled .l file.
 class LSystem {
 public:
@@ -83,6 +121,8 @@ public:
     /// (array subscript out of range, '%' by 0, file functions) throw cambium::Error
     /// naming file:line:col and the production or block.
     ModuleString derive(std::optional<int> steps = std::nullopt) const;
+    /// A derivation at the axiom (Start block run), to advance step by step.
+    Derivation start() const;
     /// The compiled program (productions, decomposition, homomorphism, globals).
     const Program& program() const;
 
@@ -107,6 +147,7 @@ public:
     ModuleString expand_object(ModuleRef module) const;
 
 private:
+    friend class Derivation;
     explicit LSystem(std::unique_ptr<Program> program, LoadOptions options);
     void run_query(Deriver& deriver) const;
     ModuleString join_at_commands(const ModuleString& s) const;

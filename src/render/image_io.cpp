@@ -45,11 +45,11 @@ enum class AlphaStorage { straight, associated };
 /// Display-referred pixels: exposure, sRGB-encoded, quantised to `Int` with `channels`
 /// channels (3: RGB, 4: RGBA with colour stored as `storage` says).
 template <class Int>
-std::vector<Int> encode_srgb(const Image& image, int channels, float exposure,
+std::vector<Int> encode_srgb(const Image& image, int channels, const WriteOptions& options,
                              AlphaStorage storage = AlphaStorage::straight)
 {
     constexpr float max = static_cast<float>(std::numeric_limits<Int>::max());
-    float gain = std::exp2(exposure);
+    float gain = std::exp2(options.exposure);
     // A transparent image's colour is premultiplied; it is encoded straight.
     bool unpremultiply = image.transparent && channels == 4;
     bool associate = channels == 4 && storage == AlphaStorage::associated;
@@ -60,7 +60,9 @@ std::vector<Int> encode_srgb(const Image& image, int channels, float exposure,
         float scale = unpremultiply && alpha > 0 ? gain / image.rgba[i * 4 + 3] : gain;
         for (int c = 0; c < channels; ++c) {
             float v = image.rgba[i * 4 + c];
-            float e = c < 3 ? linear_to_srgb(v * scale) * (associate ? alpha : 1.0f) : alpha;
+            float e = c < 3 ? linear_to_srgb(tone_map(options.tonemap, v * scale)) *
+                                  (associate ? alpha : 1.0f)
+                            : alpha;
             out[i * channels + c] = static_cast<Int>(std::lround(e * max));
         }
     }
@@ -138,7 +140,7 @@ void write_with_oiio(const Image& image, const std::filesystem::path& temp, Form
         OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::UINT16);
         spec.attribute("oiio:ColorSpace", "sRGB");
         without_time_stamp(spec);
-        auto pixels = encode_srgb<std::uint16_t>(image, channels, options.exposure,
+        auto pixels = encode_srgb<std::uint16_t>(image, channels, options,
                                                  AlphaStorage::associated);
         ok = out->open(temp.string(), spec) &&
              out->write_image(OIIO::TypeDesc::UINT16, pixels.data());
@@ -151,7 +153,7 @@ void write_with_oiio(const Image& image, const std::filesystem::path& temp, Form
             spec.attribute("oiio:UnassociatedAlpha", 1);
         if (format == Format::jpeg)
             spec.attribute("Compression", "jpeg:95");
-        auto pixels = encode_srgb<std::uint8_t>(image, channels, options.exposure);
+        auto pixels = encode_srgb<std::uint8_t>(image, channels, options);
         ok = out->open(temp.string(), spec) &&
              out->write_image(OIIO::TypeDesc::UINT8, pixels.data());
     }

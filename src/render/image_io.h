@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <vector>
 
+#include "render/tonemap.h"
+
 namespace cambium::render {
 
 /// A rendered frame: rows top to bottom, 4 floats per pixel. RGB is linear; A is the
@@ -32,6 +34,8 @@ struct WriteOptions {
     /// Display formats (PNG, JPEG, TIFF) scale RGB by 2^exposure before encoding; EXR
     /// keeps the scene-referred values.
     float exposure = 0;
+    /// ... and then apply this tone curve (render/tonemap.h); EXR is never tone mapped.
+    ToneMap tonemap = ToneMap::none;
 };
 
 /// Writes by extension: .png (8-bit sRGB; RGB, or RGBA with straight alpha when the

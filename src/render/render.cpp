@@ -378,25 +378,42 @@ Image render(const geom::Scene& scene, const RenderSettings& settings, RenderRep
 Image render(const geom::Scene& scene, const Camera& camera, const RenderSettings& settings,
              RenderReport* report)
 {
+    Image image;
+    render_views(scene, std::span<const Camera>(&camera, 1), settings,
+                 [&](std::size_t, Image& frame, const RenderReport& rep) {
+        image = std::move(frame);
+        if (report)
+            *report = rep;
+        return true;
+    });
+    return image;
+}
+
+void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
+                  const RenderSettings& settings, const ViewCallback& on_view)
+{
     check_settings(settings);
-    if (camera.width() != settings.width || camera.height() != settings.height)
-        throw Error("render: the camera's image size differs from the settings'");
-    camera.check_range("view");
+    for (const Camera& camera : cameras) {
+        if (camera.width() != settings.width || camera.height() != settings.height)
+            throw Error("render: the camera's image size differs from the settings'");
+        camera.check_range("view");
+    }
+    if (cameras.empty())
+        return;
     auto start = Clock::now();
     auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
     tbb::task_arena arena(settings.threads > 0 ? settings.threads
                                                : tbb::task_arena::automatic);
     const int w = settings.width, h = settings.height;
-    std::vector<PixelState> pixels(std::size_t(w) * h);
-    RenderReport rep;
     std::atomic<std::uint64_t> nonfinite{0};
     arena.execute([&] {
         std::unique_ptr<TextureSet> textures;
         if (!scene.textures.empty())
             textures = std::make_unique<TextureSet>(scene.textures, settings.texture_folder,
                                                     settings.max_memory_bytes);
-        // Embree builds with TBB too, so the build also stays within the arena.
-        EmbreeScene accel(scene, camera, textures.get());
+        // Embree builds with TBB too, so the build also stays within the arena. One
+        // build serves every view (pixel-wide lines take the first view's pixel size).
+        EmbreeScene accel(scene, cameras.front(), textures.get());
         PathContext ctx;
         ctx.accel = &accel;
         ctx.textures = textures.get();
@@ -407,23 +424,32 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
             area_lights = std::make_unique<AreaLights>(scene, ctx.materials);
             ctx.area_lights = area_lights.get();
         }
-        ctx.background = decode_display(scene.background);
+        ctx.background = decode_display(settings.backdrop == RenderSettings::Backdrop::colour
+                                            ? settings.backdrop_colour
+                                            : scene.background);
         ctx.environment = settings.environment.get();
-        // A parallel camera looks along one direction: its misses would all see the same
-        // environment radiance, so they keep cpfg's background there.
-        ctx.environment_visible = settings.environment != nullptr &&
-                                  camera.projection() == Camera::Projection::perspective;
         ctx.ambient = {settings.ambient.r, settings.ambient.g, settings.ambient.b};
         ctx.max_depth = settings.max_depth;
         ctx.unlit = scene.shading == geom::Shading::filled || scene.shading == geom::Shading::wireframe;
         ctx.facet_normals = scene.shading == geom::Shading::flat;
         ctx.roulette_depth = settings.roulette_depth;
-        ctx.camera_cone = camera_cone(camera);
         if (!scene.bounds.empty())
             ctx.scene_radius =
                 static_cast<float>(0.5 * geom::length(scene.bounds.hi - scene.bounds.lo));
         prepare_path_context(ctx);
 
+        for (std::size_t view = 0; view < cameras.size(); ++view) {
+        const Camera& camera = cameras[view];
+        // A parallel camera looks along one direction: its misses would all see the same
+        // environment radiance, so they keep cpfg's background there.
+        ctx.environment_visible =
+            settings.environment != nullptr &&
+            (settings.backdrop == RenderSettings::Backdrop::environment ||
+             (settings.backdrop == RenderSettings::Backdrop::view &&
+              camera.projection() == Camera::Projection::perspective));
+        ctx.camera_cone = camera_cone(camera);
+        std::vector<PixelState> pixels(std::size_t(w) * h);
+        RenderReport rep;
         RenderState state{ctx, accel, camera, settings,
                     FilterTable(settings.filter, settings.filter_radius),
                     camera.aperture_radius() > 0 &&
@@ -505,21 +531,22 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
         rep.cancelled = cancelled;
         rep.out_of_time = out_of_time;
         rep.skipped_rays = accel.skipped_rays();
+        rep.nonfinite_samples = nonfinite.exchange(0);
+        if (rep.nonfinite_samples > 0)
+            warn("render: " + std::to_string(rep.nonfinite_samples) +
+                 " sample(s) with a radiance that is not finite were counted as black");
+        if (rep.skipped_rays > 0)
+            warn("render: " + std::to_string(rep.skipped_rays) +
+                 " ray(s) not finite or starting too far from the origin were skipped");
+        for (const PixelState& st : pixels)
+            rep.samples += st.samples;
+        Image image = resolve(pixels, settings);
+        rep.seconds = elapsed();
+        if (!on_view(view, image, rep) || rep.cancelled)
+            break;
+        start = Clock::now();  // the next view's time budget and seconds
+        }
     });
-    rep.nonfinite_samples = nonfinite.load();
-    if (rep.nonfinite_samples > 0)
-        warn("render: " + std::to_string(rep.nonfinite_samples) +
-             " sample(s) with a radiance that is not finite were counted as black");
-    if (rep.skipped_rays > 0)
-        warn("render: " + std::to_string(rep.skipped_rays) +
-             " ray(s) not finite or starting too far from the origin were skipped");
-    for (const PixelState& st : pixels)
-        rep.samples += st.samples;
-    Image image = resolve(pixels, settings);
-    rep.seconds = elapsed();
-    if (report)
-        *report = rep;
-    return image;
 }
 
 }  // namespace cambium::render

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "base/limits.h"
@@ -91,6 +92,13 @@ struct RenderSettings {
     /// Camera rays that miss contribute nothing instead of the background: RGB is
     /// premultiplied by the coverage alpha (Image::transparent) for PNG/TIFF/EXR output.
     bool transparent_background = false;
+    /// What camera rays that miss see (--background): the view's background colour
+    /// (cpfg's window; the environment shows there in perspective views), a colour of
+    /// its own (display values, decoded from sRGB), or the environment in both
+    /// projections (a parallel view sees the environment's radiance along its direction).
+    enum class Backdrop { view, colour, environment };
+    Backdrop backdrop = Backdrop::view;
+    geom::Rgb backdrop_colour{0, 0, 0};
     /// Compute the albedo, normal and depth layers (Image::albedo/normal/depth): one
     /// extra camera-ray intersection per sample.
     bool aovs = true;
@@ -127,6 +135,18 @@ Image render(const geom::Scene& scene, const RenderSettings& settings,
 /// Renders with an explicit camera (tests, turntables); the settings' lens is not applied.
 Image render(const geom::Scene& scene, const Camera& camera, const RenderSettings& settings,
              RenderReport* report = nullptr);
+
+/// Called after each view of render_views() with its index, its image (which may be
+/// moved from) and its report; returning false stops the sequence.
+using ViewCallback = std::function<bool(std::size_t view, Image& image, const RenderReport&)>;
+
+/// Renders one scene from several cameras (a turntable), loading its textures and
+/// building its BVH once. Every view uses the same sampling pattern (random numbers
+/// hashed from pixel, sample and seed), so noise does not move between frames; the
+/// time budget applies to each view; a cancel ends the sequence after the view it
+/// interrupted. The first view's report counts the build.
+void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
+                  const RenderSettings& settings, const ViewCallback& on_view);
 
 /// Installs a SIGINT handler that sets the returned flag (pass it as
 /// RenderSettings::cancel); a second Ctrl-C kills the process as usual. Idempotent.

@@ -66,6 +66,24 @@ app::Options model_options(const CorpusModel& model)
     return o;
 }
 
+std::string without_newlines(std::string s)
+{
+    std::erase(s, '\n');
+    std::erase(s, '\r');
+    return s;
+}
+
+std::string string_difference(const std::string& ours, const std::string& cpfg)
+{
+    if (ours == cpfg)
+        return {};
+    std::size_t at = 0;
+    while (at < ours.size() && at < cpfg.size() && ours[at] == cpfg[at])
+        ++at;
+    return "at character " + std::to_string(at) + ": ours '" + ours.substr(at, 40) +
+           "' cpfg '" + cpfg.substr(at, 40) + "'";
+}
+
 std::string read_text(const fs::path& file)
 {
     std::ifstream in(file, std::ios::binary);

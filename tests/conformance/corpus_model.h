@@ -31,6 +31,12 @@ std::vector<CorpusModel> corpus_models(const std::filesystem::path& corpus);
 /// made absolute (relative to the model's folder).
 app::Options model_options(const CorpusModel& model);
 
+/// `s` without line breaks (cpfg's string files break lines).
+std::string without_newlines(std::string s);
+
+/// "" when the strings are equal, else where they first differ and what follows there.
+std::string string_difference(const std::string& ours, const std::string& cpfg);
+
 /// The text of a file (empty when it cannot be read).
 std::string read_text(const std::filesystem::path& file);
 

@@ -18,13 +18,6 @@ const std::set<std::string> known_string_differences = {
 #include "string_known.inc"
 };
 
-std::string without_newlines(std::string s)
-{
-    std::erase(s, '\n');
-    std::erase(s, '\r');
-    return s;
-}
-
 TEST(StringConformance, CorpusStringsMatchCpfg)
 {
     compare_with_oracle("string.str", known_string_differences,
@@ -33,13 +26,7 @@ TEST(StringConformance, CorpusStringsMatchCpfg)
         app::Options options = model_options(model);
         app::Model loaded = app::load_model(options);
         std::string ours = lsys::to_text(app::derive(loaded, options), loaded.lsystem.symbols());
-        if (ours == ref)
-            return std::string();
-        std::size_t at = 0;
-        while (at < ours.size() && at < ref.size() && ours[at] == ref[at])
-            ++at;
-        return "at character " + std::to_string(at) + ": ours '" + ours.substr(at, 40) +
-               "' cpfg '" + ref.substr(at, 40) + "'";
+        return string_difference(ours, ref);
     });
 }
 

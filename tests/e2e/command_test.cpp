@@ -485,3 +485,104 @@ TEST(Command, QuietMeansNoWarnings)
     EXPECT_EQ(quiet.status, 0) << quiet.output;
     EXPECT_EQ(quiet.output, "");
 }
+
+namespace {
+
+/// A small growing plant: 3 steps, each adding a segment.
+fs::path growing_plant(const fs::path& dir)
+{
+    write(dir / "g.l", "lsystem: 1\nderivation length: 3\naxiom: A\nA --> F[+F]A\nendlsystem\n");
+    write(dir / "g.v", "line style: cylinder\ninitial line width: 0.2\n");
+    return dir;
+}
+
+std::string plant_files(const fs::path& dir)
+{
+    return (dir / "g.l").string() + " " + (dir / "g.v").string();
+}
+
+}  // namespace
+
+TEST(Sequence, AnimationWithoutAFileRendersEveryStepWithNumberedNames)
+{
+    fs::path dir = growing_plant(scratch("anim"));
+    Result r = run("-a -q -w 24 18 --spp 1 -o " + (dir / "f%02d.png").string() + " -str " +
+                   (dir / "s%d.str").string() + " " + plant_files(dir));
+    ASSERT_EQ(r.status, 0) << r.output;
+    // cpfg's defaults: 1 .. derivation length
+    for (const char* file : {"f01.png", "f02.png", "f03.png", "s1.str", "s2.str", "s3.str"})
+        EXPECT_TRUE(fs::exists(dir / file)) << file;
+    EXPECT_FALSE(fs::exists(dir / "f00.png"));
+    std::ifstream third(dir / "s3.str");
+    std::string text((std::istreambuf_iterator<char>(third)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(text.substr(0, 10), "F[+F]F[+F]");
+}
+
+TEST(Sequence, AnimationFileSelectsFrames)
+{
+    fs::path dir = growing_plant(scratch("anim_file"));
+    write(dir / "g.a", "first frame: 0\nlast frame: 3\nstep: 2\n");
+    Result r = run("-a -q -str " + (dir / "s%d.str").string() + " " + plant_files(dir) + " " +
+                   (dir / "g.a").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    // 0, 2, then 4: the last frame is reached or passed, past the derivation length
+    EXPECT_TRUE(fs::exists(dir / "s0.str"));
+    EXPECT_TRUE(fs::exists(dir / "s2.str"));
+    EXPECT_TRUE(fs::exists(dir / "s4.str"));
+    EXPECT_FALSE(fs::exists(dir / "s1.str"));
+    EXPECT_FALSE(fs::exists(dir / "s3.str"));
+}
+
+TEST(Sequence, SeveralFramesIntoOneNameIsAnErrorBeforeAnyWork)
+{
+    fs::path dir = growing_plant(scratch("anim_name"));
+    Result r = run("-a -q -o " + (dir / "one.png").string() + " " + plant_files(dir));
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("number field"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "one.png"));
+}
+
+TEST(Sequence, TurntableFramesSubsetAndResume)
+{
+    fs::path dir = growing_plant(scratch("turn"));
+    std::string common = "-q -w 24 18 --spp 1 --turntable 6 -o " + (dir / "t%d.png").string() +
+                         " " + plant_files(dir);
+    Result r = run("--frames 2-3 " + common);
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "t1.png"));
+    EXPECT_TRUE(fs::exists(dir / "t2.png"));
+    EXPECT_TRUE(fs::exists(dir / "t3.png"));
+    EXPECT_FALSE(fs::exists(dir / "t4.png"));
+    // --resume leaves frames already written alone and renders the rest
+    auto written = fs::last_write_time(dir / "t2.png");
+    r = run("--resume " + common);
+    ASSERT_EQ(r.status, 0) << r.output;
+    for (const char* frame : {"t1.png", "t2.png", "t3.png", "t4.png", "t5.png", "t6.png"})
+        EXPECT_TRUE(fs::exists(dir / frame)) << frame;
+    EXPECT_EQ(fs::last_write_time(dir / "t2.png"), written);
+}
+
+TEST(Sequence, VideoWithoutFfmpegSaysHowToInstallIt)
+{
+    fs::path dir = growing_plant(scratch("video"));
+    std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+    setenv("PATH", dir.c_str(), 1);  // no ffmpeg there
+    Result r = run("-q --turntable 4 -o " + (dir / "t.mp4").string() + " " + plant_files(dir));
+    setenv("PATH", path.c_str(), 1);
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("apt-get install ffmpeg"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "t.mp4"));
+    EXPECT_FALSE(fs::exists(dir / "t.mp4.frames"));
+}
+
+TEST(Sequence, TurntableVideoWithFfmpeg)
+{
+    if (std::system("command -v ffmpeg >/dev/null 2>&1") != 0)
+        GTEST_SKIP() << "ffmpeg is not installed";
+    fs::path dir = growing_plant(scratch("video_ok"));
+    Result r = run("-q -w 24 18 --spp 1 --turntable 4 -o " + (dir / "t.mp4").string() + " " +
+                   plant_files(dir));
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_GT(fs::file_size(dir / "t.mp4"), 0u);
+    EXPECT_FALSE(fs::exists(dir / "t.mp4.frames"));  // the frames go once encoded
+}

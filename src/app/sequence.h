@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: Apache-2.0
+// Sequences of frames: cpfg's animation mode (-a with the .a file) and turntables, plus
+// the command line's camera options for stills.
+#pragma once
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "app/command_line.h"
+#include "app/pipeline.h"
+#include "geom/animation_file.h"
+#include "render/render.h"
+
+namespace cambium::app {
+
+/// What a sequence writes besides images, and how it talks: the command's own
+/// string writer (-str, -strb with their frame numbers) and message printer.
+struct SequenceOutputs {
+    std::vector<std::filesystem::path> images;  ///< patterns with a number field
+    render::RenderSettings settings;
+    std::function<void(const Model&, const lsys::ModuleString&, int step)> write_strings;
+    std::function<void(const std::string&)> say;
+};
+
+/// Whether the command renders a sequence (-a or --turntable) instead of a still.
+bool is_sequence(const Options& options);
+
+/// Renders the sequence; returns the exit status (130 when interrupted).
+int run_sequence(const Options& options, const SequenceOutputs& outputs);
+
+/// The frames -a selects: those of the animation file, else cpfg's defaults (frames 1
+/// to the derivation length, or --steps).
+std::vector<geom::AnimationFrame> animation_frames(const Model& model, const Options& options);
+
+/// Derives the frames' strings incrementally, each derivation step once, calling
+/// `on_frame` with every frame and its string (what -str writes). The End block runs
+/// after the last frame. Returns the number of steps derived.
+int derive_frames(const Model& model, const std::vector<geom::AnimationFrame>& frames,
+                  const std::function<void(const geom::AnimationFrame&,
+                                           const lsys::ModuleString&)>& on_frame);
+
+/// The staging options' part of the render settings: --background.
+void apply_staging(render::RenderSettings& settings, const Options& options);
+
+/// How images are written: --exposure and --tonemap.
+render::WriteOptions write_options(const Options& options);
+
+/// The scene's view with --orbit, --zoom, --fit, --fov, --perspective / --parallel.
+void apply_camera_options(geom::Scene& scene, const Options& options);
+
+}  // namespace cambium::app
