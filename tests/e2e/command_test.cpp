@@ -422,6 +422,8 @@ TEST(Command, PlantedSymlinkAtTemporaryNameIsNotFollowed)
     EXPECT_EQ(r.status, 0) << r.output;
     EXPECT_EQ(bytes_of(dir / "victim"), "precious");
     EXPECT_NE(bytes_of(dir / "s.str").find("F[+F]F"), std::string::npos);
+}
+
 TEST(Command, HugeGeometryIsRefusedWithAMessageNeverAnEmbreeAbort)
 {
     // F(1e38) used to end in Embree's assertion `ray.valid()` (exit 134)
@@ -466,6 +468,7 @@ TEST(Command, ViewFileCameraOutOfRangeIsAnErrorAtItsColumn)
     EXPECT_NE(r.output.find("p.v:2:16: error: value 1e+30 is out of range"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(dir / "out.png"));
 }
+
 // Warnings go to the command's diagnostics sink: printed once each, and not at all with -q.
 TEST(Command, QuietMeansNoWarnings)
 {
