@@ -5,6 +5,11 @@ JOBS ?= $(shell nproc)
 CAMBIUM = $(BUILD)/src/app/cambium
 MAKEFLAGS += --no-print-directory
 DEFAULT = scenes/default
+# ccache, when a developer has it, makes rebuilds in fresh clones cheap (optional; the
+# paths it hashes are made relative to this folder so clones share the cache).
+CCACHE := $(shell command -v ccache 2>/dev/null)
+LAUNCHER = $(if $(CCACHE),-DCMAKE_CXX_COMPILER_LAUNCHER=$(CCACHE))
+export CCACHE_BASEDIR := $(CURDIR)
 
 .PHONY: setup configure build render test sanitize clean
 
@@ -13,7 +18,7 @@ setup:
 
 configure:
 	@echo "build: configuring $(BUILD) (Release)"
-	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release > $(BUILD).configure.log 2>&1 || { cat $(BUILD).configure.log; exit 1; }
+	@cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(LAUNCHER) > $(BUILD).configure.log 2>&1 || { cat $(BUILD).configure.log; exit 1; }
 
 # Everything: the command, the tests and the benchmarks.
 build: configure
@@ -44,7 +49,7 @@ sanitize: export UBSAN_OPTIONS = print_stacktrace=1:halt_on_error=1
 sanitize: export LSAN_OPTIONS = suppressions=$(CURDIR)/scripts/lsan-suppressions.txt
 sanitize:
 	@echo "sanitize: configuring $(ASAN_BUILD) (address,undefined)"
-	@cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCAMBIUM_SANITIZE=address,undefined \
+	@cmake -S . -B $(ASAN_BUILD) $(LAUNCHER) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCAMBIUM_SANITIZE=address,undefined \
 		-DCAMBIUM_BUILD_BENCHMARKS=OFF > $(ASAN_BUILD).configure.log 2>&1 || { cat $(ASAN_BUILD).configure.log; exit 1; }
 	@echo "sanitize: compiling with $(JOBS) jobs"
 	@cmake --build $(ASAN_BUILD) --parallel $(JOBS)
