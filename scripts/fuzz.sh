@@ -12,7 +12,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
 
-targets=(lsystem view_file surface tsurface contour function curve background string_text string_binary)
+targets=(lsystem view_file surface tsurface contour function curve background string_text string_binary animation)
 target=${1:-all}
 minutes=${2:-5}
 build=${FUZZ_BUILD:-build-fuzz}
@@ -63,6 +63,7 @@ seed() {  # seed TARGET: fills $build/seeds/TARGET
         curve)       mapfile -t files < <(corpus_files '*.crv' '*.con') ;;
         background)  mapfile -t files < <(corpus_files '*.dat') ;;
         string_text) mapfile -t files < <(corpus_files '*.str') ;;
+        animation)   mapfile -t files < <(corpus_files '*.a') ;;
       esac
       local i=0
       for f in "${files[@]}"; do cp "$f" "$dir/corpus$((i++))"; done ;;
