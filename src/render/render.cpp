@@ -66,6 +66,34 @@ void check_settings(const RenderSettings& s)
         throw Error("render: the filter radius must be between 0 and 16 pixels");
     if (!(s.aperture_radius >= 0) || !(s.focus_distance >= 0))
         throw Error("render: the aperture and the focus distance must not be negative");
+    const PixelRect& c = s.crop;
+    if (!c.empty() && (c.x < 0 || c.y < 0 || c.x > s.width - c.width || c.y > s.height - c.height))
+        throw Error("render: the crop " + std::to_string(c.width) + "x" + std::to_string(c.height) +
+                    "+" + std::to_string(c.x) + "+" + std::to_string(c.y) +
+                    " is not inside the image");
+}
+
+/// The pixels returned: the crop, or the whole image.
+PixelRect output_rect(const RenderSettings& s)
+{
+    return s.crop.empty() ? PixelRect{0, 0, s.width, s.height} : s.crop;
+}
+
+/// The pixels sampled: the crop grown by the margin that adaptive sampling's decisions
+/// can cross. A pixel stops when its 3x3 neighbourhood has converged, checked after
+/// every pass but the last, so after pass k a pixel's sums depend on pixels up to k - 1
+/// away; pixels at the margin's edge (which clamp their neighbourhood there, not at the
+/// image's edge) may decide wrongly, but their error reaches only passes - 1 pixels in.
+PixelRect sampled_rect(const RenderSettings& s, std::size_t passes)
+{
+    PixelRect out = output_rect(s);
+    if (s.noise_target <= 0 || passes <= 1)
+        return out;
+    int margin = int(std::min<std::size_t>(passes - 1, std::size_t(std::max(s.width, s.height))));
+    int x0 = std::max(0, out.x - margin), y0 = std::max(0, out.y - margin);
+    int x1 = std::min(s.width, out.x + out.width + margin);
+    int y1 = std::min(s.height, out.y + out.height + margin);
+    return {x0, y0, x1 - x0, y1 - y0};
 }
 
 /// Draws a pixel-space offset from a separable filter profile: a 1D table over
@@ -225,7 +253,8 @@ double relative_error(const PixelState& st)
     return std::sqrt(variance / n) / std::max(mean, 0.01);
 }
 
-/// Marks pixels whose 3x3 neighbourhood meets the noise target as done.
+/// Marks pixels whose 3x3 neighbourhood meets the noise target as done (over the sampled
+/// rectangle, w x h: its edges are the image's or lie in the crop's margin).
 void mark_converged(std::vector<PixelState>& px, int w, int h, double target)
 {
     std::vector<double> err(px.size());
@@ -244,18 +273,22 @@ void mark_converged(std::vector<PixelState>& px, int w, int h, double target)
         }
 }
 
-/// The image of the sums so far.
-Image resolve(const std::vector<PixelState>& px, const RenderSettings& s)
+/// The image of the sums so far over `out`, from the sums over `sampled` (which holds it).
+Image resolve(const std::vector<PixelState>& px, const PixelRect& sampled, const PixelRect& out,
+              const RenderSettings& s)
 {
-    Image img{s.width, s.height, std::vector<float>(px.size() * 4)};
+    const std::size_t count = std::size_t(out.width) * out.height;
+    Image img{out.width, out.height, std::vector<float>(count * 4)};
     img.transparent = s.transparent_background;
     if (s.aovs) {
-        img.albedo.assign(px.size() * 3, 0.0f);
-        img.normal.assign(px.size() * 3, 0.0f);
-        img.depth.assign(px.size(), infinity);
+        img.albedo.assign(count * 3, 0.0f);
+        img.normal.assign(count * 3, 0.0f);
+        img.depth.assign(count, infinity);
     }
-    for (std::size_t i = 0; i < px.size(); ++i) {
-        const PixelState& st = px[i];
+    for (std::size_t i = 0; i < count; ++i) {
+        int x = out.x - sampled.x + int(i % std::size_t(out.width));
+        int y = out.y - sampled.y + int(i / std::size_t(out.width));
+        const PixelState& st = px[std::size_t(y) * std::size_t(sampled.width) + std::size_t(x)];
         if (st.samples == 0)
             continue;
         float inv = 1.0f / static_cast<float>(st.samples);
@@ -404,7 +437,11 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
     auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
     tbb::task_arena arena(settings.threads > 0 ? settings.threads
                                                : tbb::task_arena::automatic);
-    const int w = settings.width, h = settings.height;
+    std::vector<int> targets = pass_targets(settings);
+    // The sampled pixels, in image coordinates; `pixels` below holds them row by row.
+    const PixelRect region = sampled_rect(settings, targets.size());
+    const PixelRect out_rect = output_rect(settings);
+    const int w = region.width, h = region.height;
     std::atomic<std::uint64_t> nonfinite{0};
     arena.execute([&] {
         std::unique_ptr<TextureSet> textures;
@@ -458,7 +495,6 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
 
         const int tiles_x = (w + tile_size - 1) / tile_size;
         const int tiles_y = (h + tile_size - 1) / tile_size;
-        std::vector<int> targets = pass_targets(settings);
         ProgressLine progress(settings.progress, start);
         std::atomic<bool> stop{false}, cancelled{false}, out_of_time{false};
         double last_pass_s = 0;
@@ -512,7 +548,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                             if (st.done)
                                 continue;
                             for (std::uint32_t i = st.samples; i < target; ++i, ++taken)
-                                take_sample(state, x, y, i, st);
+                                take_sample(state, region.x + x, region.y + y, i, st);
                         }
                     progress.add(taken);
                 }
@@ -525,7 +561,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
             if (settings.noise_target > 0)
                 mark_converged(pixels, w, h, settings.noise_target);
             if (settings.on_pass)
-                settings.on_pass(resolve(pixels, settings));
+                settings.on_pass(resolve(pixels, region, out_rect, settings));
         }
         progress.finish();
         rep.cancelled = cancelled;
@@ -540,7 +576,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                  " ray(s) not finite or starting too far from the origin were skipped");
         for (const PixelState& st : pixels)
             rep.samples += st.samples;
-        Image image = resolve(pixels, settings);
+        Image image = resolve(pixels, region, out_rect, settings);
         rep.seconds = elapsed();
         if (!on_view(view, image, rep) || rep.cancelled)
             break;

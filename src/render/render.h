@@ -30,9 +30,24 @@ enum class PixelFilter {
 /// The largest image rendered: 2^26 pixels (8192 x 8192, about 5 GiB of pixel state).
 inline constexpr std::int64_t max_image_pixels = std::int64_t{1} << 26;
 
+/// A rectangle of pixels: columns x .. x + width - 1 and rows y .. y + height - 1, rows
+/// counted from the top.
+struct PixelRect {
+    int x = 0, y = 0, width = 0, height = 0;
+    bool empty() const { return width <= 0 || height <= 0; }
+    bool operator==(const PixelRect&) const = default;
+};
+
 /// How to render a frame.
 struct RenderSettings {
     int width = 640, height = 480;  ///< cpfg's default window
+    /// The pixels to render (empty = the whole image): render() returns an Image of the
+    /// crop's size whose pixels equal, bit for bit, the same pixels of the whole image
+    /// (tiles for --tile and --mpi). Every pixel is a function of its own samples; only
+    /// adaptive sampling looks at neighbours, so the crop is sampled with a margin as
+    /// wide as the convergence checks can reach (one pixel per pass) and the margin
+    /// dropped. Not under a time budget, which depends on the machine's speed anyway.
+    PixelRect crop;
     /// Samples per pixel; with a noise target or a time budget, the most any pixel gets.
     int samples_per_pixel = 64;
     /// Path segments at most: 1 = direct light only, 2 = one bounce, ...
