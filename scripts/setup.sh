@@ -20,6 +20,9 @@ packages=(
   libgtest-dev libbenchmark-dev nlohmann-json3-dev
   # zlib: the conformance tests read cpfg's gzipped rayshade exports (scene.ray.gz)
   zlib1g-dev
+  # Open MPI (BSD licence) for --mpi: the module libcambium_mpi.so links it, the tests
+  # run mpirun (docs/distributed.md)
+  libopenmpi-dev openmpi-bin
 )
 # Not installed on purpose: python3-imath. Imath's CMake package names its Python binding,
 # which Cambium does not use (CMakeLists.txt keeps the resulting notice quiet).

@@ -139,6 +139,50 @@ std::optional<Options> parse_command_line(int argc, char** argv)
     return parse_command_line(std::vector<std::string>(argv + 1, argv + argc));
 }
 
+namespace {
+
+/// --tile I/N: band I (from 0) of N.
+std::pair<int, int> tile_option(const std::string& text)
+{
+    std::size_t slash = text.find('/');
+    auto fail = [&]() -> std::pair<int, int> {
+        throw Error("--tile: expected I/N with 0 <= I < N (band I of N, from 0), not '" + text +
+                    "'");
+    };
+    if (slash == std::string::npos)
+        return fail();
+    int index = 0, count = 0;
+    auto a = std::from_chars(text.data(), text.data() + slash, index);
+    auto b = std::from_chars(text.data() + slash + 1, text.data() + text.size(), count);
+    if (a.ec != std::errc() || a.ptr != text.data() + slash || b.ec != std::errc() ||
+        b.ptr != text.data() + text.size() || index < 0 || count < 1 || index >= count)
+        return fail();
+    return {index, count};
+}
+
+/// --tile, --assemble and --mpi: one at a time, and what each can split.
+void check_distributed_options(const Options& options)
+{
+    int given = (options.tile ? 1 : 0) + (options.assemble ? 1 : 0) + (options.mpi ? 1 : 0);
+    if (given > 1)
+        throw Error("--tile, --assemble and --mpi are different ways to split a render; give one");
+    bool sequence = options.shot.animate || options.shot.turntable > 0;
+    if ((options.tile || options.assemble) && sequence)
+        throw Error("--tile and --assemble split a still; split a sequence with --frames A-B "
+                    "(docs/distributed.md)");
+    int count = options.tile ? options.tile->second : options.assemble.value_or(1);
+    if (count > options.height)
+        throw Error("--tile: " + std::to_string(count) + " bands of an image of " +
+                    std::to_string(options.height) + " rows; give at most one band per row");
+    if ((options.tile || options.assemble) && !options.renders())
+        throw Error("--tile and --assemble need an image output (-o)");
+    if (options.mpi && options.shot.resume)
+        throw Error("--resume with --mpi is not supported yet: the ranks must agree on the "
+                    "frames; give --frames A-B instead");
+}
+
+}  // namespace
+
 std::optional<Options> parse_command_line(const std::vector<std::string>& words)
 {
     Options options;
@@ -160,6 +204,14 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
         ->check(CLI::Range(1, 64));
     cli.add_option("--threads", options.threads, "Render threads (default: all cores)")
         ->check(CLI::Range(0, 1024));
+    std::string tile;
+    cli.add_option("--tile", tile,
+                   "Render band I of N bands of rows (I from 0) into a tile file for --assemble");
+    cli.add_option("--assemble", options.assemble,
+                   "Paste the N tile files of --tile I/N into the outputs (no rendering)")
+        ->check(CLI::Range(1, max_image_side));
+    cli.add_flag("--mpi", options.mpi,
+                 "Share the render among the ranks of an MPI job: mpirun -np N cambium --mpi ...");
     cli.add_option("--seed", options.seed, "Sampling seed (default 0)")
         ->check(CLI::NonNegativeNumber);
     cli.add_option("--max-modules", options.max_modules,
@@ -253,6 +305,9 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     if (cli.count("--env-rotate") > 0 && !options.sky && !options.environment_map)
         throw Error("--env-rotate turns the --env map or the --sky; give one of them");
     check_shot_options(options);
+    if (!tile.empty())
+        options.tile = tile_option(tile);
+    check_distributed_options(options);
     options.lsystem = files[0];
     options.view = files[1];
     if (files.size() == 3)

@@ -74,6 +74,10 @@ struct Options {
     int samples_per_pixel = 64;
     int max_depth = 6;
     int threads = 0;
+    // A render in pieces (docs/distributed.md)
+    std::optional<std::pair<int, int>> tile;  ///< --tile I/N: band I of N bands (0-based)
+    std::optional<int> assemble;              ///< --assemble N: the N tiles into the outputs
+    bool mpi = false;                         ///< --mpi: shared among the ranks of an MPI job
     std::uint64_t seed = 0;
     bool quiet = false;
     std::string filter = "box";        ///< --filter box|gaussian|blackman-harris

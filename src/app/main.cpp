@@ -3,15 +3,20 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <fstream>
 #include <functional>
+#include <memory>
+#include <string_view>
 
 #include <unistd.h>
 
 #include <fmt/format.h>
 
 #include "app/command_line.h"
+#include "app/distributed.h"
+#include "app/tiles.h"
 #include "app/pipeline.h"
 #include "base/atomic_file.h"
 #include "app/sequence.h"
@@ -130,7 +135,39 @@ void write_strings(const Model& model, const lsys::ModuleString& string, const O
     }
 }
 
-int run(const Options& options)
+/// --assemble N: the tiles' pixels into the outputs, written as a single run writes them.
+int assemble(const Options& options, const std::vector<std::filesystem::path>& images,
+             const std::function<void(const std::string&)>& say)
+{
+    render::Image image =
+        assemble_tiles(images.front(), *options.assemble, options.width, options.height);
+    render::WriteOptions write = write_options(options);
+    for (const auto& out : images) {
+        render::write_image(image, out, write);
+        say("wrote " + out.string());
+    }
+    return 0;
+}
+
+/// --tile I/N: band I of the still into its tile file (app/tiles.h).
+void write_tile(const Options& options, const std::filesystem::path& first_output,
+                const geom::Scene& scene, render::RenderSettings settings,
+                const std::function<void(const std::string&)>& say)
+{
+    auto [index, count] = *options.tile;
+    settings.crop = band(index, count, settings.width, settings.height);
+    Tile tile{index, count, settings.width, settings.height, settings.crop,
+              render::render(scene, settings)};
+    std::filesystem::path file = tile_file(first_output, index, count);
+    write_atomically(file, [&](std::ostream& out) {
+        std::string bytes = encode_tile(tile);
+        out.write(bytes.data(), std::streamsize(bytes.size()));
+    });
+    say(fmt::format("wrote {} (rows {} to {})", file.string(), tile.rect.y,
+                    tile.rect.y + tile.rect.height - 1));
+}
+
+int run(const Options& options, Mpi* mpi)
 {
     // One sink for the whole command, render threads included; -q keeps warnings quiet.
     Diagnostics diagnostics(options.quiet ? Diagnostics::Output::quiet
@@ -146,8 +183,12 @@ int run(const Options& options)
             render::check_output_format(out);  // fail before the work, not after
     if (options.environment_requested)
         warn("-e: no environmental program is connected; ?E modules keep their parameters");
+    if (options.assemble)
+        return assemble(options, images, say);
+    // With --mpi, rank 0 alone writes files.
+    const bool writes = !mpi || mpi->rank() == 0;
     if (is_sequence(options)) {
-        SequenceOutputs outputs{images, render_settings(options, images), {}, say};
+        SequenceOutputs outputs{images, render_settings(options, images), {}, say, mpi};
         outputs.write_strings = [&](const Model& model, const lsys::ModuleString& s, int step) {
             write_strings(model, s, options, step, say);
         };
@@ -158,8 +199,9 @@ int run(const Options& options)
     Model model = load_model(options);
     lsys::ModuleString string = derive(model, options);
     say(fmt::format("derived {} modules in {:.3f} s", string.size(), seconds_since(start)));
-    write_strings(model, string, options,
-                  options.steps.value_or(model.lsystem.derivation_length()), say);
+    if (writes)
+        write_strings(model, string, options,
+                      options.steps.value_or(model.lsystem.derivation_length()), say);
 
     geom::Scene scene = interpret(model, string, options);
     const geom::Geometry& g = scene.geometry;
@@ -167,7 +209,7 @@ int run(const Options& options)
                     "{} triangles, {} instances",
                     g.lines.segment_count(), g.curves.segment_count(), g.spheres.size(),
                     g.discs.size(), g.mesh.size(), scene.instances.size()));
-    if (options.view_volume) {
+    if (options.view_volume && writes) {
         // As cpfg, the view file's `box:` wins over the computed bounds.
         geom::write_view_volume(scene.view.box.value_or(scene.bounds), *options.view_volume);
         say("wrote " + options.view_volume->string());
@@ -177,8 +219,17 @@ int run(const Options& options)
 
     render::RenderSettings settings = render_settings(options, images);
     apply_camera_options(scene, options);
+    if (options.tile) {
+        write_tile(options, images.front(), scene, settings, say);
+        return 0;
+    }
     render::RenderReport report;
-    render::Image image = render::render(scene, settings, &report);
+    if (mpi)
+        mpi->checkpoint();
+    render::Image image = mpi ? render_still(*mpi, scene, settings, &report)
+                              : render::render(scene, settings, &report);
+    if (!writes)
+        return 0;
     say(fmt::format("rendered {}x{}, {:.1f} samples per pixel on average, in {:.2f} s{}",
                     options.width, options.height,
                     double(report.samples) / (double(options.width) * options.height),
@@ -193,25 +244,51 @@ int run(const Options& options)
     return 0;
 }
 
+/// Under mpirun with --mpi, before MPI is initialised: whether this is a rank other than
+/// 0 (Open MPI's and PMIx's environment), which leaves command-line errors, the same on
+/// every rank, to rank 0 to print.
+bool other_mpi_rank(int argc, char** argv)
+{
+    if (std::find(argv + 1, argv + argc, std::string_view("--mpi")) == argv + argc)
+        return false;
+    for (const char* name : {"OMPI_COMM_WORLD_RANK", "PMIX_RANK"})
+        if (const char* rank = std::getenv(name))
+            return std::string_view(rank) != "0";
+    return false;
+}
+
 }  // namespace
 }  // namespace cambium::app
 
 int main(int argc, char** argv)
 {
+    using cambium::app::Mpi;
+    std::unique_ptr<Mpi> mpi;
+    // With --mpi, an error ends every rank (Mpi::fail), printed once.
+    auto fail = [&](const std::string& message) {
+        if (mpi)
+            mpi->fail(message);
+        if (!cambium::app::other_mpi_rank(argc, argv))
+            std::fprintf(stderr, "cambium: %s\n", message.c_str());
+        return 1;
+    };
     try {
         auto options = cambium::app::parse_command_line(argc, argv);
         if (!options)
             return 0;
+        if (options->mpi) {
+            mpi = std::make_unique<Mpi>(&argc, &argv);
+            if (mpi->rank() != 0)
+                options->quiet = true;  // messages, warnings and progress on rank 0 only
+        }
         cambium::set_warnings_enabled(!options->quiet);  // -q: nothing but errors
-        return cambium::app::run(*options);
+        return cambium::app::run(*options, mpi.get());
     } catch (const cambium::Interrupted& e) {
-        std::fprintf(stderr, "cambium: %s\n", e.what());
+        fail(e.what());
         return 128 + e.signal();  // a helper program was running; it is stopped
     } catch (const cambium::Error& e) {
-        std::fprintf(stderr, "cambium: %s\n", e.what());
-        return 1;
+        return fail(e.what());
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "cambium: error: %s\n", e.what());
-        return 1;
+        return fail(std::string("error: ") + e.what());
     }
 }

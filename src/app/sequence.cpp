@@ -112,14 +112,17 @@ public:
         : m_total(total), m_say(std::move(say)), m_start(Clock::now())
     {
     }
+    /// `seconds` < 0: rendered by another MPI rank, time unknown here.
     void frame_done(int number, double seconds)
     {
         ++m_done;
         double elapsed = std::chrono::duration<double>(Clock::now() - m_start).count();
         std::size_t left = m_total - std::min(m_done, m_total);
         double eta = m_done > 0 ? elapsed / double(m_done) * double(left) : 0;
-        m_say(fmt::format("frame {}: rendered in {:.2f} s; {} of {} done, {} left, about {} to go",
-                          number, seconds, m_done, m_total, left, clock_time(eta)));
+        std::string how = seconds < 0 ? "rendered by another rank"
+                                      : fmt::format("rendered in {:.2f} s", seconds);
+        m_say(fmt::format("frame {}: {}; {} of {} done, {} left, about {} to go", number, how,
+                          m_done, m_total, left, clock_time(eta)));
     }
 
 private:
@@ -179,18 +182,44 @@ int run_animation(const Options& options, const SequenceOutputs& out)
     for (const geom::AnimationFrame& f : frames)
         to_render += filter.to_render(f.number) ? 1 : 0;
     out.say(fmt::format("{} frames, {} to render", frames.size(), to_render));
+    if (out.mpi)
+        out.mpi->checkpoint();
+    std::optional<FrameExchange> exchange;
+    if (out.mpi)
+        exchange.emplace(*out.mpi);
+    const bool writes = !exchange || exchange->writes();
+    std::vector<int> numbers;  // of the frames to render, in order
+    for (const geom::AnimationFrame& f : frames)
+        if (filter.to_render(f.number))
+            numbers.push_back(f.number);
 
     render::ViewOverrides overrides = view_overrides(options.shot);
     SequenceProgress progress(to_render, out.say);
     int status = 0;
+    auto write_received = [&](std::size_t k, render::Image& image) {
+        write_frame_images(image, numbers[k], options, out);
+        progress.frame_done(numbers[k], -1);
+    };
+    std::size_t reached = 0;  // frames to render reached so far, on every rank alike
     auto render_frame = [&](const geom::Scene& scene, const std::optional<render::Camera>& fixed,
                             const geom::AnimationFrame& f) {
+        std::size_t k = reached++;
+        if (exchange && !exchange->renders(k))
+            return;
+        if (exchange)
+            exchange->receive_until(k, write_received);  // rendered while rank 0 rendered its last
         render::RenderReport report;
         render::Image image =
             render::render(scene, frame_camera(scene, fixed, f, out.settings), out.settings,
                            &report);
-        write_frame_images(image, f.number, options, out);
-        progress.frame_done(f.number, report.seconds);
+        auto write = [&](std::size_t, render::Image& done) {
+            write_frame_images(done, f.number, options, out);
+            progress.frame_done(f.number, report.seconds);
+        };
+        if (exchange)
+            exchange->rendered(k, image, write);
+        else
+            write(k, image);
         if (report.cancelled)
             status = 130;
     };
@@ -213,7 +242,8 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         if (options.homomorphism_in_string)
             homomorphic = model.lsystem.interpretation_string(string);
         const lsys::ModuleString& written = options.homomorphism_in_string ? homomorphic : string;
-        out.write_strings(model, written, f.number);
+        if (writes)
+            out.write_strings(model, written, f.number);
         if (!options.view_volume && !filter.to_render(f.number))
             return;
         if (refit && animation->new_view_between_frames)
@@ -221,7 +251,7 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         lsys::ModuleString turtle = turtle_string(model, written, options);
         geom::Scene scene = interpret_turtle_string(model, turtle, options);
         scene.view = render::apply_overrides(scene.view, overrides, scene.bounds);
-        if (options.view_volume) {
+        if (options.view_volume && writes) {
             fs::path file = frame_file(*options.view_volume, f.number);
             geom::write_view_volume(scene.view.box.value_or(scene.bounds), file);
             out.say("wrote " + file.string());
@@ -248,6 +278,8 @@ int run_animation(const Options& options, const SequenceOutputs& out)
             render_frame(scene, camera, k.frame);
         }
     }
+    if (exchange && status == 0)
+        exchange->receive_until(reached, write_received);
     return status;
 }
 
@@ -257,10 +289,15 @@ int run_turntable(const Options& options, const SequenceOutputs& out)
     require_numbered_names(Options{}, out.images, static_cast<std::size_t>(n));
     Model model = load_model(options);
     lsys::ModuleString derived = derive(model, options);
-    out.write_strings(model, derived, options.steps.value_or(model.lsystem.derivation_length()));
+    const bool writes = !out.mpi || out.mpi->rank() == 0;
+    if (writes)
+        out.write_strings(model, derived,
+                          options.steps.value_or(model.lsystem.derivation_length()));
     geom::Scene scene = interpret(model, derived, options);
     scene.view = render::apply_overrides(scene.view, view_overrides(options.shot), scene.bounds);
-    if (options.view_volume)
+    if (out.mpi)
+        out.mpi->checkpoint();
+    if (options.view_volume && writes)
         geom::write_view_volume(scene.view.box.value_or(scene.bounds), *options.view_volume);
 
     const render::RenderSettings& s = out.settings;
@@ -281,14 +318,42 @@ int run_turntable(const Options& options, const SequenceOutputs& out)
     out.say(fmt::format("turntable of {} frames, {} to render", n, cameras.size()));
     SequenceProgress progress(cameras.size(), out.say);
     int status = 0;
-    render::render_views(scene, cameras, s,
+    // --mpi: this rank's share of the views; `ordinals` maps them back.
+    std::optional<FrameExchange> exchange;
+    if (out.mpi)
+        exchange.emplace(*out.mpi);
+    std::vector<render::Camera> mine;
+    std::vector<std::size_t> ordinals;
+    for (std::size_t k = 0; k < cameras.size(); ++k)
+        if (!exchange || exchange->renders(k)) {
+            mine.push_back(cameras[k]);
+            ordinals.push_back(k);
+        }
+    auto write_received = [&](std::size_t k, render::Image& image) {
+        write_frame_images(image, numbers[k], options, out);
+        progress.frame_done(numbers[k], -1);
+    };
+    render::render_views(scene, mine, s,
                          [&](std::size_t view, render::Image& image, const render::RenderReport& r) {
-        write_frame_images(image, numbers[view], options, out);
-        progress.frame_done(numbers[view], r.seconds);
+        std::size_t k = ordinals[view];
+        auto write = [&](std::size_t, render::Image& done) {
+            write_frame_images(done, numbers[k], options, out);
+            progress.frame_done(numbers[k], r.seconds);
+        };
+        if (!exchange) {
+            write(k, image);
+        } else {
+            exchange->rendered(k, image, write);
+            // The other ranks' views rendered meanwhile, up to rank 0's next one.
+            exchange->receive_until(std::min(cameras.size(), k + std::size_t(out.mpi->size())),
+                                    write_received);
+        }
         if (r.cancelled)
             status = 130;
         return true;
     });
+    if (exchange && status == 0)
+        exchange->receive_until(cameras.size(), write_received);
     return status;
 }
 
@@ -376,7 +441,7 @@ int run_sequence(const Options& options, const SequenceOutputs& outputs)
     }
     int status = options.shot.turntable > 0 ? run_turntable(options, frames)
                                             : run_animation(options, frames);
-    if (status != 0)
+    if (status != 0 || (outputs.mpi && outputs.mpi->rank() != 0))
         return status;
     for (const fs::path& video : videos) {
         encode_video(ffmpeg, video_frames_folder(video), options.shot.fps, video);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "app/command_line.h"
+#include "app/distributed.h"
 #include "app/pipeline.h"
 #include "geom/animation_file.h"
 #include "render/render.h"
@@ -22,6 +23,9 @@ struct SequenceOutputs {
     render::RenderSettings settings;
     std::function<void(const Model&, const lsys::ModuleString&, int step)> write_strings;
     std::function<void(const std::string&)> say;
+    /// --mpi: the frames are shared among the job's ranks (app/distributed.h); rank 0
+    /// writes every file. Null: every frame here.
+    Mpi* mpi = nullptr;
 };
 
 /// Whether the command renders a sequence (-a or --turntable) instead of a still.

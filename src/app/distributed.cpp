@@ -1,0 +1,234 @@
+// SPDX-License-Identifier: Apache-2.0
+// --mpi: the module loader and the sharing of stills (bands) and sequences (frames).
+//
+// Every rank loads, derives and interprets the model itself (cheap next to rendering)
+// and renders its share; only images travel, as the exact bytes of app/tiles.h.
+#include "app/distributed.h"
+
+#include <dlfcn.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "app/mpi_module.h"
+#include "app/tiles.h"
+#include "base/diagnostics.h"
+
+namespace cambium::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int still_tag = 1;
+constexpr int frame_tag = 2;
+
+/// Where the module may be: beside the executable (the build tree) and in the
+/// install's library folder.
+std::vector<fs::path> module_candidates()
+{
+    std::error_code error;
+    fs::path exe = fs::read_symlink("/proc/self/exe", error);
+    if (error)
+        return {};
+    return {exe.parent_path() / "libcambium_mpi.so",
+            exe.parent_path() / CAMBIUM_MPI_MODULE_FROM_BIN};
+}
+
+template <typename F>
+F* symbol(void* handle, const char* name, const fs::path& file)
+{
+    void* p = dlsym(handle, name);
+    if (!p)
+        throw Error(FileLoc{file.string()},
+                    fmt::format("is not Cambium's MPI module: it has no {}", name));
+    return reinterpret_cast<F*>(p);
+}
+
+void* grow(void* context, std::uint64_t bytes)
+{
+    auto* buffer = static_cast<std::string*>(context);
+    buffer->resize(bytes);
+    return buffer->data();
+}
+
+}  // namespace
+
+struct Mpi::Module {
+    void* handle = nullptr;
+    cambium_mpi_finalize_fn* finalize = nullptr;
+    cambium_mpi_abort_fn* abort = nullptr;
+    cambium_mpi_send_fn* send = nullptr;
+    cambium_mpi_receive_fn* receive = nullptr;
+    cambium_mpi_all_min_fn* all_min = nullptr;
+    char error[512] = {};
+};
+
+Mpi::Mpi(int* argc, char*** argv) : m_module(std::make_unique<Module>())
+{
+    std::vector<fs::path> candidates = module_candidates();
+    fs::path file;
+    std::string reasons;
+    for (const fs::path& candidate : candidates) {
+        if (!fs::exists(candidate))
+            continue;
+        // Global: Open MPI's own plugins, loaded later, need libmpi's symbols.
+        m_module->handle = dlopen(candidate.c_str(), RTLD_NOW | RTLD_GLOBAL);
+        if (m_module->handle) {
+            file = candidate;
+            break;
+        }
+        reasons += fmt::format("\n  {}: {}", candidate.string(), dlerror());
+    }
+    if (!m_module->handle) {
+        std::string places;
+        for (const fs::path& candidate : candidates)
+            places += "\n  " + candidate.lexically_normal().string();
+        throw Error(reasons.empty()
+                        ? "--mpi: this cambium was built without MPI (libcambium_mpi.so is in "
+                          "none of:" + places +
+                              "); install libopenmpi-dev and build again (docs/distributed.md)"
+                        : "--mpi: the MPI module cannot be loaded (is Open MPI installed? "
+                          "apt-get install openmpi-bin):" + reasons);
+    }
+    auto* version = symbol<cambium_mpi_version_fn>(m_module->handle,
+                                                   "cambium_mpi_interface_version", file);
+    if (version() != cambium_mpi_version)
+        throw Error(FileLoc{file.string()}, "is the MPI module of another Cambium version");
+    auto* init = symbol<cambium_mpi_init_fn>(m_module->handle, "cambium_mpi_init", file);
+    Module& m = *m_module;
+    m.finalize = symbol<cambium_mpi_finalize_fn>(m.handle, "cambium_mpi_finalize", file);
+    m.abort = symbol<cambium_mpi_abort_fn>(m.handle, "cambium_mpi_abort", file);
+    m.send = symbol<cambium_mpi_send_fn>(m.handle, "cambium_mpi_send", file);
+    m.receive = symbol<cambium_mpi_receive_fn>(m.handle, "cambium_mpi_receive", file);
+    m.all_min = symbol<cambium_mpi_all_min_fn>(m.handle, "cambium_mpi_all_min", file);
+    if (init(argc, argv, &m_rank, &m_size, m.error, sizeof m.error) != 0)
+        throw Error(std::string("--mpi: ") + m.error);
+}
+
+Mpi::~Mpi()
+{
+    if (m_module->finalize)
+        m_module->finalize();
+    // The module stays loaded: Open MPI does not support being unloaded.
+}
+
+void Mpi::send(const std::string& bytes, int to, int tag)
+{
+    if (m_module->send(bytes.data(), bytes.size(), to, tag, m_module->error,
+                       sizeof m_module->error) != 0)
+        throw Error(std::string("--mpi: ") + m_module->error);
+}
+
+std::string Mpi::receive(int from, int tag)
+{
+    std::string bytes;
+    if (m_module->receive(from, tag, &grow, &bytes, m_module->error, sizeof m_module->error) != 0)
+        throw Error(std::string("--mpi: ") + m_module->error);
+    return bytes;
+}
+
+int Mpi::lowest_failed(bool failed)
+{
+    int lowest = m_size;
+    if (m_module->all_min(failed ? m_rank : m_size, &lowest, m_module->error,
+                          sizeof m_module->error) != 0)
+        throw Error(std::string("--mpi: ") + m_module->error);
+    return lowest;
+}
+
+void Mpi::abort(int code)
+{
+    m_module->abort(code);
+    std::_Exit(code);  // MPI_Abort does not return; in case it does
+}
+
+void Mpi::checkpoint()
+{
+    if (m_checked)
+        return;
+    m_checked = true;
+    if (lowest_failed(false) < m_size) {
+        // Another rank failed and printed why; this one ends quietly.
+        m_module->finalize();
+        m_module->finalize = nullptr;
+        std::exit(1);
+    }
+}
+
+void Mpi::fail(const std::string& message)
+{
+    std::string line = m_rank == 0 ? "cambium: " + message + "\n"
+                                   : fmt::format("cambium (rank {}): {}\n", m_rank, message);
+    if (m_checked) {
+        std::fputs(line.c_str(), stderr);
+        std::fflush(stderr);
+        abort(1);
+    }
+    m_checked = true;
+    if (lowest_failed(true) == m_rank)
+        std::fputs(line.c_str(), stderr);
+    m_module->finalize();
+    m_module->finalize = nullptr;
+    std::exit(1);
+}
+
+render::Image render_still(Mpi& mpi, const geom::Scene& scene, render::RenderSettings settings,
+                           render::RenderReport* report)
+{
+    const int ranks = mpi.size(), w = settings.width, h = settings.height;
+    if (ranks > h)
+        throw Error(fmt::format("--mpi: {} ranks for an image of {} rows: give at most one rank "
+                                "per row",
+                                ranks, h));
+    settings.crop = band(mpi.rank(), ranks, w, h);
+    Tile mine{mpi.rank(), ranks, w, h, settings.crop, render::render(scene, settings, report)};
+    if (mpi.rank() != 0) {
+        mpi.send(encode_tile(mine), 0, still_tag);
+        return {};
+    }
+    render::Image whole = blank_image(w, h, settings.aovs, settings.transparent_background);
+    paste(whole, mine.image, mine.rect.x, mine.rect.y);
+    for (int r = 1; r < ranks; ++r) {
+        Tile tile = decode_tile(mpi.receive(r, still_tag), fmt::format("rank {}'s tile", r));
+        if (tile.rect != band(r, ranks, w, h))
+            throw Error(fmt::format("--mpi: rank {} sent another tile than its own", r));
+        paste(whole, tile.image, tile.rect.x, tile.rect.y);
+    }
+    return whole;
+}
+
+void FrameExchange::rendered(std::size_t k, render::Image& image, const Write& write)
+{
+    if (!writes()) {
+        m_mpi.send(encode_tile({int(k), int(k) + 1, image.width, image.height,
+                                {0, 0, image.width, image.height}, std::move(image)}),
+                   0, frame_tag);
+        return;
+    }
+    receive_until(k, write);
+    write(k, image);
+    m_next = k + 1;
+}
+
+void FrameExchange::receive_until(std::size_t end, const Write& write)
+{
+    if (!writes())
+        return;
+    for (; m_next < end; ++m_next) {
+        int from = int(m_next % std::size_t(m_mpi.size()));
+        if (from == 0)
+            throw Error(fmt::format("--mpi: frame {} of rank 0 was not rendered", m_next));
+        Tile tile = decode_tile(m_mpi.receive(from, frame_tag),
+                                fmt::format("rank {}'s frame", from));
+        if (std::size_t(tile.index) != m_next)
+            throw Error(fmt::format("--mpi: rank {} sent frame {}, not frame {}", from, tile.index,
+                                    m_next));
+        write(m_next, tile.image);
+    }
+}
+
+}  // namespace cambium::app
