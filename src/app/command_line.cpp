@@ -172,7 +172,8 @@ void check_distributed_options(const Options& options)
                     "(docs/distributed.md)");
     int count = options.tile ? options.tile->second : options.assemble.value_or(1);
     if (count > options.height)
-        throw Error("--tile: " + std::to_string(count) + " bands of an image of " +
+        throw Error(std::string(options.tile ? "--tile: " : "--assemble: ") +
+                    std::to_string(count) + " bands of an image of " +
                     std::to_string(options.height) + " rows; give at most one band per row");
     if ((options.tile || options.assemble) && !options.renders())
         throw Error("--tile and --assemble need an image output (-o)");

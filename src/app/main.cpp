@@ -230,10 +230,15 @@ int run(const Options& options, Mpi* mpi)
                               : render::render(scene, settings, &report);
     if (!writes)
         return 0;
-    say(fmt::format("rendered {}x{}, {:.1f} samples per pixel on average, in {:.2f} s{}",
-                    options.width, options.height,
-                    double(report.samples) / (double(options.width) * options.height),
-                    report.seconds, report.cancelled ? " (interrupted)" : ""));
+    if (mpi)
+        say(fmt::format("rendered {}x{} on {} ranks; rank 0's band in {:.2f} s{}", options.width,
+                        options.height, mpi->size(), report.seconds,
+                        report.cancelled ? " (interrupted)" : ""));
+    else
+        say(fmt::format("rendered {}x{}, {:.1f} samples per pixel on average, in {:.2f} s{}",
+                        options.width, options.height,
+                        double(report.samples) / (double(options.width) * options.height),
+                        report.seconds, report.cancelled ? " (interrupted)" : ""));
     render::WriteOptions write = write_options(options);
     for (const auto& out : images) {
         render::write_image(image, out, write);

@@ -55,18 +55,24 @@ void expect_same_pixels(const Image& whole, const Image& crop, const PixelRect& 
 const PixelRect crops[] = {{0, 0, 7, 5},   {41, 35, 7, 5}, {13, 9, 20, 17}, {0, 20, 48, 1},
                            {47, 0, 1, 40}, {24, 19, 1, 1}, {5, 0, 30, 40},  {0, 0, 48, 40}};
 
-TEST(Crop, EqualsTheWholeImageBitForBit)
+/// Renders the whole image with `set`, then each crop, and compares them.
+void expect_crops_equal_whole(const geom::Scene& s, RenderSettings set)
 {
-    geom::Scene s = crossing_scene();
-    RenderSettings set = small(48, 40, 12, 3);
-    set.ambient = {0.2f, 0.2f, 0.2f};
-    set.aovs = true;
-    set.filter = PixelFilter::gaussian;
+    set.crop = {};
     Image whole = render(s, set);
     for (const PixelRect& rect : crops) {
         set.crop = rect;
         expect_same_pixels(whole, render(s, set), rect);
     }
+}
+
+TEST(Crop, EqualsTheWholeImageBitForBit)
+{
+    RenderSettings set = small(48, 40, 12, 3);
+    set.ambient = {0.2f, 0.2f, 0.2f};
+    set.aovs = true;
+    set.filter = PixelFilter::gaussian;
+    expect_crops_equal_whole(crossing_scene(), set);
 }
 
 TEST(Crop, AdaptiveSamplingEqualsTheWholeImageBitForBit)
@@ -76,23 +82,15 @@ TEST(Crop, AdaptiveSamplingEqualsTheWholeImageBitForBit)
     set.ambient = {0.2f, 0.2f, 0.2f};
     set.noise_target = 0.04f;
     RenderReport report;
-    Image whole = render(s, set, &report);
+    render(s, set, &report);
     // Adaptive sampling did decide: some pixels stopped early, others went on.
     ASSERT_LT(report.samples, 48u * 40u * 256u / 2);
     ASSERT_GT(report.samples, 48u * 40u * 32u);
-    for (const PixelRect& rect : crops) {
-        set.crop = rect;
-        expect_same_pixels(whole, render(s, set), rect);
-    }
+    expect_crops_equal_whole(s, set);
     // Many equal passes: a margin of passes - 1 pixels, wider than some crops' distance
     // to the image's edge.
     set.passes = 12;
-    set.crop = {};
-    whole = render(s, set);
-    for (const PixelRect& rect : crops) {
-        set.crop = rect;
-        expect_same_pixels(whole, render(s, set), rect);
-    }
+    expect_crops_equal_whole(s, set);
 }
 
 TEST(Crop, OutsideTheImageIsAnError)
