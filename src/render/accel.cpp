@@ -13,6 +13,7 @@
 #include <limits>
 #include <mutex>
 #include <numbers>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -67,15 +68,29 @@ Vec3f vec(const geom::Float3& a) { return {a[0], a[1], a[2]}; }
 Vec3f vec(const geom::Float4& a) { return {a[0], a[1], a[2]}; }
 
 /// An intersection context that carries the primitive to ignore (Embree 3 passes the
-/// context to the context filter function, so it may be extended C-style).
+/// context to filter functions, so it may be extended C-style). Every ray this file traces
+/// has one: the self-hit filter of curves and spheres reads it.
 struct SkipContext {
     RTCIntersectContext context;
     PrimId skip;
 };
 
-void skip_filter(const RTCFilterFunctionNArguments* args)
+SkipContext make_context(PrimId skip, bool coherent)
+{
+    SkipContext c;
+    rtcInitIntersectContext(&c.context);
+    c.context.flags =
+        coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    c.skip = skip;
+    return c;
+}
+
+/// Rejects candidate hits on the primitive the ray leaves (round shapes only: see ShapeKind).
+void skip_self(const RTCFilterFunctionNArguments* args)
 {
     const auto* ctx = reinterpret_cast<const SkipContext*>(args->context);
+    if (ctx->skip.geom == PrimId::none)
+        return;
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] == 0)
             continue;
@@ -84,18 +99,6 @@ void skip_filter(const RTCFilterFunctionNArguments* args)
             RTCHitN_instID(args->hit, args->N, i, 0) == ctx->skip.inst)
             args->valid[i] = 0;
     }
-}
-
-SkipContext make_context(PrimId skip, bool coherent)
-{
-    SkipContext c;
-    rtcInitIntersectContext(&c.context);
-    c.context.flags =
-        coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-    if (skip.geom != PrimId::none)
-        c.context.filter = &skip_filter;
-    c.skip = skip;
-    return c;
 }
 
 /// A 3x3 matrix by columns.
@@ -111,6 +114,7 @@ struct Placement {
     std::uint32_t index = PrimId::none;  ///< in Scene::instances
     Mat3 linear, normals;
     float radius_scale = 1;
+    float largest_scale = 1;  ///< the most the linear part stretches a coordinate (inf-norm)
 };
 
 Placement make_placement(const geom::Instance& inst, std::uint32_t index)
@@ -126,6 +130,10 @@ Placement make_placement(const geom::Instance& inst, std::uint32_t index)
     // (A^-1)^T has the columns (b x c, c x a, a x b) / det.
     p.normals = {cross(b, c) * inv, cross(c, a) * inv, cross(a, b) * inv};
     p.radius_scale = std::cbrt(std::fabs(det));
+    float largest = 0;
+    for (int row = 0; row < 3; ++row)
+        largest = std::fmax(largest, std::fabs(m[row]) + std::fabs(m[3 + row]) + std::fabs(m[6 + row]));
+    p.largest_scale = largest;
     return p;
 }
 
@@ -174,6 +182,9 @@ struct GeometrySource {
     const std::vector<std::int16_t>* texture = nullptr;
     /// Caps and joints: the line segment each belongs to (their attributes are its).
     const std::vector<std::uint32_t>* segment = nullptr;
+    /// The filters its Embree geometry runs on each candidate hit (none: no filter at all):
+    /// the primitive a ray leaves, the pixels a pixel-width line covers, alpha cut-outs.
+    bool skips_self = false, pixel_line = false, cut_out = false;
 
     std::uint32_t attribute_index(std::uint32_t prim) const
     {
@@ -187,6 +198,9 @@ struct LocalSurface {
     Vec3f shading;       ///< interpolated normal (front side), or zero: the geometric one
     float radius = 0;
     bool two_sided = false;
+    /// Flat shapes: their largest coordinate (object space), a measure of the float error
+    /// of a hit on them.
+    float extent = 0;
 };
 
 using TextureCoords = std::array<float, 2>;
@@ -210,7 +224,25 @@ struct ShapeKind {
     /// Spawned rays start this far off the surface: per unit of radius, per unit of the
     /// hit's largest coordinate, and absolute (see EmbreeScene::intersect).
     float offset_per_radius, offset_per_scale, offset_absolute;
+    /// Whether a ray leaving the shape must skip it: Embree's round curves and spheres
+    /// have no self-intersection protection (FACTS.md: half the rays leaving a curve would
+    /// hit it again), so their geometries filter the primitive a ray leaves. Flat shapes
+    /// rely on their offset alone and run no filter for it.
+    bool self_hits;
 };
+
+/// Embree's round Hermite curves are many times slower for a ray with a direction
+/// component exactly zero (9x per sample on the corpus's GeneralizedCylinder, whose every
+/// camera ray, as in cpfg's default parallel view, points down -z). In scenes with such
+/// curves, components below a millionth of the largest are raised to that: a tilt under
+/// 1e-6 rad, far below a pixel. (Other scenes keep their rays exact: pixel-width lines
+/// are drawn to OpenGL's exact pixels.)
+Vec3f off_axis(const Vec3f& d)
+{
+    float least = 1e-6f * std::fmax(std::fabs(d.x), std::fmax(std::fabs(d.y), std::fabs(d.z)));
+    auto raise = [least](float c) { return std::fabs(c) < least ? std::copysign(least, c) : c; };
+    return {raise(d.x), raise(d.y), raise(d.z)};
+}
 
 // ---- Shared by the shapes ------------------------------------------------------------
 
@@ -332,6 +364,12 @@ TextureTangents line_tangents(const GeometrySource& part, std::uint32_t prim, fl
 
 // ---- Caps and joints: the flat free ends and round bends of shaded lines ------------
 
+/// The largest coordinate of a disc (centre and radius).
+float disc_extent(const Key& c)
+{
+    return std::fmax(std::fabs(c[0]), std::fmax(std::fabs(c[1]), std::fabs(c[2]))) + c[3];
+}
+
 RTCGeometry build_caps(RTCDevice device, const GeometrySource& part)
 {
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
@@ -344,7 +382,8 @@ LocalSurface cap_surface(const GeometrySource& part, std::uint32_t prim, float, 
                          const Vec3f&)
 {
     // the solid cylinder's end: its normal points out, like the tube's
-    return {vec(part.ends->cap_normals[prim]), Vec3f(), part.ends->caps[prim][3], false};
+    const Key& cap = part.ends->caps[prim];
+    return {vec(part.ends->cap_normals[prim]), Vec3f(), cap[3], false, disc_extent(cap)};
 }
 
 /// The rim's t; s is the centre of the unrolled tube (one texel across the end).
@@ -482,7 +521,8 @@ RTCGeometry build_discs(RTCDevice device, const GeometrySource& part)
 LocalSurface disc_surface(const GeometrySource& part, std::uint32_t prim, float, float,
                           const Vec3f&)
 {
-    return {vec(part.geometry->discs.normals[prim]), Vec3f(), 0, true};
+    return {vec(part.geometry->discs.normals[prim]), Vec3f(), 0, true,
+            disc_extent(part.geometry->discs.centres[prim])};
 }
 
 // ---- Triangles (polygons, surfaces, meshes) -----------------------------------------
@@ -507,13 +547,17 @@ LocalSurface triangle_surface(const GeometrySource& part, std::uint32_t prim, fl
 {
     const geom::TriangleMesh& m = part.geometry->mesh;
     const auto& tri = m.triangles[prim];
-    Vec3f p0 = vec(m.positions[tri[0]]);
-    Vec3f face = cross(vec(m.positions[tri[1]]) - p0, vec(m.positions[tri[2]]) - p0);
+    Vec3f p0 = vec(m.positions[tri[0]]), p1 = vec(m.positions[tri[1]]),
+          p2 = vec(m.positions[tri[2]]);
+    Vec3f face = cross(p1 - p0, p2 - p0);
     Vec3f n0 = vec(m.normals[tri[0]]), n1 = vec(m.normals[tri[1]]), n2 = vec(m.normals[tri[2]]);
     // The front is where the vertex normals point; a flat face's winding if they vanish.
     if (dot(face, n0 + n1 + n2) < 0)
         face = -face;
-    return {face, n0 * (1 - u - v) + n1 * u + n2 * v, 0, true};
+    float extent = 0;
+    for (const Vec3f& p : {p0, p1, p2})
+        extent = std::fmax(extent, std::fmax(std::fabs(p.x), std::fmax(std::fabs(p.y), std::fabs(p.z))));
+    return {face, n0 * (1 - u - v) + n1 * u + n2 * v, 0, true, extent};
 }
 
 TextureCoords triangle_coords(const GeometrySource& part, std::uint32_t prim, float u, float v,
@@ -550,17 +594,23 @@ TextureTangents triangle_tangents(const GeometrySource& part, std::uint32_t prim
 
 // ---- The table ----------------------------------------------------------------------
 
-// Spawn offsets, measured (accel_test): with the leaving primitive skipped, no offset is
-// needed even at curve joints; a small one guards against float error at large coordinates.
+// Spawn offsets, measured (accel_test): with the leaving primitive skipped, round shapes
+// need no offset even at curve joints; a small one guards against float error at large
+// coordinates. Flat shapes skip nothing: their offset is ~80 float ulps of the hit's
+// largest coordinate or the primitive's (see EmbreeScene::intersect), which clears the
+// error of Embree's hit distance at any angle (physics_test: a plane lit at grazing angles).
 constexpr std::array<ShapeKind, 7> shape_kinds{{
-    /* line */ {build_lines, line_surface, line_coords, line_tangents, 1e-3f, 1e-6f, 0},
-    /* curve */ {build_curves, curve_surface, curve_coords, curve_tangents, 1e-3f, 1e-6f, 0},
-    /* sphere */ {build_spheres, sphere_surface, sphere_coords, sphere_tangents, 1e-4f, 1e-6f, 0},
-    /* disc */ {build_discs, disc_surface, no_coords, no_tangents, 0, 1e-5f, 1e-7f},
+    /* line */ {build_lines, line_surface, line_coords, line_tangents, 1e-3f, 1e-6f, 0, true},
+    /* curve */
+    {build_curves, curve_surface, curve_coords, curve_tangents, 1e-3f, 1e-6f, 0, true},
+    /* sphere */
+    {build_spheres, sphere_surface, sphere_coords, sphere_tangents, 1e-4f, 1e-6f, 0, true},
+    /* disc */ {build_discs, disc_surface, no_coords, no_tangents, 0, 1e-5f, 1e-7f, false},
     /* triangle */
-    {build_triangles, triangle_surface, triangle_coords, triangle_tangents, 0, 1e-5f, 1e-7f},
-    /* cap */ {build_caps, cap_surface, cap_coords, no_tangents, 1e-3f, 1e-6f, 0},
-    /* joint */ {build_joints, joint_surface, joint_coords, no_tangents, 1e-3f, 1e-6f, 0},
+    {build_triangles, triangle_surface, triangle_coords, triangle_tangents, 0, 1e-5f, 1e-7f,
+     false},
+    /* cap */ {build_caps, cap_surface, cap_coords, no_tangents, 1e-3f, 1e-5f, 1e-7f, false},
+    /* joint */ {build_joints, joint_surface, joint_coords, no_tangents, 1e-3f, 1e-6f, 0, true},
 }};
 
 const ShapeKind& kind(Shape s) { return shape_kinds[static_cast<std::size_t>(s)]; }
@@ -645,6 +695,10 @@ struct EmbreeScene::Impl : HitResolver {
     /// their radii converted (a radius in pixels depends on each copy's depth).
     geom::Geometry placed_lines;
     std::size_t segments = 0;
+    std::vector<Shape> filtered_geometries;  ///< the shape of each geometry with a filter
+    bool tilt_rays = false;  ///< some Hermite curves are built: rays are traced off_axis()
+
+    Vec3f traced(const Vec3f& dir) const { return tilt_rays ? off_axis(dir) : dir; }
     mutable std::atomic<std::uint64_t> skipped_rays{0};
 
     ~Impl()
@@ -667,6 +721,7 @@ struct EmbreeScene::Impl : HitResolver {
     RTCScene new_scene()
     {
         RTCScene s = rtcNewScene(device);
+        // transmittance() counts what it passes through in a context filter.
         rtcSetSceneFlags(s, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
         rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
         return s;
@@ -716,6 +771,110 @@ bool any_texture(const std::vector<T>& textures)
 
 }  // namespace
 
+/// A hit's materials: the side hit, then the instance's for inherit_material; a generalized
+/// cylinder's colour blend toward its end material.
+struct HitMaterials {
+    std::uint16_t material = 0, end_material = 0;
+    float blend = 0;
+};
+
+HitMaterials materials_at(const GeometrySource& part, std::uint32_t prim, bool back,
+                          const Placement* placement, float u)
+{
+    std::uint32_t index = part.attribute_index(prim);
+    std::uint16_t material = at_or(*part.material, index, std::uint16_t{0});
+    if (back && part.back_material)
+        material = at_or(*part.back_material, index, material);
+    auto resolve = [&](std::uint16_t mat) -> std::uint16_t {
+        if (mat != geom::inherit_material)
+            return mat;
+        return placement ? (back ? placement->instance->back_material
+                                 : placement->instance->material)
+                         : 0;
+    };
+    HitMaterials m;
+    m.material = resolve(material);
+    const geom::HermiteCurves& c = part.geometry->curves;
+    if (part.shape == Shape::curve && prim < c.end_material.size()) {
+        std::uint16_t end = resolve(c.end_material[prim]);
+        if (end != m.material) {
+            m.end_material = end;
+            m.blend = std::clamp(u, 0.0f, 1.0f);
+        }
+    }
+    return m;
+}
+
+/// Most surfaces a transmittance ray passes through before it counts as blocked.
+constexpr int max_pass_throughs = 64;
+
+/// The context of a transmittance ray: what it has passed through so far. Embree may
+/// report one hit more than once (with spatial splits, from each BVH leaf holding the
+/// primitive), so each counted hit is remembered.
+struct OpacityContext {
+    SkipContext skip;  ///< first: the geometry filters read the context as a SkipContext
+    const HitResolver* resolver = nullptr;
+    std::span<const float> opacity;
+    float through = 1;
+    struct Counted {
+        std::uint32_t geom, prim, inst;
+        float t;
+    };
+    int count = 0;
+    std::array<Counted, max_pass_throughs> counted;
+
+    float opacity_of(std::uint16_t m) const { return m < opacity.size() ? opacity[m] : 1.0f; }
+    bool seen(const Counted& c) const
+    {
+        for (int k = 0; k < count; ++k) {
+            const Counted& o = counted[std::size_t(k)];
+            if (o.geom == c.geom && o.prim == c.prim && o.inst == c.inst &&
+                std::fabs(o.t - c.t) <= 1e-6f * std::fmax(o.t, c.t))
+                return true;
+        }
+        return false;
+    }
+};
+
+/// The context filter of transmittance rays: multiplies in the transparency of each
+/// surface met and lets the ray go on, reading only the hit's material (no normals,
+/// texture coordinates or shading); an opaque surface is kept as the blocking hit.
+void opacity_filter(const RTCFilterFunctionNArguments* args)
+{
+    auto* ctx = reinterpret_cast<OpacityContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0)
+            continue;
+        OpacityContext::Counted c{RTCHitN_geomID(args->hit, args->N, i),
+                                  RTCHitN_primID(args->hit, args->N, i),
+                                  RTCHitN_instID(args->hit, args->N, i, 0),
+                                  RTCRayN_tfar(args->ray, args->N, i)};
+        if (ctx->seen(c)) {
+            args->valid[i] = 0;
+            continue;
+        }
+        const Placement* p = ctx->resolver->placement(c.inst);
+        const GeometrySource& part = *ctx->resolver->part(c.inst, c.geom);
+        float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
+        // The ray and Ng are both in the hit primitive's own space here.
+        Vec3f ng(RTCHitN_Ng_x(args->hit, args->N, i), RTCHitN_Ng_y(args->hit, args->N, i),
+                 RTCHitN_Ng_z(args->hit, args->N, i));
+        Vec3f dir(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                  RTCRayN_dir_z(args->ray, args->N, i));
+        LocalSurface local = kind(part.shape).surface(part, c.prim, u, v, ng);
+        bool back = local.two_sided && dot(local.geometric, dir) > 0;
+        HitMaterials m = materials_at(part, c.prim, back, p, u);
+        float opacity = ctx->opacity_of(m.material);
+        if (m.blend > 0)
+            opacity += (ctx->opacity_of(m.end_material) - opacity) * m.blend;
+        if (opacity >= 1 || ctx->count == max_pass_throughs)
+            continue;  // blocks the ray
+        ctx->through *= 1 - opacity;
+        ctx->counted[std::size_t(ctx->count++)] = c;
+        args->valid[i] = 0;
+    }
+}
+
 int HitResolver::texture_of(const GeometrySource& part, std::uint32_t prim,
                             const Placement* p) const
 {
@@ -728,8 +887,7 @@ int HitResolver::texture_of(const GeometrySource& part, std::uint32_t prim,
     return t;
 }
 
-/// Keeps a hit on a pixel-width line only in the pixels OpenGL draws (pixel_lines.h),
-/// then applies the alpha cut-out where the line is textured.
+/// Keeps a hit on a pixel-width line only in the pixels OpenGL draws (pixel_lines.h).
 void pixel_line_filter(const RTCFilterFunctionNArguments* args)
 {
     const auto* part = static_cast<const GeometrySource*>(args->geometryUserPtr);
@@ -747,7 +905,17 @@ void pixel_line_filter(const RTCFilterFunctionNArguments* args)
         if (!pixel_line_draws(*part->owner->camera, {a[0], a[1], a[2]}, {b[0], b[1], b[2]}, a[3], hit))
             args->valid[i] = 0;
     }
-    if (part->owner->textures)
+}
+
+/// The filters a geometry needs, in order (attached only to geometries that need one).
+void geometry_filter(const RTCFilterFunctionNArguments* args)
+{
+    const auto* part = static_cast<const GeometrySource*>(args->geometryUserPtr);
+    if (part->skips_self)
+        skip_self(args);
+    if (part->pixel_line)
+        pixel_line_filter(args);
+    if (part->cut_out)
         alpha_filter(args);
 }
 
@@ -756,14 +924,15 @@ void EmbreeScene::Impl::attach(RTCScene s, GeometrySource part,
 {
     RTCGeometry g = kind(part.shape).build(device, part);
     part.owner = this;
+    part.skips_self = kind(part.shape).self_hits;
+    part.pixel_line = part.shape == Shape::line && part.unlit;
+    part.cut_out = textures && (alpha || part.pixel_line);
     parts.push_back(part);
     rtcSetGeometryUserData(g, &parts.back());
-    if (part.shape == Shape::line && part.unlit) {
-        rtcSetGeometryIntersectFilterFunction(g, &pixel_line_filter);
-        rtcSetGeometryOccludedFilterFunction(g, &pixel_line_filter);
-    } else if (alpha && textures) {
-        rtcSetGeometryIntersectFilterFunction(g, &alpha_filter);
-        rtcSetGeometryOccludedFilterFunction(g, &alpha_filter);
+    if (part.skips_self || part.pixel_line || part.cut_out) {
+        rtcSetGeometryIntersectFilterFunction(g, &geometry_filter);
+        rtcSetGeometryOccludedFilterFunction(g, &geometry_filter);
+        filtered_geometries.push_back(part.shape);
     }
     rtcCommitGeometry(g);
     unsigned id = rtcAttachGeometry(s, g);
@@ -790,8 +959,10 @@ void EmbreeScene::Impl::add_geometry(RTCScene s, const geom::Geometry& geo,
                 attach(s, line_end_source(Shape::joint, geo, keys, e), ids, cut);
         }
     }
-    if (!geo.curves.segments.empty())
+    if (!geo.curves.segments.empty()) {
         attach(s, curves_source(geo), ids, alpha || any_texture(geo.curves.texture));
+        tilt_rays = true;
+    }
     // Spheres are textured but not cut out: cpfg's @O spheres are solid.
     if (geo.spheres.size() > 0)
         attach(s, spheres_source(geo), ids, false);
@@ -925,7 +1096,7 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     }
     SkipContext context = make_context(skip, coherent);
     RTCRayHit rh;
-    rh.ray = make_ray(org, dir, tnear, tfar);
+    rh.ray = make_ray(org, m.traced(dir), tnear, tfar);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(m.scene, &context.context, &rh);
@@ -934,7 +1105,8 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
 
     SurfaceHit h;
     h.t = rh.ray.tfar;
-    h.position = org + dir * h.t;
+    // Where Embree found it: along the direction it traced (make_ray).
+    h.position = org + m.traced(dir) * h.t;
     h.geom_id = rh.hit.geomID;
     h.prim_id = rh.hit.primID;
     h.inst_id = rh.hit.instID[0];
@@ -967,26 +1139,10 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     // A shading normal turned away from the ray (or absent) gives way to the true one.
     h.normal = dot(shading, dir) < 0 ? shading : geometric;
 
-    // Materials: the side hit, then the instance's for inherit_material.
-    std::uint32_t index = part.attribute_index(h.prim_id);
-    std::uint16_t material = at_or(*part.material, index, std::uint16_t{0});
-    if (h.back && part.back_material)
-        material = at_or(*part.back_material, index, material);
-    auto resolve = [&](std::uint16_t mat) -> std::uint16_t {
-        if (mat != geom::inherit_material)
-            return mat;
-        return placement ? (h.back ? placement->instance->back_material
-                                   : placement->instance->material)
-                         : 0;
-    };
-    h.material = resolve(material);
-    if (part.shape == Shape::curve && h.prim_id < part.geometry->curves.end_material.size()) {
-        std::uint16_t end = resolve(part.geometry->curves.end_material[h.prim_id]);
-        if (end != h.material) {
-            h.end_material = end;
-            h.material_blend = std::clamp(rh.hit.u, 0.0f, 1.0f);
-        }
-    }
+    HitMaterials materials = materials_at(part, h.prim_id, h.back, placement, rh.hit.u);
+    h.material = materials.material;
+    h.end_material = materials.end_material;
+    h.material_blend = materials.blend;
     int texture = m.texture_of(part, h.prim_id, placement);
     h.texture = static_cast<std::int16_t>(texture);
     if (texture != geom::no_texture) {
@@ -1000,10 +1156,38 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
 
     float scale = std::fmax(std::fabs(h.position.x),
                             std::fmax(std::fabs(h.position.y), std::fabs(h.position.z)));
+    if (!shape.self_hits) {
+        // Nothing skips a flat primitive: its offset must clear the float error of the hit,
+        // which grows with the primitive's coordinates and (through the hit distance's
+        // error) with the ray's length.
+        float extent = local.extent * (placement ? placement->largest_scale : 1);
+        scale = std::fmax(scale, extent) + 0.2f * h.t;
+    }
     h.spawn_offset = shape.offset_per_radius * h.radius + shape.offset_per_scale * scale +
                      shape.offset_absolute;
     return h;
 }
+
+float EmbreeScene::transmittance(const Vec3f& org, const Vec3f& dir, float tnear, float tfar,
+                                 PrimId skip, std::span<const float> opacity) const
+{
+    if (!traceable(org, dir, tnear, tfar)) {
+        ++m_impl->skipped_rays;
+        return 1;
+    }
+    OpacityContext context;
+    context.skip = make_context(skip, false);
+    context.skip.context.filter = &opacity_filter;
+    context.resolver = m_impl.get();
+    context.opacity = opacity;
+    RTCRay r = make_ray(org, m_impl->traced(dir), tnear, tfar);
+    rtcOccluded1(m_impl->scene, &context.skip.context, &r);
+    if (r.tfar < 0 && std::isinf(r.tfar))
+        return 0;
+    return context.through;
+}
+
+std::vector<Shape> EmbreeScene::filtered_shapes() const { return m_impl->filtered_geometries; }
 
 bool EmbreeScene::occluded(const Vec3f& org, const Vec3f& dir, float tnear, float tfar,
                            PrimId skip) const
@@ -1013,7 +1197,7 @@ bool EmbreeScene::occluded(const Vec3f& org, const Vec3f& dir, float tnear, floa
         return false;
     }
     SkipContext context = make_context(skip, false);
-    RTCRay r = make_ray(org, dir, tnear, tfar);
+    RTCRay r = make_ray(org, m_impl->traced(dir), tnear, tfar);
     rtcOccluded1(m_impl->scene, &context.context, &r);
     // Embree marks an occluded ray by setting tfar to -inf.
     return r.tfar < 0 && std::isinf(r.tfar);
