@@ -56,8 +56,10 @@ struct SurfaceHit {
     bool back = false;         ///< the ray hit the back side of a disc or triangle
     bool inside = false;       ///< the ray hit a closed primitive from within
     float radius = 0;          ///< curve or sphere radius at the hit (world units)
-    /// Distance to move a spawned ray's origin along `geometric_normal`: Embree's round
-    /// curves have no self-intersection protection (FACTS.md), so this scales with the radius.
+    /// Distance to move a spawned ray's origin along `geometric_normal`: for round shapes
+    /// (which rays leaving them also skip: Embree's curves have no self-intersection
+    /// protection, FACTS.md) it scales with the radius; flat ones are skipped by nothing,
+    /// so theirs covers the float error of the hit (accel.cpp, ShapeKind).
     float spawn_offset = 0;
     /// Drawn in its flat colour, not shaded: cpfg's `line style: pixel` lines are
     /// unlit GL lines, and this keeps their look (docs/deviations.md).
