@@ -8,10 +8,13 @@
 //
 // The path tracer's rays are counted by interposing rtcIntersect1 / rtcOccluded1: this
 // executable defines them, cambium_render (a static library) links to these definitions,
-// and they forward to Embree's through dlsym(RTLD_NEXT). The interposer also keeps the
-// render's Embree scene alive and records the first rays it traces, which are then
-// replayed with raw rtcIntersect1 on that same scene (no filter function) for the
-// comparison.
+// and they forward to Embree's through dlsym(RTLD_NEXT). The interposer also records the
+// first rays of each kind the render traces; when its one pass ends (on_pass, while the
+// render's Embree scene and the buffers it shares are alive) they are replayed with raw
+// rtcIntersect1 / rtcOccluded1 on that same scene and the same threads. The render builds
+// the BVH once: build_s is the time from render() to its first ray. The replay's context
+// carries "skip nothing", so the early-out self-hit filter of round shapes still runs
+// there as in the render (its only cost is the call).
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -59,11 +62,12 @@ struct Recorder {
     std::atomic<std::uint64_t> intersections{0}, occlusions{0};
     std::atomic<bool> started{false};
     Clock::time_point first_call;
+    double rss_at_first_call = 0;
     std::mutex mutex;
-    RTCScene scene = nullptr;          // retained: outlives the render
+    RTCScene scene = nullptr;          // the render's: alive until render() returns
     /// The first rays traced, as given: slots filled without a lock (each call takes its
-    /// index from `intersections`), so recording costs the path tracer one atomic add.
-    std::vector<RTCRay> rays;
+    /// index from its counter), so recording costs the path tracer one atomic add.
+    std::vector<RTCRay> rays, occlusion_rays;
     std::size_t capacity = 0;
 };
 Recorder recorder;
@@ -89,8 +93,11 @@ void note_call(RTCScene scene)
         std::lock_guard lock(recorder.mutex);
         if (!recorder.started) {
             recorder.first_call = Clock::now();
+            // Less the recorder's own buffers (allocated and touched before the render).
+            recorder.rss_at_first_call =
+                peak_rss_mb() - double((recorder.rays.size() + recorder.occlusion_rays.size()) *
+                                       sizeof(RTCRay)) / (1024.0 * 1024.0);
             recorder.scene = scene;
-            rtcRetainScene(scene);
             recorder.started = true;
         }
     }
@@ -113,7 +120,9 @@ extern "C" void rtcOccluded1(RTCScene scene, RTCIntersectContext* context, RTCRa
 {
     if (recorder.capacity > 0) {
         note_call(scene);
-        recorder.occlusions.fetch_add(1, std::memory_order_relaxed);
+        std::uint64_t slot = recorder.occlusions.fetch_add(1, std::memory_order_relaxed);
+        if (slot < recorder.capacity)
+            recorder.occlusion_rays[slot] = *ray;
     }
     real_occluded()(scene, context, ray);
 }
@@ -267,22 +276,37 @@ bool accel_draws_instances()
     return accel.intersect({0, 0.5f, 5}, {0, 0, -1}, 0, 100).has_value();
 }
 
-/// Raw rtcIntersect1 over the recorded rays, in parallel; returns seconds.
-double replay(RTCScene scene, const std::vector<RTCRay>& rays, std::uint64_t& hits)
+/// The intersection context as render/accel.cpp extends it (SkipContext): Embree's, then
+/// the primitive a ray must skip, here none (the filters of round shapes read it).
+struct ReplayContext {
+    RTCIntersectContext context;
+    std::uint32_t skip[3] = {RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID,
+                             RTC_INVALID_GEOMETRY_ID};
+    ReplayContext() { rtcInitIntersectContext(&context); }
+};
+
+/// Raw rtcIntersect1 (or rtcOccluded1) over the recorded rays, in parallel; returns seconds.
+double replay(RTCScene scene, const std::vector<RTCRay>& rays, bool occlusion,
+              std::uint64_t& hits)
 {
     std::atomic<std::uint64_t> hit_count{0};
     auto t0 = Clock::now();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 1024),
                       [&](const tbb::blocked_range<std::size_t>& r) {
-        RTCIntersectContext context;
-        rtcInitIntersectContext(&context);
+        ReplayContext c;
         std::uint64_t local = 0;
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            if (occlusion) {
+                RTCRay ray = rays[i];
+                real_occluded()(scene, &c.context, &ray);
+                local += ray.tfar < 0 ? 1 : 0;
+                continue;
+            }
             RTCRayHit rh;
             rh.ray = rays[i];
             rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
             rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-            real_intersect()(scene, &context, &rh);
+            real_intersect()(scene, &c.context, &rh);
             local += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
         }
         hit_count += local;
@@ -290,6 +314,12 @@ double replay(RTCScene scene, const std::vector<RTCRay>& rays, std::uint64_t& hi
     hits = hit_count;
     return seconds_since(t0);
 }
+
+/// Raw Embree on the recorded rays of both kinds.
+struct RawFigures {
+    std::uint64_t hits = 0, occluded = 0;
+    double intersect_s = 0, occluded_s = 0;
+};
 
 int run(int argc, char** argv)
 {
@@ -337,60 +367,77 @@ int run(int argc, char** argv)
     settings.threads = threads;
     settings.ambient = {0.1f, 0.1f, 0.1f};
     settings.aovs = false;  // the path tracer alone
+    settings.passes = 1;    // one pass: its end (on_pass) is the end of tracing
     auto camera = cambium::render::make_camera(scene.view, scene.bounds, width, height);
-
-    // BVH build, on its own.
-    double build_s = 0, rss_after_build = 0;
     std::size_t built_segments = 0;
     arena.execute([&] {
-        auto b0 = Clock::now();
-        cambium::render::EmbreeScene accel(scene, camera);
-        build_s = seconds_since(b0);
-        built_segments = accel.segment_count();
-        rss_after_build = peak_rss_mb();
+        // Counted apart, on the scene's own geometry (no BVH is built).
+        built_segments =
+            scene.geometry.lines.segment_count() + scene.geometry.curves.segment_count();
     });
 
-    // The path tracer, counted by the interposer.
+    // The path tracer, counted by the interposer; the raw replay at the end of its pass,
+    // while its Embree scene is alive.
     recorder.rays.resize(2'000'000);  // touched here, before the clock starts
+    recorder.occlusion_rays.resize(2'000'000);
     recorder.capacity = recorder.rays.size();
+    Clock::time_point trace_end;
+    std::uint64_t intersections = 0, occlusions = 0;
+    RawFigures raw;
+    settings.on_pass = [&](const cambium::render::Image&) {
+        trace_end = Clock::now();
+        recorder.capacity = 0;
+        intersections = recorder.intersections;
+        occlusions = recorder.occlusions;
+        recorder.rays.resize(std::min<std::size_t>(recorder.rays.size(), intersections));
+        recorder.occlusion_rays.resize(
+            std::min<std::size_t>(recorder.occlusion_rays.size(), occlusions));
+        arena.execute([&] {
+            raw.intersect_s = replay(recorder.scene, recorder.rays, false, raw.hits);
+            raw.occluded_s = replay(recorder.scene, recorder.occlusion_rays, true, raw.occluded);
+        });
+    };
     auto r0 = Clock::now();
     cambium::render::RenderReport report;
     cambium::render::Image image = cambium::render::render(scene, camera, settings, &report);
-    double render_s = seconds_since(r0);
-    double trace_s = std::chrono::duration<double>(Clock::now() - recorder.first_call).count();
-    recorder.capacity = 0;
-    std::uint64_t intersections = recorder.intersections, occlusions = recorder.occlusions;
-    recorder.rays.resize(std::min<std::size_t>(recorder.rays.size(), intersections));
+    double build_s = std::chrono::duration<double>(recorder.first_call - r0).count();
+    double trace_s = std::chrono::duration<double>(trace_end - recorder.first_call).count();
+    double render_s = std::chrono::duration<double>(trace_end - r0).count();
     double covered = 0;
     for (std::size_t i = 3; i < image.rgba.size(); i += 4)
         covered += image.rgba[i];
 
-    // Raw Embree on the same (recorded) rays, same scene, same threads.
-    std::uint64_t raw_hits = 0;
-    double raw_s = 0;
-    arena.execute([&] { raw_s = replay(recorder.scene, recorder.rays, raw_hits); });
-    rtcReleaseScene(recorder.scene);
-
     double rays = double(intersections + occlusions);
+    // Raw Embree's time for the path tracer's mix of rays, at the replayed rates.
+    auto rate = [](std::size_t n, double s) { return s > 0 ? double(n) / s : 0.0; };
+    double raw_intersect_rate = rate(recorder.rays.size(), raw.intersect_s);
+    double raw_occluded_rate = rate(recorder.occlusion_rays.size(), raw.occluded_s);
+    double raw_mix_s = (raw_intersect_rate > 0 ? double(intersections) / raw_intersect_rate : 0) +
+                       (raw_occluded_rate > 0 ? double(occlusions) / raw_occluded_rate : 0);
+    double raw_rays_per_s = raw_mix_s > 0 ? rays / raw_mix_s : 0;
     std::printf(
         "{\"scale\":%g,\"threads\":%d,\"segments\":%zu,\"embree_segments\":%zu,"
         "\"instances\":%zu,\"instances_in_accel\":%s,\"generate_s\":%.3f,\"build_s\":%.3f,"
         "\"peak_rss_mb_after_build\":%.1f,\"image\":\"%dx%d\",\"spp\":%d,\"max_depth\":%d,"
         "\"render_s\":%.3f,\"trace_s\":%.3f,\"paths\":%llu,\"coverage\":%.3f,"
         "\"intersect_rays\":%llu,\"occlusion_rays\":%llu,\"rays_per_s\":%.0f,"
-        "\"paths_per_s\":%.0f,\"raw_embree\":{\"rays\":%zu,\"seconds\":%.3f,"
-        "\"rays_per_s\":%.0f,\"hit_fraction\":%.3f},\"path_tracer_intersect_rays_per_s\":%.0f,"
+        "\"paths_per_s\":%.0f,\"raw_embree\":{\"intersect_rays\":%zu,\"intersect_s\":%.3f,"
+        "\"intersect_rays_per_s\":%.0f,\"hit_fraction\":%.3f,\"occlusion_rays\":%zu,"
+        "\"occlusion_s\":%.3f,\"occlusion_rays_per_s\":%.0f,\"rays_per_s\":%.0f},"
+        "\"path_tracer_intersect_rays_per_s\":%.0f,\"path_tracer_fraction_of_raw\":%.3f,"
         "\"peak_rss_mb\":%.1f}\n",
         scale, threads, scene.geometry.lines.segment_count(), built_segments,
         scene.instances.size(), instances ? "true" : "false", generate_s, build_s,
-        rss_after_build, width, height, spp, depth, render_s, trace_s,
+        recorder.rss_at_first_call, width, height, spp, depth, render_s, trace_s,
         static_cast<unsigned long long>(report.samples), covered / (double(width) * height),
         static_cast<unsigned long long>(intersections),
         static_cast<unsigned long long>(occlusions), rays / trace_s,
-        double(report.samples) / trace_s, recorder.rays.size(), raw_s,
-        double(recorder.rays.size()) / raw_s,
-        recorder.rays.empty() ? 0.0 : double(raw_hits) / double(recorder.rays.size()),
-        double(intersections) / trace_s, peak_rss_mb());
+        double(report.samples) / trace_s, recorder.rays.size(), raw.intersect_s,
+        raw_intersect_rate,
+        recorder.rays.empty() ? 0.0 : double(raw.hits) / double(recorder.rays.size()),
+        recorder.occlusion_rays.size(), raw.occluded_s, raw_occluded_rate, raw_rays_per_s,
+        double(intersections) / trace_s,
+        raw_rays_per_s > 0 ? rays / trace_s / raw_rays_per_s : 0.0, peak_rss_mb());
     return 0;
 }
 

@@ -13,6 +13,7 @@
 #include <limits>
 #include <mutex>
 #include <numbers>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -67,15 +68,29 @@ Vec3f vec(const geom::Float3& a) { return {a[0], a[1], a[2]}; }
 Vec3f vec(const geom::Float4& a) { return {a[0], a[1], a[2]}; }
 
 /// An intersection context that carries the primitive to ignore (Embree 3 passes the
-/// context to the context filter function, so it may be extended C-style).
+/// context to filter functions, so it may be extended C-style). Every ray this file traces
+/// has one: the self-hit filter of curves and spheres reads it.
 struct SkipContext {
     RTCIntersectContext context;
     PrimId skip;
 };
 
-void skip_filter(const RTCFilterFunctionNArguments* args)
+SkipContext make_context(PrimId skip, bool coherent)
+{
+    SkipContext c;
+    rtcInitIntersectContext(&c.context);
+    c.context.flags =
+        coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    c.skip = skip;
+    return c;
+}
+
+/// Rejects candidate hits on the primitive the ray leaves (round shapes only: see ShapeKind).
+void skip_self(const RTCFilterFunctionNArguments* args)
 {
     const auto* ctx = reinterpret_cast<const SkipContext*>(args->context);
+    if (ctx->skip.geom == PrimId::none)
+        return;
     for (unsigned i = 0; i < args->N; ++i) {
         if (args->valid[i] == 0)
             continue;
@@ -84,18 +99,6 @@ void skip_filter(const RTCFilterFunctionNArguments* args)
             RTCHitN_instID(args->hit, args->N, i, 0) == ctx->skip.inst)
             args->valid[i] = 0;
     }
-}
-
-SkipContext make_context(PrimId skip, bool coherent)
-{
-    SkipContext c;
-    rtcInitIntersectContext(&c.context);
-    c.context.flags =
-        coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-    if (skip.geom != PrimId::none)
-        c.context.filter = &skip_filter;
-    c.skip = skip;
-    return c;
 }
 
 /// A 3x3 matrix by columns.
@@ -111,6 +114,7 @@ struct Placement {
     std::uint32_t index = PrimId::none;  ///< in Scene::instances
     Mat3 linear, normals;
     float radius_scale = 1;
+    float largest_scale = 1;  ///< the most the linear part stretches a coordinate (inf-norm)
 };
 
 Placement make_placement(const geom::Instance& inst, std::uint32_t index)
@@ -126,6 +130,10 @@ Placement make_placement(const geom::Instance& inst, std::uint32_t index)
     // (A^-1)^T has the columns (b x c, c x a, a x b) / det.
     p.normals = {cross(b, c) * inv, cross(c, a) * inv, cross(a, b) * inv};
     p.radius_scale = std::cbrt(std::fabs(det));
+    float largest = 0;
+    for (int row = 0; row < 3; ++row)
+        largest = std::fmax(largest, std::fabs(m[row]) + std::fabs(m[3 + row]) + std::fabs(m[6 + row]));
+    p.largest_scale = largest;
     return p;
 }
 
@@ -159,24 +167,494 @@ T at_or(const std::vector<T>& v, std::size_t i, T fallback)
 
 struct HitResolver;
 
-/// One Embree geometry's source primitives.
+/// One Embree geometry's source primitives and where their attributes live.
 struct GeometrySource {
     Shape shape = Shape::line;
     const geom::Geometry* geometry = nullptr;
-    const Key* line_keys = nullptr;  ///< lines: keys with world-unit radii
+    const Key* line_keys = nullptr;  ///< lines, caps, joints: keys with world-unit radii
     bool unlit = false;
     const HitResolver* owner = nullptr;
     const LineEnds* ends = nullptr;  ///< caps and joints: the segments they belong to
+    /// Per-primitive attributes, indexed by attribute_index(): front and back (flat
+    /// shapes only) materials, textures (none: never textured).
+    const std::vector<std::uint16_t>* material = nullptr;
+    const std::vector<std::uint16_t>* back_material = nullptr;
+    const std::vector<std::int16_t>* texture = nullptr;
+    /// Caps and joints: the line segment each belongs to (their attributes are its).
+    const std::vector<std::uint32_t>* segment = nullptr;
+    /// The filters its Embree geometry runs on each candidate hit (none: no filter at all):
+    /// the primitive a ray leaves, the pixels a pixel-width line covers, alpha cut-outs.
+    bool skips_self = false, pixel_line = false, cut_out = false;
+
+    std::uint32_t attribute_index(std::uint32_t prim) const
+    {
+        return segment ? (*segment)[prim] : prim;
+    }
 };
 
-/// The segment of the scene's lines whose hit this is (a cap's or joint's: its segment).
-std::uint32_t line_segment(const GeometrySource& part, std::uint32_t prim)
+/// What a primitive says about its hit in object space.
+struct LocalSurface {
+    Vec3f geometric;     ///< true normal (front side for discs and triangles)
+    Vec3f shading;       ///< interpolated normal (front side), or zero: the geometric one
+    float radius = 0;
+    bool two_sided = false;
+    /// Flat shapes: their largest coordinate (object space), a measure of the float error
+    /// of a hit on them.
+    float extent = 0;
+};
+
+using TextureCoords = std::array<float, 2>;
+using TextureTangents = std::array<Vec3f, 2>;
+
+/// Everything accel does that depends on the kind of primitive: one entry per Shape in
+/// `shape_kinds`, so a new kind of primitive is added in one place.
+struct ShapeKind {
+    /// Embree's geometry of the part's primitives (throws cambium::Error on a bad index).
+    RTCGeometry (*build)(RTCDevice device, const GeometrySource& part);
+    /// The hit's surface in object space from Embree's (u, v) and normal ng.
+    LocalSurface (*surface)(const GeometrySource& part, std::uint32_t prim, float u, float v,
+                            const Vec3f& ng);
+    /// Texture coordinates (s, t) of a hit.
+    TextureCoords (*texture_coords)(const GeometrySource& part, std::uint32_t prim, float u,
+                                    float v, const Vec3f& ng);
+    /// dP/ds and dP/dt in object space at a hit (texture_coords' derivatives); zero where
+    /// a coordinate does not change.
+    TextureTangents (*texture_tangents)(const GeometrySource& part, std::uint32_t prim,
+                                        float u, const Vec3f& ng, float radius);
+    /// Spawned rays start this far off the surface: per unit of radius, per unit of the
+    /// hit's largest coordinate, and absolute (see EmbreeScene::intersect).
+    float offset_per_radius, offset_per_scale, offset_absolute;
+    /// Whether a ray leaving the shape must skip it: Embree's round curves and spheres
+    /// have no self-intersection protection (FACTS.md: half the rays leaving a curve would
+    /// hit it again), so their geometries filter the primitive a ray leaves. Flat shapes
+    /// rely on their offset alone and run no filter for it.
+    bool self_hits;
+};
+
+/// Embree's round Hermite curves are many times slower for a ray with a direction
+/// component exactly zero (9x per sample on the corpus's GeneralizedCylinder, whose every
+/// camera ray, as in cpfg's default parallel view, points down -z). In scenes with such
+/// curves, components below a millionth of the largest are raised to that: a tilt under
+/// 1e-6 rad, far below a pixel. (Other scenes keep their rays exact: pixel-width lines
+/// are drawn to OpenGL's exact pixels.)
+Vec3f off_axis(const Vec3f& d)
 {
-    switch (part.shape) {
-    case Shape::cap: return part.ends->cap_segment[prim];
-    case Shape::joint: return part.ends->joint_segment[prim];
-    default: return prim;
-    }
+    float least = 1e-6f * std::fmax(std::fabs(d.x), std::fmax(std::fabs(d.y), std::fabs(d.z)));
+    auto raise = [least](float c) { return std::fabs(c) < least ? std::copysign(least, c) : c; };
+    return {raise(d.x), raise(d.y), raise(d.z)};
+}
+
+// ---- Shared by the shapes ------------------------------------------------------------
+
+void check_segments(const std::vector<std::uint32_t>& segments, std::size_t keys,
+                    const char* what)
+{
+    for (std::uint32_t first : segments)
+        if (first + 1 >= keys)
+            throw Error(std::string("scene: ") + what + " segment starts at key " +
+                        std::to_string(first) + " of " + std::to_string(keys));
+}
+
+template <class T>
+void check_size(const std::vector<T>& v, std::size_t n, const char* what)
+{
+    if (v.size() != n)
+        throw Error(std::string("scene: ") + std::to_string(v.size()) + " " + what + " for " +
+                    std::to_string(n));
+}
+
+/// Copies `data` into a new Embree-owned buffer (Embree pads it for its SSE loads, which
+/// shared float3 and uint3 buffers would need by hand).
+template <class T>
+void copy_buffer(RTCGeometry g, RTCBufferType type, RTCFormat format, const std::vector<T>& data)
+{
+    void* dst = rtcSetNewGeometryBuffer(g, type, 0, format, sizeof(T), data.size());
+    if (dst)
+        std::memcpy(dst, data.data(), sizeof(T) * data.size());
+}
+
+void share_keys(RTCGeometry g, RTCBufferType type, const Key* keys, std::size_t n)
+{
+    rtcSetSharedGeometryBuffer(g, type, 0, RTC_FORMAT_FLOAT4, keys, 0, sizeof(Key), n);
+}
+
+void share_segments(RTCGeometry g, const std::vector<std::uint32_t>& segments)
+{
+    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, segments.data(), 0,
+                               sizeof(std::uint32_t), segments.size());
+}
+
+void set_flags(RTCGeometry g, const std::vector<std::uint8_t>& flags, std::size_t segments)
+{
+    // Neighbour flags close the joints of a polyline without caps or bulges.
+    if (flags.size() == segments)
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_FLAGS, 0, RTC_FORMAT_UCHAR, flags.data(), 0,
+                                   sizeof(std::uint8_t), flags.size());
+    else if (!flags.empty())
+        warn("scene: " + std::to_string(flags.size()) + " curve flags for " +
+             std::to_string(segments) + " segments; flags ignored");
+}
+
+/// Around a tube, s runs once round the circumference; along it, t as its keys say.
+TextureTangents tube_tangents(const Vec3f& axis, const Vec3f& ng, float radius, float dv)
+{
+    return {normalize(cross(axis, normalize(ng))) * (2 * pi * radius),
+            dv != 0 ? axis * (1 / dv) : Vec3f()};
+}
+
+TextureTangents no_tangents(const GeometrySource&, std::uint32_t, float, const Vec3f&, float)
+{
+    return {Vec3f(), Vec3f()};
+}
+
+TextureCoords no_coords(const GeometrySource&, std::uint32_t, float, float, const Vec3f&)
+{
+    return {0, 0};
+}
+
+// ---- Lines (F, G): cone curves, or round ones for pixel-width lines ------------------
+
+RTCGeometry build_lines(RTCDevice device, const GeometrySource& part)
+{
+    const geom::LinearCurves& l = part.geometry->lines;
+    check_segments(l.segments, l.keys.size(), "line");
+    // cpfg's pixel lines are GL lines: Embree's round (swept-sphere) curves suit them;
+    // shaded cylinders are exact frustums closed by caps and joints (LineEnds).
+    RTCGeometry g = rtcNewGeometry(device, part.unlit ? RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE
+                                                      : RTC_GEOMETRY_TYPE_CONE_LINEAR_CURVE);
+    share_keys(g, RTC_BUFFER_TYPE_VERTEX, part.line_keys, l.keys.size());
+    share_segments(g, l.segments);
+    if (part.unlit)
+        set_flags(g, l.flags, l.segments.size());
+    return g;
+}
+
+LocalSurface line_surface(const GeometrySource& part, std::uint32_t prim, float u, float,
+                          const Vec3f& ng)
+{
+    const geom::LinearCurves& l = part.geometry->lines;
+    const Key& k0 = part.line_keys[l.segments[prim]];
+    const Key& k1 = part.line_keys[l.segments[prim] + 1];
+    return {ng, Vec3f(), k0[3] + (k1[3] - k0[3]) * u, false};
+}
+
+/// Texture t at key k of the lines (0 without per-key t).
+float line_t(const geom::LinearCurves& l, std::uint32_t k)
+{
+    return l.v.size() == l.keys.size() ? l.v[k] : 0.0f;
+}
+
+TextureCoords line_coords(const GeometrySource& part, std::uint32_t prim, float u, float,
+                          const Vec3f& ng)
+{
+    const geom::LinearCurves& l = part.geometry->lines;
+    std::uint32_t k = l.segments[prim];
+    float t = line_t(l, k) + (line_t(l, k + 1) - line_t(l, k)) * u;
+    return {angle_around(vec(part.line_keys[k + 1]) - vec(part.line_keys[k]), ng), t};
+}
+
+TextureTangents line_tangents(const GeometrySource& part, std::uint32_t prim, float,
+                              const Vec3f& ng, float radius)
+{
+    const geom::LinearCurves& l = part.geometry->lines;
+    std::uint32_t k = l.segments[prim];
+    Vec3f axis = vec(part.line_keys[k + 1]) - vec(part.line_keys[k]);
+    return tube_tangents(axis, ng, radius, line_t(l, k + 1) - line_t(l, k));
+}
+
+// ---- Caps and joints: the flat free ends and round bends of shaded lines ------------
+
+/// The largest coordinate of a disc (centre and radius).
+float disc_extent(const Key& c)
+{
+    return std::fmax(std::fabs(c[0]), std::fmax(std::fabs(c[1]), std::fabs(c[2]))) + c[3];
+}
+
+RTCGeometry build_caps(RTCDevice device, const GeometrySource& part)
+{
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
+    share_keys(g, RTC_BUFFER_TYPE_VERTEX, part.ends->caps.data(), part.ends->caps.size());
+    copy_buffer(g, RTC_BUFFER_TYPE_NORMAL, RTC_FORMAT_FLOAT3, part.ends->cap_normals);
+    return g;
+}
+
+LocalSurface cap_surface(const GeometrySource& part, std::uint32_t prim, float, float,
+                         const Vec3f&)
+{
+    // the solid cylinder's end: its normal points out, like the tube's
+    const Key& cap = part.ends->caps[prim];
+    return {vec(part.ends->cap_normals[prim]), Vec3f(), cap[3], false, disc_extent(cap)};
+}
+
+/// The rim's t; s is the centre of the unrolled tube (one texel across the end).
+TextureCoords cap_coords(const GeometrySource& part, std::uint32_t prim, float, float,
+                         const Vec3f&)
+{
+    const geom::LinearCurves& l = part.geometry->lines;
+    return {0.5f, line_t(l, l.segments[part.ends->cap_segment[prim]] +
+                               part.ends->cap_at_end[prim])};
+}
+
+RTCGeometry build_joints(RTCDevice device, const GeometrySource& part)
+{
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+    share_keys(g, RTC_BUFFER_TYPE_VERTEX, part.ends->joints.data(), part.ends->joints.size());
+    return g;
+}
+
+LocalSurface joint_surface(const GeometrySource& part, std::uint32_t prim, float, float,
+                           const Vec3f& ng)
+{
+    return {ng, Vec3f(), part.ends->joints[prim][3], false};
+}
+
+TextureCoords joint_coords(const GeometrySource& part, std::uint32_t prim, float, float,
+                           const Vec3f&)
+{
+    const geom::LinearCurves& l = part.geometry->lines;
+    return {0.5f, line_t(l, l.segments[part.ends->joint_segment[prim]] + 1)};
+}
+
+// ---- Curves: generalized cylinders as round Hermite segments ------------------------
+
+RTCGeometry build_curves(RTCDevice device, const GeometrySource& part)
+{
+    const geom::HermiteCurves& c = part.geometry->curves;
+    check_segments(c.segments, c.points.size(), "curve");
+    check_size(c.tangents, c.points.size(), "curve tangents");
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ROUND_HERMITE_CURVE);
+    share_keys(g, RTC_BUFFER_TYPE_VERTEX, c.points.data(), c.points.size());
+    share_keys(g, RTC_BUFFER_TYPE_TANGENT, c.tangents.data(), c.tangents.size());
+    share_segments(g, c.segments);
+    set_flags(g, c.flags, c.segments.size());
+    return g;
+}
+
+/// The direction of a Hermite segment's axis (its derivative) at u.
+Vec3f hermite_axis(const geom::HermiteCurves& c, std::uint32_t k, float u)
+{
+    auto d = hermite_derivative(u);
+    return vec(c.points[k]) * d[0] + vec(c.tangents[k]) * d[1] + vec(c.points[k + 1]) * d[2] +
+           vec(c.tangents[k + 1]) * d[3];
+}
+
+LocalSurface curve_surface(const GeometrySource& part, std::uint32_t prim, float u, float,
+                           const Vec3f& ng)
+{
+    const geom::HermiteCurves& c = part.geometry->curves;
+    std::uint32_t k = c.segments[prim];
+    auto h = hermite(u);
+    float radius = c.points[k][3] * h[0] + c.tangents[k][3] * h[1] + c.points[k + 1][3] * h[2] +
+                   c.tangents[k + 1][3] * h[3];
+    return {ng, Vec3f(), radius, false};
+}
+
+float curve_dv(const geom::HermiteCurves& c, std::uint32_t k)
+{
+    return c.v.size() == c.points.size() ? c.v[k + 1] - c.v[k] : 0.0f;
+}
+
+TextureCoords curve_coords(const GeometrySource& part, std::uint32_t prim, float u, float,
+                           const Vec3f& ng)
+{
+    const geom::HermiteCurves& c = part.geometry->curves;
+    std::uint32_t k = c.segments[prim];
+    float t = c.v.size() == c.points.size() ? c.v[k] + curve_dv(c, k) * u : 0.0f;
+    return {angle_around(hermite_axis(c, k, u), ng), t};
+}
+
+TextureTangents curve_tangents(const GeometrySource& part, std::uint32_t prim, float u,
+                               const Vec3f& ng, float radius)
+{
+    const geom::HermiteCurves& c = part.geometry->curves;
+    std::uint32_t k = c.segments[prim];
+    return tube_tangents(hermite_axis(c, k, u), ng, radius, curve_dv(c, k));
+}
+
+// ---- Spheres (@O) -------------------------------------------------------------------
+
+RTCGeometry build_spheres(RTCDevice device, const GeometrySource& part)
+{
+    const geom::Spheres& sp = part.geometry->spheres;
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+    share_keys(g, RTC_BUFFER_TYPE_VERTEX, sp.centres.data(), sp.centres.size());
+    return g;
+}
+
+LocalSurface sphere_surface(const GeometrySource& part, std::uint32_t prim, float, float,
+                            const Vec3f& ng)
+{
+    return {ng, Vec3f(), part.geometry->spheres.centres[prim][3], false};
+}
+
+/// s = longitude / 2 pi about z, t = latitude / pi + 1/2.
+TextureCoords sphere_coords(const GeometrySource&, std::uint32_t, float, float, const Vec3f& ng)
+{
+    Vec3f n = normalize(ng);
+    return {std::atan2(n.y, n.x) / (2 * pi) + 0.5f,
+            std::asin(std::fmax(-1.0f, std::fmin(1.0f, n.z))) / pi + 0.5f};
+}
+
+TextureTangents sphere_tangents(const GeometrySource&, std::uint32_t, float, const Vec3f& ng,
+                                float radius)
+{
+    Vec3f n = normalize(ng);
+    float rxy = std::sqrt(n.x * n.x + n.y * n.y);
+    if (rxy <= 0)
+        return {Vec3f(), Vec3f()};
+    Vec3f east(-n.y / rxy, n.x / rxy, 0), north(-n.z * n.x / rxy, -n.z * n.y / rxy, rxy);
+    return {east * (2 * pi * radius * rxy), north * (pi * radius)};
+}
+
+// ---- Discs (@o, @c) -----------------------------------------------------------------
+
+RTCGeometry build_discs(RTCDevice device, const GeometrySource& part)
+{
+    const geom::Discs& d = part.geometry->discs;
+    check_size(d.normals, d.centres.size(), "disc normals");
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
+    share_keys(g, RTC_BUFFER_TYPE_VERTEX, d.centres.data(), d.centres.size());
+    copy_buffer(g, RTC_BUFFER_TYPE_NORMAL, RTC_FORMAT_FLOAT3, d.normals);
+    return g;
+}
+
+LocalSurface disc_surface(const GeometrySource& part, std::uint32_t prim, float, float,
+                          const Vec3f&)
+{
+    return {vec(part.geometry->discs.normals[prim]), Vec3f(), 0, true,
+            disc_extent(part.geometry->discs.centres[prim])};
+}
+
+// ---- Triangles (polygons, surfaces, meshes) -----------------------------------------
+
+RTCGeometry build_triangles(RTCDevice device, const GeometrySource& part)
+{
+    const geom::TriangleMesh& m = part.geometry->mesh;
+    check_size(m.normals, m.positions.size(), "mesh normals");
+    for (const auto& tri : m.triangles)
+        for (std::uint32_t i : tri)
+            if (i >= m.positions.size())
+                throw Error("scene: triangle vertex " + std::to_string(i) + " of " +
+                            std::to_string(m.positions.size()));
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    copy_buffer(g, RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3, m.positions);
+    copy_buffer(g, RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT3, m.triangles);
+    return g;
+}
+
+LocalSurface triangle_surface(const GeometrySource& part, std::uint32_t prim, float u, float v,
+                              const Vec3f&)
+{
+    const geom::TriangleMesh& m = part.geometry->mesh;
+    const auto& tri = m.triangles[prim];
+    Vec3f p0 = vec(m.positions[tri[0]]), p1 = vec(m.positions[tri[1]]),
+          p2 = vec(m.positions[tri[2]]);
+    Vec3f face = cross(p1 - p0, p2 - p0);
+    Vec3f n0 = vec(m.normals[tri[0]]), n1 = vec(m.normals[tri[1]]), n2 = vec(m.normals[tri[2]]);
+    // The front is where the vertex normals point; a flat face's winding if they vanish.
+    if (dot(face, n0 + n1 + n2) < 0)
+        face = -face;
+    float extent = 0;
+    for (const Vec3f& p : {p0, p1, p2})
+        extent = std::fmax(extent, std::fmax(std::fabs(p.x), std::fmax(std::fabs(p.y), std::fabs(p.z))));
+    return {face, n0 * (1 - u - v) + n1 * u + n2 * v, 0, true, extent};
+}
+
+TextureCoords triangle_coords(const GeometrySource& part, std::uint32_t prim, float u, float v,
+                              const Vec3f&)
+{
+    const geom::TriangleMesh& m = part.geometry->mesh;
+    const auto& tri = m.triangles[prim];
+    const auto& uv = m.uvs;
+    if (uv.size() != m.positions.size())
+        return {0, 0};
+    float w = 1 - u - v;
+    return {uv[tri[0]][0] * w + uv[tri[1]][0] * u + uv[tri[2]][0] * v,
+            uv[tri[0]][1] * w + uv[tri[1]][1] * u + uv[tri[2]][1] * v};
+}
+
+TextureTangents triangle_tangents(const GeometrySource& part, std::uint32_t prim, float,
+                                  const Vec3f&, float)
+{
+    const geom::TriangleMesh& m = part.geometry->mesh;
+    const auto& tri = m.triangles[prim];
+    if (m.uvs.size() != m.positions.size())
+        return {Vec3f(), Vec3f()};
+    Vec3f e1 = vec(m.positions[tri[1]]) - vec(m.positions[tri[0]]);
+    Vec3f e2 = vec(m.positions[tri[2]]) - vec(m.positions[tri[0]]);
+    const geom::Float2 &uv0 = m.uvs[tri[0]], &uv1 = m.uvs[tri[1]], &uv2 = m.uvs[tri[2]];
+    float s1 = uv1[0] - uv0[0], t1 = uv1[1] - uv0[1];
+    float s2 = uv2[0] - uv0[0], t2 = uv2[1] - uv0[1];
+    float det = s1 * t2 - s2 * t1;
+    if (!(std::fabs(det) > 1e-20f))
+        return {Vec3f(), Vec3f()};
+    float inv = 1 / det;
+    return {(e1 * t2 - e2 * t1) * inv, (e2 * s1 - e1 * s2) * inv};
+}
+
+// ---- The table ----------------------------------------------------------------------
+
+// Spawn offsets, measured (accel_test): with the leaving primitive skipped, round shapes
+// need no offset even at curve joints; a small one guards against float error at large
+// coordinates. Flat shapes skip nothing: their offset is ~80 float ulps of the hit's
+// largest coordinate or the primitive's (see EmbreeScene::intersect), which clears the
+// error of Embree's hit distance at any angle (physics_test: a plane lit at grazing angles).
+constexpr std::array<ShapeKind, 7> shape_kinds{{
+    /* line */ {build_lines, line_surface, line_coords, line_tangents, 1e-3f, 1e-6f, 0, true},
+    /* curve */
+    {build_curves, curve_surface, curve_coords, curve_tangents, 1e-3f, 1e-6f, 0, true},
+    /* sphere */
+    {build_spheres, sphere_surface, sphere_coords, sphere_tangents, 1e-4f, 1e-6f, 0, true},
+    /* disc */ {build_discs, disc_surface, no_coords, no_tangents, 0, 1e-5f, 1e-7f, false},
+    /* triangle */
+    {build_triangles, triangle_surface, triangle_coords, triangle_tangents, 0, 1e-5f, 1e-7f,
+     false},
+    /* cap */ {build_caps, cap_surface, cap_coords, no_tangents, 1e-3f, 1e-5f, 1e-7f, false},
+    /* joint */ {build_joints, joint_surface, joint_coords, no_tangents, 1e-3f, 1e-6f, 0, true},
+}};
+
+const ShapeKind& kind(Shape s) { return shape_kinds[static_cast<std::size_t>(s)]; }
+
+/// The sources of a Geometry's primitives of each kind, attributes pointed at.
+GeometrySource lines_source(const geom::Geometry& g, const Key* keys, bool unlit)
+{
+    const geom::LinearCurves& l = g.lines;
+    return {Shape::line, &g, keys, unlit, nullptr, nullptr, &l.material, nullptr, &l.texture};
+}
+
+GeometrySource line_end_source(Shape shape, const geom::Geometry& g, const Key* keys,
+                               const LineEnds& ends)
+{
+    GeometrySource s = lines_source(g, keys, false);
+    s.shape = shape;
+    s.ends = &ends;
+    s.segment = shape == Shape::cap ? &ends.cap_segment : &ends.joint_segment;
+    return s;
+}
+
+GeometrySource curves_source(const geom::Geometry& g)
+{
+    return {Shape::curve, &g, nullptr, false, nullptr, nullptr, &g.curves.material, nullptr,
+            &g.curves.texture};
+}
+
+GeometrySource spheres_source(const geom::Geometry& g)
+{
+    return {Shape::sphere, &g, nullptr, false, nullptr, nullptr, &g.spheres.material, nullptr,
+            &g.spheres.texture};
+}
+
+GeometrySource discs_source(const geom::Geometry& g)
+{
+    // Discs are never textured, not even by their instance.
+    return {Shape::disc, &g, nullptr, false, nullptr, nullptr, &g.discs.material,
+            &g.discs.back_material, nullptr};
+}
+
+GeometrySource triangles_source(const geom::Geometry& g)
+{
+    return {Shape::triangle, &g, nullptr, false, nullptr, nullptr, &g.mesh.material,
+            &g.mesh.back_material, &g.mesh.texture};
 }
 
 /// What hits are resolved with: parts by geometry id, instances' placements, textures
@@ -217,6 +695,10 @@ struct EmbreeScene::Impl : HitResolver {
     /// their radii converted (a radius in pixels depends on each copy's depth).
     geom::Geometry placed_lines;
     std::size_t segments = 0;
+    std::vector<Shape> filtered_geometries;  ///< the shape of each geometry with a filter
+    bool tilt_rays = false;  ///< some Hermite curves are built: rays are traced off_axis()
+
+    Vec3f traced(const Vec3f& dir) const { return tilt_rays ? off_axis(dir) : dir; }
     mutable std::atomic<std::uint64_t> skipped_rays{0};
 
     ~Impl()
@@ -239,6 +721,7 @@ struct EmbreeScene::Impl : HitResolver {
     RTCScene new_scene()
     {
         RTCScene s = rtcNewScene(device);
+        // transmittance() counts what it passes through in a context filter.
         rtcSetSceneFlags(s, RTC_SCENE_FLAG_CONTEXT_FILTER_FUNCTION);
         rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_HIGH);
         return s;
@@ -247,126 +730,13 @@ struct EmbreeScene::Impl : HitResolver {
     /// Adds every non-empty part of g to s; ids[geomID] = its GeometrySource.
     void add_geometry(RTCScene s, const geom::Geometry& g, std::vector<const GeometrySource*>& ids,
                       const Key* line_keys, bool unlit, bool alpha, bool lines = true);
-    void attach(RTCScene s, RTCGeometry g, GeometrySource part,
-                std::vector<const GeometrySource*>& ids, bool alpha);
-
+    /// Builds the part's Embree geometry (its ShapeKind) and attaches it to s; `alpha`:
+    /// hits are cut out where its texture's alpha is below one half.
+    void attach(RTCScene s, GeometrySource part, std::vector<const GeometrySource*>& ids,
+                bool alpha);
 };
 
 namespace {
-
-/// The direction of a Hermite segment's axis (its derivative) at u.
-Vec3f hermite_axis(const geom::HermiteCurves& c, std::uint32_t k, float u)
-{
-    auto d = hermite_derivative(u);
-    return vec(c.points[k]) * d[0] + vec(c.tangents[k]) * d[1] + vec(c.points[k + 1]) * d[2] +
-           vec(c.tangents[k + 1]) * d[3];
-}
-
-/// Texture coordinates (s, t) of a hit: Embree's (u, v) and object-space normal ng.
-std::array<float, 2> texture_coords(const GeometrySource& part, std::uint32_t prim, float u,
-                                    float v, const Vec3f& ng)
-{
-    const geom::Geometry& g = *part.geometry;
-    switch (part.shape) {
-    case Shape::cap:
-    case Shape::joint: {
-        // the rim's t; s is the centre of the unrolled tube
-        std::uint32_t k = g.lines.segments[line_segment(part, prim)] +
-                          (part.shape == Shape::joint ? 1 : part.ends->cap_at_end[prim]);
-        return {0.5f, g.lines.v.size() == g.lines.keys.size() ? g.lines.v[k] : 0.0f};
-    }
-    case Shape::line: {
-        std::uint32_t k = g.lines.segments[prim];
-        float t = g.lines.v.size() == g.lines.keys.size()
-                      ? g.lines.v[k] + (g.lines.v[k + 1] - g.lines.v[k]) * u
-                      : 0.0f;
-        return {angle_around(vec(part.line_keys[k + 1]) - vec(part.line_keys[k]), ng), t};
-    }
-    case Shape::curve: {
-        const geom::HermiteCurves& c = g.curves;
-        std::uint32_t k = c.segments[prim];
-        Vec3f axis = hermite_axis(c, k, u);
-        float t = c.v.size() == c.points.size() ? c.v[k] + (c.v[k + 1] - c.v[k]) * u : 0.0f;
-        return {angle_around(axis, ng), t};
-    }
-    case Shape::sphere: {
-        Vec3f n = normalize(ng);
-        return {std::atan2(n.y, n.x) / (2 * pi) + 0.5f,
-                std::asin(std::fmax(-1.0f, std::fmin(1.0f, n.z))) / pi + 0.5f};
-    }
-    case Shape::triangle: {
-        const auto& tri = g.mesh.triangles[prim];
-        const auto& uv = g.mesh.uvs;
-        if (uv.size() != g.mesh.positions.size())
-            return {0, 0};
-        float w = 1 - u - v;
-        return {uv[tri[0]][0] * w + uv[tri[1]][0] * u + uv[tri[2]][0] * v,
-                uv[tri[0]][1] * w + uv[tri[1]][1] * u + uv[tri[2]][1] * v};
-    }
-    case Shape::disc: break;
-    }
-    return {0, 0};
-}
-
-/// dP/ds and dP/dt in object space at a hit (texture_coords' derivatives); zero where a
-/// coordinate does not change.
-std::array<Vec3f, 2> texture_tangents(const GeometrySource& part, std::uint32_t prim, float u,
-                                      const Vec3f& ng, float radius)
-{
-    const geom::Geometry& g = *part.geometry;
-    // Around a tube, s runs once round the circumference.
-    auto around = [&](const Vec3f& axis) {
-        return normalize(cross(axis, normalize(ng))) * (2 * pi * radius);
-    };
-    auto along = [](const Vec3f& dp_du, float dv_du) {
-        return dv_du != 0 ? dp_du * (1 / dv_du) : Vec3f();
-    };
-    switch (part.shape) {
-    case Shape::cap:
-    case Shape::joint: return {Vec3f(), Vec3f()};  // one texel across the end
-    case Shape::line: {
-        std::uint32_t k = g.lines.segments[prim];
-        Vec3f axis = vec(part.line_keys[k + 1]) - vec(part.line_keys[k]);
-        bool has_v = g.lines.v.size() == g.lines.keys.size();
-        float dv = has_v ? g.lines.v[k + 1] - g.lines.v[k] : 0;
-        return {around(axis), along(axis, dv)};
-    }
-    case Shape::curve: {
-        const geom::HermiteCurves& c = g.curves;
-        std::uint32_t k = c.segments[prim];
-        Vec3f axis = hermite_axis(c, k, u);
-        float dv = c.v.size() == c.points.size() ? c.v[k + 1] - c.v[k] : 0;
-        return {around(axis), along(axis, dv)};
-    }
-    case Shape::sphere: {
-        // s = longitude / 2 pi about z, t = latitude / pi + 1/2.
-        Vec3f n = normalize(ng);
-        float rxy = std::sqrt(n.x * n.x + n.y * n.y);
-        if (rxy <= 0)
-            return {Vec3f(), Vec3f()};
-        Vec3f east(-n.y / rxy, n.x / rxy, 0), north(-n.z * n.x / rxy, -n.z * n.y / rxy, rxy);
-        return {east * (2 * pi * radius * rxy), north * (pi * radius)};
-    }
-    case Shape::triangle: {
-        const geom::TriangleMesh& m = g.mesh;
-        const auto& tri = m.triangles[prim];
-        if (m.uvs.size() != m.positions.size())
-            return {Vec3f(), Vec3f()};
-        Vec3f e1 = vec(m.positions[tri[1]]) - vec(m.positions[tri[0]]);
-        Vec3f e2 = vec(m.positions[tri[2]]) - vec(m.positions[tri[0]]);
-        const geom::Float2 &uv0 = m.uvs[tri[0]], &uv1 = m.uvs[tri[1]], &uv2 = m.uvs[tri[2]];
-        float s1 = uv1[0] - uv0[0], t1 = uv1[1] - uv0[1];
-        float s2 = uv2[0] - uv0[0], t2 = uv2[1] - uv0[1];
-        float det = s1 * t2 - s2 * t1;
-        if (!(std::fabs(det) > 1e-20f))
-            return {Vec3f(), Vec3f()};
-        float inv = 1 / det;
-        return {(e1 * t2 - e2 * t1) * inv, (e2 * s1 - e1 * s2) * inv};
-    }
-    case Shape::disc: break;
-    }
-    return {Vec3f(), Vec3f()};
-}
 
 /// Rejects hits where the primitive's texture is cut out (alpha < 0.5).
 void alpha_filter(const RTCFilterFunctionNArguments* args)
@@ -383,49 +753,11 @@ void alpha_filter(const RTCFilterFunctionNArguments* args)
             continue;
         Vec3f ng(RTCHitN_Ng_x(args->hit, args->N, i), RTCHitN_Ng_y(args->hit, args->N, i),
                  RTCHitN_Ng_z(args->hit, args->N, i));
-        auto st = texture_coords(*part, prim, RTCHitN_u(args->hit, args->N, i),
-                                 RTCHitN_v(args->hit, args->N, i), ng);
+        auto st = kind(part->shape).texture_coords(*part, prim, RTCHitN_u(args->hit, args->N, i),
+                                                   RTCHitN_v(args->hit, args->N, i), ng);
         if (owner.textures->lookup(texture, st[0], st[1]).alpha < 0.5f)
             args->valid[i] = 0;
     }
-}
-
-void check_segments(const std::vector<std::uint32_t>& segments, std::size_t keys,
-                    const char* what)
-{
-    for (std::uint32_t first : segments)
-        if (first + 1 >= keys)
-            throw Error(std::string("scene: ") + what + " segment starts at key " +
-                        std::to_string(first) + " of " + std::to_string(keys));
-}
-
-template <class T>
-void check_size(const std::vector<T>& v, std::size_t n, const char* what)
-{
-    if (v.size() != n)
-        throw Error(std::string("scene: ") + std::to_string(v.size()) + " " + what + " for " +
-                    std::to_string(n));
-}
-
-/// Copies `data` into a new Embree-owned buffer (Embree pads it for its SSE loads, which
-/// shared float3 and uint3 buffers would need by hand).
-template <class T>
-void copy_buffer(RTCGeometry g, RTCBufferType type, RTCFormat format, const std::vector<T>& data)
-{
-    void* dst = rtcSetNewGeometryBuffer(g, type, 0, format, sizeof(T), data.size());
-    if (dst)
-        std::memcpy(dst, data.data(), sizeof(T) * data.size());
-}
-
-void set_flags(RTCGeometry g, const std::vector<std::uint8_t>& flags, std::size_t segments)
-{
-    // Neighbour flags close the joints of a polyline without caps or bulges.
-    if (flags.size() == segments)
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_FLAGS, 0, RTC_FORMAT_UCHAR, flags.data(), 0,
-                                   sizeof(std::uint8_t), flags.size());
-    else if (!flags.empty())
-        warn("scene: " + std::to_string(flags.size()) + " curve flags for " +
-             std::to_string(segments) + " segments; flags ignored");
 }
 
 template <class T>
@@ -439,30 +771,123 @@ bool any_texture(const std::vector<T>& textures)
 
 }  // namespace
 
+/// A hit's materials: the side hit, then the instance's for inherit_material; a generalized
+/// cylinder's colour blend toward its end material.
+struct HitMaterials {
+    std::uint16_t material = 0, end_material = 0;
+    float blend = 0;
+};
+
+HitMaterials materials_at(const GeometrySource& part, std::uint32_t prim, bool back,
+                          const Placement* placement, float u)
+{
+    std::uint32_t index = part.attribute_index(prim);
+    std::uint16_t material = at_or(*part.material, index, std::uint16_t{0});
+    if (back && part.back_material)
+        material = at_or(*part.back_material, index, material);
+    auto resolve = [&](std::uint16_t mat) -> std::uint16_t {
+        if (mat != geom::inherit_material)
+            return mat;
+        return placement ? (back ? placement->instance->back_material
+                                 : placement->instance->material)
+                         : 0;
+    };
+    HitMaterials m;
+    m.material = resolve(material);
+    const geom::HermiteCurves& c = part.geometry->curves;
+    if (part.shape == Shape::curve && prim < c.end_material.size()) {
+        std::uint16_t end = resolve(c.end_material[prim]);
+        if (end != m.material) {
+            m.end_material = end;
+            m.blend = std::clamp(u, 0.0f, 1.0f);
+        }
+    }
+    return m;
+}
+
+/// Most surfaces a transmittance ray passes through before it counts as blocked.
+constexpr int max_pass_throughs = 64;
+
+/// The context of a transmittance ray: what it has passed through so far. Embree may
+/// report one hit more than once (with spatial splits, from each BVH leaf holding the
+/// primitive), so each counted hit is remembered.
+struct OpacityContext {
+    SkipContext skip;  ///< first: the geometry filters read the context as a SkipContext
+    const HitResolver* resolver = nullptr;
+    std::span<const float> opacity;
+    float through = 1;
+    struct Counted {
+        std::uint32_t geom, prim, inst;
+        float t;
+    };
+    int count = 0;
+    std::array<Counted, max_pass_throughs> counted;
+
+    float opacity_of(std::uint16_t m) const { return m < opacity.size() ? opacity[m] : 1.0f; }
+    bool seen(const Counted& c) const
+    {
+        for (int k = 0; k < count; ++k) {
+            const Counted& o = counted[std::size_t(k)];
+            if (o.geom == c.geom && o.prim == c.prim && o.inst == c.inst &&
+                std::fabs(o.t - c.t) <= 1e-6f * std::fmax(o.t, c.t))
+                return true;
+        }
+        return false;
+    }
+};
+
+/// The context filter of transmittance rays: multiplies in the transparency of each
+/// surface met and lets the ray go on, reading only the hit's material (no normals,
+/// texture coordinates or shading); an opaque surface is kept as the blocking hit.
+void opacity_filter(const RTCFilterFunctionNArguments* args)
+{
+    auto* ctx = reinterpret_cast<OpacityContext*>(args->context);
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] == 0)
+            continue;
+        OpacityContext::Counted c{RTCHitN_geomID(args->hit, args->N, i),
+                                  RTCHitN_primID(args->hit, args->N, i),
+                                  RTCHitN_instID(args->hit, args->N, i, 0),
+                                  RTCRayN_tfar(args->ray, args->N, i)};
+        if (ctx->seen(c)) {
+            args->valid[i] = 0;
+            continue;
+        }
+        const Placement* p = ctx->resolver->placement(c.inst);
+        const GeometrySource& part = *ctx->resolver->part(c.inst, c.geom);
+        float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
+        // The ray and Ng are both in the hit primitive's own space here.
+        Vec3f ng(RTCHitN_Ng_x(args->hit, args->N, i), RTCHitN_Ng_y(args->hit, args->N, i),
+                 RTCHitN_Ng_z(args->hit, args->N, i));
+        Vec3f dir(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
+                  RTCRayN_dir_z(args->ray, args->N, i));
+        LocalSurface local = kind(part.shape).surface(part, c.prim, u, v, ng);
+        bool back = local.two_sided && dot(local.geometric, dir) > 0;
+        HitMaterials m = materials_at(part, c.prim, back, p, u);
+        float opacity = ctx->opacity_of(m.material);
+        if (m.blend > 0)
+            opacity += (ctx->opacity_of(m.end_material) - opacity) * m.blend;
+        if (opacity >= 1 || ctx->count == max_pass_throughs)
+            continue;  // blocks the ray
+        ctx->through *= 1 - opacity;
+        ctx->counted[std::size_t(ctx->count++)] = c;
+        args->valid[i] = 0;
+    }
+}
+
 int HitResolver::texture_of(const GeometrySource& part, std::uint32_t prim,
                             const Placement* p) const
 {
-    const geom::Geometry& g = *part.geometry;
-    std::int16_t t = geom::no_texture;
-    switch (part.shape) {
-    case Shape::line:
-    case Shape::cap:
-    case Shape::joint:
-        t = at_or(g.lines.texture, line_segment(part, prim), geom::no_texture);
-        break;
-    case Shape::curve: t = at_or(g.curves.texture, prim, geom::no_texture); break;
-    case Shape::sphere: t = at_or(g.spheres.texture, prim, geom::no_texture); break;
-    case Shape::triangle: t = at_or(g.mesh.texture, prim, geom::no_texture); break;
-    case Shape::disc: break;
-    }
+    if (!part.texture)
+        return geom::no_texture;
+    std::int16_t t = at_or(*part.texture, part.attribute_index(prim), geom::no_texture);
     // A prototype's untextured primitives take their instance's texture.
-    if (t == geom::no_texture && p && part.shape != Shape::disc)
+    if (t == geom::no_texture && p)
         t = p->instance->texture;
     return t;
 }
 
-/// Keeps a hit on a pixel-width line only in the pixels OpenGL draws (pixel_lines.h),
-/// then applies the alpha cut-out where the line is textured.
+/// Keeps a hit on a pixel-width line only in the pixels OpenGL draws (pixel_lines.h).
 void pixel_line_filter(const RTCFilterFunctionNArguments* args)
 {
     const auto* part = static_cast<const GeometrySource*>(args->geometryUserPtr);
@@ -480,22 +905,34 @@ void pixel_line_filter(const RTCFilterFunctionNArguments* args)
         if (!pixel_line_draws(*part->owner->camera, {a[0], a[1], a[2]}, {b[0], b[1], b[2]}, a[3], hit))
             args->valid[i] = 0;
     }
-    if (part->owner->textures)
+}
+
+/// The filters a geometry needs, in order (attached only to geometries that need one).
+void geometry_filter(const RTCFilterFunctionNArguments* args)
+{
+    const auto* part = static_cast<const GeometrySource*>(args->geometryUserPtr);
+    if (part->skips_self)
+        skip_self(args);
+    if (part->pixel_line)
+        pixel_line_filter(args);
+    if (part->cut_out)
         alpha_filter(args);
 }
 
-void EmbreeScene::Impl::attach(RTCScene s, RTCGeometry g, GeometrySource part,
+void EmbreeScene::Impl::attach(RTCScene s, GeometrySource part,
                                std::vector<const GeometrySource*>& ids, bool alpha)
 {
+    RTCGeometry g = kind(part.shape).build(device, part);
     part.owner = this;
+    part.skips_self = kind(part.shape).self_hits;
+    part.pixel_line = part.shape == Shape::line && part.unlit;
+    part.cut_out = textures && (alpha || part.pixel_line);
     parts.push_back(part);
     rtcSetGeometryUserData(g, &parts.back());
-    if (part.shape == Shape::line && part.unlit) {
-        rtcSetGeometryIntersectFilterFunction(g, &pixel_line_filter);
-        rtcSetGeometryOccludedFilterFunction(g, &pixel_line_filter);
-    } else if (alpha && textures) {
-        rtcSetGeometryIntersectFilterFunction(g, &alpha_filter);
-        rtcSetGeometryOccludedFilterFunction(g, &alpha_filter);
+    if (part.skips_self || part.pixel_line || part.cut_out) {
+        rtcSetGeometryIntersectFilterFunction(g, &geometry_filter);
+        rtcSetGeometryOccludedFilterFunction(g, &geometry_filter);
+        filtered_geometries.push_back(part.shape);
     }
     rtcCommitGeometry(g);
     unsigned id = rtcAttachGeometry(s, g);
@@ -511,85 +948,28 @@ void EmbreeScene::Impl::add_geometry(RTCScene s, const geom::Geometry& geo,
 {
     const geom::LinearCurves& l = geo.lines;
     if (lines && !l.segments.empty()) {
-        check_segments(l.segments, l.keys.size(), "line");
         const Key* keys = line_keys ? line_keys : l.keys.data();
         bool cut = alpha || any_texture(l.texture);
-        // cpfg's pixel lines are GL lines: Embree's round (swept-sphere) curves suit
-        // them; shaded cylinders are exact frustums (LineEnds).
-        RTCGeometry g = rtcNewGeometry(device, unlit ? RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE
-                                                     : RTC_GEOMETRY_TYPE_CONE_LINEAR_CURVE);
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, keys, 0,
-                                   sizeof(Key), l.keys.size());
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
-                                   l.segments.data(), 0, sizeof(std::uint32_t),
-                                   l.segments.size());
-        if (unlit)
-            set_flags(g, l.flags, l.segments.size());
-        attach(s, g, {Shape::line, &geo, keys, unlit, nullptr}, ids, cut);
+        attach(s, lines_source(geo, keys, unlit), ids, cut);
         if (!unlit) {
             const LineEnds& e = line_ends.emplace_back(render::line_ends(l, keys));
-            if (!e.caps.empty()) {
-                RTCGeometry d = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
-                rtcSetSharedGeometryBuffer(d, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                           e.caps.data(), 0, sizeof(Key), e.caps.size());
-                copy_buffer(d, RTC_BUFFER_TYPE_NORMAL, RTC_FORMAT_FLOAT3, e.cap_normals);
-                attach(s, d, {Shape::cap, &geo, keys, false, nullptr, &e}, ids, cut);
-            }
-            if (!e.joints.empty()) {
-                RTCGeometry j = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
-                rtcSetSharedGeometryBuffer(j, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                           e.joints.data(), 0, sizeof(Key), e.joints.size());
-                attach(s, j, {Shape::joint, &geo, keys, false, nullptr, &e}, ids, cut);
-            }
+            if (!e.caps.empty())
+                attach(s, line_end_source(Shape::cap, geo, keys, e), ids, cut);
+            if (!e.joints.empty())
+                attach(s, line_end_source(Shape::joint, geo, keys, e), ids, cut);
         }
     }
-    const geom::HermiteCurves& c = geo.curves;
-    if (!c.segments.empty()) {
-        check_segments(c.segments, c.points.size(), "curve");
-        check_size(c.tangents, c.points.size(), "curve tangents");
-        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ROUND_HERMITE_CURVE);
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                   c.points.data(), 0, sizeof(Key), c.points.size());
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_TANGENT, 0, RTC_FORMAT_FLOAT4,
-                                   c.tangents.data(), 0, sizeof(Key), c.tangents.size());
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
-                                   c.segments.data(), 0, sizeof(std::uint32_t),
-                                   c.segments.size());
-        set_flags(g, c.flags, c.segments.size());
-        attach(s, g, {Shape::curve, &geo, nullptr, false, nullptr}, ids,
-               alpha || any_texture(c.texture));
+    if (!geo.curves.segments.empty()) {
+        attach(s, curves_source(geo), ids, alpha || any_texture(geo.curves.texture));
+        tilt_rays = true;
     }
-    const geom::Spheres& sp = geo.spheres;
-    if (sp.size() > 0) {
-        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                   sp.centres.data(), 0, sizeof(Key), sp.centres.size());
-        // Spheres are textured but not cut out: cpfg's @O spheres are solid.
-        attach(s, g, {Shape::sphere, &geo, nullptr, false, nullptr}, ids, false);
-    }
-    const geom::Discs& d = geo.discs;
-    if (d.size() > 0) {
-        check_size(d.normals, d.centres.size(), "disc normals");
-        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                   d.centres.data(), 0, sizeof(Key), d.centres.size());
-        copy_buffer(g, RTC_BUFFER_TYPE_NORMAL, RTC_FORMAT_FLOAT3, d.normals);
-        attach(s, g, {Shape::disc, &geo, nullptr, false, nullptr}, ids, false);
-    }
-    const geom::TriangleMesh& m = geo.mesh;
-    if (m.size() > 0) {
-        check_size(m.normals, m.positions.size(), "mesh normals");
-        for (const auto& tri : m.triangles)
-            for (std::uint32_t i : tri)
-                if (i >= m.positions.size())
-                    throw Error("scene: triangle vertex " + std::to_string(i) + " of " +
-                                std::to_string(m.positions.size()));
-        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-        copy_buffer(g, RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3, m.positions);
-        copy_buffer(g, RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT3, m.triangles);
-        attach(s, g, {Shape::triangle, &geo, nullptr, false, nullptr}, ids,
-               alpha || any_texture(m.texture));
-    }
+    // Spheres are textured but not cut out: cpfg's @O spheres are solid.
+    if (geo.spheres.size() > 0)
+        attach(s, spheres_source(geo), ids, false);
+    if (geo.discs.size() > 0)
+        attach(s, discs_source(geo), ids, false);
+    if (geo.mesh.size() > 0)
+        attach(s, triangles_source(geo), ids, alpha || any_texture(geo.mesh.texture));
 }
 
 EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
@@ -704,64 +1084,6 @@ RTCRay make_ray(const Vec3f& org, const Vec3f& dir, float tnear, float tfar)
     return r;
 }
 
-/// What a primitive says about its hit in object space.
-struct LocalSurface {
-    Vec3f geometric;     ///< true normal (front side for discs and triangles)
-    Vec3f shading;       ///< interpolated normal (front side), or zero: the geometric one
-    float radius = 0;
-    bool two_sided = false;
-};
-
-LocalSurface local_surface(const GeometrySource& part, std::uint32_t prim, float u, float v,
-                           const Vec3f& ng)
-{
-    const geom::Geometry& g = *part.geometry;
-    LocalSurface s;
-    s.geometric = ng;
-    switch (part.shape) {
-    case Shape::line: {
-        const Key& k0 = part.line_keys[g.lines.segments[prim]];
-        const Key& k1 = part.line_keys[g.lines.segments[prim] + 1];
-        s.radius = k0[3] + (k1[3] - k0[3]) * u;
-        break;
-    }
-    case Shape::curve: {
-        std::uint32_t k = g.curves.segments[prim];
-        auto h = hermite(u);
-        s.radius = g.curves.points[k][3] * h[0] + g.curves.tangents[k][3] * h[1] +
-                   g.curves.points[k + 1][3] * h[2] + g.curves.tangents[k + 1][3] * h[3];
-        break;
-    }
-    case Shape::sphere: s.radius = g.spheres.centres[prim][3]; break;
-    case Shape::cap:
-        // the solid cylinder's end: its normal points out, like the tube's
-        s.geometric = vec(part.ends->cap_normals[prim]);
-        s.radius = part.ends->caps[prim][3];
-        break;
-    case Shape::joint: s.radius = part.ends->joints[prim][3]; break;
-    case Shape::disc:
-        s.geometric = vec(g.discs.normals[prim]);
-        s.two_sided = true;
-        break;
-    case Shape::triangle: {
-        const geom::TriangleMesh& m = g.mesh;
-        const auto& tri = m.triangles[prim];
-        Vec3f p0 = vec(m.positions[tri[0]]);
-        Vec3f face = cross(vec(m.positions[tri[1]]) - p0, vec(m.positions[tri[2]]) - p0);
-        Vec3f n0 = vec(m.normals[tri[0]]), n1 = vec(m.normals[tri[1]]),
-              n2 = vec(m.normals[tri[2]]);
-        s.shading = n0 * (1 - u - v) + n1 * u + n2 * v;
-        // The front is where the vertex normals point; a flat face's winding if they vanish.
-        if (dot(face, n0 + n1 + n2) < 0)
-            face = -face;
-        s.geometric = face;
-        s.two_sided = true;
-        break;
-    }
-    }
-    return s;
-}
-
 }  // namespace
 
 std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& dir, float tnear,
@@ -774,7 +1096,7 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     }
     SkipContext context = make_context(skip, coherent);
     RTCRayHit rh;
-    rh.ray = make_ray(org, dir, tnear, tfar);
+    rh.ray = make_ray(org, m.traced(dir), tnear, tfar);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(m.scene, &context.context, &rh);
@@ -783,7 +1105,8 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
 
     SurfaceHit h;
     h.t = rh.ray.tfar;
-    h.position = org + dir * h.t;
+    // Where Embree found it: along the direction it traced (make_ray).
+    h.position = org + m.traced(dir) * h.t;
     h.geom_id = rh.hit.geomID;
     h.prim_id = rh.hit.primID;
     h.inst_id = rh.hit.instID[0];
@@ -793,11 +1116,11 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     const GeometrySource& part = *m.part(h.inst_id, h.geom_id);
     h.shape = part.shape;
     h.unlit = part.unlit;
-    const geom::Geometry& g = *part.geometry;
 
     // Embree reports an instanced hit's normal in the prototype's frame.
     Vec3f ng(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
-    LocalSurface local = local_surface(part, h.prim_id, rh.hit.u, rh.hit.v, ng);
+    const ShapeKind& shape = kind(part.shape);
+    LocalSurface local = shape.surface(part, h.prim_id, rh.hit.u, rh.hit.v, ng);
     Vec3f geometric = local.geometric, shading = local.shading;
     h.radius = local.radius;
     if (placement) {
@@ -816,68 +1139,55 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     // A shading normal turned away from the ray (or absent) gives way to the true one.
     h.normal = dot(shading, dir) < 0 ? shading : geometric;
 
-    // Materials: the side hit, then the instance's for inherit_material.
-    std::uint16_t material = 0;
-    switch (part.shape) {
-    case Shape::line:
-    case Shape::cap:
-    case Shape::joint:
-        material = at_or(g.lines.material, line_segment(part, h.prim_id), std::uint16_t{0});
-        break;
-    case Shape::curve: material = at_or(g.curves.material, h.prim_id, std::uint16_t{0}); break;
-    case Shape::sphere: material = at_or(g.spheres.material, h.prim_id, std::uint16_t{0}); break;
-    case Shape::disc:
-        material = at_or(g.discs.material, h.prim_id, std::uint16_t{0});
-        if (h.back)
-            material = at_or(g.discs.back_material, h.prim_id, material);
-        break;
-    case Shape::triangle:
-        material = at_or(g.mesh.material, h.prim_id, std::uint16_t{0});
-        if (h.back)
-            material = at_or(g.mesh.back_material, h.prim_id, material);
-        break;
-    }
-    auto resolve = [&](std::uint16_t mat) -> std::uint16_t {
-        if (mat != geom::inherit_material)
-            return mat;
-        return placement ? (h.back ? placement->instance->back_material
-                                   : placement->instance->material)
-                         : 0;
-    };
-    h.material = resolve(material);
-    if (part.shape == Shape::curve && h.prim_id < g.curves.end_material.size()) {
-        std::uint16_t end = resolve(g.curves.end_material[h.prim_id]);
-        if (end != h.material) {
-            h.end_material = end;
-            h.material_blend = std::clamp(rh.hit.u, 0.0f, 1.0f);
-        }
-    }
+    HitMaterials materials = materials_at(part, h.prim_id, h.back, placement, rh.hit.u);
+    h.material = materials.material;
+    h.end_material = materials.end_material;
+    h.material_blend = materials.blend;
     int texture = m.texture_of(part, h.prim_id, placement);
     h.texture = static_cast<std::int16_t>(texture);
     if (texture != geom::no_texture) {
-        auto st = texture_coords(part, h.prim_id, rh.hit.u, rh.hit.v, ng);
+        auto st = shape.texture_coords(part, h.prim_id, rh.hit.u, rh.hit.v, ng);
         h.u = st[0];
         h.v = st[1];
-        auto [dpds, dpdt] = texture_tangents(part, h.prim_id, rh.hit.u, ng, local.radius);
+        auto [dpds, dpdt] = shape.texture_tangents(part, h.prim_id, rh.hit.u, ng, local.radius);
         h.dpds = placement ? placement->linear * dpds : dpds;
         h.dpdt = placement ? placement->linear * dpdt : dpdt;
     }
 
     float scale = std::fmax(std::fabs(h.position.x),
                             std::fmax(std::fabs(h.position.y), std::fabs(h.position.z)));
-    // Measured (accel_test): with the leaving primitive skipped, no offset is needed even
-    // at curve joints; a small one guards against float error at large coordinates.
-    switch (part.shape) {
-    case Shape::line:
-    case Shape::cap:
-    case Shape::joint:
-    case Shape::curve: h.spawn_offset = 1e-3f * h.radius + 1e-6f * scale; break;
-    case Shape::sphere: h.spawn_offset = 1e-4f * h.radius + 1e-6f * scale; break;
-    case Shape::disc:
-    case Shape::triangle: h.spawn_offset = 1e-5f * scale + 1e-7f; break;
+    if (!shape.self_hits) {
+        // Nothing skips a flat primitive: its offset must clear the float error of the hit,
+        // which grows with the primitive's coordinates and (through the hit distance's
+        // error) with the ray's length.
+        float extent = local.extent * (placement ? placement->largest_scale : 1);
+        scale = std::fmax(scale, extent) + 0.2f * h.t;
     }
+    h.spawn_offset = shape.offset_per_radius * h.radius + shape.offset_per_scale * scale +
+                     shape.offset_absolute;
     return h;
 }
+
+float EmbreeScene::transmittance(const Vec3f& org, const Vec3f& dir, float tnear, float tfar,
+                                 PrimId skip, std::span<const float> opacity) const
+{
+    if (!traceable(org, dir, tnear, tfar)) {
+        ++m_impl->skipped_rays;
+        return 1;
+    }
+    OpacityContext context;
+    context.skip = make_context(skip, false);
+    context.skip.context.filter = &opacity_filter;
+    context.resolver = m_impl.get();
+    context.opacity = opacity;
+    RTCRay r = make_ray(org, m_impl->traced(dir), tnear, tfar);
+    rtcOccluded1(m_impl->scene, &context.skip.context, &r);
+    if (r.tfar < 0 && std::isinf(r.tfar))
+        return 0;
+    return context.through;
+}
+
+std::vector<Shape> EmbreeScene::filtered_shapes() const { return m_impl->filtered_geometries; }
 
 bool EmbreeScene::occluded(const Vec3f& org, const Vec3f& dir, float tnear, float tfar,
                            PrimId skip) const
@@ -887,7 +1197,7 @@ bool EmbreeScene::occluded(const Vec3f& org, const Vec3f& dir, float tnear, floa
         return false;
     }
     SkipContext context = make_context(skip, false);
-    RTCRay r = make_ray(org, dir, tnear, tfar);
+    RTCRay r = make_ray(org, m_impl->traced(dir), tnear, tfar);
     rtcOccluded1(m_impl->scene, &context.context, &r);
     // Embree marks an occluded ray by setting tfar to -inf.
     return r.tfar < 0 && std::isinf(r.tfar);

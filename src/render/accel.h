@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
+#include <vector>
 
 #include "geom/scene.h"
 #include "render/camera.h"
@@ -54,8 +56,10 @@ struct SurfaceHit {
     bool back = false;         ///< the ray hit the back side of a disc or triangle
     bool inside = false;       ///< the ray hit a closed primitive from within
     float radius = 0;          ///< curve or sphere radius at the hit (world units)
-    /// Distance to move a spawned ray's origin along `geometric_normal`: Embree's round
-    /// curves have no self-intersection protection (FACTS.md), so this scales with the radius.
+    /// Distance to move a spawned ray's origin along `geometric_normal`: for round shapes
+    /// (which rays leaving them also skip: Embree's curves have no self-intersection
+    /// protection, FACTS.md) it scales with the radius; flat ones are skipped by nothing,
+    /// so theirs covers the float error of the hit (accel.cpp, ShapeKind).
     float spawn_offset = 0;
     /// Drawn in its flat colour, not shaded: cpfg's `line style: pixel` lines are
     /// unlit GL lines, and this keeps their look (docs/deviations.md).
@@ -88,14 +92,27 @@ public:
     EmbreeScene& operator=(const EmbreeScene&) = delete;
 
     /// First hit along org + t dir, t in [tnear, tfar], ignoring the primitive `skip`
-    /// (the convex primitive a spawned ray leaves cannot truly be hit again; Embree
-    /// would report spurious hits on it). `coherent` for camera rays.
+    /// if it is round (a curve, sphere or joint: the convex primitive a spawned ray leaves
+    /// cannot truly be hit again; Embree would report spurious hits on it). Flat
+    /// primitives are never skipped: rays leave them from `SurfaceHit::spawn_offset`.
+    /// `coherent` for camera rays.
     std::optional<SurfaceHit> intersect(const Vec3f& org, const Vec3f& dir, float tnear,
                                         float tfar, PrimId skip = {},
                                         bool coherent = false) const;
     /// Whether anything but `skip` blocks org + t dir for t in [tnear, tfar].
     bool occluded(const Vec3f& org, const Vec3f& dir, float tnear, float tfar,
                   PrimId skip = {}) const;
+    /// The fraction of light passing along org + t dir for t in [tnear, tfar] (skipping
+    /// `skip` as intersect() does): the product of (1 - opacity) over every surface met,
+    /// each wall of a closed primitive counted, with `opacity` by material index (1 past
+    /// its end); 0 if an opaque surface blocks it or after 64 surfaces. Reads only each
+    /// hit's material, in one traversal.
+    float transmittance(const Vec3f& org, const Vec3f& dir, float tnear, float tfar,
+                        PrimId skip, std::span<const float> opacity) const;
+
+    /// The shape of each Embree geometry that runs a filter function on candidate hits
+    /// (self-hits of round shapes, pixel-line coverage, alpha cut-outs), in build order.
+    std::vector<Shape> filtered_shapes() const;
 
     /// Rays that intersect() and occluded() skipped (a miss, not occluded) because
     /// Embree would abort on them: not finite, or starting beyond geom::max_ray_start.

@@ -12,6 +12,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 namespace cambium::render {
 
@@ -116,25 +117,14 @@ bool any_transparent(const PathContext& ctx)
 }
 
 /// The fraction of light passing from s.origin along wi for t < tfar: 0 if an opaque
-/// surface blocks it, the product of transparencies through transparent ones.
-float transmittance(const PathContext& ctx, bool transparent_scene, Spawn s, const Vec3f& wi,
-                    float tfar)
+/// surface blocks it, the product of transparencies through transparent ones (one
+/// opacity-only traversal: EmbreeScene::transmittance).
+float transmittance(const PathContext& ctx, const PathContext::SceneFlags& facts, Spawn s,
+                    const Vec3f& wi, float tfar)
 {
-    if (!transparent_scene)
+    if (!facts.transparent)
         return ctx.accel->occluded(s.origin, wi, 0, tfar, s.skip) ? 0.0f : 1.0f;
-    float through = 1;
-    for (int i = 0; i < max_pass_throughs; ++i) {
-        std::optional<SurfaceHit> hit = ctx.accel->intersect(s.origin, wi, 0, tfar, s.skip);
-        if (!hit)
-            return through;
-        SurfaceMaterial scratch;
-        through *= 1 - hit_material(ctx, *hit, scratch).opacity;
-        if (through <= 0)
-            return 0;
-        tfar = std::isinf(tfar) ? tfar : tfar - hit->t;
-        s = {hit->position, hit->prim()};
-    }
-    return 0;
+    return ctx.accel->transmittance(s.origin, wi, 0, tfar, s.skip, facts.opacity);
 }
 
 struct Vertex {
@@ -151,9 +141,10 @@ struct LightUniforms {
 /// Direct light from one light chosen by power (pbrt's SampleLd): a delta light at full
 /// weight, the others weighted against BSDF sampling of the same direction by the power
 /// heuristic (full weight at the path's last vertex, where no BSDF ray follows).
-Vec3f sample_ld(const PathContext& ctx, const LightSet& lights, bool transparent,
-                const Vertex& v, bool last, const LightUniforms& u)
+Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, const Vertex& v,
+                bool last, const LightUniforms& u)
 {
+    const LightSet& lights = facts.lights;
     std::optional<ChosenLight> chosen = lights.choose(u.choose);
     if (!chosen || !(chosen->probability > 0))
         return {};
@@ -164,7 +155,20 @@ Vec3f sample_ld(const PathContext& ctx, const LightSet& lights, bool transparent
     float cos = std::fabs(dot(v.hit.normal, ls.wi));
     if (is_black(f) || cos <= 0 || !same_side(v.hit, ls.wi))
         return {};
-    float through = transmittance(ctx, transparent, spawn(v.hit, ls.wi), ls.wi, ls.tfar);
+    Spawn s = spawn(v.hit, ls.wi);
+    Vec3f toward = ls.wi;
+    float tfar = ls.tfar;
+    if (!std::isinf(tfar)) {
+        // The spawned origin is off the surface: aim from it at the point where the light
+        // sample's ray ends (just short of the light), as a ray parallel to wi could meet a
+        // curved light sooner.
+        Vec3f to = v.hit.position + ls.wi * ls.tfar - s.origin;
+        tfar = length(to);
+        if (!(tfar > 0))
+            return {};
+        toward = to / tfar;
+    }
+    float through = transmittance(ctx, facts, s, toward, tfar);
     if (through <= 0)
         return {};
     float pdf = chosen->probability * ls.pdf;
@@ -206,8 +210,11 @@ TextureFootprint texture_footprint(const SurfaceHit& hit, const Vec3f& dir, floa
 void prepare_path_context(PathContext& ctx)
 {
     const EnvironmentView env(ctx);
+    std::vector<float> opacity;
+    for (const SurfaceMaterial& m : ctx.materials)
+        opacity.push_back(m.opacity);
     ctx.prepared = PathContext::SceneFlags{
-        any_transparent(ctx), env.black(), env.nee(),
+        any_transparent(ctx), std::move(opacity), env.black(), env.nee(),
         LightSet(ctx.lights, ctx.area_lights, ctx.environment, env.nee(), ctx.scene_radius)};
 }
 
@@ -289,8 +296,10 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         if (material.opacity < 1 && sampler.next() >= material.opacity) {
             if (++passes > max_pass_throughs)
                 break;
-            org = hit->position;
-            leaving = hit->prim();
+            // On through the surface: into a closed primitive the far wall is real.
+            Spawn s = spawn(*hit, dir);
+            org = s.origin;
+            leaving = s.skip;
             if (depth == 0)
                 tfar = std::isinf(tfar) ? tfar : tfar - hit->t;
             continue;
@@ -316,7 +325,7 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         Vertex vertex{*hit, bsdf, -dir};
         const bool last = depth + 1 == ctx.max_depth;
         LightUniforms lu{sampler.next(), sampler.next(), sampler.next(), sampler.next()};
-        result.radiance += beta * sample_ld(ctx, lights, facts.transparent, vertex, last, lu);
+        result.radiance += beta * sample_ld(ctx, facts, vertex, last, lu);
         if (++depth == ctx.max_depth)
             break;
 

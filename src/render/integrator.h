@@ -61,6 +61,7 @@ struct PathContext {
     /// prepare_path_context() after everything above is set.
     struct SceneFlags {
         bool transparent = false;      ///< some material lets light through
+        std::vector<float> opacity;    ///< of each material, for transmittance rays
         bool environment_black = true; ///< escaping rays see nothing
         bool environment_nee = false;  ///< the environment is sampled for NEE
         LightSet lights;               ///< what next-event estimation samples

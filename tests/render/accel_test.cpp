@@ -140,6 +140,33 @@ TEST(EmbreeScene, SpawnedRaysDoNotHitTheirOwnSegment)
     EXPECT_LE(rehits, n / 1000) << rehits << " of " << n;
 }
 
+// Filter functions run only on geometries that need one: round shapes (to skip the
+// primitive a ray leaves), pixel-width lines and alpha cut-outs; flat shapes run none.
+TEST(EmbreeScene, FiltersOnlyRoundShapesOfAnUntexturedScene)
+{
+    geom::Scene s = empty_scene({-10, -10, -10}, {10, 10, 10});
+    add_segment(s, {-1, 0, 0}, {1, 0, 0}, 0.1f);  // a cone curve with two caps
+    s.geometry.spheres.centres.push_back({0, 3, 0, 1});
+    s.geometry.spheres.material.push_back(1);
+    s.geometry.discs.centres.push_back({0, -3, 0, 1});
+    s.geometry.discs.normals.push_back({0, 0, 1});
+    s.geometry.discs.material.push_back(1);
+    geom::TriangleMesh& m = s.geometry.mesh;
+    m.positions = {{5, 0, 0}, {6, 0, 0}, {5, 1, 0}};
+    m.normals.assign(3, {0, 0, 1});
+    m.triangles = {{0, 1, 2}};
+    m.material = {1};
+    EmbreeScene accel(s, unit_camera(s));
+    EXPECT_EQ(accel.filtered_shapes(), (std::vector<Shape>{Shape::line, Shape::sphere}));
+    // Skipping a flat primitive does nothing: rays leave it by its offset.
+    auto cap = accel.intersect({-3, 0, 0}, {1, 0, 0}, 0, inf);
+    ASSERT_TRUE(cap);
+    EXPECT_EQ(cap->shape, Shape::cap);
+    auto again = accel.intersect({-3, 0, 0}, {1, 0, 0}, 0, inf, cap->prim());
+    ASSERT_TRUE(again);
+    EXPECT_EQ(again->shape, Shape::cap);
+}
+
 // A straight polyline of short joined segments (neighbour flags) is one convex tube: rays
 // leaving one segment must not hit its neighbours at the joints either.
 TEST(EmbreeScene, SpawnedRaysDoNotHitJoinedNeighbours)

@@ -273,6 +273,54 @@ TEST(Physics, TransparencyPassesLightStochastically)
     std::printf("[transparency] %.4f (0.5), stacked %.4f (0.75)\n", seen, through);
 }
 
+// A transparent sphere between a plane point and a directional light: the shadow ray
+// passes both of its walls, so the light arrives attenuated twice, (1 - opacity)^2.
+TEST(Physics, TransparentSphereAttenuatesTwice)
+{
+    geom::Scene s = lit_plane(0.6f);
+    s.materials[2].diffuse = grey(0.5f);
+    s.materials[2].transparency = 0.6f;  // opacity 0.4: 0.6 of the light passes each wall
+    // Its shadow centre is the plane's origin; the camera looks straight down past it.
+    add_sphere(s.geometry, {2, 0, 2}, 0.5f, 2);
+    s.lights.push_back(directional({1, 0, 1}));
+    float expect = srgb_to_linear(0.6f) / std::sqrt(2.0f) * 0.6f * 0.6f;
+    float got = radiance_at(s, 0, 0);
+    EXPECT_NEAR(got, expect, 0.01f * expect);
+    std::printf("[transparency] through a sphere: %.5f expected %.5f (t^2)\n", got, expect);
+}
+
+// Flat primitives skip nothing: their spawn offset alone must keep shadow rays leaving at
+// grazing angles from meeting the surface they leave, also far from the origin on a
+// tilted plane (hit points not exactly on it). Any self-hit darkens the closed form.
+TEST(Physics, FlatSurfacesLitAtGrazingAnglesDoNotShadowThemselves)
+{
+    geom::Scene s;
+    s.materials[1].diffuse = grey(0.8f);
+    const float x0 = 1000, y0 = -2000;
+    auto z = [&](float x) { return 0.3f * (x - x0); };
+    Vec3f n = normalize(Vec3f(-0.3f, 0, 1)), along = normalize(Vec3f(1, 0, 0.3f));
+    geom::Float3 nf{n.x, n.y, n.z};
+    for (float dy : {-60.0f, 0.0f}) {
+        add_triangle(s.geometry, {{{x0 - 50, y0 + dy, z(x0 - 50)}, {x0 + 50, y0 + dy, z(x0 + 50)},
+                                   {x0 + 50, y0 + dy + 60, z(x0 + 50)}}},
+                     {nf, nf, nf}, {{{0, 0}, {1, 0}, {1, 1}}}, 1, 1);
+        add_triangle(s.geometry, {{{x0 - 50, y0 + dy, z(x0 - 50)}, {x0 + 50, y0 + dy + 60, z(x0 + 50)},
+                                   {x0 - 50, y0 + dy + 60, z(x0 - 50)}}},
+                     {nf, nf, nf}, {{{0, 0}, {1, 1}, {0, 1}}}, 1, 1);
+    }
+    s.lights.push_back(directional({0, 0, 1}));
+    for (float degrees : {1.0f, 5.0f, 20.0f}) {
+        float e = degrees * pi / 180;
+        for (float side : {1.0f, -1.0f}) {
+            Vec3f l = n * std::sin(e) + along * (side * std::cos(e));
+            s.lights[0] = directional({l.x, l.y, l.z});
+            float expect = srgb_to_linear(0.8f) * std::sin(e);
+            float got = radiance_at(s, x0 + 3.7f, y0 + 1.3f);
+            EXPECT_NEAR(got, expect, 0.01f * expect) << degrees << " degrees, side " << side;
+        }
+    }
+}
+
 // A sphere of emitted radiance Le, radius R, centre at distance D from a plane point, at
 // angle theta from its normal: E = pi Le (R/D)^2 cos theta, so L = albedo Le (R/D)^2 cos
 // theta, found by BSDF rays alone.

@@ -167,10 +167,16 @@ TEST(Primitives, InstancesPlaceInheritAndTransformNormals)
     EXPECT_EQ(sphere->shape, Shape::sphere);
     EXPECT_NEAR(sphere->t, 9, 1e-4f);
     EXPECT_NEAR(sphere->radius, std::cbrt(2.0f), 1e-5f);
-    // Skipping one instance's primitive leaves the other instance's copy visible.
-    auto skipped = accel.intersect({11, 0, 5}, {0, 0, -1}, 0, inf, hit->prim());
-    EXPECT_FALSE(skipped);
-    EXPECT_TRUE(accel.intersect({-10, 0, 5}, {0, 0, -1}, 0, 10, hit->prim()));
+    // Flat primitives are never skipped (rays leave them by their offset; no filter runs).
+    auto flat = accel.intersect({11, 0, 5}, {0, 0, -1}, 0, inf, hit->prim());
+    ASSERT_TRUE(flat);
+    EXPECT_EQ(flat->prim_id, hit->prim_id);
+    // Skipping one instance's sphere leaves the other instance's copy visible.
+    auto skipped = accel.intersect({10, 0, 30}, {0, 0, -1}, 0, inf, sphere->prim());
+    EXPECT_TRUE(!skipped || skipped->shape != Shape::sphere);
+    auto other_sphere = accel.intersect({-10, 0, 30}, {0, 0, -1}, 0, inf, sphere->prim());
+    ASSERT_TRUE(other_sphere);
+    EXPECT_EQ(other_sphere->shape, Shape::sphere);
 }
 
 // Texture coordinates: t along a line from its keys' v, (s, t) = longitude and latitude on
