@@ -75,6 +75,7 @@ struct Options {
     int max_depth = 6;
     int threads = 0;
     std::uint64_t seed = 0;
+    std::string sampler = "sobol";     ///< --sampler sobol|white (hidden, for comparisons)
     bool quiet = false;
     std::string filter = "box";        ///< --filter box|gaussian|blackman-harris
     float filter_radius = 0;           ///< --filter-radius (0: the filter's default)
