@@ -215,6 +215,10 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
                  "Share the render among the ranks of an MPI job: mpirun -np N cambium --mpi ...");
     cli.add_option("--seed", options.seed, "Sampling seed (default 0)")
         ->check(CLI::NonNegativeNumber);
+    // Hidden (no group): the white-noise sampler is kept only for comparisons.
+    cli.add_option("--sampler", options.sampler, "Sample sequence: sobol (default) or white")
+        ->check(CLI::IsMember({"sobol", "white"}))
+        ->group("");
     cli.add_option("--max-modules", options.max_modules,
                    "Stop a derivation whose string grows past this many modules (default 1e8)")
         ->check(CLI::Range(std::size_t{1}, std::size_t{1'000'000'000}));

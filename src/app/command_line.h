@@ -79,6 +79,7 @@ struct Options {
     std::optional<int> assemble;              ///< --assemble N: the N tiles into the outputs
     bool mpi = false;                         ///< --mpi: shared among the ranks of an MPI job
     std::uint64_t seed = 0;
+    std::string sampler = "sobol";     ///< --sampler sobol|white (hidden, for comparisons)
     bool quiet = false;
     std::string filter = "box";        ///< --filter box|gaussian|blackman-harris
     float filter_radius = 0;           ///< --filter-radius (0: the filter's default)

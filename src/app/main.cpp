@@ -64,6 +64,8 @@ render::RenderSettings render_settings(const Options& options,
     settings.samples_per_pixel = options.samples_per_pixel;
     settings.max_depth = options.max_depth;
     settings.seed = options.seed;
+    settings.sampler = options.sampler == "white" ? render::SampleSequence::white
+                                                  : render::SampleSequence::sobol;
     settings.threads = options.threads;
     settings.max_memory_bytes = options.max_memory_bytes;
     settings.filter = pixel_filter(options.filter);

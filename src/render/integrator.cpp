@@ -4,8 +4,8 @@
 // against BSDF sampling), transmission, opacity, Russian roulette, ray cones for texture
 // filtering.
 //
-// Sampler dimensions per vertex: [opacity, only on a material with opacity < 1], then a
-// fixed budget of 4 for the light (choice + 3) and 3 for the BSDF ray and roulette.
+// Sampler dimensions: each path vertex spends the fixed block sample_dimension::vertex(depth)
+// (light choice, light point, BSDF, opacity, roulette), whatever it meets (sampler.h).
 #include "render/integrator.h"
 
 #include <array>
@@ -127,6 +127,38 @@ float transmittance(const PathContext& ctx, const PathContext::SceneFlags& facts
     return ctx.accel->transmittance(s.origin, wi, 0, tfar, s.skip, facts.opacity);
 }
 
+/// The draws that decide, surface after surface, whether a ray stops (with probability
+/// opacity) or passes through. The vertex's opacity dimension decides at the first
+/// surface; after a pass the same value, rescaled to what is left of [opacity, 1), is
+/// again uniform and decides at the next, so the decisions stay stratified; once its
+/// bits run low, fresh white noise decides.
+class PassThroughDraws {
+public:
+    PassThroughDraws(const Sampler& sampler, std::uint32_t dimension)
+        : m_sampler(&sampler), m_dimension(dimension)
+    {
+    }
+
+    bool stops(float opacity)
+    {
+        constexpr std::uint32_t rescaled_passes = 8;
+        float u = m_passed == 0                ? m_sampler->get1d(m_dimension)
+                  : m_passed < rescaled_passes ? m_u
+                                               : m_sampler->extra(m_dimension, m_passed);
+        if (u < opacity)
+            return true;
+        m_u = std::fmin((u - opacity) / (1 - opacity), 0x1.fffffep-1f);
+        ++m_passed;
+        return false;
+    }
+
+private:
+    const Sampler* m_sampler;
+    std::uint32_t m_dimension;
+    std::uint32_t m_passed = 0;
+    float m_u = 0;
+};
+
 struct Vertex {
     const SurfaceHit& hit;
     const Bsdf& bsdf;
@@ -240,7 +272,7 @@ VisibleSurface visible_surface(const SurfaceHit& hit, const SurfaceMaterial& mat
 }  // namespace
 
 PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec3f& camera_dir,
-                      Sampler& sampler, float camera_tfar, VisibleSurface* first)
+                      const Sampler& sampler, float camera_tfar, VisibleSurface* first)
 {
     if (!ctx.prepared)
         throw std::logic_error("trace_path: prepare_path_context() was not called");
@@ -259,7 +291,9 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
     Vec3f scatter_prev;       // where it was drawn (the last scattering vertex)
     int passes = 0;
     float travelled = 0;  // along the path, for the ray cone
+    PassThroughDraws pass_through(sampler, sample_dimension::vertex(0) + sample_dimension::opacity);
     for (int depth = 0; depth < ctx.max_depth;) {
+        const std::uint32_t block = sample_dimension::vertex(depth);
         std::optional<SurfaceHit> hit = ctx.accel->intersect(org, dir, 0, tfar, leaving, depth == 0);
         if (!hit) {
             if (depth == 0 && ctx.environment_visible) {
@@ -293,7 +327,7 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             *first = visible_surface(*hit, material, *diffuse_seen);
         }
         // Opacity: the ray stops here with probability opacity, else passes on unchanged.
-        if (material.opacity < 1 && sampler.next() >= material.opacity) {
+        if (material.opacity < 1 && !pass_through.stops(material.opacity)) {
             if (++passes > max_pass_throughs)
                 break;
             // On through the surface: into a closed primitive the far wall is real.
@@ -324,13 +358,15 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         Bsdf bsdf = make_bsdf(material, diffuse);
         Vertex vertex{*hit, bsdf, -dir};
         const bool last = depth + 1 == ctx.max_depth;
-        LightUniforms lu{sampler.next(), sampler.next(), sampler.next(), sampler.next()};
+        auto [u_choose, u_area] = sampler.get2d(block + sample_dimension::light_choice);
+        auto [u_light0, u_light1] = sampler.get2d(block + sample_dimension::light_point);
+        LightUniforms lu{u_choose, u_area, u_light0, u_light1};
         result.radiance += beta * sample_ld(ctx, facts, vertex, last, lu);
         if (++depth == ctx.max_depth)
             break;
 
         // Continue the path: sample the BSDF, then Russian roulette on the throughput.
-        float u1 = sampler.next(), u2 = sampler.next(), u_rr = sampler.next();
+        auto [u1, u2] = sampler.get2d(block + sample_dimension::bsdf);
         BsdfSample bs = bsdf_sample(bsdf, hit->normal, vertex.wo, u1, u2);
         if (bs.pdf <= 0 || !same_side(*hit, bs.wi))
             break;
@@ -339,7 +375,7 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             break;
         if (depth >= ctx.roulette_depth) {
             float survive = std::fmin(max_component(beta), 0.95f);
-            if (u_rr >= survive)
+            if (sampler.get1d(block + sample_dimension::roulette) >= survive)
                 break;
             beta *= 1.0f / survive;
         }
@@ -348,6 +384,8 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         dir = bs.wi;
         tfar = infinity;
         leaving = s.skip;
+        pass_through = PassThroughDraws(sampler, sample_dimension::vertex(depth) +
+                                                     sample_dimension::opacity);
         bsdf_pdf_prev = bs.pdf;
         scatter_prev = hit->position;
     }

@@ -102,7 +102,7 @@ struct VisibleSurface {
 /// Traces the camera ray (org, dir), which ends at tfar (far clipping), with the sampler's
 /// dimensions; fills `first` when given. Allocates nothing.
 PathResult trace_path(const PathContext& ctx, const Vec3f& org, const Vec3f& dir,
-                      Sampler& sampler,
+                      const Sampler& sampler,
                       float tfar = std::numeric_limits<float>::infinity(),
                       VisibleSurface* first = nullptr);
 

@@ -191,7 +191,8 @@ LightLiSample LightSet::sample_li(std::uint32_t index, const Vec3f& p, float u0,
         return {ls->wi, ls->radiance, ls->pdf, ls->distance - ls->margin, false};
     }
     case LightKind::environment: {
-        EnvironmentSample es = m_environment->sample(u0, u1);
+        // (u1, u2): the pair the sampler stratifies jointly; u0 chooses among areas.
+        EnvironmentSample es = m_environment->sample(u1, u2);
         return {es.direction, es.radiance, es.pdf, std::numeric_limits<float>::infinity(),
                 false};
     }

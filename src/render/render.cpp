@@ -179,8 +179,9 @@ RayCone camera_cone(const Camera& camera)
 void take_sample(const RenderState& f, int x, int y, std::uint32_t i, PixelState& st)
 {
     const RenderSettings& s = f.settings;
-    Sampler sampler(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), i, s.seed);
-    float jx = sampler.next(), jy = sampler.next();
+    const Sampler sampler(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), i,
+                          s.seed, s.sampler);
+    auto [jx, jy] = sampler.get2d(sample_dimension::film);
     double px, py;
     if (f.filter.box()) {
         px = x + jx;  // in float, as before filters existed: the same images
@@ -189,8 +190,12 @@ void take_sample(const RenderState& f, int x, int y, std::uint32_t i, PixelState
         px = x + 0.5 + f.filter.offset(jx);
         py = y + 0.5 + f.filter.offset(jy);
     }
-    CameraRay ray = f.lens ? f.camera.generate_ray(px, py, sampler.next(), sampler.next())
-                           : f.camera.generate_ray(px, py);
+    CameraRay ray = [&] {
+        if (!f.lens)
+            return f.camera.generate_ray(px, py);
+        auto [lens_u, lens_v] = sampler.get2d(sample_dimension::lens);
+        return f.camera.generate_ray(px, py, lens_u, lens_v);
+    }();
     Vec3f org(ray.org), dir(ray.dir);
     if (ray.tnear > 0)
         org = Vec3f(ray.org + ray.dir * ray.tnear);  // front clipping: start at the plane

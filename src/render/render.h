@@ -15,6 +15,7 @@
 #include "render/camera.h"
 #include "render/environment.h"
 #include "render/image_io.h"
+#include "render/sampler.h"
 
 namespace cambium::render {
 
@@ -55,6 +56,8 @@ struct RenderSettings {
     /// Russian roulette starts after this many segments.
     int roulette_depth = 3;
     std::uint64_t seed = 0;
+    /// Owen-scrambled Sobol (default) or white noise (for comparisons, --sampler).
+    SampleSequence sampler = SampleSequence::sobol;
     int threads = 0;  ///< 0 = all cores
     /// Radiance (linear RGB) of the uniform environment that secondary rays see when they
     /// escape: the physically-based stand-in for cpfg's ambient term. Camera rays that

@@ -28,7 +28,7 @@ Vec3f uniform_direction(Sampler& s)
 /// Monte Carlo estimate of the integral of pdf() over the sphere (should be 1).
 double pdf_integral(const Environment& env, int n)
 {
-    Sampler s(1, 2, 3, 4);
+    Sampler s(1, 2, 3, 4, SampleSequence::white);
     double sum = 0;
     for (int i = 0; i < n; ++i)
         sum += env.pdf(uniform_direction(s));
@@ -172,7 +172,7 @@ TEST(SkyEnvironment, PdfIsTheSunAndSphereMixtureAndSamplesAgree)
     auto sky = make_sky_environment(p);
     // Uniform Monte Carlo misses the tiny sun cone: it sees (1 - 1/2) of the mass.
     EXPECT_NEAR(pdf_integral(*sky, 100000), 0.5, 1e-3);
-    Sampler s(1, 1, 1, 1);
+    Sampler s(1, 1, 1, 1, SampleSequence::white);
     int in_sun = 0, n = 20000;
     float cos_sun = std::cos(0.2665f * pi / 180);
     for (int i = 0; i < n; ++i) {
@@ -306,7 +306,7 @@ TEST(RotatedEnvironment, LightComesFromTheTurnedDirection)
     EXPECT_NEAR(turned->pdf(d1), map->pdf(d0), 1e-6f * map->pdf(d0));
     EXPECT_NEAR(pdf_integral(*turned, 20000), 1.0, 0.05);
     // Nearly all samples come from around d1, and agree with pdf().
-    Sampler s(3, 3, 3, 3);
+    Sampler s(3, 3, 3, 3, SampleSequence::white);
     int near = 0, n = 2000;
     for (int i = 0; i < n; ++i) {
         EnvironmentSample e = turned->sample(s.next(), s.next());

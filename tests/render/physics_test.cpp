@@ -136,7 +136,7 @@ TEST(Physics, GlossyFurnace)
         geom::Scene ball = s;
         ball.geometry = {};
         add_sphere(ball.geometry, {0, 0, 0}, 3.5f);
-        float sphere = furnace(ball, c, 4, 4, 12, 12, 64, 1000, nullptr, &se_sphere);
+        float sphere = furnace(ball, c, 4, 4, 12, 12, 128, 1000, nullptr, &se_sphere);
         EXPECT_LT(se_sphere, 0.01 * albedo) << shininess;
         // Never more than the albedo; the loss at grazing angles is the lobe's part below
         // the surface, under a fifth of it seen from this camera.

@@ -1,0 +1,361 @@
+// SPDX-License-Identifier: Apache-2.0
+// Convergence: how fast the path tracer's noise falls with samples on the benchmark plants.
+// Each plant is rendered through the app pipeline (its model.json command line) at 1, 2,
+// 4, ... max spp, and compared with its own high-spp reference (cached under the build
+// folder): relative RMSE over the plant's pixels, the slope of log RMSE against log spp,
+// the spp and time to reach a noise target (on the fitted line; the time interpolated
+// between the measured renders, each with its set-up), samples/s and rays/s over all
+// the renders (set-ups included), and peak memory. Prints one JSON object per plant and
+// sampler.
+//
+//   build/benchmarks/convergence [--plant NAME]... [--sampler sobol|white|both]
+//       [--size WxH] [--threads N] [--max-spp N] [--reference-spp N] [--target NOISE]
+//
+// Defaults: the four plants below, both samplers, 320x240, 2 threads, up to 64 spp, a
+// 1024-spp Sobol reference. The noise target (time_to_target_s) is, unless given, white
+// noise's error at max spp when both samplers run (else Sobol's). Without the corpus
+// (../shared/corpus, or $CAMBIUM_CORPUS) it prints {"skipped": ...} and exits 0.
+//
+// Noise: sqrt(mean over plant pixels and RGB of (value - reference)^2) / mean(reference),
+// plant pixels being those the reference's camera rays hit at least half the time.
+#include <embree3/rtcore.h>
+
+#include <dlfcn.h>
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "app/command_line.h"
+#include "app/pipeline.h"
+#include "render/render.h"
+
+namespace fs = std::filesystem;
+
+// ---- Ray counting: this executable's rtcIntersect1 / rtcOccluded1 count each call and
+// forward to Embree's (cambium_render is static and links to these definitions).
+namespace {
+std::atomic<std::uint64_t> rays_traced{0};
+
+template <typename F>
+F embree_function(const char* name)
+{
+    return reinterpret_cast<F>(dlsym(RTLD_NEXT, name));
+}
+}  // namespace
+
+extern "C" void rtcIntersect1(RTCScene scene, RTCIntersectContext* context, RTCRayHit* rayhit)
+{
+    using F = void (*)(RTCScene, RTCIntersectContext*, RTCRayHit*);
+    static F real = embree_function<F>("rtcIntersect1");
+    rays_traced.fetch_add(1, std::memory_order_relaxed);
+    real(scene, context, rayhit);
+}
+
+extern "C" void rtcOccluded1(RTCScene scene, RTCIntersectContext* context, RTCRay* ray)
+{
+    using F = void (*)(RTCScene, RTCIntersectContext*, RTCRay*);
+    static F real = embree_function<F>("rtcOccluded1");
+    rays_traced.fetch_add(1, std::memory_order_relaxed);
+    real(scene, context, ray);
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+namespace render = cambium::render;
+
+/// The benchmark plants: thin twigs, leaves, transparent organs and instancing, and
+/// textured generalized cylinders.
+const std::map<std::string, std::string> plants = {
+    {"FernLeaf", "cpfg/10-manuals/15-VlabTools/FernLeaf"},
+    {"WeepingBirch", "cpfg/10-manuals/11-CPFG/WeepingBirch"},
+    {"Lilac", "cpfg/10-manuals/11-CPFG/Lilac"},
+    {"GeneralizedCylinder", "cpfg/10-manuals/11-CPFG/GeneralizedCylinder"},
+};
+
+struct Settings {
+    std::vector<std::string> plants;
+    std::vector<render::SampleSequence> samplers{render::SampleSequence::white,
+                                                render::SampleSequence::sobol};
+    int width = 320, height = 240, threads = 2, max_spp = 64, reference_spp = 1024;
+    double target = 0;
+};
+
+double peak_rss_mb()
+{
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return static_cast<double>(usage.ru_maxrss) / 1024.0;
+}
+
+const char* name(render::SampleSequence s)
+{
+    return s == render::SampleSequence::white ? "white" : "sobol";
+}
+
+/// The plant's scene, through the same path as `cambium <model.json's command>`; the
+/// current folder becomes the model's (its files are named relative to it).
+cambium::geom::Scene load_plant(const fs::path& folder)
+{
+    std::ifstream in(folder / "model.json");
+    nlohmann::json json = nlohmann::json::parse(in);
+    std::istringstream words(json.at("command").get<std::string>());
+    std::vector<std::string> args;
+    std::string word;
+    words >> word;  // "cpfg"
+    while (words >> word)
+        args.push_back(word);
+    args.push_back("-q");
+    fs::current_path(folder);
+    cambium::app::Options options = *cambium::app::parse_command_line(args);
+    cambium::app::Model model = cambium::app::load_model(options);
+    return cambium::app::interpret(model, cambium::app::derive(model, options), options);
+}
+
+struct Run {
+    render::Image image;
+    double seconds = 0;
+    std::uint64_t rays = 0;
+};
+
+Run render_at(const cambium::geom::Scene& scene, const Settings& s, int spp,
+              render::SampleSequence sampler, std::uint64_t seed)
+{
+    render::RenderSettings rs;
+    rs.width = s.width;
+    rs.height = s.height;
+    rs.threads = s.threads;
+    rs.samples_per_pixel = spp;
+    rs.sampler = sampler;
+    rs.seed = seed;
+    rs.aovs = false;
+    std::uint64_t rays_before = rays_traced.load();
+    auto start = Clock::now();
+    Run run{render::render(scene, rs), 0, 0};
+    run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    run.rays = rays_traced.load() - rays_before;
+    return run;
+}
+
+/// The reference image, cached as raw floats in `cache` (it costs most of the run).
+std::vector<float> reference(const cambium::geom::Scene& scene, const Settings& s,
+                             const fs::path& file)
+{
+    std::size_t n = std::size_t(s.width) * s.height * 4;
+    std::vector<float> rgba(n);
+    std::ifstream in(file, std::ios::binary);
+    if (in.read(reinterpret_cast<char*>(rgba.data()), std::streamsize(n * sizeof(float))) &&
+        in.peek() == std::char_traits<char>::eof())
+        return rgba;
+    // A seed of its own: the reference's noise is independent of the measured renders'.
+    rgba = render_at(scene, s, s.reference_spp, render::SampleSequence::sobol, 0x5eed).image.rgba;
+    fs::create_directories(file.parent_path());
+    std::ofstream out(file, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(rgba.data()), std::streamsize(n * sizeof(float)));
+    return rgba;
+}
+
+/// Relative RMSE over the plant's pixels (see the top of the file).
+double relative_rmse(const std::vector<float>& image, const std::vector<float>& ref)
+{
+    double sq = 0, sum = 0;
+    std::size_t values = 0;
+    for (std::size_t p = 0; p + 3 < ref.size(); p += 4) {
+        if (ref[p + 3] < 0.5f)
+            continue;
+        for (std::size_t c = 0; c < 3; ++c) {
+            double d = double(image[p + c]) - ref[p + c];
+            sq += d * d;
+            sum += ref[p + c];
+            ++values;
+        }
+    }
+    return values > 0 && sum > 0 ? std::sqrt(sq / double(values)) / (sum / double(values)) : 0;
+}
+
+/// Least-squares line y = a + b x.
+std::pair<double, double> fit_line(const std::vector<double>& x, const std::vector<double>& y)
+{
+    double n = double(x.size()), sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        sx += x[i];
+        sy += y[i];
+        sxx += x[i] * x[i];
+        sxy += x[i] * y[i];
+    }
+    double b = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+    return {(sy - b * sx) / n, b};
+}
+
+struct Curve {
+    std::vector<double> spp, rmse, seconds;
+    std::uint64_t rays = 0, samples = 0;
+    double render_seconds = 0;
+};
+
+/// The time a render of `spp` samples takes (each render's set-up included, as a user's
+/// run pays it): interpolated between the measured runs, extrapolated past the last at
+/// the last step's cost per spp.
+double seconds_at(const Curve& c, double spp)
+{
+    if (spp <= c.spp.front())
+        return c.seconds.front() * spp / c.spp.front();
+    std::size_t i = 1;
+    while (i + 1 < c.spp.size() && c.spp[i] < spp)
+        ++i;
+    double per_spp = std::max(0.0, (c.seconds[i] - c.seconds[i - 1]) / (c.spp[i] - c.spp[i - 1]));
+    return c.seconds[i - 1] + per_spp * (spp - c.spp[i - 1]);
+}
+
+std::string json_array(const std::vector<double>& v, const char* format)
+{
+    std::string out = "[";
+    char buffer[64];
+    for (std::size_t i = 0; i < v.size(); ++i) {
+        std::snprintf(buffer, sizeof buffer, format, v[i]);
+        if (i > 0)
+            out += ',';
+        out += buffer;
+    }
+    return out + "]";
+}
+
+void report(const std::string& plant, const Settings& s, render::SampleSequence sampler,
+            const Curve& c, double target)
+{
+    std::vector<double> log_spp, log_rmse;
+    for (std::size_t i = 0; i < c.spp.size(); ++i) {
+        log_spp.push_back(std::log(c.spp[i]));
+        log_rmse.push_back(std::log(c.rmse[i]));
+    }
+    auto [a, slope] = fit_line(log_spp, log_rmse);
+    double spp_to_target = std::exp((std::log(target) - a) / slope);
+    double total_spp = 0;
+    for (double spp : c.spp)
+        total_spp += spp;
+    std::printf("{\"plant\":\"%s\",\"sampler\":\"%s\",\"image\":\"%dx%d\",\"threads\":%d,"
+                "\"reference_spp\":%d,\"spp\":%s,\"relative_rmse\":%s,\"seconds\":%s,"
+                "\"slope\":%.3f,\"target_noise\":%.5f,\"spp_to_target\":%.1f,"
+                "\"time_to_target_s\":%.3f,\"samples_per_s\":%.0f,"
+                "\"rays_per_s\":%.0f,\"peak_rss_mb\":%.0f}\n",
+                plant.c_str(), name(sampler), s.width, s.height, s.threads, s.reference_spp,
+                json_array(c.spp, "%.0f").c_str(), json_array(c.rmse, "%.5f").c_str(),
+                json_array(c.seconds, "%.3f").c_str(), slope, target, spp_to_target,
+                seconds_at(c, spp_to_target), double(s.width) * s.height * total_spp / c.render_seconds,
+                double(c.rays) / c.render_seconds, peak_rss_mb());
+    std::fflush(stdout);
+}
+
+void run_plant(const std::string& plant, const fs::path& folder, const Settings& s,
+               const fs::path& cache)
+{
+    cambium::geom::Scene scene = load_plant(folder);
+    std::vector<float> ref = reference(
+        scene, s,
+        cache / (plant + "-" + std::to_string(s.width) + "x" + std::to_string(s.height) + "-" +
+                 std::to_string(s.reference_spp) + ".f32"));
+    std::map<render::SampleSequence, Curve> curves;
+    for (render::SampleSequence sampler : s.samplers) {
+        Curve& c = curves[sampler];
+        for (int spp = 1; spp <= s.max_spp; spp *= 2) {
+            Run run = render_at(scene, s, spp, sampler, 0);
+            c.spp.push_back(spp);
+            c.rmse.push_back(relative_rmse(run.image.rgba, ref));
+            c.seconds.push_back(run.seconds);
+            c.rays += run.rays;
+            c.render_seconds += run.seconds;
+        }
+    }
+    double target = s.target;
+    if (!(target > 0)) {
+        const Curve& basis = curves.count(render::SampleSequence::white)
+                                 ? curves[render::SampleSequence::white]
+                                 : curves.begin()->second;
+        target = basis.rmse.back();
+    }
+    for (const auto& [sampler, curve] : curves)
+        report(plant, s, sampler, curve, target);
+}
+
+Settings parse(int argc, char** argv)
+{
+    Settings s;
+    for (int i = 1; i < argc; ++i) {
+        std::string arg = argv[i];
+        auto value = [&]() -> std::string {
+            if (i + 1 >= argc)
+                throw std::runtime_error(arg + " needs a value");
+            return argv[++i];
+        };
+        if (arg == "--plant") {
+            std::string p = value();
+            if (!plants.count(p))
+                throw std::runtime_error("unknown plant " + p);
+            s.plants.push_back(p);
+        } else if (arg == "--sampler") {
+            std::string v = value();
+            if (v == "sobol")
+                s.samplers = {render::SampleSequence::sobol};
+            else if (v == "white")
+                s.samplers = {render::SampleSequence::white};
+            else if (v != "both")
+                throw std::runtime_error("--sampler: sobol, white or both");
+        } else if (arg == "--size") {
+            if (std::sscanf(value().c_str(), "%dx%d", &s.width, &s.height) != 2)
+                throw std::runtime_error("--size WxH");
+        } else if (arg == "--threads") {
+            s.threads = std::stoi(value());
+        } else if (arg == "--max-spp") {
+            s.max_spp = std::stoi(value());
+        } else if (arg == "--reference-spp") {
+            s.reference_spp = std::stoi(value());
+        } else if (arg == "--target") {
+            s.target = std::stod(value());
+        } else {
+            throw std::runtime_error("unknown argument " + arg);
+        }
+    }
+    if (s.plants.empty())
+        for (const auto& [plant, folder] : plants)
+            s.plants.push_back(plant);
+    return s;
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
+    try {
+        Settings s = parse(argc, argv);
+        const char* env = std::getenv("CAMBIUM_CORPUS");
+        fs::path corpus = fs::absolute(env ? env : CAMBIUM_CORPUS_DEFAULT);
+        fs::path cache = fs::absolute(CAMBIUM_BUILD_DIR) / "convergence-cache";
+        for (const std::string& plant : s.plants) {
+            fs::path folder = corpus / plants.at(plant);
+            if (!fs::exists(folder / "model.json")) {
+                std::printf("{\"plant\":\"%s\",\"skipped\":\"no corpus model at %s\"}\n",
+                            plant.c_str(), folder.string().c_str());
+                continue;
+            }
+            run_plant(plant, folder, s, cache);
+        }
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "convergence: %s\n", e.what());
+        return 1;
+    }
+    return 0;
+}
