@@ -27,7 +27,9 @@ corpus = pathlib.Path(sys.argv[1])
 for f in sorted((corpus / "cpfg").rglob("model.json")):
     m = json.loads(f.read_text())
     if not m.get("env_program", False):
-        print(m["id"], f.parent, *m["command"].split()[1:], sep="\t")
+        # a still, as cpfg's window shows it: without -a (animate mode)
+        args = [a for a in m["command"].split()[1:] if a != "-a"]
+        print(m["id"], f.parent, *args, sep="\t")
 PY
 
 rows=""

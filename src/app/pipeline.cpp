@@ -119,22 +119,28 @@ lsys::ModuleString derive(const Model& model, const Options& options)
 }
 
 namespace {
-/// The view file's `render mode:` (the last one given). `fast` is filled (manual 5.2:
-/// filled with wireframe spheres); `interpolated` and `shadows` are shaded (the former's
-/// colour blending is the generalized cylinders' concern).
+/// The view file's `render mode:` or `shade mode:` (the last one given). `fast` is
+/// filled (manual 5.2: filled with wireframe spheres); `interpolated` and `shadows` are
+/// shaded (the former's colour blending is the generalized cylinders' concern). The
+/// older `shade mode:` numbers as cpfg converts them: 1 simple fill (filled), 4 and 5
+/// B-spline polygons and 7 wireframe (wireframe), the rest shaded (2 interpolated fill,
+/// 3 Gouraud, 6 two-sided).
 geom::Shading render_mode(const geom::ViewFile& view)
 {
     geom::Shading mode = geom::Shading::shaded;
     for (const geom::ViewCommand& c : view.deferred) {
-        if (c.name != "render mode")
-            continue;
         std::istringstream in(c.value);
         std::string word;
         in >> word;
-        mode = word == "flat"        ? geom::Shading::flat
-               : word == "filled" || word == "fast" ? geom::Shading::filled
-               : word == "wireframe" ? geom::Shading::wireframe
-                                     : geom::Shading::shaded;
+        if (c.name == "render mode")
+            mode = word == "flat"        ? geom::Shading::flat
+                   : word == "filled" || word == "fast" ? geom::Shading::filled
+                   : word == "wireframe" ? geom::Shading::wireframe
+                                         : geom::Shading::shaded;
+        else if (c.name == "shade mode")
+            mode = word == "1"                                ? geom::Shading::filled
+                   : word == "4" || word == "5" || word == "7" ? geom::Shading::wireframe
+                                                               : geom::Shading::shaded;
     }
     return mode;
 }

@@ -192,6 +192,25 @@ std::size_t geometry_bytes(const Geometry& g)
                         m.back_material, m.texture);
 }
 
+/// `interpretation past %:` (manual 5.2.3): whether the turtle goes on after a cut in
+/// the string (on, cpfg's default) or skips the rest of the cut branch (off).
+bool interprets_past_cut(const ViewFile& view)
+{
+    bool past = true;
+    for (const ViewCommand& c : view.deferred) {
+        if (c.name != "interpretation past %")
+            continue;
+        std::istringstream in(c.value);
+        std::string flag;
+        in >> flag;
+        if (flag == "on" || flag == "off")
+            past = flag == "on";
+        else
+            warn(c.loc, "interpretation past %: expected 'on' or 'off'; 'on' is kept");
+    }
+    return past;
+}
+
 class Interpreter {
     /// A polygon vertex: the turtle's position and the frame its texture axes use.
     struct PolygonCorner {
@@ -208,6 +227,7 @@ public:
                       m_scene.bounds)  // the root's: its contour files are read once
     {
         m_turtle.cylinder.sides = m_cylinders.settings().sides;
+        m_past_cut = interprets_past_cut(view);
         m_turtle.line_width = view.initial_line_width;
         m_turtle.color = view.initial_color;
         m_turtle.back_color = view.initial_back_color;
@@ -237,7 +257,8 @@ public:
     {
         prepare(symbols);
         string.for_each([&](lsys::ModuleRef m) {
-            interpret_module(m, m_root == this);
+            if (!skipped_after_cut(m))
+                interpret_module(m, m_root == this);
             ++m_module_index;
             if (m_root == this && m_module_index % memory_check_interval == 0)
                 check_memory();
@@ -277,6 +298,7 @@ private:
         std::vector<TurtleOp> ops;
         std::vector<int> surfaces;
         std::vector<char> objects;  ///< empty without object hooks
+        int cut = -1, conditional_cut = -1;  ///< `%` and `@mc`, if the string has them
     };
 
     void prepare(const lsys::SymbolTable& symbols)
@@ -289,12 +311,37 @@ private:
         tables->symbols = &symbols;
         tables->ops = symbol_ops(symbols);
         tables->surfaces = surface_slots(symbols);
+        tables->cut = symbols.find("%");
+        tables->conditional_cut = symbols.find("@mc");
         if (m_options.is_object && m_options.expand_object) {
             tables->objects.resize(symbols.size());
             for (std::size_t id = 0; id < symbols.size(); ++id)
                 tables->objects[id] = m_options.is_object(static_cast<lsys::SymbolId>(id)) ? 1 : 0;
         }
         m_tables = std::move(tables);
+    }
+
+    /// Under `interpretation past %: off`, a cut (`%`, or `@mc(1)`: manual 5.1.9) and
+    /// everything after it up to the ']' that ends its branch are skipped; that ']' is
+    /// interpreted, so the turtle state comes back as after the whole branch.
+    bool skipped_after_cut(lsys::ModuleRef m)
+    {
+        const SymbolTables& t = *m_tables;
+        if (m_cut_depth >= 0) {
+            TurtleOp op = t.ops[m.symbol];
+            if (op == TurtleOp::Push)
+                ++m_cut_depth;
+            else if (op == TurtleOp::Pop && m_cut_depth-- == 0)
+                return false;  // the branch's end: m_cut_depth is -1 again
+            return true;
+        }
+        bool cut = (static_cast<int>(m.symbol) == t.cut && m.params.empty()) ||
+                   (static_cast<int>(m.symbol) == t.conditional_cut && !m.params.empty() &&
+                    m.params[0] == 1.0f);
+        if (m_past_cut || !cut)
+            return false;
+        m_cut_depth = 0;
+        return true;
     }
 
     /// `top`: a module of the string itself. Modules of an object's expansion are never
@@ -1183,6 +1230,8 @@ private:
     bool m_chain_open = false;  ///< the last key is at the turtle and may be shared
     bool m_taper_open = false;  ///< the last segment's top width may still change
     bool m_warned_unbalanced = false;
+    bool m_past_cut = true;  ///< `interpretation past %:`
+    int m_cut_depth = -1;    ///< skipping a cut branch: brackets opened since; -1: not
 };
 
 }  // namespace

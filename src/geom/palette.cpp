@@ -22,8 +22,9 @@ Material undefined_material()
 
 std::vector<Material> grey_table()
 {
-    Material grey;
-    grey.diffuse = grey.ambient = {unloaded_grey, unloaded_grey, unloaded_grey};
+    Material grey;  // a colour-index colour: no OpenGL ambient term (cpfg does not light them)
+    grey.ambient = {0, 0, 0};
+    grey.diffuse = {unloaded_grey, unloaded_grey, unloaded_grey};
     return std::vector<Material>(256, grey);
 }
 constexpr std::size_t material_record_bytes = 15;
@@ -41,8 +42,9 @@ std::vector<Material> read_colormap(const std::filesystem::path& file)
                         std::to_string(bytes.size()));
     std::vector<Material> table(256);
     for (std::size_t i = 0; i < 256; ++i) {
+        // colormap mode draws without OpenGL lighting: no ambient term
         table[i].diffuse = rgb_from_bytes(&bytes[3 * i]);
-        table[i].ambient = table[i].diffuse;
+        table[i].ambient = {0, 0, 0};
     }
     return table;
 }

@@ -42,6 +42,7 @@ Deriver::Deriver(const Program& program, DeriveLimits limits)
     m_bracket_open = symbol_or_none(symbols, "[");
     m_bracket_close = symbol_or_none(symbols, "]");
     m_cut = symbol_or_none(symbols, "%");
+    m_conditional_cut = symbol_or_none(symbols, "@mc");
     m_sub_start = symbol_or_none(symbols, "?");
     m_sub_end = symbol_or_none(symbols, "$");
     m_equals = symbol_or_none(symbols, "=");
@@ -321,7 +322,7 @@ std::size_t Deriver::rewrite(const Indexed& src, ModuleString& dst, bool decompo
         std::size_t consumed = 1;
         if (apply_first_match(set, ls, src, i, offset, dst, consumed)) {
             ++applied;
-        } else if (sym == m_cut && !decomposition) {
+        } else if (!decomposition && cuts(s, i, offset)) {
             consumed = cut_end(s, i) - i;
         } else {
             dst.append(s.symbol(i),
@@ -345,7 +346,17 @@ std::size_t Deriver::rewrite(const Indexed& src, ModuleString& dst, bool decompo
 bool Deriver::never_rewritten(const ProductionSet& set, int sym, bool decomposition) const
 {
     return !set.candidates(static_cast<SymbolId>(sym)) && sym != m_sub_start &&
-           sym != m_sub_end && (decomposition || sym != m_cut);
+           sym != m_sub_end && (decomposition || (sym != m_cut && sym != m_conditional_cut));
+}
+
+bool Deriver::cuts(const ModuleString& s, std::size_t i, std::size_t offset) const
+{
+    int sym = s.symbol(i);
+    // %(par) marks a fragment (moved, not cut: docs/deviations.md); @mc(flag) cuts
+    // only when its flag is 1
+    if (sym == m_cut)
+        return s.param_count(i) == 0;
+    return sym == m_conditional_cut && s.param_count(i) > 0 && s.param_data()[offset] == 1.0f;
 }
 
 std::size_t Deriver::cut_end(const ModuleString& s, std::size_t i) const

@@ -164,6 +164,10 @@ private:
     double m_module_growth = 1.0, m_param_growth = 1.0;  ///< last step's, for reserve()
     int m_bracket_open = -1, m_bracket_close = -1, m_cut = -1, m_sub_start = -1, m_sub_end = -1;
     int m_equals = -1;
+    int m_conditional_cut = -1;  ///< @mc
+    /// Whether module i (parameters from offset) cuts its branch while rewriting: a `%`
+    /// without parameters, or `@mc(1)` (manual 5.1.9).
+    bool cuts(const ModuleString& s, std::size_t i, std::size_t offset) const;
     /// The L-system being matched is a `ring lsystem`: contexts wrap around once.
     bool m_ring = false;
     std::vector<ModuleString> m_homomorphism_stack;  ///< successor buffers, by depth

@@ -46,6 +46,7 @@ bool continues_at_command(char first, char second)
     case 'T': set = "sxfpid"; break;
     case 'P': set = "SCD"; break;
     case 'D': set = "dies"; break;
+    case 'm': set = "c"; break;  // @mc, the conditional cut
     default: return false;
     }
     return second != '\0' && set.find(second) != std::string_view::npos;

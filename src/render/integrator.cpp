@@ -76,6 +76,15 @@ const SurfaceMaterial& material_at(const PathContext& ctx, std::uint16_t m)
     return m < ctx.materials.size() ? ctx.materials[m] : fallback;
 }
 
+/// What a texture did to a surface's diffuse colour, per channel (1 untextured): in
+/// cpfg's window GL_MODULATE multiplies the whole lit colour, ambient and specular too.
+Vec3f texture_tint(const SurfaceMaterial& m, const Vec3f& diffuse_seen)
+{
+    auto ratio = [](float seen, float plain) { return plain > 0 ? seen / plain : 1.0f; };
+    return {ratio(diffuse_seen.x, m.diffuse.x), ratio(diffuse_seen.y, m.diffuse.y),
+            ratio(diffuse_seen.z, m.diffuse.z)};
+}
+
 /// The power heuristic (beta = 2) for a sample drawn with pdf a against one of pdf b.
 float power_heuristic(float a, float b)
 {
@@ -345,6 +354,10 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             result.radiance += beta * (diffuse + material.emission);
             break;
         }
+        const bool textured = ctx.textures && hit->texture != geom::no_texture;
+        const Vec3f tint = textured ? texture_tint(material, diffuse) : Vec3f(1.0f);
+        if (depth == 0 && !is_black(material.ambient_glow))
+            result.radiance += beta * material.ambient_glow * tint;
         if (!is_black(material.emission)) {
             // A BSDF-sampled hit on a listed light: weighted against sampling the light.
             float w = 1;
@@ -356,6 +369,10 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             result.radiance += beta * material.emission * w;
         }
         Bsdf bsdf = make_bsdf(material, diffuse);
+        if (textured) {  // the highlight takes the texture's colour, as in cpfg's window
+            Vec3f g = bsdf.glossy * tint;
+            bsdf.glossy = {std::fmin(g.x, 1.0f), std::fmin(g.y, 1.0f), std::fmin(g.z, 1.0f)};
+        }
         Vertex vertex{*hit, bsdf, -dir};
         const bool last = depth + 1 == ctx.max_depth;
         auto [u_choose, u_area] = sampler.get2d(block + sample_dimension::light_choice);

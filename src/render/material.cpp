@@ -70,6 +70,7 @@ SurfaceMaterial mix(const SurfaceMaterial& a, const SurfaceMaterial& b, float w)
     m.exponent = lerp(a.exponent, b.exponent);
     m.emission = lerp(a.emission, b.emission);
     m.opacity = lerp(a.opacity, b.opacity);
+    m.ambient_glow = lerp(a.ambient_glow, b.ambient_glow);
     return m;
 }
 
@@ -127,7 +128,19 @@ BsdfSample bsdf_sample(const Bsdf& b, const Vec3f& n, const Vec3f& wo, float u1,
     return {wi, bsdf_eval(b, n, wo, wi) * (std::fabs(dot(n, wi)) / pdf), pdf};
 }
 
-std::vector<SurfaceMaterial> make_materials(const std::vector<geom::Material>& materials)
+geom::Rgb opengl_ambient_light(const std::vector<geom::Light>& lights)
+{
+    constexpr float light_model_ambient = 0.2f;  // OpenGL's GL_LIGHT_MODEL_AMBIENT default
+    geom::Rgb sum{light_model_ambient, light_model_ambient, light_model_ambient};
+    if (lights.empty())
+        return {sum.r + 1, sum.g + 1, sum.b + 1};  // cpfg's default light has A: 1 1 1
+    for (const geom::Light& l : lights)
+        sum = {sum.r + l.ambient.r, sum.g + l.ambient.g, sum.b + l.ambient.b};
+    return sum;
+}
+
+std::vector<SurfaceMaterial> make_materials(const std::vector<geom::Material>& materials,
+                                            const geom::Rgb& ambient_light)
 {
     std::vector<SurfaceMaterial> out;
     out.reserve(materials.size());
@@ -145,6 +158,11 @@ std::vector<SurfaceMaterial> make_materials(const std::vector<geom::Material>& m
         s.specular = decode_display(m.specular) * (2 / (s.exponent + 2));
         s.emission = decode_display(m.emission);
         s.opacity = 1 - std::clamp(m.transparency, 0.0f, 1.0f);
+        // OpenGL adds ambient x light ambient to the displayed colour (clamped at 1).
+        geom::Rgb glow{std::min(m.ambient.r * ambient_light.r, 1.0f),
+                       std::min(m.ambient.g * ambient_light.g, 1.0f),
+                       std::min(m.ambient.b * ambient_light.b, 1.0f)};
+        s.ambient_glow = decode_display(glow);
         out.push_back(s);
     }
     return out;

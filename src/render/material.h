@@ -34,6 +34,9 @@ struct SurfaceMaterial {
     float exponent = 0;      ///< Phong exponent (cpfg shininess / 4)
     Vec3f emission;          ///< emitted radiance
     float opacity = 1;       ///< 1 - transparency: probability a ray stops here
+    /// OpenGL's ambient term in cpfg's window (material ambient x the scene's ambient
+    /// light), added where a camera ray meets the surface; it lights nothing else.
+    Vec3f ambient_glow;
 };
 
 /// The material a fraction `w` of the way from `a` to `b`: every parameter linear in w
@@ -63,7 +66,13 @@ float bsdf_pdf(const Bsdf& bsdf, const Vec3f& n, const Vec3f& wo, const Vec3f& w
 /// Draws wi from two uniforms: a lobe in proportion to its albedo, then a direction.
 BsdfSample bsdf_sample(const Bsdf& bsdf, const Vec3f& n, const Vec3f& wo, float u1, float u2);
 
-/// The cpfg materials decoded to linear RGB (display values decoded as sRGB).
-std::vector<SurfaceMaterial> make_materials(const std::vector<geom::Material>& materials);
+/// The cpfg materials decoded to linear RGB (display values decoded as sRGB). Each
+/// material's ambient (display value) times `ambient_light` is its ambient_glow.
+std::vector<SurfaceMaterial> make_materials(const std::vector<geom::Material>& materials,
+                                            const geom::Rgb& ambient_light = {0, 0, 0});
+
+/// The ambient light of cpfg's OpenGL window: the light model's 0.2 plus each light's
+/// `A:` (default 1); with no `light:` cpfg makes one default light.
+geom::Rgb opengl_ambient_light(const std::vector<geom::Light>& lights);
 
 }  // namespace cambium::render

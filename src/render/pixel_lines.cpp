@@ -28,8 +28,12 @@ bool gl_line_draws(const PixelPoint& a, const PixelPoint& b, double width_px, co
     double dx = bx - ax;
     double t = dx == 0 ? 0 : std::clamp((cx - ax) / dx, 0.0, 1.0);
     double offset = cy - (ay + t * (by - ay));
-    // Half-open, so a line of width N on a pixel boundary draws N pixels, not N + 1.
-    return offset >= -width_px / 2 && offset < width_px / 2;
+    // Half-open, so a line of width N on a pixel boundary draws N pixels, not N + 1. The
+    // window moves by a hair so that a width rounded below N (0.9999999 px from the
+    // world radius) on a boundary still draws its N pixels, not N - 1 (HilbertPanels'
+    // grid lines lie on pixel boundaries).
+    constexpr double hair = 1e-6;
+    return offset >= -width_px / 2 - hair && offset < width_px / 2 - hair;
 }
 
 bool pixel_line_draws(const Camera& camera, const geom::Vec3& a, const geom::Vec3& b,

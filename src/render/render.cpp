@@ -459,7 +459,9 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         PathContext ctx;
         ctx.accel = &accel;
         ctx.textures = textures.get();
-        ctx.materials = make_materials(scene.materials);
+        ctx.materials = make_materials(scene.materials, settings.opengl_ambient
+                                                           ? opengl_ambient_light(scene.lights)
+                                                           : geom::Rgb{0, 0, 0});
         ctx.lights = make_lights(scene.lights);
         std::unique_ptr<AreaLights> area_lights;
         if (settings.area_lights) {

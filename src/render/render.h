@@ -63,6 +63,9 @@ struct RenderSettings {
     /// escape: the physically-based stand-in for cpfg's ambient term. Camera rays that
     /// miss see the background colour instead. Ignored when `environment` is set.
     geom::Rgb ambient{0.05f, 0.05f, 0.05f};
+    /// Add cpfg's OpenGL ambient term (material ambient x the lights' ambient) where
+    /// camera rays meet a surface (docs/materials.md).
+    bool opengl_ambient = true;
     /// What escaping rays see instead of `ambient` (make_sky_environment,
     /// make_map_environment); null = the uniform ambient.
     std::shared_ptr<const Environment> environment;

@@ -31,6 +31,8 @@ TEST(Palette, ColormapEntriesAreDiffuseAndEntryZeroIsBackground)
     auto entries = palette.entries(1);
     EXPECT_FLOAT_EQ(entries[7].diffuse.r, 1.0f);
     EXPECT_FLOAT_EQ(entries[7].diffuse.g, 0.2f);
+    // cpfg draws colour indices without OpenGL lighting: no ambient term
+    EXPECT_FLOAT_EQ(entries[7].ambient.r, 0.0f);
     EXPECT_FLOAT_EQ(palette.background(1).g, 20 / 255.0f);
 }
 

@@ -222,6 +222,32 @@ TEST(DeriveCut, PercentRemovesRestOfBranch)
     EXPECT_EQ(derive_text(src), "A[B]G");
 }
 
+// Manual 5.1.9: @mc(flag) "operates as the module % (with no parameter) only if the
+// value of flag is equal to 1. Otherwise, it has no effect."
+TEST(DeriveCut, ConditionalCutCutsOnlyWhenFlagIsOne)
+{
+    const char* src = "lsystem: 1\nderivation length: 1\n"
+                      "axiom: A[B@mc(1)CD[E]F]G[H@mc(0)I]J[K@mc(2)L]\nendlsystem\n";
+    EXPECT_EQ(derive_text(src), "A[B]G[H@mc(0)I]J[K@mc(2)L]");
+}
+
+TEST(DeriveCut, ConditionalCutFlagComesFromTheProduction)
+{
+    // the cut happens in the step after @mc(1) is produced, as with %
+    const char* src = "lsystem: 1\nderivation length: 2\naxiom: A(0)[A(1)]\n"
+                      "A(n) --> B@mc(n)C\nendlsystem\n";
+    EXPECT_EQ(derive_text(src, 1), "B@mc(0)C[B@mc(1)C]");
+    EXPECT_EQ(derive_text(src, 2), "B@mc(0)C[B]");
+}
+
+// Manual 5.1.9: %(par) supports fragmentation (the substring is moved, not cut): it is
+// not the cut of a plain %.
+TEST(DeriveCut, PercentWithParameterDoesNotCut)
+{
+    const char* src = "lsystem: 1\nderivation length: 1\naxiom: A[B%(1)CD]G\nendlsystem\n";
+    EXPECT_EQ(derive_text(src), "A[B%(1)CD]G");
+}
+
 TEST(DeriveStochastic, SameSeedSameString)
 {
     const char* src = R"(lsystem: 1

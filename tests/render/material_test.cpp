@@ -152,6 +152,30 @@ TEST(Material, MapsCpfgMaterials)
     EXPECT_FLOAT_EQ(m.emission.x, srgb_to_linear(0.2f));
 }
 
+// cpfg's window adds material ambient x (0.2 + each light's A:) to the lit colour
+// (11-sympodial-asym: ambient (49, 39, 0) under two lights turns red fruit orange).
+TEST(Material, AmbientGlowIsOpenGLsAmbientTerm)
+{
+    geom::Light two;
+    two.ambient = {0.5f, 1, 1};
+    geom::Rgb light = opengl_ambient_light({geom::Light{}, two});
+    EXPECT_FLOAT_EQ(light.r, 1.7f);
+    EXPECT_FLOAT_EQ(light.g, 2.2f);
+    geom::Rgb none = opengl_ambient_light({});  // cpfg's default light: A 1 1 1
+    EXPECT_FLOAT_EQ(none.b, 1.2f);
+
+    geom::Material g;
+    g.ambient = {49 / 255.0f, 39 / 255.0f, 0};
+    g.diffuse = {1, 0, 0};
+    SurfaceMaterial m = make_materials({g}, {2.2f, 2.2f, 2.2f})[0];
+    EXPECT_FLOAT_EQ(m.ambient_glow.x, srgb_to_linear(49 / 255.0f * 2.2f));
+    EXPECT_FLOAT_EQ(m.ambient_glow.y, srgb_to_linear(39 / 255.0f * 2.2f));
+    EXPECT_FLOAT_EQ(m.ambient_glow.z, 0);
+    g.ambient = {0.9f, 0.9f, 0.9f};  // clamped at 1, as OpenGL clamps the colour
+    EXPECT_FLOAT_EQ(make_materials({g}, {2, 2, 2})[0].ambient_glow.x, 1);
+    EXPECT_FLOAT_EQ(make_materials({g})[0].ambient_glow.x, 0);  // no ambient light
+}
+
 // OpenGL's specular term under a directional light of colour c facing the surface,
 // seen from the mirror direction: specular * c * (n.h)^shininess = specular * c. The
 // mapped lobe must give the same radiance there (irradiance pi c, radiance f pi c).

@@ -7,6 +7,7 @@
 
 #include "base/diagnostics.h"
 #include "render/color.h"
+#include "render/pixel_lines.h"
 #include "render/render.h"
 #include "test_scenes.h"
 
@@ -72,6 +73,36 @@ TEST(Render, PixelLineOfWidthNCoversNPixelsPerColumn)
         }
         for (int y = 32; y <= 66; ++y)  // left of column 24, where the x-major line starts
             EXPECT_EQ(covered_pixels(img, y, true, 24).first, int(width)) << "row " << y << ", width " << width;
+    }
+}
+
+// A horizontal line exactly on a pixel boundary (y = 0 and y = 1 are rows 50.0 and 45.0)
+// still covers N pixels of each column: the width computed back from the world radius
+// may come out a hair under N (HilbertPanels' 1-pixel grid lines vanished).
+TEST(Render, PixelLineOnAPixelBoundaryCoversNPixels)
+{
+    for (float width : {1.0f, 2.0f}) {
+        for (double y : {0.0, 1.0}) {
+            geom::Scene s = empty_scene({-20, -5, 0}, {20, 5, 0});
+            s.line_radius_in_pixels = true;
+            add_segment(s, {-15, y, 0}, {15, y, 0}, width / 2);
+            Image img = render(s, small(200, 100, 4));
+            for (int x = 30; x <= 170; x += 7)
+                EXPECT_EQ(covered_pixels(img, x, false, img.height).first, int(width))
+                    << "column " << x << ", y " << y << ", width " << width;
+        }
+    }
+}
+
+// The width the renderer computes back from a world radius can come out a hair under
+// N; on a pixel boundary the line must still draw N rows, not N - 1.
+TEST(Render, GlLineRuleKeepsWidthRoundedDownOnABoundary)
+{
+    for (double width : {0.9999999, 1.0, 1.0000001, 1.9999999, 2.0}) {
+        int rows = 0;
+        for (int row = 20; row < 28; ++row)
+            rows += gl_line_draws({0, 24.0}, {100, 24.0}, width, {50.3, row + 0.5}) ? 1 : 0;
+        EXPECT_EQ(rows, static_cast<int>(std::lround(width))) << "width " << width;
     }
 }
 
