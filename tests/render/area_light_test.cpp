@@ -218,6 +218,7 @@ TEST(AreaLight, RenderSamplesEmittersUnlessTurnedOff)
     settings.max_depth = 2;
     settings.threads = 2;
     settings.ambient = {0, 0, 0};
+    settings.opengl_ambient = false;  // the emitter alone lights the patch
     settings.aovs = false;
     auto block = [&](bool area) {
         settings.area_lights = area;

@@ -30,7 +30,8 @@ inline geom::Scene empty_scene(const geom::Vec3& lo, const geom::Vec3& hi)
     return s;
 }
 
-/// Settings for a small test render: no ambient, 2 threads, direct light by default.
+/// Settings for a small test render: no ambient (neither the environment nor cpfg's
+/// OpenGL ambient term), 2 threads, direct light by default.
 inline RenderSettings small(int w, int h, int spp, int depth = 1)
 {
     RenderSettings s;
@@ -40,6 +41,7 @@ inline RenderSettings small(int w, int h, int spp, int depth = 1)
     s.max_depth = depth;
     s.threads = 2;
     s.ambient = {0, 0, 0};
+    s.opengl_ambient = false;
     return s;
 }
 
