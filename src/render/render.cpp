@@ -191,7 +191,8 @@ void take_sample(const RenderState& f, int x, int y, std::uint32_t i, PixelState
     st.caught += r.catcher ? 1 : 0;
     st.lit_with += r.lit_with;
     st.lit_without += r.lit_without;
-    double l = luminance(r.radiance);
+    // Adaptive sampling watches a shadow catcher's light estimate (its colour is 0).
+    double l = r.catcher ? r.lit_with : luminance(r.radiance);
     st.luminance += l;
     st.luminance_sq += l * l;
 }

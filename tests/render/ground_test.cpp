@@ -129,5 +129,21 @@ TEST(ShadowCatcher, AlphaIsTheLightThePlantTakesAway)
     EXPECT_LT(catcher.mean(c, 2.5, 2.5, 3), 0.02f);
 }
 
+TEST(ShadowCatcher, AdaptiveSamplingFollowsTheShadowsNoise)
+{
+    // The catcher's colour is 0 everywhere; its light estimate is what is noisy in the
+    // shadow (the sky's occlusion), and adaptive sampling must keep sampling there.
+    BallOverGround s(true, 0.2f);
+    s.settings.ground.shadow_catcher = true;
+    s.settings.samples_per_pixel = 256;
+    s.settings.noise_target = 0.002f;
+    RenderReport report;
+    render(s.scene, s.camera, s.settings, &report);
+    const std::uint64_t pixels = std::uint64_t(s.settings.width) * s.settings.height;
+    // without: every pixel stops at 16 samples (16 x pixels in all)
+    EXPECT_GT(report.samples, 16 * pixels + 20 * 256);  // shadowed pixels went on
+    EXPECT_LT(report.samples, 200 * pixels);  // the unshadowed ground stopped early
+}
+
 }  // namespace
 }  // namespace cambium::render
