@@ -7,7 +7,8 @@
 // turntable: 36 frames through render_views (one BVH) against 36 x (one frame's render
 // minus its BVH build) + one build, each measured here; animation: the frames of cpfg's
 // default animation (1 .. derivation length) derived incrementally, counting the steps
-// the L-system takes, against deriving every frame from the axiom.
+// the L-system takes (also with lineage tracked, as --inbetween does), against deriving
+// every frame from the axiom.
 #include <chrono>
 #include <cstdio>
 #include <exception>
@@ -82,6 +83,15 @@ void animation(const cambium::app::Options& options)
     double incremental = seconds_since(t);
     int incremental_steps = steps_taken;
 
+    // The same with lineage tracked (--inbetween): still each step once.
+    steps_taken = 0;
+    t = Clock::now();
+    cambium::app::derive_frames_with_lineage(model, frames, true,
+        [](const cambium::geom::AnimationFrame&, const cambium::lsys::ModuleString&,
+           const std::vector<std::uint32_t>&) {});
+    double with_lineage = seconds_since(t);
+    int lineage_steps = steps_taken;
+
     steps_taken = 0;
     t = Clock::now();
     for (const auto& f : frames)
@@ -89,10 +99,11 @@ void animation(const cambium::app::Options& options)
     double from_axiom = seconds_since(t);
     std::printf("{\"benchmark\":\"animation\",\"frames\":%zu,\"last_step\":%d,"
                 "\"steps_derived\":%d,\"each_step_once\":%s,\"incremental_s\":%.4f,"
+                "\"with_lineage_steps\":%d,\"with_lineage_s\":%.4f,"
                 "\"from_axiom_steps\":%d,\"from_axiom_s\":%.4f,\"same_strings\":%s}\n",
                 frames.size(), last, incremental_steps,
-                incremental_steps == last ? "true" : "false", incremental, steps_taken,
-                from_axiom, modules == 0 ? "true" : "false");
+                incremental_steps == last ? "true" : "false", incremental, lineage_steps,
+                with_lineage, steps_taken, from_axiom, modules == 0 ? "true" : "false");
 }
 
 }  // namespace

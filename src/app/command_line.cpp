@@ -187,13 +187,16 @@ void check_distributed_options(const Options& options)
 std::optional<Options> parse_command_line(const std::vector<std::string>& words)
 {
     Options options;
-    std::vector<std::string> args = take_cpfg_options(words, options);
+    std::vector<std::string> args = take_ground_option(take_cpfg_options(words, options),
+                                                       options.shot);
 
     CLI::App cli{"cambium: renders cpfg plant models physically.\n"
                  "cpfg options: -w W H (image size, default 640 480), -m[n] file.map, -M[n] file.mat, -c<n>, -w W H, -str file,\n"
                  "-strb file, -homo, -vv file, -rgb file, -tga file, -v, -V, -P cpp, -e file,\n"
                  "-a (every frame of the animation file); window options (-g -wp -wt -mb -pm -sb -s<n>)\n"
-                 "are accepted and ignored."};
+                 "are accepted and ignored.\n"
+                 "--ground [COLOUR|FILE]: a ground plane under the plant, grey (default), a colour\n"
+                 "(#rrggbb or R,G,B) or a tiled texture image."};
     cli.set_version_flag("--version", "cambium " CAMBIUM_VERSION);
     cli.add_option("-o", options.outputs,
                    "Output image (.png .exr .tif .jpg); may be given more than once")

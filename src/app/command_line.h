@@ -43,6 +43,9 @@ struct ShotOptions {
     int fps = 24;                              ///< --fps of video outputs
     std::string tonemap = "none";              ///< --tonemap none|filmic (display outputs)
     std::optional<std::string> background;     ///< --background COLOUR|sky|env
+    std::optional<std::string> ground;         ///< --ground [COLOUR|FILE] ("": grey)
+    bool shadow_catcher = false;               ///< --shadow-catcher
+    int inbetween = 0;                         ///< --inbetween K frames between steps
 };
 
 struct Options {

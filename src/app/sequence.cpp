@@ -9,7 +9,9 @@
 // and interprets once and renders every view from one BVH (render::render_views).
 #include "app/sequence.h"
 
+#include <algorithm>
 #include <chrono>
+#include <limits>
 #include <optional>
 
 #include <fmt/format.h>
@@ -19,8 +21,10 @@
 #include "base/diagnostics.h"
 #include "geom/view_file.h"
 #include "geom/view_volume.h"
+#include "lsys/inbetween.h"
 #include "lsys/string_io.h"
 #include "render/framing.h"
+#include "render/ground.h"
 
 namespace cambium::app {
 namespace {
@@ -167,11 +171,86 @@ render::Camera frame_camera(const geom::Scene& scene, const std::optional<render
     return camera;
 }
 
+/// The textures of a sequence's frames, opened once (render::load_textures) and opened
+/// again only when a frame's view file names other textures (new view between frames).
+class SequenceTextures {
+public:
+    void share(const geom::Scene& scene, render::RenderSettings& settings)
+    {
+        if (scene.textures.empty() && settings.ground.texture.empty())
+            return;
+        if (settings.textures && same_definitions(scene.textures))
+            return;
+        settings.textures = render::load_textures(scene, settings);
+        m_definitions = scene.textures;
+    }
+
+private:
+    bool same_definitions(const std::vector<geom::TextureDef>& defs) const
+    {
+        return std::equal(defs.begin(), defs.end(), m_definitions.begin(), m_definitions.end(),
+                          [](const geom::TextureDef& a, const geom::TextureDef& b) {
+                              return a.file == b.file && a.decal == b.decal &&
+                                     a.linear_filter == b.linear_filter && a.mipmap == b.mipmap;
+                          });
+    }
+    std::vector<geom::TextureDef> m_definitions;
+};
+
+/// The symbols whose parameters are lengths or widths: a module of them that appears in
+/// a step grows from nothing over the in-between frames before it (--inbetween). The
+/// turtle's steps F f G g without a parameter are steps of 1.
+std::vector<lsys::Growth> grown_symbols(const lsys::LSystem& lsystem)
+{
+    std::vector<lsys::Growth> growth(lsystem.symbols().size());
+    auto set = [&](const char* name, float implied) {
+        if (int id = lsystem.symbols().find(name); id >= 0)
+            growth[std::size_t(id)] = {true, implied};
+    };
+    for (const char* step : {"F", "f", "G", "g"})
+        set(step, 1);
+    for (const char* size : {"!", "@O", "@o", "@c"})
+        set(size, 0);
+    return growth;
+}
+
+/// The image numbers of an animation: the derivation step of each frame (cpfg), or with
+/// K in-betweens, 1, 2, 3 ... through every frame, the in-betweens before the frame
+/// they lead to (frame i of the selection is number i (K + 1) + 1).
+struct FrameNumbering {
+    int inbetween = 0;
+    int anchor(const geom::AnimationFrame& f, std::size_t index) const
+    {
+        return inbetween == 0 ? f.number : int(index) * (inbetween + 1) + 1;
+    }
+    /// The k-th (1..K) in-between before frame `index` (>= 1).
+    int between(std::size_t index, int k) const
+    {
+        return int(index - 1) * (inbetween + 1) + 1 + k;
+    }
+};
+
+/// An in-between frame's object motion: the frame intervals' rotate / scale
+/// interpolated between the two frames.
+geom::AnimationFrame between_frame(const geom::AnimationFrame& a, const geom::AnimationFrame& b,
+                                   float t, int number)
+{
+    geom::AnimationFrame f = b;
+    f.number = number;
+    f.rotation_deg = a.rotation_deg * (1 - t) + b.rotation_deg * t;
+    f.scale = a.scale * (1 - t) + b.scale * t;
+    return f;
+}
+
 int run_animation(const Options& options, const SequenceOutputs& out)
 {
     Model model = load_model(options);
     std::vector<geom::AnimationFrame> frames = animation_frames(model, options);
-    require_numbered_names(options, out.images, frames.size());
+    const FrameNumbering numbering{options.shot.inbetween};
+    const std::size_t images_total =
+        frames.empty() ? 0
+                       : frames.size() + std::size_t(numbering.inbetween) * (frames.size() - 1);
+    require_numbered_names(options, out.images, images_total);
     FrameFilter filter(options.shot, out.images);
     std::optional<geom::AnimationFile> animation;
     if (options.animation)
@@ -179,21 +258,23 @@ int run_animation(const Options& options, const SequenceOutputs& out)
     const bool refit = animation && (animation->scale_between_frames ||
                                      animation->new_view_between_frames);
     std::size_t to_render = 0;
-    for (const geom::AnimationFrame& f : frames)
-        to_render += filter.to_render(f.number) ? 1 : 0;
-    out.say(fmt::format("{} frames, {} to render", frames.size(), to_render));
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        to_render += filter.to_render(numbering.anchor(frames[i], i)) ? 1 : 0;
+        for (int k = 1; i > 0 && k <= numbering.inbetween; ++k)
+            to_render += filter.to_render(numbering.between(i, k)) ? 1 : 0;
+    }
+    out.say(fmt::format("{} frames, {} to render", images_total, to_render));
     if (out.mpi)
         out.mpi->checkpoint();
     std::optional<FrameExchange> exchange;
     if (out.mpi)
         exchange.emplace(*out.mpi);
     const bool writes = !exchange || exchange->writes();
-    std::vector<int> numbers;  // of the frames to render, in order
-    for (const geom::AnimationFrame& f : frames)
-        if (filter.to_render(f.number))
-            numbers.push_back(f.number);
+    std::vector<int> numbers;  // image numbers of the frames rendered, in call order
 
     render::ViewOverrides overrides = view_overrides(options.shot);
+    render::RenderSettings settings = out.settings;
+    SequenceTextures textures;
     SequenceProgress progress(to_render, out.say);
     int status = 0;
     auto write_received = [&](std::size_t k, render::Image& image) {
@@ -204,14 +285,15 @@ int run_animation(const Options& options, const SequenceOutputs& out)
     auto render_frame = [&](const geom::Scene& scene, const std::optional<render::Camera>& fixed,
                             const geom::AnimationFrame& f) {
         std::size_t k = reached++;
+        numbers.push_back(f.number);
         if (exchange && !exchange->renders(k))
             return;
         if (exchange)
             exchange->receive_until(k, write_received);  // rendered while rank 0 rendered its last
+        textures.share(scene, settings);
         render::RenderReport report;
         render::Image image =
-            render::render(scene, frame_camera(scene, fixed, f, out.settings), out.settings,
-                           &report);
+            render::render(scene, frame_camera(scene, fixed, f, settings), settings, &report);
         auto write = [&](std::size_t, render::Image& done) {
             write_frame_images(done, f.number, options, out);
             progress.frame_done(f.number, report.seconds);
@@ -225,58 +307,109 @@ int run_animation(const Options& options, const SequenceOutputs& out)
     };
 
     // Derive every frame once; render now (refitting per frame, or a perspective view),
-    // or keep the turtle strings to render with one camera fitted to all of them.
+    // or keep the turtle strings to render with one camera fitted to all of them. With a
+    // ground every frame is kept: the ground's height is the lowest point of them all.
+    const bool keep_all = settings.ground.enabled;
     struct Kept {
-        geom::AnimationFrame frame;
+        geom::AnimationFrame frame;  ///< numbered as its images
         lsys::ModuleString turtle;
+        std::optional<geom::View> own_view;  ///< refitted per frame (else the fixed camera)
     };
     std::vector<Kept> kept;
-    geom::Bounds3 all_bounds;
+    geom::Bounds3 all_bounds, fixed_bounds;
+    double lowest = std::numeric_limits<double>::infinity();
     std::optional<geom::View> fixed_view;
-    int derived = derive_frames(model, frames, [&](const geom::AnimationFrame& f,
-                                                   const lsys::ModuleString& string) {
-        if (!filter.selected(f.number) || status != 0)
+    // One frame's turtle string (and image number in `frame`): rendered or kept.
+    auto take = [&](lsys::ModuleString turtle, const geom::AnimationFrame& frame) {
+        geom::Scene scene = interpret_turtle_string(model, turtle, options);
+        scene.view = render::apply_overrides(scene.view, overrides, scene.bounds);
+        bool own_camera = refit || scene.view.perspective;
+        if (own_camera && !keep_all) {
+            render_frame(scene, std::nullopt, frame);
             return;
-        // -homo: strings after the homomorphism, which the turtle then reads as they are
-        lsys::ModuleString homomorphic;
-        if (options.homomorphism_in_string)
-            homomorphic = model.lsystem.interpretation_string(string);
-        const lsys::ModuleString& written = options.homomorphism_in_string ? homomorphic : string;
+        }
+        all_bounds.extend(scene.bounds);
+        if (keep_all)
+            lowest = std::min(lowest, render::lowest_point(scene));
+        if (!own_camera) {
+            fixed_view = scene.view;
+            fixed_bounds.extend(scene.bounds);
+        }
+        kept.push_back({frame, std::move(turtle),
+                        own_camera ? std::optional<geom::View>(scene.view) : std::nullopt});
+    };
+    // -homo: strings after the homomorphism, which the turtle then reads as they are
+    auto written_string = [&](const lsys::ModuleString& derived) {
+        return options.homomorphism_in_string ? model.lsystem.interpretation_string(derived)
+                                              : derived;
+    };
+    const std::vector<lsys::Growth> grows = grown_symbols(model.lsystem);
+    lsys::ModuleString before;  // the previous frame's string (--inbetween)
+    const geom::AnimationFrame* previous = nullptr;
+    int derived = derive_frames_with_lineage(
+        model, frames, numbering.inbetween > 0,
+        [&](const geom::AnimationFrame& f, const lsys::ModuleString& string,
+            const std::vector<std::uint32_t>& lineage) {
+        std::size_t index = std::size_t(&f - frames.data());
+        int number = numbering.anchor(f, index);
+        if (status != 0)
+            return;
+        if (previous)  // the in-betweens leading to this frame
+            for (int k = 1; k <= numbering.inbetween && status == 0; ++k) {
+                geom::AnimationFrame g = between_frame(
+                    *previous, f, float(k) / float(numbering.inbetween + 1),
+                    numbering.between(index, k));
+                if (!filter.to_render(g.number))
+                    continue;
+                lsys::ModuleString grown = lsys::inbetween(
+                    before, string, lineage, float(k) / float(numbering.inbetween + 1), grows);
+                take(turtle_string(model, written_string(grown), options), g);
+            }
+        if (numbering.inbetween > 0) {
+            before = string;
+            previous = &f;
+        }
+        if (!filter.selected(number))
+            return;
+        lsys::ModuleString written = written_string(string);
         if (writes)
             out.write_strings(model, written, f.number);
-        if (!options.view_volume && !filter.to_render(f.number))
+        if (!options.view_volume && !filter.to_render(number))
             return;
         if (refit && animation->new_view_between_frames)
             model.view = std::make_shared<const geom::ViewFile>(geom::read_view_file(options.view));
-        lsys::ModuleString turtle = turtle_string(model, written, options);
-        geom::Scene scene = interpret_turtle_string(model, turtle, options);
-        scene.view = render::apply_overrides(scene.view, overrides, scene.bounds);
         if (options.view_volume && writes) {
+            geom::Scene scene = interpret(model, written, options);
+            scene.view = render::apply_overrides(scene.view, overrides, scene.bounds);
             fs::path file = frame_file(*options.view_volume, f.number);
             geom::write_view_volume(scene.view.box.value_or(scene.bounds), file);
             out.say("wrote " + file.string());
         }
-        if (!filter.to_render(f.number))
+        if (!filter.to_render(number))
             return;
-        if (refit || scene.view.perspective) {
-            render_frame(scene, std::nullopt, f);
-            return;
-        }
-        fixed_view = scene.view;
-        all_bounds.extend(scene.bounds);
-        kept.push_back({f, std::move(turtle)});
+        geom::AnimationFrame anchor = f;
+        anchor.number = number;
+        take(turtle_string(model, written, options), anchor);
     });
-    out.say(fmt::format("derived {} steps once for {} frames", derived, frames.size()));
-    if (!kept.empty()) {
-        const render::RenderSettings& s = out.settings;
-        render::Camera camera = render::make_camera(*fixed_view, all_bounds, s.width, s.height);
-        for (const Kept& k : kept) {
-            if (status != 0)
-                break;
-            geom::Scene scene = interpret_turtle_string(model, k.turtle, options);
-            scene.view = *fixed_view;
-            render_frame(scene, camera, k.frame);
+    out.say(fmt::format("derived {} steps once for {} frames", derived, images_total));
+    if (keep_all && !kept.empty()) {
+        // One ground for the whole sequence: at the lowest point of every frame, its
+        // texture tiled by the size of the largest frame.
+        settings.ground.height = lowest;
+        if (!(settings.ground.tile > 0)) {
+            geom::Vec3 e = all_bounds.extent();
+            settings.ground.tile = std::max({e.x, e.y, e.z, 1e-3});
         }
+    }
+    std::optional<render::Camera> camera;
+    if (fixed_view)
+        camera = render::make_camera(*fixed_view, fixed_bounds, settings.width, settings.height);
+    for (const Kept& k : kept) {
+        if (status != 0)
+            break;
+        geom::Scene scene = interpret_turtle_string(model, k.turtle, options);
+        scene.view = k.own_view.value_or(*fixed_view);
+        render_frame(scene, k.own_view ? std::nullopt : camera, k.frame);
     }
     if (exchange && status == 0)
         exchange->receive_until(reached, write_received);
@@ -377,23 +510,48 @@ int derive_frames(const Model& model, const std::vector<geom::AnimationFrame>& f
                   const std::function<void(const geom::AnimationFrame&,
                                            const lsys::ModuleString&)>& on_frame)
 {
+    return derive_frames_with_lineage(
+        model, frames, false,
+        [&](const geom::AnimationFrame& f, const lsys::ModuleString& s,
+            const std::vector<std::uint32_t>&) { on_frame(f, s); });
+}
+
+int derive_frames_with_lineage(const Model& model,
+                               const std::vector<geom::AnimationFrame>& frames, bool lineage,
+                               const FrameWithLineage& on_frame)
+{
     lsys::Derivation derivation = model.lsystem.start();
+    if (lineage)
+        derivation.track_lineage();
     for (std::size_t i = 0; i < frames.size(); ++i) {
         derivation.advance(frames[i].derive_steps);
         // cpfg runs the End block once the last frame is reached, or on stop()
         bool last = i + 1 == frames.size() || derivation.stopped();
         if (last && (!derivation.stopped() || derivation.stop_runs_end()))
             derivation.finish();
-        on_frame(frames[i], derivation.string());
+        on_frame(frames[i], derivation.string(), derivation.lineage());
         if (derivation.stopped())
             break;  // stop() ends the animation (manual 5.1)
     }
     return derivation.steps_done();
 }
-
 void apply_staging(render::RenderSettings& settings, const Options& options)
 {
-    const std::optional<std::string>& background = options.shot.background;
+    const ShotOptions& shot = options.shot;
+    if (shot.ground || shot.shadow_catcher) {
+        render::RenderSettings::Ground& ground = settings.ground;
+        ground.enabled = true;
+        ground.shadow_catcher = shot.shadow_catcher;
+        const std::string value = shot.ground.value_or("");
+        if (is_ground_texture(value)) {
+            ground.texture = fs::absolute(value);
+            ground.colour = {1, 1, 1};  // the texture's own colours
+        } else if (!value.empty()) {
+            auto rgb = background_colour(value, "--ground");
+            ground.colour = {rgb[0], rgb[1], rgb[2]};
+        }
+    }
+    const std::optional<std::string>& background = shot.background;
     if (!background)
         return;
     if (*background == "sky" || *background == "env") {

@@ -45,7 +45,18 @@ int derive_frames(const Model& model, const std::vector<geom::AnimationFrame>& f
                   const std::function<void(const geom::AnimationFrame&,
                                            const lsys::ModuleString&)>& on_frame);
 
-/// The staging options' part of the render settings: --background.
+/// A frame, its string and, when asked for, its lineage from the previous frame's string
+/// (lsys::Derivation::lineage(); empty when not tracked).
+using FrameWithLineage = std::function<void(const geom::AnimationFrame&, const lsys::ModuleString&,
+                                            const std::vector<std::uint32_t>& lineage)>;
+
+/// derive_frames(), tracking each frame's lineage when `lineage` (for --inbetween).
+int derive_frames_with_lineage(const Model& model,
+                               const std::vector<geom::AnimationFrame>& frames, bool lineage,
+                               const FrameWithLineage& on_frame);
+
+/// The staging options' part of the render settings: --background, --ground,
+/// --shadow-catcher.
 void apply_staging(render::RenderSettings& settings, const Options& options);
 
 /// How images are written: --exposure and --tonemap.

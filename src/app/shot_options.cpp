@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <filesystem>
 
 #include "app/video.h"
 #include "base/diagnostics.h"
@@ -40,8 +41,54 @@ void add_shot_options(CLI::App& cli, ShotOptions& shot)
     cli.add_option("--background", shot.background,
                    "What the camera sees behind the plant: a colour (#rrggbb or R,G,B in 0..1), "
                    "sky (with --sky) or env (with --env), in both projections");
+    cli.add_flag("--shadow-catcher", shot.shadow_catcher,
+                 "The ground only darkens: alpha carries the plant's shadow for compositing");
+    cli.add_option("--inbetween", shot.inbetween,
+                   "With -a: K frames interpolated between derivation steps (growth)")
+        ->check(CLI::Range(0, 1000));
     cli.add_option("--fps", shot.fps, "Frames per second of video outputs (default 24)")
         ->check(CLI::Range(1, 240));
+}
+
+namespace {
+
+bool is_colour_word(const std::string& word)
+{
+    return (word.size() == 7 && word[0] == '#') ||
+           std::count(word.begin(), word.end(), ',') == 2;
+}
+
+}  // namespace
+
+bool is_ground_texture(const std::string& value)
+{
+    static const std::array<std::string_view, 12> images = {
+        ".png", ".jpg", ".jpeg", ".exr", ".tif", ".tiff", ".hdr", ".tga", ".rgb", ".bmp",
+        ".sgi", ".tx"};
+    std::string ext = std::filesystem::path(value).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) {
+        return static_cast<char>(std::tolower(c));
+    });
+    return std::find(images.begin(), images.end(), ext) != images.end();
+}
+
+std::vector<std::string> take_ground_option(const std::vector<std::string>& args,
+                                            ShotOptions& shot)
+{
+    std::vector<std::string> rest;
+    for (std::size_t i = 0; i < args.size(); ++i) {
+        const std::string& a = args[i];
+        if (a.rfind("--ground=", 0) == 0) {
+            shot.ground = a.substr(9);
+        } else if (a == "--ground") {
+            bool valued = i + 1 < args.size() &&
+                          (is_colour_word(args[i + 1]) || is_ground_texture(args[i + 1]));
+            shot.ground = valued ? args[++i] : std::string();
+        } else {
+            rest.push_back(a);
+        }
+    }
+    return rest;
 }
 
 std::pair<int, int> frame_range(const std::string& text)
@@ -62,12 +109,14 @@ std::pair<int, int> frame_range(const std::string& text)
     return {first, last};
 }
 
-std::array<float, 3> background_colour(const std::string& text)
+std::array<float, 3> background_colour(const std::string& text, const char* option)
 {
     std::array<float, 3> rgb{};
     auto fail = [&]() -> std::array<float, 3> {
-        throw Error("--background: expected sky, env, #rrggbb or R,G,B (0 to 1), not '" + text +
-                    "'");
+        throw Error(std::string(option) + ": expected " +
+                    (std::string_view(option) == "--background" ? "sky, env, "
+                                                                : "an image file, ") +
+                    "#rrggbb or R,G,B (0 to 1), not '" + text + "'");
     };
     if (text.size() == 7 && text[0] == '#') {
         for (int c = 0; c < 3; ++c) {
@@ -116,6 +165,13 @@ void check_shot_options(const Options& options)
         throw Error("--background env shows the --env map behind the plant; give --env too");
     if (shot.background && *shot.background != "sky" && *shot.background != "env")
         background_colour(*shot.background);
+    if (shot.ground && !shot.ground->empty() && !is_ground_texture(*shot.ground))
+        background_colour(*shot.ground, "--ground");
+    if (shot.ground && is_ground_texture(*shot.ground) &&
+        !std::filesystem::is_regular_file(*shot.ground))
+        throw Error(FileLoc{*shot.ground}, "--ground: no such texture file");
+    if (shot.inbetween > 0 && !shot.animate)
+        throw Error("--inbetween interpolates the frames of a growth animation; give -a too");
     bool video = shot.video || std::any_of(options.outputs.begin(), options.outputs.end(),
                                            [](const auto& f) { return is_video(f); });
     if (video && shot.turntable == 0 && !shot.animate)

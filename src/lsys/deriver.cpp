@@ -229,6 +229,7 @@ void Deriver::step_located()
         m_next.reserve(modules_ahead, params_ahead);
     std::size_t modules = m_string.size(), params = m_string.param_total();
     rewrite(m_indexed, m_next, false);
+    compose_lineage(true);
     m_module_growth = growth(modules, m_next.size());
     m_param_growth = growth(params, m_next.param_total());
     std::swap(m_string, m_next);
@@ -270,6 +271,7 @@ void Deriver::decompose()
         index(m_string, m_indexed);
         m_next.clear();
         applied = rewrite(m_indexed, m_next, true);
+        compose_lineage(false);
         std::swap(m_string, m_next);
         if (applied == 0)
             break;
@@ -289,10 +291,37 @@ void Deriver::decompose()
     }
 }
 
+void Deriver::compose_lineage(bool first)
+{
+    if (!m_track_lineage)
+        return;
+    if (first) {
+        m_lineage.swap(m_pass_lineage);
+        return;
+    }
+    for (std::uint32_t& parent : m_pass_lineage)
+        parent = parent == no_parent ? no_parent : m_lineage[parent];
+    m_lineage.swap(m_pass_lineage);
+}
+
 std::size_t Deriver::rewrite(const Indexed& src, ModuleString& dst, bool decomposition)
 {
     const ModuleString& s = *src.string;
     m_source = &s;
+    m_pass_lineage.clear();
+    // Lineage: modules i .. i + n copied are their own continuations; of a successor, the
+    // first module with the predecessor's symbol continues it and the others are new.
+    auto record = [&](std::size_t i, std::size_t first_new, bool copied) {
+        if (!m_track_lineage)
+            return;
+        bool continued = false;
+        for (std::size_t k = first_new; k < dst.size(); ++k) {
+            bool same = copied || (!continued && dst.symbol(k) == s.symbol(i));
+            continued = continued || same;
+            m_pass_lineage.push_back(same ? static_cast<std::uint32_t>(copied ? i + (k - first_new) : i)
+                                          : no_parent);
+        }
+    };
     m_lsystem_stack.assign(1, 0);
     std::size_t applied = 0;
     std::size_t offset = 0;  // first parameter of module i
@@ -312,7 +341,9 @@ std::size_t Deriver::rewrite(const Indexed& src, ModuleString& dst, bool decompo
             if (stochastic)
                 for (std::size_t k = i; k < run; ++k)
                     m_stochastic.next_double();  // cpfg draws for every module
+            std::size_t first_new = dst.size();
             dst.append_range(s, i, run, offset);
+            record(i, first_new, true);
             offset += run_params;
             i = run;
             check_size(dst);
@@ -320,13 +351,16 @@ std::size_t Deriver::rewrite(const Indexed& src, ModuleString& dst, bool decompo
         }
         int sym = s.symbol(i);
         std::size_t consumed = 1;
+        std::size_t first_new = dst.size();
         if (apply_first_match(set, ls, src, i, offset, dst, consumed)) {
             ++applied;
+            record(i, first_new, false);
         } else if (!decomposition && cuts(s, i, offset)) {
             consumed = cut_end(s, i) - i;
         } else {
             dst.append(s.symbol(i),
                        std::span<const float>(s.param_data() + offset, s.param_count(i)));
+            record(i, first_new, true);
         }
         // Sub-L-system switching: ?(id) enters, $ returns
         if (sym == m_sub_start && s.param_count(i) > 0) {

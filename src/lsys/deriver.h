@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "base/limits.h"
+#include "lsys/inbetween.h"
 #include "lsys/program.h"
 
 namespace cambium::lsys {
@@ -56,6 +57,15 @@ public:
     bool stop_runs_end() const { return m_runtime.stop_runs_end; }
     void step();
     void finish();
+    /// Records, from the next step on, which module of the previous string each module
+    /// of the new one continues (lineage()). Off by default: it costs 4 bytes a module.
+    void track_lineage(bool on) { m_track_lineage = on; }
+    /// After a step with tracking on: for each module of string(), the index in the
+    /// string before the step of the module it continues, or no_parent. A module
+    /// continues another when it is that module copied (no production applied), or the
+    /// first module with the predecessor's symbol in the successor of the production
+    /// applied to it (F(x) --> F(x+1) G: the F); decomposition passes compose the same way.
+    const std::vector<std::uint32_t>& lineage() const { return m_lineage; }
     /// Moves the current string out (the Deriver is spent afterwards).
     ModuleString take_string();
     /// The current string, for a query pass that fills ?P ?H ?L ?U parameters in place.
@@ -158,6 +168,11 @@ private:
     std::vector<std::uint32_t> m_matches;     ///< stochastic candidates
     std::vector<float> m_match_probs;         ///< their probabilities
     int m_steps = 0;
+    bool m_track_lineage = false;
+    std::vector<std::uint32_t> m_lineage;       ///< of the last step (track_lineage)
+    std::vector<std::uint32_t> m_pass_lineage;  ///< of the last rewrite() pass
+    /// Composes the last rewrite() pass onto m_lineage (or starts it with `first`).
+    void compose_lineage(bool first);
     bool m_needs_index = false;          ///< some production has a context
     bool m_keep_objects = false;         ///< apply_homomorphism leaves objects as they are
     bool m_in_homomorphism = false;      ///< apply_homomorphism is running (for messages)

@@ -175,15 +175,32 @@ Derivation::Derivation(Derivation&&) noexcept = default;
 Derivation& Derivation::operator=(Derivation&&) noexcept = default;
 Derivation::~Derivation() = default;
 
+void Derivation::track_lineage()
+{
+    m_track_lineage = true;
+    m_deriver->track_lineage(true);
+}
+
 void Derivation::advance(int steps)
 {
     const LoadOptions& options = m_lsystem->m_options;
+    if (m_track_lineage) {  // no step yet: every module continues itself
+        m_lineage.resize(m_deriver->string().size());
+        for (std::size_t k = 0; k < m_lineage.size(); ++k)
+            m_lineage[k] = static_cast<std::uint32_t>(k);
+    }
     for (int i = 0; i < steps && !m_deriver->stop_requested(); ++i) {
         // cpfg (with its default "environment display" off) answers queries while
         // interpreting the string before each step, not after the last one
         if (m_lsystem->m_has_queries && options.query)
             m_lsystem->run_query(*m_deriver);
         m_deriver->step();
+        if (m_track_lineage) {
+            std::vector<std::uint32_t> step = m_deriver->lineage();
+            for (std::uint32_t& parent : step)
+                parent = parent == no_parent ? no_parent : m_lineage[parent];
+            m_lineage = std::move(step);
+        }
         if (options.on_step)
             options.on_step(m_deriver->steps_done(), m_deriver->string());
     }

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "base/limits.h"
+#include "lsys/inbetween.h"
 #include "lsys/module_string.h"
 
 namespace cambium::lsys {
@@ -79,6 +80,12 @@ public:
     bool stop_runs_end() const;
     /// Moves the string out; the Derivation is spent afterwards.
     ModuleString take_string();
+    /// Records lineage from the next advance() on (Deriver::track_lineage).
+    void track_lineage();
+    /// After advance() with lineage tracked: for each module of string(), the index of
+    /// the module it continues in the string before that advance() (through every step
+    /// it made), or no_parent for a module that appeared (Deriver::lineage()).
+    const std::vector<std::uint32_t>& lineage() const { return m_lineage; }
 
 private:
     friend class LSystem;
@@ -86,6 +93,8 @@ private:
     const LSystem* m_lsystem;
     std::unique_ptr<Deriver> m_deriver;
     bool m_finished = false;
+    bool m_track_lineage = false;
+    std::vector<std::uint32_t> m_lineage;
 };
 
 /// A parsed and compiled .l file.

@@ -139,12 +139,15 @@ std::vector<Camera> turntable_cameras(const geom::View& view, const geom::Bounds
     double low = s.below * upright - s.radius * tilt, high = s.above * upright + s.radius * tilt;
     double middle = (low + high) / 2;
     double usable = 1 - 2 * margin;
+    // --zoom (the view's scale factor) magnifies the fitted orbit, as make_camera does:
+    // smaller pixels in parallel, the eye nearer in perspective.
+    double zoom = view.scale_factor > 0 ? view.scale_factor : 1.0;
 
     std::vector<Camera> cameras;
     cameras.reserve(static_cast<std::size_t>(frames));
     if (!view.perspective) {
         double pixel_size = std::max({2 * s.radius / (width * usable),
-                                      (high - low) / (height * usable), 1e-9});
+                                      (high - low) / (height * usable), 1e-9}) / zoom;
         double back_off = s.radius + std::max(std::abs(s.below), std::abs(s.above)) +
                           std::abs(middle) + 1.0;
         for (int k = 0; k < frames; ++k) {
@@ -172,7 +175,7 @@ std::vector<Camera> turntable_cameras(const geom::View& view, const geom::Bounds
         (rims_inside(camera_at(mid, 0), s, margin) ? far : near) = mid;
     }
     for (int k = 0; k < frames; ++k)
-        cameras.push_back(camera_at(far, 2 * std::numbers::pi * k / frames));
+        cameras.push_back(camera_at(far / zoom, 2 * std::numbers::pi * k / frames));
     return cameras;
 }
 

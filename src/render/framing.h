@@ -32,8 +32,10 @@ geom::View apply_overrides(geom::View view, const ViewOverrides& overrides,
 /// `bounds`, all with the same scale. The framing holds the cylinder the bounds sweep
 /// about that axis (with `margin` of the image kept free), so the plant stays inside
 /// every frame. `elevation_deg` sets the angle of the view above the plane
-/// perpendicular to up (default: the view's own). The view's clipping planes are not
-/// applied (an orbit would cut through them).
+/// perpendicular to up (default: the view's own). The view's `scale factor` (--zoom)
+/// magnifies the fitted framing as make_camera does (pixels smaller by the factor in
+/// parallel, the eye nearer by it in perspective), so a factor above 1 may crop the plant.
+/// The view's clipping planes are not applied (an orbit would cut through them).
 std::vector<Camera> turntable_cameras(const geom::View& view, const geom::Bounds3& bounds,
                                       int frames, std::optional<double> elevation_deg,
                                       int width, int height, double margin = 0.05);

@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <stdexcept>
 #include <utility>
 
@@ -125,12 +126,37 @@ bool any_transparent(const PathContext& ctx)
     return false;
 }
 
+/// Whether the ground takes part in rays other than camera rays: a shadow catcher is seen
+/// by camera rays only, and a ray leaving the ground cannot meet it again.
+bool ground_blocks(const PathContext& ctx, const PrimId& leaving)
+{
+    return ctx.ground && !ctx.ground->shadow_catcher && leaving.geom != ground_geom_id;
+}
+
+/// The first hit along org + t dir, t < tfar: the Embree scene's or the ground's. The
+/// camera ray meets the ground beyond the far clipping plane too (the plane is staging,
+/// not part of the plant, and reaches the horizon).
+std::optional<SurfaceHit> first_hit(const PathContext& ctx, const Vec3f& org, const Vec3f& dir,
+                                    float tfar, PrimId leaving, bool camera)
+{
+    std::optional<SurfaceHit> hit = ctx.accel->intersect(org, dir, 0, tfar, leaving, camera);
+    bool sees_ground = camera ? ctx.ground && leaving.geom != ground_geom_id
+                              : ground_blocks(ctx, leaving);
+    if (!sees_ground)
+        return hit;
+    if (std::optional<float> t = ctx.ground->distance(org, dir, hit ? hit->t : infinity))
+        return ctx.ground->hit(org, dir, *t);
+    return hit;
+}
+
 /// The fraction of light passing from s.origin along wi for t < tfar: 0 if an opaque
 /// surface blocks it, the product of transparencies through transparent ones (one
 /// opacity-only traversal: EmbreeScene::transmittance).
 float transmittance(const PathContext& ctx, const PathContext::SceneFlags& facts, Spawn s,
                     const Vec3f& wi, float tfar)
 {
+    if (ground_blocks(ctx, s.skip) && ctx.ground->distance(s.origin, wi, tfar))
+        return 0;
     if (!facts.transparent)
         return ctx.accel->occluded(s.origin, wi, 0, tfar, s.skip) ? 0.0f : 1.0f;
     return ctx.accel->transmittance(s.origin, wi, 0, tfar, s.skip, facts.opacity);
@@ -218,6 +244,59 @@ Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, co
     return f * ls.li * (cos * through * w / pdf);
 }
 
+/// What a ray that escapes along d sees: the environment, or the uniform ambient.
+Vec3f escaped_radiance(const PathContext& ctx, const Vec3f& d)
+{
+    return ctx.environment ? ctx.environment->radiance(d) : ctx.ambient;
+}
+
+float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+/// A direction about the unit normal n drawn with density cos / pi (Malley's method).
+Vec3f cosine_direction(const Vec3f& n, float u1, float u2)
+{
+    float r = std::sqrt(u1), phi = 2 * std::numbers::pi_v<float> * u2;
+    Vec3f t, b;
+    make_basis(n, t, b);
+    return normalize(t * (r * std::cos(phi)) + b * (r * std::sin(phi)) +
+                     n * std::sqrt(std::fmax(0.0f, 1 - u1)));
+}
+
+/// A shadow catcher's point (Cycles' idea): the light a white Lambertian surface there
+/// reflects with the plant in the way and without it, from the same samples: one light
+/// chosen by power (lights, emissive primitives, a non-uniform environment; full weight,
+/// no MIS) and, when the environment is uniform, one cosine-distributed direction toward
+/// it. Light the plant reflects onto the ground is not counted. Uses 6 dimensions.
+void catch_shadow(const PathContext& ctx, const PathContext::SceneFlags& facts,
+                  const SurfaceHit& hit, Sampler& sampler, PathResult& result)
+{
+    result.catcher = true;
+    LightUniforms u{sampler.next(), sampler.next(), sampler.next(), sampler.next()};
+    float c1 = sampler.next(), c2 = sampler.next();
+    auto add = [&](const Vec3f& wi, const Vec3f& reflected, float tfar) {
+        float without = luminance(reflected);
+        if (!(without > 0) || !std::isfinite(without))
+            return;
+        result.lit_without += without;
+        result.lit_with +=
+            without * transmittance(ctx, facts.transparent, spawn(hit, wi), wi, tfar);
+    };
+    std::optional<ChosenLight> chosen = facts.lights.choose(u.choose);
+    if (chosen && chosen->probability > 0) {
+        LightLiSample ls = facts.lights.sample_li(chosen->index, hit.position, u.u0, u.u1, u.u2);
+        float cos = dot(hit.normal, ls.wi);
+        if (ls.pdf > 0 && cos > 0)
+            add(ls.wi,
+                ls.li * (cos / (std::numbers::pi_v<float> * chosen->probability * ls.pdf)),
+                ls.tfar);
+    }
+    if (!facts.environment_black && !facts.environment_nee) {
+        // f cos / pdf = (1 / pi) cos / (cos / pi) = 1
+        Vec3f wi = cosine_direction(hit.normal, c1, c2);
+        add(wi, escaped_radiance(ctx, wi), infinity);
+    }
+}
+
 }  // namespace
 
 TextureFootprint texture_footprint(const SurfaceHit& hit, const Vec3f& dir, float width)
@@ -287,9 +366,7 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         throw std::logic_error("trace_path: prepare_path_context() was not called");
     const PathContext::SceneFlags& facts = *ctx.prepared;
     const LightSet& lights = facts.lights;
-    auto env_radiance = [&](const Vec3f& d) {
-        return ctx.environment ? ctx.environment->radiance(d) : ctx.ambient;
-    };
+    auto env_radiance = [&](const Vec3f& d) { return escaped_radiance(ctx, d); };
 
     PathResult result;
     Vec3f beta(1.0f);
@@ -303,7 +380,7 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
     PassThroughDraws pass_through(sampler, sample_dimension::vertex(0) + sample_dimension::opacity);
     for (int depth = 0; depth < ctx.max_depth;) {
         const std::uint32_t block = sample_dimension::vertex(depth);
-        std::optional<SurfaceHit> hit = ctx.accel->intersect(org, dir, 0, tfar, leaving, depth == 0);
+        std::optional<SurfaceHit> hit = first_hit(ctx, org, dir, tfar, leaving, depth == 0);
         if (!hit) {
             if (depth == 0 && ctx.environment_visible) {
                 result.radiance += beta * env_radiance(dir);
@@ -346,6 +423,10 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             if (depth == 0)
                 tfar = std::isinf(tfar) ? tfar : tfar - hit->t;
             continue;
+        }
+        if (depth == 0 && hit->geom_id == ground_geom_id && ctx.ground->shadow_catcher) {
+            catch_shadow(ctx, facts, *hit, sampler, result);
+            break;
         }
         if (depth == 0)
             result.hit = true;

@@ -12,6 +12,7 @@
 #include "render/accel.h"
 #include "render/area_light.h"
 #include "render/environment.h"
+#include "render/ground.h"
 #include "render/light.h"
 #include "render/material.h"
 #include "render/sampler.h"
@@ -53,6 +54,8 @@ struct PathContext {
     bool facet_normals = false;
     /// The camera rays' cone (zero: textures are looked up at their finest level).
     RayCone camera_cone;
+    /// The ground plane (--ground), beside the Embree scene; none: no ground.
+    std::optional<GroundPlane> ground;
     /// Half the scene's diagonal: how far area lights' power is taken to reach when lights
     /// are chosen (variance only; 0 counts as 1).
     float scene_radius = 0;
@@ -88,6 +91,12 @@ TextureFootprint texture_footprint(const SurfaceHit& hit, const Vec3f& dir, floa
 struct PathResult {
     Vec3f radiance;
     bool hit = false;
+    /// The camera ray met a shadow catcher (radiance 0, hit false): the luminance a white
+    /// Lambertian surface there reflects from direct light and the uniform environment,
+    /// with the plant in the way (`lit_with`) and without (`lit_without`), estimated
+    /// from the same light and direction samples.
+    bool catcher = false;
+    float lit_with = 0, lit_without = 0;
 };
 
 /// What the camera ray meets first (transparent or not), for the image's albedo, normal

@@ -148,8 +148,9 @@ private:
 struct PixelState {
     Vec3f radiance, albedo, normal;
     double luminance = 0, luminance_sq = 0;  // for the adaptive error estimate
+    double lit_with = 0, lit_without = 0;    // shadow-catcher samples' light (PathResult)
     float depth = infinity;
-    std::uint32_t samples = 0, hits = 0;
+    std::uint32_t samples = 0, hits = 0, caught = 0;  // caught: met the shadow catcher
     bool done = false;  // adaptive sampling: converged
 };
 
@@ -209,7 +210,7 @@ void take_sample(const RenderState& f, int x, int y, std::uint32_t i, PixelState
         st.normal += first.normal;
         st.depth = std::min(st.depth, static_cast<float>(first.t + ray.tnear));
     }
-    if (s.transparent_background && !r.hit)
+    if ((s.transparent_background || s.ground.shadow_catcher) && !r.hit)
         r.radiance = Vec3f();
     // One NaN or infinite sample would spoil its pixel for good: it counts as black
     // instead (pbrt does the same), and the render reports how many there were.
@@ -220,7 +221,11 @@ void take_sample(const RenderState& f, int x, int y, std::uint32_t i, PixelState
     st.radiance += r.radiance;
     st.hits += r.hit ? 1 : 0;
     st.samples += 1;
-    double l = luminance(r.radiance);
+    st.caught += r.catcher ? 1 : 0;
+    st.lit_with += r.lit_with;
+    st.lit_without += r.lit_without;
+    // Adaptive sampling watches a shadow catcher's light estimate (its colour is 0).
+    double l = r.catcher ? r.lit_with : luminance(r.radiance);
     st.luminance += l;
     st.luminance_sq += l * l;
 }
@@ -278,13 +283,24 @@ void mark_converged(std::vector<PixelState>& px, int w, int h, double target)
         }
 }
 
+/// A shadow catcher's share of a pixel's coverage, in samples: its samples that met the
+/// catcher (those with light) times the fraction of the light the plant takes away, as a
+/// ratio of the sums (Cycles' catcher): 0 where nothing is in the way.
+float shadow_coverage(const PixelState& st)
+{
+    if (!(st.lit_without > 0) || st.lit_with >= st.lit_without)
+        return 0;
+    float missing = static_cast<float>(1 - st.lit_with / st.lit_without);
+    return missing * static_cast<float>(st.caught);
+}
+
 /// The image of the sums so far over `out`, from the sums over `sampled` (which holds it).
 Image resolve(const std::vector<PixelState>& px, const PixelRect& sampled, const PixelRect& out,
               const RenderSettings& s)
 {
     const std::size_t count = std::size_t(out.width) * out.height;
     Image img{out.width, out.height, std::vector<float>(count * 4)};
-    img.transparent = s.transparent_background;
+    img.transparent = s.transparent_background || s.ground.shadow_catcher;
     if (s.aovs) {
         img.albedo.assign(count * 3, 0.0f);
         img.normal.assign(count * 3, 0.0f);
@@ -300,7 +316,7 @@ Image resolve(const std::vector<PixelState>& px, const PixelRect& sampled, const
         img.rgba[i * 4 + 0] = st.radiance.x * inv;
         img.rgba[i * 4 + 1] = st.radiance.y * inv;
         img.rgba[i * 4 + 2] = st.radiance.z * inv;
-        img.rgba[i * 4 + 3] = static_cast<float>(st.hits) * inv;
+        img.rgba[i * 4 + 3] = (static_cast<float>(st.hits) + shadow_coverage(st)) * inv;
         if (s.aovs) {
             Vec3f a = st.albedo * inv, n = st.normal * inv;
             img.albedo[i * 3 + 0] = a.x;
@@ -367,6 +383,32 @@ std::atomic<bool> interrupted{false};
 
 extern "C" void on_interrupt(int) { interrupted.store(true); }
 
+/// The ground plane of the settings under `scene`: its material appended to `materials`,
+/// its texture after the scene's (load_textures).
+GroundPlane make_ground(const geom::Scene& scene, const RenderSettings& settings,
+                        std::vector<SurfaceMaterial>& materials)
+{
+    const RenderSettings::Ground& g = settings.ground;
+    if (materials.size() >= geom::inherit_material)
+        throw Error("render: no material index is left for the ground");
+    geom::Material surface;
+    surface.diffuse = g.colour;
+    materials.push_back(make_materials({surface}).front());
+    GroundPlane plane;
+    plane.height = static_cast<float>(g.height.value_or(lowest_point(scene)));
+    plane.material = static_cast<std::uint16_t>(materials.size() - 1);
+    if (!g.texture.empty())
+        plane.texture = static_cast<std::int16_t>(scene.textures.size());
+    double tile = g.tile;
+    if (!(tile > 0)) {
+        geom::Vec3 e = scene.bounds.empty() ? geom::Vec3{} : scene.bounds.extent();
+        tile = std::max({e.x, e.y, e.z, 1e-3});
+    }
+    plane.tile = static_cast<float>(tile);
+    plane.shadow_catcher = g.shadow_catcher;
+    return plane;
+}
+
 std::string clock_time(double seconds)
 {
     long s = std::lround(std::max(0.0, seconds));
@@ -388,6 +430,16 @@ std::string format_progress(double fraction, double elapsed_s)
     if (fraction <= 0)
         return line + "?";
     return line + clock_time(elapsed_s * (1 - fraction) / fraction);
+}
+
+std::shared_ptr<const TextureSet> load_textures(const geom::Scene& scene,
+                                                const RenderSettings& settings)
+{
+    std::vector<geom::TextureDef> defs = scene.textures;
+    if (settings.ground.enabled && !settings.ground.texture.empty())
+        defs.push_back({settings.ground.texture, false, true, true});
+    return std::make_shared<const TextureSet>(defs, settings.texture_folder,
+                                              settings.max_memory_bytes);
 }
 
 const std::atomic<bool>* install_interrupt_handler()
@@ -449,19 +501,20 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
     const int w = region.width, h = region.height;
     std::atomic<std::uint64_t> nonfinite{0};
     arena.execute([&] {
-        std::unique_ptr<TextureSet> textures;
-        if (!scene.textures.empty())
-            textures = std::make_unique<TextureSet>(scene.textures, settings.texture_folder,
-                                                    settings.max_memory_bytes);
+        std::shared_ptr<const TextureSet> textures = settings.textures;
+        if (!textures && (!scene.textures.empty() || !settings.ground.texture.empty()))
+            textures = load_textures(scene, settings);
         // Embree builds with TBB too, so the build also stays within the arena. One
-        // build serves every view (pixel-wide lines take the first view's pixel size).
-        EmbreeScene accel(scene, cameras.front(), textures.get());
+        // build serves every view, except for pixel-wide lines, whose width is the view's.
+        auto accel = std::make_unique<EmbreeScene>(scene, cameras.front(), textures.get());
         PathContext ctx;
-        ctx.accel = &accel;
+        ctx.accel = accel.get();
         ctx.textures = textures.get();
         ctx.materials = make_materials(scene.materials, settings.opengl_ambient
                                                            ? opengl_ambient_light(scene.lights)
                                                            : geom::Rgb{0, 0, 0});
+        if (settings.ground.enabled)
+            ctx.ground = make_ground(scene, settings, ctx.materials);
         ctx.lights = make_lights(scene.lights);
         std::unique_ptr<AreaLights> area_lights;
         if (settings.area_lights) {
@@ -484,6 +537,11 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
 
         for (std::size_t view = 0; view < cameras.size(); ++view) {
         const Camera& camera = cameras[view];
+        if (view > 0 && scene.line_radius_in_pixels) {
+            accel.reset();  // one BVH at a time
+            accel = std::make_unique<EmbreeScene>(scene, camera, textures.get());
+            ctx.accel = accel.get();
+        }
         // A parallel camera looks along one direction: its misses would all see the same
         // environment radiance, so they keep cpfg's background there.
         ctx.environment_visible =
@@ -494,7 +552,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         ctx.camera_cone = camera_cone(camera);
         std::vector<PixelState> pixels(std::size_t(w) * h);
         RenderReport rep;
-        RenderState state{ctx, accel, camera, settings,
+        RenderState state{ctx, *accel, camera, settings,
                     FilterTable(settings.filter, settings.filter_radius),
                     camera.aperture_radius() > 0 &&
                         camera.projection() == Camera::Projection::perspective,
@@ -573,7 +631,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         progress.finish();
         rep.cancelled = cancelled;
         rep.out_of_time = out_of_time;
-        rep.skipped_rays = accel.skipped_rays();
+        rep.skipped_rays = accel->skipped_rays();
         rep.nonfinite_samples = nonfinite.exchange(0);
         if (rep.nonfinite_samples > 0)
             warn("render: " + std::to_string(rep.nonfinite_samples) +

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -18,6 +19,8 @@
 #include "render/sampler.h"
 
 namespace cambium::render {
+
+class TextureSet;
 
 /// The pixel reconstruction filter. Filters are importance sampled: each sample's
 /// position within the pixel's footprint is drawn from the filter (tabulated, 64 bins
@@ -120,6 +123,30 @@ struct RenderSettings {
     enum class Backdrop { view, colour, environment };
     Backdrop backdrop = Backdrop::view;
     geom::Rgb backdrop_colour{0, 0, 0};
+
+    /// A ground plane under the plant (--ground): the plane y = height, perpendicular to
+    /// the view's up vector (+y), infinite, lit like the plant and receiving its shadows
+    /// (render/ground.h).
+    struct Ground {
+        bool enabled = false;
+        /// nullopt: the scene's lowest point (lowest_point). A sequence sets it once.
+        std::optional<double> height;
+        geom::Rgb colour{0.5f, 0.5f, 0.5f};  ///< display value: neutral mid grey
+        /// Tiled over the ground, modulating `colour` (empty: none). Absolute, or
+        /// relative to the working folder (it comes from the command line).
+        std::filesystem::path texture;
+        /// World units per texture repeat; 0: the scene's largest extent (at least 1e-3).
+        double tile = 0;
+        /// The ground only darkens (--shadow-catcher): camera rays that meet it give
+        /// colour 0 and alpha 1 - (light with the plant / light without it), so the
+        /// image composites over any background; no other ray sees it. Makes the image
+        /// transparent (premultiplied) like transparent_background.
+        bool shadow_catcher = false;
+    };
+    Ground ground;
+    /// Textures opened once for a sequence whose frames share their texture definitions
+    /// (load_textures of any of its scenes); null: each render opens its scene's own.
+    std::shared_ptr<const TextureSet> textures;
     /// Compute the albedo, normal and depth layers (Image::albedo/normal/depth): one
     /// extra camera-ray intersection per sample.
     bool aovs = true;
@@ -162,12 +189,18 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
 using ViewCallback = std::function<bool(std::size_t view, Image& image, const RenderReport&)>;
 
 /// Renders one scene from several cameras (a turntable), loading its textures and
-/// building its BVH once. Every view uses the same sampling pattern (random numbers
+/// building its BVH once (once per view for `line style: pixel` lines, whose width
+/// depends on the view). Every view uses the same sampling pattern (random numbers
 /// hashed from pixel, sample and seed), so noise does not move between frames; the
 /// time budget applies to each view; a cancel ends the sequence after the view it
 /// interrupted. The first view's report counts the build.
 void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                   const RenderSettings& settings, const ViewCallback& on_view);
+
+/// The scene's textures followed by the ground's (settings.ground.texture), opened once:
+/// share them between the frames of a sequence through RenderSettings::textures.
+std::shared_ptr<const TextureSet> load_textures(const geom::Scene& scene,
+                                                const RenderSettings& settings);
 
 /// Installs a SIGINT handler that sets the returned flag (pass it as
 /// RenderSettings::cancel); a second Ctrl-C kills the process as usual. Idempotent.

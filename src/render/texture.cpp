@@ -7,6 +7,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include <algorithm>
+#include <atomic>
 #include <string>
 
 #include "base/diagnostics.h"
@@ -89,10 +90,17 @@ void check_texture_size(const std::filesystem::path& file, std::uint64_t max_mem
 
 }  // namespace
 
+namespace {
+std::atomic<std::uint64_t> texture_sets_constructed{0};
+}  // namespace
+
+std::uint64_t TextureSet::constructed_count() { return texture_sets_constructed.load(); }
+
 TextureSet::TextureSet(const std::vector<geom::TextureDef>& defs,
                        const std::filesystem::path& base, std::uint64_t max_memory_bytes)
     : m_impl(std::make_unique<Impl>())
 {
+    texture_sets_constructed.fetch_add(1);
     if (defs.empty())
         return;
     // One private system per render: no state shared with other renders in the process.

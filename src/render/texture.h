@@ -50,6 +50,8 @@ public:
     TextureSet& operator=(const TextureSet&) = delete;
 
     std::size_t size() const;
+    /// How many TextureSets this process has constructed (a sequence should open one).
+    static std::uint64_t constructed_count();
     /// Whether `index` is a texture (not no_texture and in range).
     bool valid(int index) const;
     /// E: decal (replaces the diffuse colour) rather than modulate.

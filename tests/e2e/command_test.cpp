@@ -56,6 +56,14 @@ fs::path scratch(const std::string& name)
 
 void write(const fs::path& file, const std::string& text) { std::ofstream(file) << text; }
 
+/// `pattern` (one %02d-like field) with n in it.
+std::string fmt_number(const char* pattern, int n)
+{
+    std::array<char, 64> name{};
+    std::snprintf(name.data(), name.size(), pattern, n);
+    return name.data();
+}
+
 /// An image file read back: its channel names and pixels as floats (0 .. 1 for 8-bit).
 struct Picture {
     int width = 0, height = 0, channels = 0;
@@ -590,4 +598,73 @@ TEST(Sequence, TurntableVideoWithFfmpeg)
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_GT(fs::file_size(dir / "t.mp4"), 0u);
     EXPECT_FALSE(fs::exists(dir / "t.mp4.frames"));  // the frames go once encoded
+}
+
+TEST(Staging, GroundUnderThePlantAndShadowCatcher)
+{
+    fs::path dir = growing_plant(scratch("ground"));
+    write(dir / "g.v", "line style: cylinder\ninitial line width: 0.2\nlight: V: 0.3 1 0.2\n");
+    std::string common = "-q -w 32 24 --spp 4 --orbit 0 30 " + plant_files(dir);
+    // Without a ground the bottom corners are background; with one, ground (grey).
+    Result r = run("--transparent -o " + (dir / "bare.exr").string() + " " + common);
+    ASSERT_EQ(r.status, 0) << r.output;
+    r = run("--ground -o " + (dir / "ground.exr").string() + " " + common);
+    ASSERT_EQ(r.status, 0) << r.output;
+    r = run("--ground '#ff0000' -o " + (dir / "red.exr").string() + " " + common);
+    ASSERT_EQ(r.status, 0) << r.output;
+    r = run("--shadow-catcher -o " + (dir / "catcher.exr").string() + " " + common);
+    ASSERT_EQ(r.status, 0) << r.output;
+    Picture bare = read_picture(dir / "bare.exr"), ground = read_picture(dir / "ground.exr");
+    Picture red = read_picture(dir / "red.exr"), catcher = read_picture(dir / "catcher.exr");
+    ASSERT_EQ(ground.width, 32);
+    int a = ground.channel("A");
+    ASSERT_GE(a, 0);
+    EXPECT_EQ(bare.at(1, 22, a), 0.0f);
+    EXPECT_EQ(ground.at(1, 22, a), 1.0f);
+    EXPECT_GT(ground.at(1, 22, 0), 0.0f);
+    EXPECT_NEAR(ground.at(1, 22, 0), ground.at(1, 22, 2), 1e-6);  // grey
+    EXPECT_GT(red.at(1, 22, 0), 10 * red.at(1, 22, 2));           // red
+    // The catcher: transparent where nothing shadows it, the plant still opaque.
+    EXPECT_EQ(catcher.at(1, 22, a), 0.0f);
+    float plant_alpha = 0;
+    for (int x = 0; x < 32; ++x)
+        plant_alpha = std::max(plant_alpha, catcher.at(x, 12, a));
+    EXPECT_EQ(plant_alpha, 1.0f);
+}
+
+TEST(Staging, GroundAndInbetweenOptionsAreChecked)
+{
+    fs::path dir = growing_plant(scratch("ground_bad"));
+    Result r = run("-q --ground 2,0,0 -o " + (dir / "x.png").string() + " " + plant_files(dir));
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("--ground"), std::string::npos) << r.output;
+    r = run("-q --ground " + (dir / "missing.png").string() + " -o " + (dir / "x.png").string() +
+            " " + plant_files(dir));
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("missing.png"), std::string::npos) << r.output;
+    r = run("-q --inbetween 2 -o " + (dir / "x.png").string() + " " + plant_files(dir));
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("-a"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "x.png"));
+}
+
+TEST(Sequence, InbetweenFramesAreNumberedBetweenTheSteps)
+{
+    fs::path dir = growing_plant(scratch("inbetween"));
+    Result r = run("-a -q -w 24 18 --spp 1 --inbetween 2 -o " + (dir / "f%02d.png").string() +
+                   " -str " + (dir / "s%d.str").string() + " " + plant_files(dir));
+    ASSERT_EQ(r.status, 0) << r.output;
+    // steps 1, 2, 3 are frames 1, 4, 7; two in-betweens lead to each of the last two
+    for (int n = 1; n <= 7; ++n)
+        EXPECT_TRUE(fs::exists(dir / fmt_number("f%02d.png", n))) << n;
+    EXPECT_FALSE(fs::exists(dir / "f08.png"));
+    // strings keep the derivation steps' numbers
+    for (const char* file : {"s1.str", "s2.str", "s3.str"})
+        EXPECT_TRUE(fs::exists(dir / file)) << file;
+    EXPECT_FALSE(fs::exists(dir / "s4.str"));
+    // an in-between differs from both steps around it
+    Picture step1 = read_picture(dir / "f01.png"), between = read_picture(dir / "f02.png");
+    Picture step2 = read_picture(dir / "f04.png");
+    EXPECT_GT(rgb_difference(step1, between), 0);
+    EXPECT_GT(rgb_difference(between, step2), 0);
 }

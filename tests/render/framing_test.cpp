@@ -92,6 +92,31 @@ TEST(Turntable, PerspectiveFramingHoldsThePlantAtOneDistance)
     EXPECT_GT(bottom.y - top.y, 0.4 * 240);
 }
 
+TEST(Turntable, ZoomMagnifiesTheFittedOrbit)
+{
+    // --zoom K multiplies the view's scale factor; the turntable honours it.
+    for (bool perspective : {false, true}) {
+        geom::View view;
+        view.perspective = perspective;
+        auto fitted = turntable_cameras(view, plant_bounds(), 4, 20.0, 320, 240);
+        ViewOverrides zoom;
+        zoom.zoom = 2;
+        view = apply_overrides(view, zoom, plant_bounds());
+        auto zoomed = turntable_cameras(view, plant_bounds(), 4, 20.0, 320, 240);
+        Vec3 centre = plant_bounds().center();
+        for (std::size_t k = 0; k < 4; ++k) {
+            if (perspective) {
+                EXPECT_NEAR(geom::length(zoomed[k].origin() - centre),
+                            geom::length(fitted[k].origin() - centre) / 2, 1e-6);
+            } else {
+                EXPECT_DOUBLE_EQ(zoomed[k].pixel_size(), fitted[k].pixel_size() / 2);
+            }
+            // the plant's centre stays where it was in the image
+            EXPECT_NEAR(zoomed[k].project(centre).x, fitted[k].project(centre).x, 1e-6);
+        }
+    }
+}
+
 TEST(ViewOverrides, OrbitTurnsTheViewpointAboutTheReferencePoint)
 {
     geom::View view;
@@ -190,6 +215,36 @@ TEST(RenderViews, EveryViewEqualsASeparateRender)
         return false;
     });
     EXPECT_EQ(calls, 1);
+}
+
+TEST(RenderViews, PixelWideLinesAreSizedForEachView)
+{
+    // `line style: pixel`: a line is as many pixels wide in every view, near or far.
+    geom::Scene scene = testing::empty_scene({-1, 0, -1}, {1, 4, 1});
+    scene.line_radius_in_pixels = true;
+    testing::add_segment(scene, {0, 0, 0}, {0, 3, 0}, 2.0f);
+    scene.materials[1].diffuse = {0.8f, 0.5f, 0.2f};
+    scene.lights.push_back(testing::directional({1, 1, 1}));
+    RenderSettings settings = testing::small(40, 30, 2, 1);
+    std::vector<Camera> cameras = {
+        Camera::perspective({0, 1.5, 6}, {0, 1.5, 0}, {0, 1, 0}, 45, 40, 30),
+        Camera::perspective({0, 1.5, 30}, {0, 1.5, 0}, {0, 1, 0}, 45, 40, 30)};
+    std::vector<Image> views;
+    render_views(scene, cameras, settings, [&](std::size_t, Image& image, const RenderReport&) {
+        views.push_back(image);
+        return true;
+    });
+    ASSERT_EQ(views.size(), 2u);
+    EXPECT_EQ(views[1].rgba, render(scene, cameras[1], settings).rgba);
+    // the far view's line is as wide as the near one's (in pixels)
+    auto width = [](const Image& image) {
+        int covered = 0;
+        for (int x = 0; x < image.width; ++x)
+            covered += image.at(x, 15, 3) > 0.5f ? 1 : 0;
+        return covered;
+    };
+    EXPECT_GE(width(views[1]), 3);
+    EXPECT_NEAR(width(views[1]), width(views[0]), 1);
 }
 
 }  // namespace
