@@ -268,18 +268,23 @@ Vec3f cosine_direction(const Vec3f& n, float u1, float u2)
 /// no MIS) and, when the environment is uniform, one cosine-distributed direction toward
 /// it. Light the plant reflects onto the ground is not counted. Uses 6 dimensions.
 void catch_shadow(const PathContext& ctx, const PathContext::SceneFlags& facts,
-                  const SurfaceHit& hit, Sampler& sampler, PathResult& result)
+                  const SurfaceHit& hit, const Sampler& sampler, PathResult& result)
 {
+    // The camera vertex's own block: the light pairs for the light, the BSDF pair for
+    // the cosine-distributed direction toward the environment.
     result.catcher = true;
-    LightUniforms u{sampler.next(), sampler.next(), sampler.next(), sampler.next()};
-    float c1 = sampler.next(), c2 = sampler.next();
+    const std::uint32_t block = sample_dimension::vertex(0);
+    auto [u_choose, u_area] = sampler.get2d(block + sample_dimension::light_choice);
+    auto [u_light0, u_light1] = sampler.get2d(block + sample_dimension::light_point);
+    LightUniforms u{u_choose, u_area, u_light0, u_light1};
+    auto [c1, c2] = sampler.get2d(block + sample_dimension::bsdf);
     auto add = [&](const Vec3f& wi, const Vec3f& reflected, float tfar) {
         float without = luminance(reflected);
         if (!(without > 0) || !std::isfinite(without))
             return;
         result.lit_without += without;
         result.lit_with +=
-            without * transmittance(ctx, facts.transparent, spawn(hit, wi), wi, tfar);
+            without * transmittance(ctx, facts, spawn(hit, wi), wi, tfar);
     };
     std::optional<ChosenLight> chosen = facts.lights.choose(u.choose);
     if (chosen && chosen->probability > 0) {
