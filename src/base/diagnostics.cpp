@@ -10,11 +10,16 @@ namespace cambium {
 
 std::string FileLoc::to_string() const
 {
+    // Appended piece by piece: `":" + std::to_string(n)` trips GCC 12's false
+    // -Wrestrict on the inlined insert (GCC bug 105329).
     std::string s = file;
     if (line > 0) {
-        s += ":" + std::to_string(line);
-        if (column > 0)
-            s += ":" + std::to_string(column);
+        s.push_back(':');
+        s.append(std::to_string(line));
+        if (column > 0) {
+            s.push_back(':');
+            s.append(std::to_string(column));
+        }
     }
     return s;
 }

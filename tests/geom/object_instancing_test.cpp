@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "geom/interpreter.h"
+#include "geom/object_instancing.h"
 #include "lsys/lsystem.h"
 
 using namespace cambium;

@@ -1,0 +1,61 @@
+// SPDX-License-Identifier: Apache-2.0
+// `@L` labels: their text, printf-formatted from the module's parameters.
+#include "geom/label.h"
+
+#include <cmath>
+#include <cstdio>
+#include <string_view>
+
+#include "geom/scene_limits.h"
+
+namespace cambium::geom {
+
+std::optional<std::string> label_text(std::span<const float> params, std::span<const std::string> strings)
+{
+    std::optional<int> string = params.empty() ? std::nullopt : whole_number(params[0]);
+    if (!string || *string < 0 || static_cast<std::size_t>(*string) >= strings.size())
+        return std::nullopt;
+    return format_label(strings[static_cast<std::size_t>(*string)], params.subspan(1));
+}
+
+std::string format_label(const std::string& format, std::span<const float> values)
+{
+    std::string out;
+    std::size_t next = 0;
+    for (std::size_t i = 0; i < format.size(); ++i) {
+        if (format[i] != '%' || i + 1 >= format.size()) {
+            out += format[i];
+            continue;
+        }
+        if (format[i + 1] == '%') {
+            out += '%';
+            ++i;
+            continue;
+        }
+        // only flags, width and precision may stand between '%' and the conversion
+        std::size_t end = format.find_first_not_of("-+ #0123456789.", i + 1);
+        if (end == std::string::npos || end - i > 12 ||
+            std::string_view("diouxXeEfFgG").find(format[end]) == std::string_view::npos) {
+            out += format[i];
+            continue;
+        }
+        std::string spec = format.substr(i, end - i + 1);
+        double value = next < values.size() ? static_cast<double>(values[next++]) : 0.0;
+        char buffer[128];
+        char conversion = format[end];
+        // an integer conversion of a value no long long holds prints it as %g
+        bool integral = std::abs(value) < 9e18;
+        if (std::string_view("diouxX").find(conversion) != std::string_view::npos && integral)
+            std::snprintf(buffer, sizeof buffer, (spec.substr(0, spec.size() - 1) + "lld").c_str(),
+                          static_cast<long long>(value));
+        else if (!integral)
+            std::snprintf(buffer, sizeof buffer, (spec.substr(0, spec.size() - 1) + "g").c_str(), value);
+        else
+            std::snprintf(buffer, sizeof buffer, spec.c_str(), value);
+        out += buffer;
+        i = end;
+    }
+    return out;
+}
+
+}  // namespace cambium::geom
