@@ -4,6 +4,7 @@
 
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "geom/view_file.h"
 
@@ -87,6 +88,28 @@ TEST(ViewFile, MalformedNumberNamesLineAndColumn)
         EXPECT_NE(std::string(e.what()).find("bad.v:3:15: error: expected a number"), std::string::npos)
             << e.what();
     }
+}
+
+TEST(ViewFile, ReportsSeveralErrorsWithTheirPositionsAndReadsOn)
+{
+    Diagnostics sink(Diagnostics::Output::quiet);
+    ScopedDiagnostics install(sink);
+    try {
+        parse_view_file("viewpoint: 0, x, 1\nscale factor: 0.9\nline style: wavy\n"
+                        "tapered lines: maybe\nangle factor: 8\n",
+                        "bad.v");
+        FAIL() << "expected an error";
+    } catch (const Error& e) {
+        std::string text = e.what();
+        EXPECT_EQ(text.rfind("bad.v: error: 3 errors:", 0), 0u) << text;
+        for (const char* part : {"bad.v:1:15: error: expected a number", "bad.v:3:", "bad.v:4:"})
+            EXPECT_NE(text.find(part), std::string::npos) << part << " missing in: " << text;
+    }
+    std::vector<int> lines;
+    for (const Diagnostic& d : sink.collected())
+        if (d.severity == Severity::error)
+            lines.push_back(d.loc.line);
+    EXPECT_EQ(lines, (std::vector<int>{1, 3, 4}));
 }
 
 TEST(ViewFile, UnknownCommandIsNotAnError)
