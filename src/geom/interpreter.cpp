@@ -107,6 +107,7 @@ public:
         m_scene.line_radius_in_pixels = view.line_style == LineStyle::pixel;
         m_scene.view = view.view;
         m_scene.lights = effective_lights(view);
+        m_scene.label_font = label_font(view);
         m_scene.bounds.extend(Vec3{0, 0, 0});  // cpfg's box always holds the origin
         if (m_root == this) {
             load_surfaces();

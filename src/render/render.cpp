@@ -28,6 +28,7 @@
 #include "render/accel.h"
 #include "render/color.h"
 #include "render/integrator.h"
+#include "render/labels.h"
 #include "render/texture.h"
 
 namespace cambium::render {
@@ -541,6 +542,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         for (const PixelState& st : pixels)
             rep.samples += st.samples;
         Image image = resolve(pixels, settings);
+        draw_labels(image, scene, camera, accel);  // over the image, as cpfg's window does
         rep.seconds = elapsed();
         if (!on_view(view, image, rep) || rep.cancelled)
             break;
