@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "geom/label.h"
 #include "geom/view_file.h"
 
 using namespace cambium;
@@ -241,4 +242,24 @@ TEST(ViewFileRanges, CameraAndLightValuesBeyondTheLimitAreErrorsAtTheirColumn)
     }
     // at the limit still fine
     EXPECT_NO_THROW(parse_view_file("viewpoint: 1e10 -1e10 0\n", "t.v"));
+}
+
+TEST(LabelFont, XFontNamesAndWinfontGiveFamilySizeAndStyle)
+{
+    LabelFont d = label_font(parse_view_file("", "t.v"));
+    EXPECT_EQ(d.family, "courier");  // cpfg's default: -*-courier-bold-r-*-12-*
+    EXPECT_EQ(d.pixel_size, 12);
+    EXPECT_TRUE(d.bold);
+    LabelFont x = label_font(parse_view_file("font: -adobe-helvetica-medium-o-normal-*-24-*-*-*-*-*-*-*\n", "t.v"));
+    EXPECT_EQ(x.family, "helvetica");
+    EXPECT_EQ(x.pixel_size, 24);
+    EXPECT_FALSE(x.bold);
+    EXPECT_TRUE(x.italic);
+    LabelFont points = label_font(parse_view_file("font: -*-times-bold-r-*-*-*-140-*-*-*-*-*-*\n", "t.v"));
+    EXPECT_EQ(points.pixel_size, 14);  // decipoints
+    LabelFont w = label_font(parse_view_file("winfont: \"Times New Roman\" 18 Ib\n", "t.v"));
+    EXPECT_EQ(w.family, "Times New Roman");
+    EXPECT_EQ(w.pixel_size, 18);
+    EXPECT_TRUE(w.bold);
+    EXPECT_TRUE(w.italic);
 }
