@@ -6,6 +6,7 @@
 #include "fuzz_input.h"
 #include "geom/gencyl.h"
 #include "geom/interpreter.h"
+#include "geom/object_instancing.h"
 #include "geom/surface.h"
 #include "geom/view_file.h"
 #include "lsys/string_io.h"

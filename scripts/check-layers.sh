@@ -4,7 +4,8 @@
 #   base    the standard library (and POSIX headers) only
 #   lsys    + base
 #   geom    + lsys; never Embree, TBB, OpenImageIO or render
-#   render  + geom/scene.h, geom/scene_limits.h and geom/vec.h (the Scene contract), Embree, TBB, OpenImageIO
+#   render  + geom/scene.h, geom/scene_limits.h and geom/vec.h (the Scene contract), Embree, TBB, OpenImageIO,
+#           FreeType and fontconfig (labels)
 #   app     everything
 # Standard and POSIX headers are <name>, <name.h> and <sys/name.h>; any other <dir/...> is a
 # third-party library; "layer/file.h" is the project's own.
@@ -20,12 +21,12 @@ BEGIN {
     project["geom"] = "^(base|lsys|geom)/"
     project["render"] = "^(base|render)/|^geom/(scene|scene_limits|vec)\\.h$"
     project["app"] = "."
-    library["render"] = "^(embree3|tbb|OpenImageIO)/"
+    library["render"] = "^(embree3|tbb|OpenImageIO|fontconfig)/|^ft2build\\.h$"
     library["app"] = "."
     rule["base"] = "the standard library only"
     rule["lsys"] = "the standard library and base only"
     rule["geom"] = "the standard library, base and lsys only"
-    rule["render"] = "base, geom/scene.h, geom/scene_limits.h, geom/vec.h, Embree, TBB and OpenImageIO only"
+    rule["render"] = "base, geom/scene.h, geom/scene_limits.h, geom/vec.h, Embree, TBB, OpenImageIO, FreeType and fontconfig only"
     rule["app"] = "anything"
 }
 FNR == 1 {

@@ -13,6 +13,9 @@ packages=(
   # libraries of the renderer and the command
   libembree-dev libtbb-dev libcli11-dev libfmt-dev
   libopenimageio-dev libopenexr-dev
+  # @L labels: FreeType draws the glyphs, fontconfig finds a font for cpfg's font names,
+  # DejaVu is the font it finds on a bare system
+  libfreetype-dev libfontconfig-dev fonts-dejavu-core
   # OpenImageIO's CMake package requires its command-line tools (iconvert, oiiotool, ...)
   # to exist; Debian has them only as a Recommends of libopenimageio-dev.
   openimageio-tools

@@ -5,16 +5,22 @@
 
 #include <atomic>
 #include <cstdio>
+#include <utility>
 
 namespace cambium {
 
 std::string FileLoc::to_string() const
 {
+    // Appended piece by piece: `":" + std::to_string(n)` trips GCC 12's false
+    // -Wrestrict on the inlined insert (GCC bug 105329).
     std::string s = file;
     if (line > 0) {
-        s += ":" + std::to_string(line);
-        if (column > 0)
-            s += ":" + std::to_string(column);
+        s.push_back(':');
+        s.append(std::to_string(line));
+        if (column > 0) {
+            s.push_back(':');
+            s.append(std::to_string(column));
+        }
     }
     return s;
 }
@@ -70,7 +76,7 @@ void Diagnostics::report(Severity severity, const FileLoc& loc, const std::strin
     if (!m_said.insert(text).second)
         return;
     m_list.push_back(std::move(d));
-    if (m_output == Output::print)
+    if (m_output == Output::print && severity == Severity::warning)
         std::fprintf(stderr, "%s\n", text.c_str());
 }
 
@@ -128,6 +134,41 @@ void warn(const FileLoc& loc, const std::string& message)
 }
 
 void warn(const std::string& message) { warn(FileLoc{}, message); }
+
+ErrorList::ErrorList(std::string file, std::size_t limit) : m_file(std::move(file)), m_limit(limit) {}
+
+void ErrorList::add(const Error& error)
+{
+    if (m_errors.size() >= m_limit)  // the summary itself, on its way out
+        throw_summary(" (stopped after " + std::to_string(m_limit) + ")");
+    if (Diagnostics* sink = current_sink()) {
+        // the message without its "loc: error: " prefix, which to_string() writes again
+        std::string text = error.what();
+        std::string prefix = located(error.loc(), "error", "");
+        sink->report(Severity::error, error.loc(), text.starts_with(prefix) ? text.substr(prefix.size()) : text);
+    }
+    m_errors.push_back(error);
+    if (m_errors.size() >= m_limit)
+        throw_summary(" (stopped after " + std::to_string(m_limit) + ")");
+}
+
+void ErrorList::finish() const
+{
+    if (m_errors.size() == 1)
+        throw m_errors.front();
+    if (!m_errors.empty())
+        throw_summary("");
+}
+
+void ErrorList::throw_summary(const std::string& note) const
+{
+    std::string message = std::to_string(m_errors.size()) + " errors" + note + ":";
+    for (const Error& e : m_errors) {
+        message.push_back('\n');
+        message.append(e.what());
+    }
+    throw Error(FileLoc{m_file, 0, 0}, message);
+}
 
 // A silenced default drops warnings instead of remembering them, so a warning first met
 // while silenced is still printed the next time once warnings are back on.

@@ -49,7 +49,9 @@ struct Diagnostic {
 
 /// Where the diagnostics of one run (a load, a render, a command) go: kept in order, each
 /// distinct text once per sink (a second run with its own sink hears the same warning
-/// again), and printed to stderr as they come unless quiet. Thread-safe.
+/// again), and warnings printed to stderr as they come unless quiet. Errors are kept but
+/// not printed: they reach the user in the Error that ends the run (see ErrorList).
+/// Thread-safe.
 /// A library user or a test makes one, installs it with ScopedDiagnostics, and reads
 /// collected() or count() afterwards.
 class Diagnostics {
@@ -95,6 +97,29 @@ private:
 /// Reports "loc: warning: message" to the installed sink (see ScopedDiagnostics).
 void warn(const FileLoc& loc, const std::string& message);
 void warn(const std::string& message);
+
+/// The errors of one input file, so that a reader can go on after an error (at the next
+/// production, the next line) and report several before failing. Each added error goes
+/// to the installed sink (Severity::error, with its location); finish() then throws one
+/// Error: the error itself when there was one, else "FILE: error: N errors:" followed by
+/// each, one a line. The `limit`-th error throws at once (a file of garbage stops early).
+class ErrorList {
+public:
+    static constexpr std::size_t default_limit = 20;
+    explicit ErrorList(std::string file, std::size_t limit = default_limit);
+
+    void add(const Error& error);
+    std::size_t size() const { return m_errors.size(); }
+    /// Throws when any error was added; returns otherwise.
+    void finish() const;
+
+private:
+    [[noreturn]] void throw_summary(const std::string& note) const;
+
+    std::string m_file;
+    std::size_t m_limit;
+    std::vector<Error> m_errors;
+};
 
 /// Silences (drops what would reach it) or restores the process-wide default sink; an
 /// installed sink is not affected.

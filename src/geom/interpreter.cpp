@@ -14,6 +14,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "geom/label.h"
+#include "geom/object_instancing.h"
 #include "geom/patch.h"
 #include "geom/polygon.h"
 #include "geom/query.h"
@@ -38,126 +40,6 @@ std::vector<TurtleOp> symbol_ops(const lsys::SymbolTable& symbols)
 #include "geom/turtle_symbols.def"
 #undef X
     return ops;
-}
-
-/// Whether `format` is text around exactly one printf conversion of a double: flags,
-/// width and precision of at most two digits each, conversion e E f F g G (an `l` may
-/// precede it, as in cpfg's "%lg"). Anything else must not reach snprintf.
-bool is_float_format(const std::string& format)
-{
-    std::size_t percent = format.find('%');
-    if (percent == std::string::npos || format.find('%', percent + 1) != std::string::npos)
-        return false;
-    std::size_t i = format.find_first_not_of("-+ #0", percent + 1);
-    auto digits = [&](std::size_t& at) {
-        std::size_t start = at;
-        while (at < format.size() && at - start < 3 && format[at] >= '0' && format[at] <= '9')
-            ++at;
-        return at - start <= 2;
-    };
-    if (i == std::string::npos || !digits(i))
-        return false;
-    if (i < format.size() && format[i] == '.' && !digits(++i))
-        return false;
-    if (i < format.size() && format[i] == 'l')
-        ++i;
-    return i < format.size() && std::string_view("eEfFgG").find(format[i]) != std::string_view::npos;
-}
-
-/// The sizes of every array of a Geometry, to cut it back to them.
-struct GeometrySizes {
-    explicit GeometrySizes(const Geometry& g)
-        : line_keys(g.lines.keys.size()), line_v(g.lines.v.size()), line_segments(g.lines.segments.size()),
-          curve_points(g.curves.points.size()), curve_v(g.curves.v.size()),
-          curve_segments(g.curves.segments.size()), spheres(g.spheres.centres.size()),
-          sphere_textures(g.spheres.texture.size()), discs(g.discs.centres.size()),
-          positions(g.mesh.positions.size()), uvs(g.mesh.uvs.size()), triangles(g.mesh.triangles.size()),
-          mesh_textures(g.mesh.texture.size())
-    {
-    }
-
-    void truncate(Geometry& g) const
-    {
-        auto cut = [](auto& v, std::size_t n) {
-            if (v.size() > n)
-                v.resize(n);
-        };
-        LinearCurves& l = g.lines;
-        cut(l.keys, line_keys), cut(l.v, line_v), cut(l.segments, line_segments), cut(l.flags, line_segments);
-        cut(l.material, line_segments), cut(l.texture, line_segments);
-        HermiteCurves& c = g.curves;
-        cut(c.points, curve_points), cut(c.tangents, curve_points), cut(c.v, curve_v);
-        cut(c.segments, curve_segments), cut(c.flags, curve_segments), cut(c.material, curve_segments);
-        cut(c.texture, curve_segments), cut(c.end_material, curve_segments);
-        cut(g.spheres.centres, spheres), cut(g.spheres.material, spheres), cut(g.spheres.texture, sphere_textures);
-        cut(g.discs.centres, discs), cut(g.discs.normals, discs), cut(g.discs.material, discs);
-        cut(g.discs.back_material, discs);
-        TriangleMesh& m = g.mesh;
-        cut(m.positions, positions), cut(m.normals, positions), cut(m.uvs, uvs), cut(m.triangles, triangles);
-        cut(m.material, triangles), cut(m.back_material, triangles), cut(m.texture, mesh_textures);
-    }
-
-    std::size_t line_keys, line_v, line_segments, curve_points, curve_v, curve_segments, spheres,
-        sphere_textures, discs, positions, uvs, triangles, mesh_textures;
-};
-
-Float3 place_point(const std::array<float, 12>& m, const Float3& p)
-{
-    return {m[0] * p[0] + m[3] * p[1] + m[6] * p[2] + m[9], m[1] * p[0] + m[4] * p[1] + m[7] * p[2] + m[10],
-            m[2] * p[0] + m[5] * p[1] + m[8] * p[2] + m[11]};
-}
-
-/// A normal under the placement: by the inverse transpose of its 3x3 part (the
-/// cofactor matrix over the determinant, of which only the sign matters), normalised.
-Float3 place_normal(const std::array<float, 12>& m, const Float3& n)
-{
-    Vec3 x{m[0], m[1], m[2]}, y{m[3], m[4], m[5]}, z{m[6], m[7], m[8]};
-    Vec3 r = cross(y, z) * n[0] + cross(z, x) * n[1] + cross(x, y) * n[2];
-    if (dot(x, cross(y, z)) < 0)
-        r = r * -1.0;
-    double len = std::sqrt(dot(r, r));
-    if (len == 0)
-        return n;
-    return {static_cast<float>(r.x / len), static_cast<float>(r.y / len), static_cast<float>(r.z / len)};
-}
-
-/// Appends a prototype's triangles placed by an instance (transform, materials in place
-/// of inherit_material, texture for untextured triangles): a `~x` surface inside an
-/// `-o>` object becomes part of the object's own geometry, since the renderer's
-/// instances are one level deep. Surfaces are triangle meshes only.
-void append_placed_mesh(TriangleMesh& into, const TriangleMesh& from, const Instance& instance)
-{
-    auto base = static_cast<std::uint32_t>(into.positions.size());
-    for (std::size_t i = 0; i < from.positions.size(); ++i) {
-        into.positions.push_back(place_point(instance.transform, from.positions[i]));
-        into.normals.push_back(i < from.normals.size() ? place_normal(instance.transform, from.normals[i])
-                                                       : Float3{0, 0, 0});
-        into.uvs.push_back(i < from.uvs.size() ? from.uvs[i] : Float2{0, 0});
-    }
-    auto pick = [](std::uint16_t own, std::uint16_t inherited) {
-        return own == inherit_material ? inherited : own;
-    };
-    for (std::size_t t = 0; t < from.triangles.size(); ++t) {
-        const auto& tri = from.triangles[t];
-        into.triangles.push_back({base + tri[0], base + tri[1], base + tri[2]});
-        std::uint16_t front = t < from.material.size() ? from.material[t] : inherit_material;
-        std::uint16_t back = t < from.back_material.size() ? from.back_material[t] : front;
-        into.material.push_back(pick(front, instance.material));
-        into.back_material.push_back(pick(back, instance.back_material));
-        std::int16_t texture = t < from.texture.size() ? from.texture[t] : no_texture;
-        into.texture.push_back(texture == no_texture ? instance.texture : texture);
-    }
-}
-
-/// The placement of an object built in the turtle's starting frame (H = +y, L = -x,
-/// U = -z at the origin): its x axis goes to -L, y to H, z to -U, the origin to the
-/// turtle. No scale: the object was built with the first occurrence's turtle scale
-/// (cpfg's rayshade output prints the same transformation).
-std::array<float, 12> object_transform(const Turtle& t)
-{
-    auto f = [](double v) { return static_cast<float>(v); };
-    return {f(-t.left.x), f(-t.left.y), f(-t.left.z), f(t.heading.x), f(t.heading.y), f(t.heading.z),
-            f(-t.up.x),   f(-t.up.y),   f(-t.up.z),   f(t.position.x), f(t.position.y), f(t.position.z)};
 }
 
 /// One pass of the turtle over the string, cpfg's interpret.c semantics.
@@ -245,11 +127,12 @@ public:
         m_scene.line_radius_in_pixels = view.line_style == LineStyle::pixel;
         m_scene.view = view.view;
         m_scene.lights = effective_lights(view);
+        m_scene.label_font = label_font(view);
         m_scene.bounds.extend(Vec3{0, 0, 0});  // cpfg's box always holds the origin
         if (m_root == this) {
             load_surfaces();
-            m_keying = object_keying(view);
-            m_instancing = options.is_object && options.expand_object;
+            if (options.is_object && options.expand_object)
+                m_objects = std::make_unique<ObjectInstancer>(view, options.expand_object);
         }
     }
 
@@ -350,10 +233,7 @@ private:
     {
         const SymbolTables& t = *m_tables;
         if (top && !t.objects.empty() && t.objects[m.symbol]) {
-            if (m_instancing)
-                place_object(m);
-            else
-                interpret_expansion(*expansion(m));
+            place_object(m);
         } else if (int slot = t.surfaces[m.symbol]; slot != not_a_surface) {
             draw_surface(slot, t.symbols->name(m.symbol)[1], m.params);
         } else {
@@ -366,78 +246,27 @@ private:
         expansion.for_each([&](lsys::ModuleRef x) { interpret_module(x, false); });
     }
 
-    /// The homomorphism successor of an object module, kept per exact module (the hook
-    /// depends on the module only) up to a bounded number of modules.
-    std::shared_ptr<const lsys::ModuleString> expansion(lsys::ModuleRef m)
-    {
-        std::string exact(reinterpret_cast<const char*>(&m.symbol), sizeof m.symbol);
-        exact.append(reinterpret_cast<const char*>(m.params.data()), m.params.size_bytes());
-        if (auto it = m_expansions.find(exact); it != m_expansions.end())
-            return it->second;
-        auto e = std::make_shared<const lsys::ModuleString>(m_options.expand_object(m));
-        if (m_cached_modules + e->size() > max_cached_expansion_modules) {
-            m_expansions.clear();
-            m_cached_modules = 0;
-        }
-        m_cached_modules += e->size() + 1;
-        m_expansions.emplace(std::move(exact), e);
-        return e;
-    }
-
     /// An object module (manual 8.1): an instance of its prototype at the turtle, then
     /// the turtle goes through the expansion as cpfg's rayshade output does ("has to go
     /// through geometry to set turtle properly").
     void place_object(lsys::ModuleRef m)
     {
-        std::shared_ptr<const lsys::ModuleString> e = expansion(m);
-        int prototype = object_prototype(m, *e);
+        std::shared_ptr<const lsys::ModuleString> e = m_objects->expansion(m);
+        // the prototype is built in the turtle's starting frame with this occurrence's
+        // width, scale, colours and texture
+        auto build = [&] {
+            Interpreter builder(m_view, m_options, this);
+            builder.carry(m_turtle);
+            builder.run(*e, *m_tables->symbols);
+            return std::move(builder.take().geometry);
+        };
+        int prototype = m_objects->prototype(m_objects->key(m_tables->symbols->name(m.symbol), m, m_turtle),
+                                             m_scene, build);
         if (prototype >= 0)
             m_scene.instances.push_back(Instance{static_cast<std::uint32_t>(prototype), object_transform(m_turtle),
                                                  material(m_turtle.color), material(m_turtle.back_color),
                                                  no_texture});  // a texture would reach untextured parts
         advance(*e);
-    }
-
-    /// The key cpfg's hash table compares: the module's name and its parameters printed
-    /// with the `rayshade objects:` format, and with `turtle considered` the turtle's
-    /// line width, scale, colours and texture.
-    std::string object_key(lsys::ModuleRef m) const
-    {
-        std::string key = std::string(m_tables->symbols->name(m.symbol));
-        char buffer[512];
-        for (float p : m.params) {
-            std::snprintf(buffer, sizeof buffer, m_keying.format.c_str(), static_cast<double>(p));
-            key += '_';
-            key += buffer;
-        }
-        if (m_keying.turtle_considered) {
-            const Turtle& t = m_turtle;
-            std::snprintf(buffer, sizeof buffer, "|%a|%a|%d|%d|%d", t.line_width, t.scale, t.color,
-                          t.back_color, t.texture);
-            key += buffer;
-        }
-        return key;
-    }
-
-    /// The prototype of an object key, built the first time from this occurrence's
-    /// expansion in the turtle's starting frame with the current width, scale, colours
-    /// and texture (cpfg's stage 2); -1 when it draws nothing.
-    int object_prototype(lsys::ModuleRef m, const lsys::ModuleString& e)
-    {
-        std::string key = object_key(m);
-        if (auto it = m_object_prototypes.find(key); it != m_object_prototypes.end())
-            return it->second;
-        Interpreter builder(m_view, m_options, this);
-        builder.carry(m_turtle);
-        builder.run(e, *m_tables->symbols);
-        Scene built = builder.take();
-        int index = -1;
-        if (!built.geometry.empty()) {
-            index = static_cast<int>(m_scene.prototypes.size());
-            m_scene.prototypes.push_back(Prototype{key, std::move(built.geometry)});
-        }
-        m_object_prototypes.emplace(std::move(key), index);
-        return index;
     }
 
     /// A prototype's builder starts with the placing turtle's drawing state.
@@ -456,29 +285,17 @@ private:
     /// is cut away again.
     void advance(const lsys::ModuleString& e)
     {
-        GeometrySizes before(m_scene.geometry);
-        const Geometry& g = m_scene.geometry;
-        std::optional<std::uint8_t> line_flag, curve_flag;
-        if (!g.lines.flags.empty())
-            line_flag = g.lines.flags.back();
-        if (!g.curves.flags.empty())
-            curve_flag = g.curves.flags.back();
+        GeometryCheckpoint before(m_scene.geometry);
         std::size_t instances = m_scene.instances.size();
         m_polygon_floor = m_polygons.size();
         m_advancing = true;
         interpret_expansion(e);
         m_advancing = false;
-        bool drew_lines = m_scene.geometry.lines.keys.size() != before.line_keys;
-        before.truncate(m_scene.geometry);
-        if (line_flag)
-            m_scene.geometry.lines.flags.back() = *line_flag;  // no longer continued
-        if (curve_flag)
-            m_scene.geometry.curves.flags.back() = *curve_flag;
-        m_scene.instances.resize(instances);
-        if (drew_lines) {
+        if (before.restore(m_scene.geometry)) {
             m_chain_open = false;  // the last key was the object's
             m_taper_open = false;
         }
+        m_scene.instances.resize(instances);
         for (const std::vector<PolygonCorner>& p : m_outer_polygons)
             emit_polygon(p);
         m_outer_polygons.clear();
@@ -954,60 +771,19 @@ private:
         m_options.system_call(m_options.strings[static_cast<std::size_t>(p[0])]);
     }
 
-    /// `@L(text [, values...])`: a label; the text's printf conversions take the values.
+    /// `@L(text [, values...])`: a label at the turtle in its colour.
     void add_label(std::span<const float> p)
     {
         Label label;
         label.position = m_turtle.position;
         label.material = material(m_turtle.color);
-        std::optional<int> string = p.empty() ? std::nullopt : whole_number(p[0]);
-        if (string && *string >= 0 && static_cast<std::size_t>(*string) < m_options.strings.size())
-            label.text = format_label(m_options.strings[static_cast<std::size_t>(*string)], p.subspan(1));
+        if (std::optional<std::string> text = label_text(p, m_options.strings))
+            label.text = std::move(*text);
         else if (!m_options.strings.empty() || !p.empty())
             warn_once(m_warned_label, "@L without a known string: label text left empty");
         m_scene.labels.push_back(std::move(label));
     }
 
-    /// Replaces each printf conversion (%g %f %d %e...) with the next value.
-    static std::string format_label(const std::string& format, std::span<const float> values)
-    {
-        std::string out;
-        std::size_t next = 0;
-        for (std::size_t i = 0; i < format.size(); ++i) {
-            if (format[i] != '%' || i + 1 >= format.size()) {
-                out += format[i];
-                continue;
-            }
-            if (format[i + 1] == '%') {
-                out += '%';
-                ++i;
-                continue;
-            }
-            // only flags, width and precision may stand between '%' and the conversion
-            std::size_t end = format.find_first_not_of("-+ #0123456789.", i + 1);
-            if (end == std::string::npos || end - i > 12 ||
-                std::string_view("diouxXeEfFgG").find(format[end]) == std::string_view::npos) {
-                out += format[i];
-                continue;
-            }
-            std::string spec = format.substr(i, end - i + 1);
-            double value = next < values.size() ? static_cast<double>(values[next++]) : 0.0;
-            char buffer[128];
-            char conversion = format[end];
-            // an integer conversion of a value no long long holds prints it as %g
-            bool integral = std::abs(value) < 9e18;
-            if (std::string_view("diouxX").find(conversion) != std::string_view::npos && integral)
-                std::snprintf(buffer, sizeof buffer, (spec.substr(0, spec.size() - 1) + "lld").c_str(),
-                              static_cast<long long>(value));
-            else if (!integral)
-                std::snprintf(buffer, sizeof buffer, (spec.substr(0, spec.size() - 1) + "g").c_str(), value);
-            else
-                std::snprintf(buffer, sizeof buffer, spec.c_str(), value);
-            out += buffer;
-            i = end;
-        }
-        return out;
-    }
 
     /// `?P` `?H` `?L` `?U`: the first two or three parameters get the vector.
     void answer_query(std::span<const float> p, const Vec3& v)
@@ -1191,8 +967,6 @@ private:
     static constexpr std::size_t max_polygon_vertices = 10'000'000;
     static constexpr std::size_t max_sub_lsystem_depth = 100'000;
 
-    static constexpr std::size_t max_cached_expansion_modules = 4'000'000;
-
     const ViewFile& m_view;
     InterpretOptions m_options;
     Interpreter* m_root;  ///< this, or the interpreter whose object this one builds
@@ -1212,12 +986,7 @@ private:
     std::vector<SurfacePrototypes> m_surface_prototypes;  ///< per surface
     LsystemPatches m_patches;
     std::shared_ptr<const SymbolTables> m_tables;
-    // `-o>` objects (root only)
-    ObjectKeying m_keying;
-    bool m_instancing = false;
-    std::unordered_map<std::string, int> m_object_prototypes;  ///< key -> prototype, -1: empty
-    std::unordered_map<std::string, std::shared_ptr<const lsys::ModuleString>> m_expansions;
-    std::size_t m_cached_modules = 0;
+    std::unique_ptr<ObjectInstancer> m_objects;  ///< `-o>` objects (root, with object hooks)
     bool m_advancing = false;              ///< inside advance(): geometry is cut afterwards
     std::size_t m_polygon_floor = 0;       ///< polygons below this index began before the object
     std::vector<std::vector<PolygonCorner>> m_outer_polygons;
@@ -1235,29 +1004,6 @@ private:
 };
 
 }  // namespace
-
-ObjectKeying object_keying(const ViewFile& view)
-{
-    ObjectKeying keying;
-    for (const ViewCommand& c : view.deferred) {
-        if (c.name != "rayshade objects")
-            continue;
-        // cpfg's rsReadViewCommand: tokens split at blanks and colons
-        std::string text = c.value;
-        std::replace(text.begin(), text.end(), ':', ' ');
-        std::istringstream in(text);
-        std::string format, word, flag;
-        if (!(in >> format))
-            continue;
-        if (is_float_format(format))
-            keying.format = format;
-        else
-            warn(c.loc, "rayshade objects: '" + format + "' is not a printf format of one number; using %g");
-        if (in >> word >> flag && word == "turtle" && flag.starts_with("considered"))
-            keying.turtle_considered = true;
-    }
-    return keying;
-}
 
 std::vector<Light> effective_lights(const ViewFile& view)
 {

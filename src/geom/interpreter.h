@@ -47,15 +47,6 @@ struct InterpretOptions {
     std::function<void(const std::string&)> system_call;
 };
 
-/// The view file's `rayshade objects: FORMAT [turtle considered]` (cpfg's
-/// rsReadViewCommand). A format that is not one printf conversion of a float (with
-/// flags, width, precision, text around it) is replaced by %g with a warning.
-struct ObjectKeying {
-    std::string format = "%g";
-    bool turtle_considered = false;
-};
-ObjectKeying object_keying(const ViewFile& view);
-
 Scene interpret(const lsys::ModuleString& string, const lsys::SymbolTable& symbols,
                 const ViewFile& view, const InterpretOptions& options);
 

@@ -191,11 +191,21 @@ struct View {
     std::optional<double> front_distance, back_distance;
 };
 
-/// `@L` text, kept for tools; the renderer ignores it.
+/// `@L` text at the turtle position, in the colour of `material` (render/labels.h).
 struct Label {
     std::string text;
     Vec3 position;
     std::uint16_t material = 0;
+};
+
+/// The font labels are drawn in, from the view file's `font:` (an X font name) or
+/// `winfont:` (name, size in pixels, flags): a fontconfig family name, a size in pixels
+/// and the style. The default is cpfg's, `-*-courier-bold-r-*-12-*`.
+struct LabelFont {
+    std::string family = "courier";
+    int pixel_size = 12;
+    bool bold = true;
+    bool italic = false;
 };
 
 /// `render mode:` (manual 5.2) read by a path tracer: shaded (lit with smooth normals),
@@ -209,6 +219,7 @@ struct Scene {
     std::vector<Prototype> prototypes;
     std::vector<Instance> instances;
     std::vector<Label> labels;
+    LabelFont label_font;
 
     /// true when line radii are in pixels (`line style: pixel`): render converts
     /// them with its camera's pixel footprint.

@@ -407,11 +407,37 @@ bool is_applied(const std::string& name)
     return std::find(applied.begin(), applied.end(), name) != applied.end();
 }
 
+/// One `name: values` line of a view file into `v` (`line_loc`: the line, column 0;
+/// `loc`: its first character).
+void parse_command(ViewFile& v, std::string_view body, std::size_t colon, const FileLoc& line_loc,
+                   const FileLoc& loc)
+{
+    std::string name = normalize_command_name(body.substr(0, colon));
+    ValueReader in(body, colon + 1, line_loc);
+    if (name == "texture") {
+        parse_texture(v, body, colon + 1, line_loc);
+    } else if (is_applied(name)) {
+        int column = 0;
+        if (keeps_default_without_number(name) && starts_without_number(body, colon + 1, column)) {
+            warn(FileLoc{line_loc.file, line_loc.line, column},
+                 "'" + name + ":' needs a number; the default is kept");
+            return;
+        }
+        apply_command(v, name, in);
+    } else if (std::find(deferred_commands.begin(), deferred_commands.end(), name) !=
+               deferred_commands.end()) {
+        v.deferred.push_back({name, std::string(body.substr(colon + 1)), loc});
+    } else {
+        warn(loc, "unknown view-file command '" + name + ":' ignored");
+    }
+}
+
 }  // namespace
 
 ViewFile parse_view_file(std::string_view text, const std::string& file_name)
 {
     ViewFile v;
+    ErrorList errors(file_name);
     std::vector<SourceLine> lines = split_lines_without_comments(text);
     for (const SourceLine& line : lines) {
         std::string_view body = line.text;
@@ -424,25 +450,13 @@ ViewFile parse_view_file(std::string_view text, const std::string& file_name)
             warn(loc, "view-file line without ':' ignored");
             continue;
         }
-        std::string name = normalize_command_name(body.substr(0, colon));
-        ValueReader in(body, colon + 1, FileLoc{file_name, line.number, 0});
-        if (name == "texture") {
-            parse_texture(v, body, colon + 1, FileLoc{file_name, line.number, 0});
-        } else if (is_applied(name)) {
-            int column = 0;
-            if (keeps_default_without_number(name) && starts_without_number(body, colon + 1, column)) {
-                warn(FileLoc{file_name, line.number, column},
-                     "'" + name + ":' needs a number; the default is kept");
-                continue;
-            }
-            apply_command(v, name, in);
-        } else if (std::find(deferred_commands.begin(), deferred_commands.end(), name) !=
-                   deferred_commands.end()) {
-            v.deferred.push_back({name, std::string(body.substr(colon + 1)), loc});
-        } else {
-            warn(loc, "unknown view-file command '" + name + ":' ignored");
+        try {
+            parse_command(v, body, colon, FileLoc{file_name, line.number, 0}, loc);
+        } catch (const Error& e) {
+            errors.add(e);  // and on to the next line
         }
     }
+    errors.finish();
     return v;
 }
 

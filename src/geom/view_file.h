@@ -82,7 +82,9 @@ struct ViewFile {
 };
 
 /// Reads a view file. Unknown commands are a warning naming file and line (as in
-/// cpfg); malformed values of known commands are an Error naming line and column.
+/// cpfg); malformed values of known commands are errors naming line and column, each
+/// reported (ErrorList) and the reading going on at the next line, thrown together
+/// at the end.
 ViewFile read_view_file(const std::filesystem::path& file);
 
 /// The same from text (tests); `file_name` is used in messages.

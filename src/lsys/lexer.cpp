@@ -349,6 +349,13 @@ Token Lexer::peek(LexMode mode)
     return t;
 }
 
+void Lexer::skip_rest_of_line()
+{
+    m_state.brace_depth = 0;
+    while (m_state.pos < m_text.size() && !(at() == '\n' && at(1) != '\t'))
+        advance();
+}
+
 std::string Lexer::rest_of_line()
 {
     std::string out;

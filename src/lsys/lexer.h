@@ -53,6 +53,11 @@ public:
     /// The rest of the current line, raw (for `lsystem:` labels), consuming it.
     std::string rest_of_line();
     FileLoc loc() const { return FileLoc{m_state.file, m_state.line, m_state.column}; }
+    /// Error recovery: skips to the newline that ends the current line (its tab-continued
+    /// lines and any open braces included), which is then read as an Eol token.
+    void skip_rest_of_line();
+    /// Whether the last token read ended a line (nothing of the next line read yet).
+    bool at_line_start() const { return m_state.at_line_start; }
     /// The read position in the text, and the raw text between two positions (the
     /// source of a production, quoted in runtime errors).
     std::size_t offset() const { return m_state.pos; }

@@ -77,7 +77,7 @@ Scope global_scope()
 class Parser {
 public:
     Parser(std::string_view text, const std::string& file_name, Program& program)
-        : m_lexer(text, file_name), m_program(program)
+        : m_lexer(text, file_name), m_program(program), m_errors(file_name)
     {
     }
     void parse_file();
@@ -93,6 +93,9 @@ private:
     bool at_keyword(const char* keyword);
     void expect_eol(const char* after);
     void skip_blank_lines();
+    /// After an error in a production or a one-line item that began at `start`: on to
+    /// the next line (at least one line on), with no scope open.
+    void recover(std::size_t start);
 
     // --- L-system structure (Appendix A) ---
     void parse_lsystem();
@@ -179,6 +182,7 @@ private:
     std::set<std::string> m_warned;    ///< undefined names already reported
     int m_nesting = 0;        ///< expressions being parsed inside each other
     int m_block_nesting = 0;  ///< blocks being parsed inside each other
+    ErrorList m_errors;       ///< errors recovered from, thrown together at the end
 };
 
 /// The source of a production on one line: line markers and comments dropped, blanks
@@ -282,13 +286,25 @@ void Parser::skip_blank_lines()
 
 // ---------------------------------------------------------------- structure
 
+void Parser::recover(std::size_t start)
+{
+    m_scope = nullptr;
+    if (m_lexer.offset() == start || !m_lexer.at_line_start())
+        m_lexer.skip_rest_of_line();
+}
+
 void Parser::parse_file()
 {
-    skip_blank_lines();
-    while (peek(LexMode::Module).kind != TokenKind::End) {
-        parse_lsystem();
+    try {
         skip_blank_lines();
+        while (peek(LexMode::Module).kind != TokenKind::End) {
+            parse_lsystem();
+            skip_blank_lines();
+        }
+    } catch (const Error& e) {
+        m_errors.add(e);  // one the parser cannot go on after
     }
+    m_errors.finish();
     if (m_program.lsystems.empty())
         throw Error(FileLoc{m_program.file_name, 0, 0}, "no 'lsystem:' found");
 }
@@ -301,9 +317,29 @@ void Parser::parse_lsystem()
     LSystemDefinition ls;
     ls.loc = label.loc;
     parse_label(ls);
-    while (parse_item(ls)) {
+    for (bool more = true; more;) {
+        std::size_t start = m_lexer.offset();
+        Token item;
+        try {
+            item = peek(LexMode::Module);
+            more = parse_item(ls);
+        } catch (const Error& e) {
+            // blocks ({...} over several lines) are not recovered from
+            static const std::set<std::string> blocks = {"define:", "start:", "end:", "start each:",
+                                                         "end each:"};
+            if (item.kind == TokenKind::Keyword && blocks.contains(item.text))
+                throw;
+            m_errors.add(e);
+            recover(start);
+        }
     }
-    parse_axiom(ls);
+    std::size_t axiom_start = m_lexer.offset();
+    try {
+        parse_axiom(ls);
+    } catch (const Error& e) {
+        m_errors.add(e);
+        recover(axiom_start);
+    }
     parse_productions(ls.productions);
     if (at_keyword("decomposition"))
         parse_decomposition(ls);
@@ -529,14 +565,20 @@ void Parser::parse_homomorphism(LSystemDefinition& ls)
 void Parser::parse_productions(ProductionSet& set)
 {
     for (;;) {
-        Token t = peek(LexMode::Module);
-        if (t.kind == TokenKind::Eol) {
-            next(LexMode::Module);
-            continue;
+        std::size_t start = m_lexer.offset();
+        try {
+            Token t = peek(LexMode::Module);
+            if (t.kind == TokenKind::Eol) {
+                next(LexMode::Module);
+                continue;
+            }
+            if (t.kind == TokenKind::Keyword || t.kind == TokenKind::End)
+                return;
+            parse_production(set);
+        } catch (const Error& e) {
+            m_errors.add(e);  // and on to the next production
+            recover(start);
         }
-        if (t.kind == TokenKind::Keyword || t.kind == TokenKind::End)
-            return;
-        parse_production(set);
     }
 }
 

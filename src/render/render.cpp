@@ -28,6 +28,7 @@
 #include "render/accel.h"
 #include "render/color.h"
 #include "render/integrator.h"
+#include "render/labels.h"
 #include "render/texture.h"
 
 namespace cambium::render {
@@ -642,6 +643,9 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         for (const PixelState& st : pixels)
             rep.samples += st.samples;
         Image image = resolve(pixels, region, out_rect, settings);
+        // Labels over the image, as cpfg's window draws them (on the crop's pixels).
+        draw_labels(image, scene, camera, *accel,
+                    LabelCanvas{out_rect.x, out_rect.y, settings.width, settings.height});
         rep.seconds = elapsed();
         if (!on_view(view, image, rep) || rep.cancelled)
             break;

@@ -9,20 +9,12 @@
 #include <sys/stat.h>
 
 #include "geom/background_scene.h"
+#include "test_util.h"
 
 using namespace cambium;
 using namespace cambium::geom;
 
 namespace {
-
-Vec3 v3(const Float3& f) { return {f[0], f[1], f[2]}; }
-
-void expect_near(const Vec3& a, const Vec3& b, double eps)
-{
-    EXPECT_NEAR(a.x, b.x, eps);
-    EXPECT_NEAR(a.y, b.y, eps);
-    EXPECT_NEAR(a.z, b.z, eps);
-}
 
 BackgroundScene build(const std::string& text, const Material& initial = Material{})
 {

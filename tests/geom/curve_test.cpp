@@ -17,24 +17,12 @@
 #include "geom/view_file.h"
 #include "lsys/lsystem.h"
 #include "lsys/module_string.h"
+#include "test_util.h"
 
 using namespace cambium;
 using namespace cambium::geom;
 
 namespace {
-
-std::filesystem::path corpus()
-{
-    const char* env = std::getenv("CAMBIUM_CORPUS");
-    return env ? env : CAMBIUM_CORPUS_DEFAULT;
-}
-
-std::filesystem::path temp_dir()
-{
-    auto dir = std::filesystem::temp_directory_path() / ("cambium_curve_test_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
-    return dir;
-}
 
 /// A curve file of the editor's format with the given type and "x y z m" lines.
 std::string curve_text(const std::string& type, const std::string& points, int count)
@@ -52,13 +40,6 @@ SpaceCurve make(Kind kind, std::vector<Vec3> points, int samples = 100)
     for (const Vec3& p : points)
         cps.push_back({p, 1});
     return SpaceCurve(cps, kind, samples);
-}
-
-void expect_near(const Vec3& a, const Vec3& b, double tolerance)
-{
-    EXPECT_NEAR(a.x, b.x, tolerance);
-    EXPECT_NEAR(a.y, b.y, tolerance);
-    EXPECT_NEAR(a.z, b.z, tolerance);
 }
 
 }  // namespace
@@ -231,7 +212,7 @@ TEST(CurveFile, ContourFilesAreReadAsSplines)
 
 TEST(CurveSet, ViewCommandsGiveIdsFromOneAndSamples)
 {
-    std::filesystem::path dir = temp_dir();
+    std::filesystem::path dir = temp_dir("curve_test");
     std::ofstream(dir / "line.crv") << curve_text("bspline", "0 0 0 1\n1 0 0 1\n2 0 0 1\n3 0 0 1\n4 0 0 1\n", 5);
     std::ofstream(dir / "up.crv") << curve_text("bspline", "0 0 0 1\n0 1 0 1\n0 2 0 1\n0 3 0 1\n", 4);
     std::vector<ViewCommand> commands = {
@@ -255,7 +236,7 @@ TEST(CurveSet, SamplesSetTheLengthTable)
 {
     // A quarter circle-like arc: the tabulated length grows with the samples (a finer
     // polyline is longer), as cpfg's curveGAL does.
-    std::filesystem::path dir = temp_dir();
+    std::filesystem::path dir = temp_dir("curve_test");
     std::ofstream(dir / "arc.crv") << curve_text("bspline", "0 0 0 3\n0 1 0 1\n1 1 0 3\n", 3);
     CurveSet coarse = CurveSet::from_view_commands({{"curve", " arc.crv 3", FileLoc{}}}, dir);
     CurveSet fine = CurveSet::from_view_commands({{"curve", " arc.crv 1000", FileLoc{}}}, dir);

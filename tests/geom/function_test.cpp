@@ -7,17 +7,12 @@
 #include <fstream>
 
 #include "geom/function.h"
+#include "test_util.h"
 
 using namespace cambium;
 using namespace cambium::geom;
 
 namespace {
-
-std::filesystem::path corpus()
-{
-    const char* env = std::getenv("CAMBIUM_CORPUS");
-    return env ? env : CAMBIUM_CORPUS_DEFAULT;
-}
 
 // With 4 points the clamped B-spline is a Bézier curve.
 const char* line_2x_plus_1 = "range: 0.0 1.0\npoints: 4\n0 1\n0.333333 1.666667\n0.666667 2.333333\n1 3\n";

@@ -12,7 +12,7 @@
 
 #include "geom/gencyl.h"
 #include "geom/interpreter.h"
-#include "module_text.h"
+#include "test_util.h"
 #include "geom/turtle.h"
 #include "geom/view_volume.h"
 #include "lsys/string_io.h"
@@ -22,18 +22,11 @@ using namespace cambium::geom;
 
 namespace {
 
-std::filesystem::path temp_dir()
-{
-    auto dir = std::filesystem::temp_directory_path() / ("cambium_gc_test_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir);
-    return dir;
-}
-
 Scene run(const std::string& text, const std::string& view_text = "line style: cylinder\n")
 {
     lsys::SymbolTable symbols;
     lsys::ModuleString s = text_modules(symbols, text);
-    std::filesystem::path dir = temp_dir();
+    std::filesystem::path dir = temp_dir("gc_test");
     ViewFile view = parse_view_file(view_text, (dir / "t.v").string());
     view.path = dir / "t.v";
     return interpret(s, symbols, view);
@@ -42,7 +35,7 @@ Scene run(const std::string& text, const std::string& view_text = "line style: c
 /// A view file using the square contour (corners tripled) as contour 1.
 std::string square_contour_view(const std::string& extra = "")
 {
-    std::filesystem::path dir = temp_dir();
+    std::filesystem::path dir = temp_dir("gc_test");
     std::ofstream(dir / "square.con") << "cver 1 1\nname: square\npoints: 4 12\ntype: closed\n"
                                          "1 1 0 3\n-1 1 0 3\n-1 -1 0 3\n1 -1 0 3\n";
     return "line style: cylinder\ncontour: 1 square.con\ncontour sides: 8\n" + extra;
@@ -484,7 +477,7 @@ TEST(GeneralizedCylinder, BsplineBranchesCopyTheirControlPoints)
 
 TEST(GeneralizedCylinder, ContourGalleryItemsTakeConsecutiveIds)
 {
-    std::filesystem::path dir = temp_dir();
+    std::filesystem::path dir = temp_dir("gc_test");
     std::ofstream(dir / "shapes.cset") << "contourgalleryver 1 1\nitems: 2\n"
                                           "cver 1 1\nname: square\npoints: 4 4\ntype: closed\n"
                                           "1 1 0 1\n-1 1 0 1\n-1 -1 0 1\n1 -1 0 1\n"
@@ -626,7 +619,7 @@ TEST(GencylHostileNumbers, ParametersNoIntHoldsAreIgnoredOrClampedWithAMessage)
 TEST(GencylHostileNumbers, ViewFileCountsBeyondTheirRangeAreClamped)
 {
     testing::internal::CaptureStderr();
-    std::filesystem::path dir = temp_dir();
+    std::filesystem::path dir = temp_dir("gc_test");
     ViewFile view = parse_view_file("contour sides: 1e30\npolygonization level: -1e30\n", (dir / "t.v").string());
     CylinderSettings s = cylinder_settings(view);
     std::string err = testing::internal::GetCapturedStderr();

@@ -6,19 +6,12 @@
 
 #include "base/diagnostics.h"
 #include "geom/interpreter.h"
-#include "module_text.h"
+#include "test_util.h"
 
 using namespace cambium;
 using namespace cambium::geom;
 
 namespace {
-
-Scene run(const std::string& text, const std::string& view_text)
-{
-    lsys::SymbolTable symbols;
-    lsys::ModuleString s = text_modules(symbols, text);
-    return interpret(s, symbols, parse_view_file(view_text, "t.v"));
-}
 
 std::array<float, 4> key_of(const Scene& scene, std::size_t segment, int end)
 {
@@ -29,7 +22,7 @@ std::array<float, 4> key_of(const Scene& scene, std::size_t segment, int end)
 
 TEST(Interpreter, ConnectedSegmentsShareKeysAndNeighbourFlags)
 {
-    Scene scene = run("F+F(2)", "angle increment: 90\n");
+    Scene scene = interpret_text("F+F(2)", "angle increment: 90\n");
     ASSERT_EQ(scene.geometry.lines.segment_count(), 2u);
     EXPECT_EQ(scene.geometry.lines.keys.size(), 3u);
     EXPECT_EQ(scene.geometry.lines.flags[0], LinearCurves::neighbour_right);
@@ -41,7 +34,7 @@ TEST(Interpreter, ConnectedSegmentsShareKeysAndNeighbourFlags)
 
 TEST(Interpreter, BranchReturnsToItsStartAndBreaksThePolyline)
 {
-    Scene scene = run("F[+F]F", "angle increment: 90\n");
+    Scene scene = interpret_text("F[+F]F", "angle increment: 90\n");
     ASSERT_EQ(scene.geometry.lines.segment_count(), 3u);
     // The branch continues the trunk's polyline; the segment after ']' starts anew.
     EXPECT_EQ(scene.geometry.lines.flags[1] & LinearCurves::neighbour_left, LinearCurves::neighbour_left);
@@ -55,7 +48,7 @@ TEST(Interpreter, BranchReturnsToItsStartAndBreaksThePolyline)
 
 TEST(Interpreter, MoveWithoutDrawingLeavesAGap)
 {
-    Scene scene = run("FfF", "");
+    Scene scene = interpret_text("FfF", "");
     ASSERT_EQ(scene.geometry.lines.segment_count(), 2u);
     EXPECT_NEAR(key_of(scene, 1, 0)[1], 2, 1e-6);
     EXPECT_EQ(scene.geometry.lines.flags[1], 0);
@@ -63,19 +56,19 @@ TEST(Interpreter, MoveWithoutDrawingLeavesAGap)
 
 TEST(Interpreter, WidthIsTwiceTheRadiusAndFollowsHashAndBang)
 {
-    Scene scene = run("F#F!(0.5)F", "initial line width: 2\nline width increment: 1\n");
+    Scene scene = interpret_text("F#F!(0.5)F", "initial line width: 2\nline width increment: 1\n");
     ASSERT_EQ(scene.geometry.lines.segment_count(), 3u);
     EXPECT_FLOAT_EQ(key_of(scene, 0, 0)[3], 1.0f);
     EXPECT_FLOAT_EQ(key_of(scene, 0, 1)[3], 1.5f);  // tapered: the top takes the new width
     EXPECT_FLOAT_EQ(key_of(scene, 1, 0)[3], 1.5f);
     EXPECT_FLOAT_EQ(key_of(scene, 2, 0)[3], 0.25f);
     EXPECT_FALSE(scene.line_radius_in_pixels);
-    EXPECT_TRUE(run("F", "initial line width: 3 pixels\n").line_radius_in_pixels);
+    EXPECT_TRUE(interpret_text("F", "initial line width: 3 pixels\n").line_radius_in_pixels);
 }
 
 TEST(Interpreter, UntaperedLinesKeepTheirWidthAndBreakTheJoint)
 {
-    Scene scene = run("F#F", "initial line width: 2\nline width increment: 1\ntapered lines: off\n");
+    Scene scene = interpret_text("F#F", "initial line width: 2\nline width increment: 1\ntapered lines: off\n");
     ASSERT_EQ(scene.geometry.lines.segment_count(), 2u);
     EXPECT_FLOAT_EQ(key_of(scene, 0, 1)[3], 1.0f);
     EXPECT_FLOAT_EQ(key_of(scene, 1, 0)[3], 1.5f);
@@ -84,7 +77,7 @@ TEST(Interpreter, UntaperedLinesKeepTheirWidthAndBreakTheJoint)
 
 TEST(Interpreter, WidthChangeInsideABranchDoesNotTaperTheTrunk)
 {
-    Scene scene = run("F[!(1)F]", "initial line width: 2\n");
+    Scene scene = interpret_text("F[!(1)F]", "initial line width: 2\n");
     ASSERT_EQ(scene.geometry.lines.segment_count(), 2u);
     EXPECT_FLOAT_EQ(key_of(scene, 0, 1)[3], 1.0f);
     EXPECT_FLOAT_EQ(key_of(scene, 1, 0)[3], 0.5f);
@@ -92,14 +85,14 @@ TEST(Interpreter, WidthChangeInsideABranchDoesNotTaperTheTrunk)
 
 TEST(Interpreter, ColourWrapsOnceAroundTheTable)
 {
-    Scene scene = run(";(255);F,(0),F", "color increment: 1\n");
+    Scene scene = interpret_text(";(255);F,(0),F", "color increment: 1\n");
     EXPECT_EQ(scene.geometry.lines.material[0], 0);
     EXPECT_EQ(scene.geometry.lines.material[1], 255);
 }
 
 TEST(Interpreter, ColourIndexSelectsTheMaterialOfEachSegment)
 {
-    Scene scene = run("F;F;(7)F,F", "initial color: 2\ncolor increment: 3\n");
+    Scene scene = interpret_text("F;F;(7)F,F", "initial color: 2\ncolor increment: 3\n");
     ASSERT_EQ(scene.geometry.lines.segment_count(), 4u);
     EXPECT_EQ(scene.geometry.lines.material[0], 2);
     EXPECT_EQ(scene.geometry.lines.material[1], 5);
@@ -109,7 +102,7 @@ TEST(Interpreter, ColourIndexSelectsTheMaterialOfEachSegment)
 
 TEST(Interpreter, BoundsEncloseTheDrawnPoints)
 {
-    Scene scene = run("-(90)F(3)+(90)F(2)", "");
+    Scene scene = interpret_text("-(90)F(3)+(90)F(2)", "");
     EXPECT_NEAR(scene.bounds.lo.x, 0, 1e-9);
     EXPECT_NEAR(scene.bounds.hi.x, 3, 1e-9);
     EXPECT_NEAR(scene.bounds.hi.y, 2, 1e-9);
@@ -117,27 +110,27 @@ TEST(Interpreter, BoundsEncloseTheDrawnPoints)
 
 TEST(Interpreter, BoundsHoldTheOriginAndMovesWithoutDrawing)
 {
-    Scene scene = run("f(5)F", "");
+    Scene scene = interpret_text("f(5)F", "");
     EXPECT_NEAR(scene.bounds.lo.y, 0, 1e-9);
     EXPECT_NEAR(scene.bounds.hi.y, 6, 1e-9);
 }
 
 TEST(Interpreter, DefaultLightIsCpfgsDirectionalLight)
 {
-    Scene scene = run("F", "");
+    Scene scene = interpret_text("F", "");
     ASSERT_EQ(scene.lights.size(), 1u);
     EXPECT_EQ(scene.lights[0].kind, Light::Kind::directional);
     EXPECT_NEAR(scene.lights[0].direction.x, 1, 1e-12);
-    scene = run("F", "light direction: 0,3,4\n");
+    scene = interpret_text("F", "light direction: 0,3,4\n");
     EXPECT_NEAR(scene.lights[0].direction.y, 0.6, 1e-12);
-    scene = run("F", "light: V: 1 0 0\nlight: O: 0 5 0\n");
+    scene = interpret_text("F", "light: V: 1 0 0\nlight: O: 0 5 0\n");
     EXPECT_EQ(scene.lights.size(), 2u);
 }
 
 TEST(Interpreter, UnbalancedPopIsIgnored)
 {
     set_warnings_enabled(false);
-    Scene scene = run("F]F", "");
+    Scene scene = interpret_text("F]F", "");
     set_warnings_enabled(true);
     EXPECT_EQ(scene.geometry.lines.segment_count(), 2u);
 }

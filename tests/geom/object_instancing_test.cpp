@@ -12,7 +12,9 @@
 #include <vector>
 
 #include "geom/interpreter.h"
+#include "geom/object_instancing.h"
 #include "lsys/lsystem.h"
+#include "test_util.h"
 
 using namespace cambium;
 using namespace cambium::geom;
@@ -306,21 +308,6 @@ endlsystem
 }
 
 namespace {
-
-/// A unit-square Bezier surface file (control point (i, j) at (j/3, i/3, 0)).
-std::string unit_square_surface()
-{
-    std::string s = "0 1 0 1 0 0\nCONTACT POINT X: 0 Y: 0 Z: 0\nEND POINT X: 0 Y: 1 Z: 0\n"
-                    "HEADING X: 0 Y: 1 Z: 0\nUP X: 0 Y: 0 Z: 1\nSIZE: 1\n"
-                    "square\nTOP COLOR: 0 DIFFUSE: 0.00 BOTTOM COLOR: 0 DIFFUSE: 0.00\n"
-                    "AL: ~ A: ~ AR: ~\nL: ~ R: ~\nBL: ~ B: ~ BR: ~\n";
-    for (int i = 0; i < 4; ++i) {
-        for (int j = 0; j < 4; ++j)
-            s += std::to_string(j / 3.0) + " " + std::to_string(i / 3.0) + " 0  ";
-        s += "\n";
-    }
-    return s;
-}
 
 /// Every triangle corner of a scene's instances in world space, with its material.
 std::vector<std::pair<std::array<double, 3>, int>> world_corners(const Scene& scene)

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "geom/patch.h"
+#include "test_util.h"
 
 using namespace cambium;
 using namespace cambium::geom;
@@ -17,15 +18,6 @@ PatchControl grid_with_bump()
         for (int j = 0; j < 4; ++j)
             c[static_cast<std::size_t>(4 * i + j)] = {double(j), double(i), (i == 1 && j == 2) ? 8.0 : 0.0};
     return c;
-}
-
-Vec3 v3(const Float3& f) { return {f[0], f[1], f[2]}; }
-
-void expect_near(const Vec3& a, const Vec3& b, double eps)
-{
-    EXPECT_NEAR(a.x, b.x, eps);
-    EXPECT_NEAR(a.y, b.y, eps);
-    EXPECT_NEAR(a.z, b.z, eps);
 }
 
 }  // namespace

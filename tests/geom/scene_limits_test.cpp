@@ -13,7 +13,7 @@
 #include "geom/function.h"
 #include "geom/interpreter.h"
 #include "geom/scene_limits.h"
-#include "module_text.h"
+#include "test_util.h"
 
 using namespace cambium;
 using namespace cambium::geom;
@@ -21,13 +21,6 @@ using namespace cambium::geom;
 namespace {
 
 constexpr float nan_value = std::numeric_limits<float>::quiet_NaN();
-
-Scene run(const std::string& text, const std::string& view_text = "")
-{
-    lsys::SymbolTable symbols;
-    lsys::ModuleString s = text_modules(symbols, text);
-    return interpret(s, symbols, parse_view_file(view_text, "t.v"));
-}
 
 /// The warnings drop_unrenderable prints, and what it dropped.
 std::string dropping(Scene& scene, DroppedGeometry* dropped = nullptr)
@@ -73,7 +66,7 @@ TEST(SceneLimits, WholeNumbersRefuseWhatNoIntHolds)
 TEST(SceneLimits, HugeAndNotFiniteSegmentsAreDroppedWithOneCountedWarning)
 {
     // the issue's string: F(1e38) goes far out, F(-1e38) comes back; both segments go
-    Scene scene = run("F(1e38)F(-1e38)F");
+    Scene scene = interpret_text("F(1e38)F(-1e38)F");
     scene.bounds = Bounds3{};  // (the view volume is checked separately below)
     scene.bounds.extend(Vec3{0, 0, 0});
     DroppedGeometry d;
@@ -91,7 +84,7 @@ TEST(SceneLimits, HugeAndNotFiniteSegmentsAreDroppedWithOneCountedWarning)
 
 TEST(SceneLimits, TheIssuesStringIsRefusedForItsViewVolume)
 {
-    Scene scene = run("F(1e38)F(-1e38)@c(1)");
+    Scene scene = interpret_text("F(1e38)F(-1e38)@c(1)");
     try {
         dropping(scene);
         FAIL() << "no error";
@@ -171,7 +164,7 @@ TEST(SceneLimits, InstancesThatEmbreeCouldNotInvertAreDropped)
 TEST(SceneLimits, NotANumberInModuleParametersDropsOnlyWhatItReaches)
 {
     // @O with a NaN diameter, then a good F: the sphere goes, the segment stays
-    Scene scene = run("@O(nan)F");
+    Scene scene = interpret_text("@O(nan)F");
     DroppedGeometry d;
     dropping(scene, &d);
     EXPECT_EQ(d.spheres, 1u);
@@ -181,7 +174,7 @@ TEST(SceneLimits, NotANumberInModuleParametersDropsOnlyWhatItReaches)
 
 TEST(SceneLimits, GoodScenesAreLeftAlone)
 {
-    Scene scene = run("F[+F@O(1)]F{.f.f.}");
+    Scene scene = interpret_text("F[+F@O(1)]F{.f.f.}");
     Scene copy = scene;
     DroppedGeometry d;
     std::string err = dropping(scene, &d);
@@ -197,7 +190,7 @@ TEST(SceneLimits, GoodScenesAreLeftAlone)
 TEST(HostileParameters, TextureColourAndTropismIndices)
 {
     testing::internal::CaptureStderr();
-    Scene scene = run("@Tx(1e30);(1e30)@Ts(1e30,1)F@Tx(nan);(nan),(-1e30)F", "initial color: 7\n");
+    Scene scene = interpret_text("@Tx(1e30);(1e30)@Ts(1e30,1)F@Tx(nan);(nan),(-1e30)F", "initial color: 7\n");
     std::string err = testing::internal::GetCapturedStderr();
     EXPECT_NE(err.find("@Tx(1e+30): no such texture; none used"), std::string::npos) << err;
     EXPECT_NE(err.find("colour index 1e+30 out of range in ;(n) ,(n) @;(n) @,(n) ignored"), std::string::npos)

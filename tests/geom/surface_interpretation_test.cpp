@@ -13,6 +13,7 @@
 #include "base/diagnostics.h"
 #include "geom/interpreter.h"
 #include "geom/view_file.h"
+#include "test_util.h"
 
 using namespace cambium;
 using namespace cambium::geom;
@@ -49,36 +50,12 @@ void write(const std::filesystem::path& file, const std::string& text)
     std::ofstream(file) << text;
 }
 
-/// One Bézier patch whose control point (i, j) is (j/3, i/3, 0): the unit square.
-/// Contact (0,0,0), end (0,1,0), heading +y, up +z, SIZE 1: the prototype frame equals
-/// the file's, times the view file's scale.
-std::string unit_square_surface()
-{
-    std::string s = "0 1 0 1 0 0\nCONTACT POINT X: 0 Y: 0 Z: 0\nEND POINT X: 0 Y: 1 Z: 0\n"
-                    "HEADING X: 0 Y: 1 Z: 0\nUP X: 0 Y: 0 Z: 1\nSIZE: 1\n"
-                    "square\nTOP COLOR: 0 DIFFUSE: 0.00 BOTTOM COLOR: 0 DIFFUSE: 0.00\n"
-                    "AL: ~ A: ~ AR: ~\nL: ~ R: ~\nBL: ~ B: ~ BR: ~\n";
-    for (int i = 0; i < 4; ++i) {
-        for (int j = 0; j < 4; ++j)
-            s += std::to_string(j / 3.0) + " " + std::to_string(i / 3.0) + " 0  ";
-        s += "\n";
-    }
-    return s;
-}
-
 ViewFile surface_view(const std::string& name)
 {
     auto dir = scratch(name);
     write(dir / "square.s", unit_square_surface());
     write(dir / "plant.v", "angle increment: 90\nsurface: a square.s 2\n");
     return read_view_file(dir / "plant.v");
-}
-
-void expect_near(const Vec3& a, const Vec3& b, double eps = 1e-5)
-{
-    EXPECT_NEAR(a.x, b.x, eps);
-    EXPECT_NEAR(a.y, b.y, eps);
-    EXPECT_NEAR(a.z, b.z, eps);
 }
 
 Vec3 column(const std::array<float, 12>& m, int c)

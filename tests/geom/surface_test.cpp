@@ -12,20 +12,12 @@
 #include "geom/text_input.h"
 #include "geom/tsurface.h"
 #include "geom/view_file.h"
+#include "test_util.h"
 
 using namespace cambium;
 using namespace cambium::geom;
 
 namespace {
-
-Vec3 v3(const Float3& f) { return {f[0], f[1], f[2]}; }
-
-void expect_near(const Vec3& a, const Vec3& b, double eps)
-{
-    EXPECT_NEAR(a.x, b.x, eps);
-    EXPECT_NEAR(a.y, b.y, eps);
-    EXPECT_NEAR(a.z, b.z, eps);
-}
 
 std::string neighbours(const std::string& l = "~", const std::string& r = "~")
 {
@@ -88,12 +80,6 @@ const Float3* find_vertex(const TriangleMesh& mesh, const Vec3& p, double eps, s
             return &mesh.positions[i];
         }
     return nullptr;
-}
-
-std::filesystem::path corpus()
-{
-    const char* env = std::getenv("CAMBIUM_CORPUS");
-    return env ? env : CAMBIUM_CORPUS_DEFAULT;
 }
 
 }  // namespace

@@ -10,23 +10,13 @@
 #include <vector>
 
 #include "geom/interpreter.h"
-#include "module_text.h"
+#include "test_util.h"
 #include "geom/query.h"
 
 using namespace cambium;
 using namespace cambium::geom;
 
 namespace {
-
-Scene run(const std::string& text, const std::string& view_text = "",
-          std::vector<std::string> strings = {})
-{
-    lsys::SymbolTable symbols;
-    lsys::ModuleString s = text_modules(symbols, text);
-    InterpretOptions options;
-    options.strings = strings;
-    return interpret(s, symbols, parse_view_file(view_text, "t.v"), options);
-}
 
 Vec3 end_of_last_segment(const Scene& scene)
 {
@@ -58,33 +48,33 @@ double mesh_area(const TriangleMesh& mesh)
 
 TEST(TurtleFeatures, MoveToSetsThePositionAndExtendsTheBounds)
 {
-    Scene scene = run("F @M(3,4,5) F");
+    Scene scene = interpret_text("F @M(3,4,5) F");
     ASSERT_EQ(scene.geometry.lines.segment_count(), 2u);
     expect_vec(end_of_last_segment(scene), {3, 5, 5});
     EXPECT_EQ(scene.geometry.lines.flags[1], 0);  // a new polyline
     EXPECT_DOUBLE_EQ(scene.bounds.hi.z, 5);
-    Scene two = run("@M(1,2) F");
+    Scene two = interpret_text("@M(1,2) F");
     expect_vec(end_of_last_segment(two), {1, 3, 0});
 }
 
 TEST(TurtleFeatures, SetHeadingDrawsAlongTheGivenVector)
 {
-    Scene scene = run("@R(0,0,3) F(2)");
+    Scene scene = interpret_text("@R(0,0,3) F(2)");
     expect_vec(end_of_last_segment(scene), {0, 0, 2});
 }
 
 TEST(TurtleFeatures, ScaleCommandsScaleSteps)
 {
     // @D(2): step 2; @Di with `scale multiplier: 3`: 6; @Dd(4): 1.5
-    Scene scene = run("@D(2) F @Di F @Dd(4) F", "scale multiplier: 3\n");
+    Scene scene = interpret_text("@D(2) F @Di F @Dd(4) F", "scale multiplier: 3\n");
     expect_vec(end_of_last_segment(scene), {0, 9.5, 0});
-    Scene initial = run("F", "initial scale: 0.25\n");
+    Scene initial = interpret_text("F", "initial scale: 0.25\n");
     expect_vec(end_of_last_segment(initial), {0, 0.25, 0});
 }
 
 TEST(TurtleFeatures, SphereDiameterAndBounds)
 {
-    Scene scene = run("f(2) @D(0.5) @O(4)");
+    Scene scene = interpret_text("f(2) @D(0.5) @O(4)");
     ASSERT_EQ(scene.geometry.spheres.size(), 1u);
     const auto& c = scene.geometry.spheres.centres[0];
     EXPECT_FLOAT_EQ(c[1], 2);
@@ -97,17 +87,17 @@ TEST(TurtleFeatures, SphereDiameterAndBounds)
 
 TEST(TurtleFeatures, SphereDefaultsToTheLineWidth)
 {
-    Scene scene = run(";(7) @O", "initial line width: 3\n");
+    Scene scene = interpret_text(";(7) @O", "initial line width: 3\n");
     ASSERT_EQ(scene.geometry.spheres.size(), 1u);
     EXPECT_FLOAT_EQ(scene.geometry.spheres.centres[0][3], 1.5f);
     EXPECT_EQ(scene.geometry.spheres.material[0], 7);
-    Scene negative = run("@O(-2)");
+    Scene negative = interpret_text("@O(-2)");
     EXPECT_FLOAT_EQ(negative.geometry.spheres.centres[0][3], 1);
 }
 
 TEST(TurtleFeatures, ScreenDiscFacesTheViewer)
 {
-    Scene scene = run("@M(0,0,4) @o(2)", "viewpoint: 3,0,0\nview reference point: 1,0,0\n");
+    Scene scene = interpret_text("@M(0,0,4) @o(2)", "viewpoint: 3,0,0\nview reference point: 1,0,0\n");
     ASSERT_EQ(scene.geometry.discs.size(), 1u);
     const auto& n = scene.geometry.discs.normals[0];
     EXPECT_FLOAT_EQ(n[0], 1);
@@ -119,7 +109,7 @@ TEST(TurtleFeatures, ScreenDiscFacesTheViewer)
 
 TEST(TurtleFeatures, HLDiscFacesUpWithFrontAndBackMaterials)
 {
-    Scene scene = run(";(3) @;(9) & @c(1)", "angle increment: 90\ninitial color: 1 1\n");
+    Scene scene = interpret_text(";(3) @;(9) & @c(1)", "angle increment: 90\ninitial color: 1 1\n");
     ASSERT_EQ(scene.geometry.discs.size(), 1u);
     const auto& n = scene.geometry.discs.normals[0];  // & by 90: H = -z, U = -y
     EXPECT_NEAR(n[1], -1, 1e-6);
@@ -129,46 +119,46 @@ TEST(TurtleFeatures, HLDiscFacesUpWithFrontAndBackMaterials)
 
 TEST(TurtleFeatures, BackColourIncrementsWrap)
 {
-    Scene scene = run("@,(0) @, @c", "initial color: 1 1\ncolor increment: 1 5\n");
+    Scene scene = interpret_text("@,(0) @, @c", "initial color: 1 1\ncolor increment: 1 5\n");
     EXPECT_EQ(scene.geometry.discs.back_material[0], 251);
 }
 
 TEST(TurtleFeatures, BackFollowsFrontUnlessInitialColorGivesTwoIndices)
 {
     // Manual 5.1.9: sides differ only when `initial color:` has two parameters.
-    Scene one = run(";(3) @;(9) @c(1)", "initial color: 1\n");
+    Scene one = interpret_text(";(3) @;(9) @c(1)", "initial color: 1\n");
     EXPECT_EQ(one.geometry.discs.material[0], 3);
     EXPECT_EQ(one.geometry.discs.back_material[0], 3);
-    Scene two = run(";(3) @;(9) @c(1)", "initial color: 1 2\n");
+    Scene two = interpret_text(";(3) @;(9) @c(1)", "initial color: 1 2\n");
     EXPECT_EQ(two.geometry.discs.back_material[0], 9);
 }
 
 TEST(TurtleFeatures, PolygonFromFAndDotVertices)
 {
     // f adds its end as a vertex; the start is not a vertex (cpfg's interpret.c)
-    Scene scene = run(";(5) { f + f + f + f }", "angle increment: 90\n");
+    Scene scene = interpret_text(";(5) { f + f + f + f }", "angle increment: 90\n");
     EXPECT_EQ(scene.geometry.mesh.size(), 2u);
     EXPECT_NEAR(mesh_area(scene.geometry.mesh), 1, 1e-6);
     EXPECT_EQ(scene.geometry.mesh.material[0], 5);
     // the first vertex's colour, as cpfg's rayshade output takes it
-    Scene later = run(";(5) { f ;(6) + f + f + f }", "angle increment: 90\n");
+    Scene later = interpret_text(";(5) { f ;(6) + f + f + f }", "angle increment: 90\n");
     EXPECT_EQ(later.geometry.mesh.material[0], 5);
-    Scene three = run("{ f + f + f }", "angle increment: 90\n");
+    Scene three = interpret_text("{ f + f + f }", "angle increment: 90\n");
     EXPECT_NEAR(mesh_area(three.geometry.mesh), 0.5, 1e-6);
-    Scene dots = run("{ . g . + g . + g . }", "angle increment: 90\n");
+    Scene dots = interpret_text("{ . g . + g . + g . }", "angle increment: 90\n");
     EXPECT_NEAR(mesh_area(dots.geometry.mesh), 1, 1e-6);
 }
 
 TEST(TurtleFeatures, GMovesAddNoPolygonVertex)
 {
     // vertices (0,1), (-1,0), (0,0): G's end (-1,1) is skipped
-    Scene scene = run("{ f + G + f + f }", "angle increment: 90\n");
+    Scene scene = interpret_text("{ f + G + f + f }", "angle increment: 90\n");
     EXPECT_NEAR(mesh_area(scene.geometry.mesh), 0.5, 1e-6);
 }
 
 TEST(TurtleFeatures, NestedPolygonsAcrossBranches)
 {
-    Scene scene = run("{ f [ { f + f + f } ] + f + f }", "angle increment: 90\n");
+    Scene scene = interpret_text("{ f [ { f + f + f } ] + f + f }", "angle increment: 90\n");
     const TriangleMesh& mesh = scene.geometry.mesh;
     ASSERT_EQ(mesh.size(), 2u);
     // the inner polygon is drawn first, above y = 1; the outer one below
@@ -182,14 +172,14 @@ TEST(TurtleFeatures, NestedPolygonsAcrossBranches)
 TEST(TurtleFeatures, ConcavePolygonFromTheTurtle)
 {
     // an L of area 3 traced with f moves and turns
-    Scene scene = run("{ f(2) + f + f - f + f + f(2) }", "angle increment: 90\n");
+    Scene scene = interpret_text("{ f(2) + f + f - f + f + f(2) }", "angle increment: 90\n");
     EXPECT_NEAR(mesh_area(scene.geometry.mesh), 3, 1e-5);
 }
 
 TEST(TurtleFeatures, PolygonTextureCoordinatesFromTheFirstVertex)
 {
     // first vertex (0,1) with H = +y, R = -L = +x: u over x in [-1,0], v over y in [0,1]
-    Scene scene = run("@Tx(1) { f + f + f + f }", "angle increment: 90\ntexture: F: a.png\n");
+    Scene scene = interpret_text("@Tx(1) { f + f + f + f }", "angle increment: 90\ntexture: F: a.png\n");
     const TriangleMesh& mesh = scene.geometry.mesh;
     ASSERT_EQ(mesh.positions.size(), 4u);
     EXPECT_NEAR(mesh.uvs[0][0], 1, 1e-6);  // (0,1)
@@ -202,7 +192,7 @@ TEST(TurtleFeatures, PolygonTextureCoordinatesFromTheFirstVertex)
 TEST(TurtleFeatures, TextureVAlongCylindersContinues)
 {
     // v grows by length / (pi width R): 3 / (2 pi 2), twice
-    Scene scene = run("@Tx(1) F(3) F(3) @Tx(0) F", "initial line width: 2\ntexture: F: Bark.PNG R: 2\n");
+    Scene scene = interpret_text("@Tx(1) F(3) F(3) @Tx(0) F", "initial line width: 2\ntexture: F: Bark.PNG R: 2\n");
     const LinearCurves& lines = scene.geometry.lines;
     ASSERT_EQ(lines.v.size(), lines.keys.size());
     double dv = 3 / (std::numbers::pi * 2 * 2);
@@ -217,49 +207,49 @@ TEST(TurtleFeatures, TextureVAlongCylindersContinues)
 
 TEST(TurtleFeatures, TropismBendsSegments)
 {
-    Scene scene = run("F", "tropism: T: 1 0 0 E: 0.5\n");
+    Scene scene = interpret_text("F", "tropism: T: 1 0 0 E: 0.5\n");
     expect_vec(end_of_last_segment(scene), {std::sin(0.5), std::cos(0.5), 0});
 }
 
 TEST(TurtleFeatures, ElasticityCommandsAndTheirScope)
 {
     const char* view = "tropism: T: 1 0 0 E: 0 S: 0.25\n";
-    expect_vec(end_of_last_segment(run("@Ts(1,0.5) F", view)), {std::sin(0.5), std::cos(0.5), 0});
-    expect_vec(end_of_last_segment(run("@Ti(1) @Ti(1) F", view)), {std::sin(0.5), std::cos(0.5), 0});
-    expect_vec(end_of_last_segment(run("@Ti(1,1) @Td(1) @Td(1,0.25) F", view)),
+    expect_vec(end_of_last_segment(interpret_text("@Ts(1,0.5) F", view)), {std::sin(0.5), std::cos(0.5), 0});
+    expect_vec(end_of_last_segment(interpret_text("@Ti(1) @Ti(1) F", view)), {std::sin(0.5), std::cos(0.5), 0});
+    expect_vec(end_of_last_segment(interpret_text("@Ti(1,1) @Td(1) @Td(1,0.25) F", view)),
                {std::sin(0.5), std::cos(0.5), 0});
     // the elasticity is part of the turtle: ] restores it
-    expect_vec(end_of_last_segment(run("[ @Ts(1,0.5) ] F", view)), {0, 1, 0});
+    expect_vec(end_of_last_segment(interpret_text("[ @Ts(1,0.5) ] F", view)), {0, 1, 0});
 }
 
 TEST(TurtleFeatures, LegacyTropismBendsAfterEachMove)
 {
     // T = (0,0,-1) = U at the start: after the first F, H pitches by asin(0.5) = 30 deg
-    Scene scene = run("F F", "tropism direction: 0,0,-1\ninitial elasticity: 0.5\n");
+    Scene scene = interpret_text("F F", "tropism direction: 0,0,-1\ninitial elasticity: 0.5\n");
     double c = std::cos(std::numbers::pi / 6), s = std::sin(std::numbers::pi / 6);
     expect_vec(end_of_last_segment(scene), {0, 1 + c, -s});
 }
 
 TEST(TurtleFeatures, SubLsystemScalesItsPart)
 {
-    Scene scene = run("F ?(1,0.5) F $ F");
+    Scene scene = interpret_text("F ?(1,0.5) F $ F");
     expect_vec(end_of_last_segment(scene), {0, 2.5, 0});
 }
 
 TEST(TurtleFeatures, LabelsTakeTheirStringAndValues)
 {
-    Scene scene = run("F @L(1,2.5)", "", {"unused", "a=%g!"});
+    Scene scene = interpret_text("F @L(1,2.5)", "", {"unused", "a=%g!"});
     ASSERT_EQ(scene.labels.size(), 1u);
     EXPECT_EQ(scene.labels[0].text, "a=2.5!");
     EXPECT_DOUBLE_EQ(scene.labels[0].position.y, 1);
     // conversions it cannot fill safely are copied as text
-    Scene odd = run("@L(0,3,4)", "", {"%s and %5.1f%% %d"});
+    Scene odd = interpret_text("@L(0,3,4)", "", {"%s and %5.1f%% %d"});
     EXPECT_EQ(odd.labels[0].text, "%s and   3.0% 4");
 }
 
 TEST(TurtleFeatures, SystemCallsAndRayshadeModulesAreIgnored)
 {
-    Scene scene = run("@S(0) @I(0,2) @J(20,20,20) F");
+    Scene scene = interpret_text("@S(0) @I(0,2) @J(20,20,20) F");
     EXPECT_EQ(scene.geometry.lines.segment_count(), 1u);
 }
 

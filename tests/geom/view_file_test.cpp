@@ -4,7 +4,9 @@
 
 #include <string>
 #include <utility>
+#include <vector>
 
+#include "geom/label.h"
 #include "geom/view_file.h"
 
 using namespace cambium;
@@ -87,6 +89,28 @@ TEST(ViewFile, MalformedNumberNamesLineAndColumn)
         EXPECT_NE(std::string(e.what()).find("bad.v:3:15: error: expected a number"), std::string::npos)
             << e.what();
     }
+}
+
+TEST(ViewFile, ReportsSeveralErrorsWithTheirPositionsAndReadsOn)
+{
+    Diagnostics sink(Diagnostics::Output::quiet);
+    ScopedDiagnostics install(sink);
+    try {
+        parse_view_file("viewpoint: 0, x, 1\nscale factor: 0.9\nline style: wavy\n"
+                        "tapered lines: maybe\nangle factor: 8\n",
+                        "bad.v");
+        FAIL() << "expected an error";
+    } catch (const Error& e) {
+        std::string text = e.what();
+        EXPECT_EQ(text.rfind("bad.v: error: 3 errors:", 0), 0u) << text;
+        for (const char* part : {"bad.v:1:15: error: expected a number", "bad.v:3:", "bad.v:4:"})
+            EXPECT_NE(text.find(part), std::string::npos) << part << " missing in: " << text;
+    }
+    std::vector<int> lines;
+    for (const Diagnostic& d : sink.collected())
+        if (d.severity == Severity::error)
+            lines.push_back(d.loc.line);
+    EXPECT_EQ(lines, (std::vector<int>{1, 3, 4}));
 }
 
 TEST(ViewFile, UnknownCommandIsNotAnError)
@@ -218,4 +242,24 @@ TEST(ViewFileRanges, CameraAndLightValuesBeyondTheLimitAreErrorsAtTheirColumn)
     }
     // at the limit still fine
     EXPECT_NO_THROW(parse_view_file("viewpoint: 1e10 -1e10 0\n", "t.v"));
+}
+
+TEST(LabelFont, XFontNamesAndWinfontGiveFamilySizeAndStyle)
+{
+    LabelFont d = label_font(parse_view_file("", "t.v"));
+    EXPECT_EQ(d.family, "courier");  // cpfg's default: -*-courier-bold-r-*-12-*
+    EXPECT_EQ(d.pixel_size, 12);
+    EXPECT_TRUE(d.bold);
+    LabelFont x = label_font(parse_view_file("font: -adobe-helvetica-medium-o-normal-*-24-*-*-*-*-*-*-*\n", "t.v"));
+    EXPECT_EQ(x.family, "helvetica");
+    EXPECT_EQ(x.pixel_size, 24);
+    EXPECT_FALSE(x.bold);
+    EXPECT_TRUE(x.italic);
+    LabelFont points = label_font(parse_view_file("font: -*-times-bold-r-*-*-*-140-*-*-*-*-*-*\n", "t.v"));
+    EXPECT_EQ(points.pixel_size, 14);  // decipoints
+    LabelFont w = label_font(parse_view_file("winfont: \"Times New Roman\" 18 Ib\n", "t.v"));
+    EXPECT_EQ(w.family, "Times New Roman");
+    EXPECT_EQ(w.pixel_size, 18);
+    EXPECT_TRUE(w.bold);
+    EXPECT_TRUE(w.italic);
 }

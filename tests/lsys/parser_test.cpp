@@ -1,5 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // Parser and lexer behaviour: module names, sections, and located error messages.
+#include <utility>
+#include <vector>
+
 #include "lsys/program.h"
 #include "test_util.h"
 
@@ -128,6 +131,54 @@ A --> Y
 endlsystem
 )";
     EXPECT_EQ(derive_text(src), "X?(2)Y$X");
+}
+
+/// Three independent errors: a missing arrow, a bad expression, an unknown header item's
+/// value; each is reported to the sink at its position and the Error lists all three.
+TEST(LsysParser, ReportsSeveralErrorsWithTheirPositions)
+{
+    Diagnostics sink(Diagnostics::Output::quiet);
+    ScopedDiagnostics install(sink);
+    std::string e = load_error("lsystem: 1\n"
+                               "derivation length: 2 +\n"
+                               "axiom: A(1)\n"
+                               "A(x) B\n"
+                               "B --> C\n"
+                               "C(x) --> D(x*)\n"
+                               "D --> E\n"
+                               "endlsystem\n");
+    EXPECT_EQ(e.rfind("test.l: error: 3 errors:", 0), 0u) << e;
+    std::vector<Diagnostic> errors = sink.collected();
+    ASSERT_EQ(sink.count(Severity::error), 3u) << sink.text();
+    std::vector<std::pair<int, int>> at;
+    for (const Diagnostic& d : errors)
+        if (d.severity == Severity::error)
+            at.emplace_back(d.loc.line, d.loc.column);
+    EXPECT_EQ(at, (std::vector<std::pair<int, int>>{{2, 23}, {4, 7}, {6, 14}}));
+    for (const char* part : {"test.l:2:23: error: expected an expression", "test.l:4:7: error: expected '-->'",
+                             "test.l:6:14: error: expected an expression, found ')'"})
+        EXPECT_NE(e.find(part), std::string::npos) << part << " missing in: " << e;
+}
+
+/// The productions between and after the errors are parsed: a file whose only fault is
+/// one production still says that one error alone, as before.
+TEST(LsysParser, OneErrorIsThrownAsItIs)
+{
+    std::string e = load_error("lsystem: 1\naxiom: A\nA(x) B\nB --> C\nendlsystem\n");
+    EXPECT_EQ(e.rfind("test.l:3:7: error: expected '-->', found end of line", 0), 0u) << e;
+}
+
+/// A file of garbage stops at the cap, not after a line per error.
+TEST(LsysParser, ErrorsAreCappedAtTwenty)
+{
+    std::string source = "lsystem: 1\naxiom: A\n";
+    for (int i = 0; i < 30; ++i)
+        source += "A(x) B" + std::to_string(i) + "\n";
+    source += "endlsystem\n";
+    std::string e = load_error(source);
+    EXPECT_EQ(e.rfind("test.l: error: 20 errors (stopped after 20):", 0), 0u) << e;
+    EXPECT_NE(e.find("test.l:22:"), std::string::npos) << e;
+    EXPECT_EQ(e.find("test.l:23:"), std::string::npos) << e;
 }
 
 }  // namespace
