@@ -4,8 +4,9 @@
 #   base    the standard library (and POSIX headers) only
 #   lsys    + base
 #   geom    + lsys; never Embree, TBB, OpenImageIO or render
-#   render  + geom/scene.h, geom/scene_limits.h and geom/vec.h (the Scene contract), Embree, TBB, OpenImageIO,
+#   render  + geom/scene.h, geom/scene_limits.h and geom/vec.h (the Scene contract), Embree, TBB,
 #           FreeType and fontconfig (labels)
+#   imageio what render may + render + OpenImageIO (libcambium_imageio.so: the only OpenImageIO user)
 #   app     everything
 # Standard and POSIX headers are <name>, <name.h> and <sys/name.h>; any other <dir/...> is a
 # third-party library; "layer/file.h" is the project's own.
@@ -20,13 +21,16 @@ BEGIN {
     project["lsys"] = "^(base|lsys)/"
     project["geom"] = "^(base|lsys|geom)/"
     project["render"] = "^(base|render)/|^geom/(scene|scene_limits|vec)\\.h$"
+    project["imageio"] = "^(base|render|imageio)/|^geom/(scene|scene_limits|vec)\\.h$"
     project["app"] = "."
-    library["render"] = "^(embree3|tbb|OpenImageIO|fontconfig)/|^ft2build\\.h$"
+    library["render"] = "^(embree3|tbb|fontconfig)/|^ft2build\\.h$"
+    library["imageio"] = "^(tbb|OpenImageIO)/"
     library["app"] = "."
     rule["base"] = "the standard library only"
     rule["lsys"] = "the standard library and base only"
     rule["geom"] = "the standard library, base and lsys only"
-    rule["render"] = "base, geom/scene.h, geom/scene_limits.h, geom/vec.h, Embree, TBB, OpenImageIO, FreeType and fontconfig only"
+    rule["render"] = "base, geom/scene.h, geom/scene_limits.h, geom/vec.h, Embree, TBB, FreeType and fontconfig only"
+    rule["imageio"] = "base, render, the Scene contract, TBB and OpenImageIO only"
     rule["app"] = "anything"
 }
 FNR == 1 {

@@ -17,6 +17,7 @@
 #include "app/mpi_module.h"
 #include "app/tiles.h"
 #include "base/diagnostics.h"
+#include "base/shared_module.h"
 
 namespace cambium::app {
 namespace {
@@ -26,26 +27,10 @@ namespace fs = std::filesystem;
 constexpr int still_tag = 1;
 constexpr int frame_tag = 2;
 
-/// Where the module may be: beside the executable (the build tree) and in the
-/// install's library folder.
-std::vector<fs::path> module_candidates()
-{
-    std::error_code error;
-    fs::path exe = fs::read_symlink("/proc/self/exe", error);
-    if (error)
-        return {};
-    return {exe.parent_path() / "libcambium_mpi.so",
-            exe.parent_path() / CAMBIUM_MPI_MODULE_FROM_BIN};
-}
-
 template <typename F>
-F* symbol(void* handle, const char* name, const fs::path& file)
+F* symbol(const SharedModule& module, const char* name)
 {
-    void* p = dlsym(handle, name);
-    if (!p)
-        throw Error(FileLoc{file.string()},
-                    fmt::format("is not Cambium's MPI module: it has no {}", name));
-    return reinterpret_cast<F*>(p);
+    return reinterpret_cast<F*>(module.symbol(name, "Cambium's MPI module"));
 }
 
 void* grow(void* context, std::uint64_t bytes)
@@ -69,23 +54,13 @@ struct Mpi::Module {
 
 Mpi::Mpi(int* argc, char*** argv) : m_module(std::make_unique<Module>())
 {
-    std::vector<fs::path> candidates = module_candidates();
-    fs::path file;
     std::string reasons;
-    for (const fs::path& candidate : candidates) {
-        if (!fs::exists(candidate))
-            continue;
-        // Global: Open MPI's own plugins, loaded later, need libmpi's symbols.
-        m_module->handle = dlopen(candidate.c_str(), RTLD_NOW | RTLD_GLOBAL);
-        if (m_module->handle) {
-            file = candidate;
-            break;
-        }
-        reasons += fmt::format("\n  {}: {}", candidate.string(), dlerror());
-    }
+    // Global: Open MPI's own plugins, loaded later, need libmpi's symbols.
+    SharedModule loaded = load_module("libcambium_mpi.so", RTLD_NOW | RTLD_GLOBAL, reasons);
+    m_module->handle = loaded.handle;
     if (!m_module->handle) {
         std::string places;
-        for (const fs::path& candidate : candidates)
+        for (const fs::path& candidate : module_candidates("libcambium_mpi.so"))
             places += "\n  " + candidate.lexically_normal().string();
         throw Error(reasons.empty()
                         ? "--mpi: this cambium was built without MPI (libcambium_mpi.so is in "
@@ -94,17 +69,16 @@ Mpi::Mpi(int* argc, char*** argv) : m_module(std::make_unique<Module>())
                         : "--mpi: the MPI module cannot be loaded (is Open MPI installed? "
                           "apt-get install openmpi-bin):" + reasons);
     }
-    auto* version = symbol<cambium_mpi_version_fn>(m_module->handle,
-                                                   "cambium_mpi_interface_version", file);
+    auto* version = symbol<cambium_mpi_version_fn>(loaded, "cambium_mpi_interface_version");
     if (version() != cambium_mpi_version)
-        throw Error(FileLoc{file.string()}, "is the MPI module of another Cambium version");
-    auto* init = symbol<cambium_mpi_init_fn>(m_module->handle, "cambium_mpi_init", file);
+        throw Error(FileLoc{loaded.file.string()}, "is the MPI module of another Cambium version");
+    auto* init = symbol<cambium_mpi_init_fn>(loaded, "cambium_mpi_init");
     Module& m = *m_module;
-    m.finalize = symbol<cambium_mpi_finalize_fn>(m.handle, "cambium_mpi_finalize", file);
-    m.abort = symbol<cambium_mpi_abort_fn>(m.handle, "cambium_mpi_abort", file);
-    m.send = symbol<cambium_mpi_send_fn>(m.handle, "cambium_mpi_send", file);
-    m.receive = symbol<cambium_mpi_receive_fn>(m.handle, "cambium_mpi_receive", file);
-    m.all_min = symbol<cambium_mpi_all_min_fn>(m.handle, "cambium_mpi_all_min", file);
+    m.finalize = symbol<cambium_mpi_finalize_fn>(loaded, "cambium_mpi_finalize");
+    m.abort = symbol<cambium_mpi_abort_fn>(loaded, "cambium_mpi_abort");
+    m.send = symbol<cambium_mpi_send_fn>(loaded, "cambium_mpi_send");
+    m.receive = symbol<cambium_mpi_receive_fn>(loaded, "cambium_mpi_receive");
+    m.all_min = symbol<cambium_mpi_all_min_fn>(loaded, "cambium_mpi_all_min");
     if (init(argc, argv, &m_rank, &m_size, m.error, sizeof m.error) != 0)
         throw Error(std::string("--mpi: ") + m.error);
 }

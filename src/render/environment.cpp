@@ -25,14 +25,13 @@
 // sphere; pdf() is that mixture, so MIS weights are exact.
 #include "render/environment.h"
 
-#include <OpenImageIO/imageio.h>
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
 
 #include "base/diagnostics.h"
+#include "render/image_codec.h"
 
 namespace cambium::render {
 namespace {
@@ -434,22 +433,8 @@ std::unique_ptr<Environment> make_map_environment(int width, int height, std::ve
 
 std::unique_ptr<Environment> make_map_environment(const std::filesystem::path& file, float scale)
 {
-    auto in = OIIO::ImageInput::open(file.string());
-    if (!in)
-        throw Error(file.string() + ": cannot read the environment map: " + OIIO::geterror());
-    const OIIO::ImageSpec& spec = in->spec();
-    int w = spec.width, h = spec.height, channels = spec.nchannels;
-    if (w <= 0 || h <= 0 || std::size_t(w) * std::size_t(h) > max_map_texels || channels <= 0)
-        throw Error(file.string() + ": environment map of " + std::to_string(w) + "x" +
-                    std::to_string(h) + " texels is empty or larger than 2^25 texels");
-    std::vector<float> pixels(std::size_t(w) * h * channels);
-    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data()))
-        throw Error(file.string() + ": cannot read the environment map: " + in->geterror());
-    std::vector<float> rgb(std::size_t(w) * h * 3);
-    for (std::size_t p = 0; p < std::size_t(w) * h; ++p)
-        for (int c = 0; c < 3; ++c)
-            rgb[p * 3 + c] = pixels[p * channels + (channels >= 3 ? c : 0)] * scale;
-    return make_map_environment(w, h, std::move(rgb));
+    MapTexels map = image_codec().read_map(file, scale, max_map_texels);
+    return make_map_environment(map.width, map.height, std::move(map.rgb));
 }
 
 }  // namespace cambium::render

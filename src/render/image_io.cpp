@@ -1,165 +1,34 @@
 // SPDX-License-Identifier: Apache-2.0
-// The rendered image and its output through OpenImageIO (PNG, EXR, TIFF, JPEG).
+// The rendered image's output: checked here, encoded by the image I/O module
+// (render/image_codec.h, OpenImageIO).
 #include "render/image_io.h"
 
-#include <OpenImageIO/imageio.h>
-
 #include <algorithm>
-#include <cmath>
-#include <cstdint>
-#include <limits>
 #include <string>
-#include <utility>
 
 #include "base/atomic_file.h"
 #include "base/diagnostics.h"
-#include "render/color.h"
+#include "render/image_codec.h"
 
 namespace cambium::render {
 
 namespace {
 
-enum class Format { png, jpeg, tiff, exr };
-
-Format format_of(const std::filesystem::path& file)
+ImageFormat format_of(const std::filesystem::path& file)
 {
     std::string ext = file.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     if (ext == ".png")
-        return Format::png;
+        return ImageFormat::png;
     if (ext == ".jpg" || ext == ".jpeg")
-        return Format::jpeg;
+        return ImageFormat::jpeg;
     if (ext == ".tif" || ext == ".tiff")
-        return Format::tiff;
+        return ImageFormat::tiff;
     if (ext == ".exr")
-        return Format::exr;
+        return ImageFormat::exr;
     throw Error(file.string() + ": unknown image format '" + ext +
                 "' (use .png, .exr, .tif or .jpg)");
-}
-
-/// How a file with an alpha channel stores colour: straight (PNG's rule) or
-/// associated, i.e. premultiplied by alpha after encoding (TIFF's usual reading).
-enum class AlphaStorage { straight, associated };
-
-/// Display-referred pixels: exposure, sRGB-encoded, quantised to `Int` with `channels`
-/// channels (3: RGB, 4: RGBA with colour stored as `storage` says).
-template <class Int>
-std::vector<Int> encode_srgb(const Image& image, int channels, const WriteOptions& options,
-                             AlphaStorage storage = AlphaStorage::straight)
-{
-    constexpr float max = static_cast<float>(std::numeric_limits<Int>::max());
-    float gain = std::exp2(options.exposure);
-    // A transparent image's colour is premultiplied; it is encoded straight.
-    bool unpremultiply = image.transparent && channels == 4;
-    bool associate = channels == 4 && storage == AlphaStorage::associated;
-    std::size_t n = std::size_t(image.width) * image.height;
-    std::vector<Int> out(n * channels);
-    for (std::size_t i = 0; i < n; ++i) {
-        float alpha = std::clamp(image.rgba[i * 4 + 3], 0.0f, 1.0f);
-        float scale = unpremultiply && alpha > 0 ? gain / image.rgba[i * 4 + 3] : gain;
-        for (int c = 0; c < channels; ++c) {
-            float v = image.rgba[i * 4 + c];
-            float e = c < 3 ? linear_to_srgb(tone_map(options.tonemap, v * scale)) *
-                                  (associate ? alpha : 1.0f)
-                            : alpha;
-            out[i * channels + c] = static_cast<Int>(std::lround(e * max));
-        }
-    }
-    return out;
-}
-
-/// OpenImageIO stamps EXR (capDate) and TIFF files with the time of writing unless
-/// DateTime is set; an empty one writes none, so identical runs give identical files.
-void without_time_stamp(OIIO::ImageSpec& spec) { spec.attribute("DateTime", ""); }
-
-bool has_layer(const Image& image, const std::vector<float>& layer, int per_pixel)
-{
-    return layer.size() == std::size_t(image.width) * image.height * per_pixel;
-}
-
-/// The EXR's channels interleaved: RGBA, then each AOV layer the image holds.
-void write_exr(OIIO::ImageOutput& out, const Image& image, const std::filesystem::path& temp,
-               bool& ok)
-{
-    std::vector<std::string> names{"R", "G", "B", "A"};
-    std::vector<std::pair<const std::vector<float>*, int>> layers;
-    if (has_layer(image, image.albedo, 3)) {
-        names.insert(names.end(), {"albedo.R", "albedo.G", "albedo.B"});
-        layers.emplace_back(&image.albedo, 3);
-    }
-    if (has_layer(image, image.normal, 3)) {
-        names.insert(names.end(), {"normal.X", "normal.Y", "normal.Z"});
-        layers.emplace_back(&image.normal, 3);
-    }
-    bool depth = has_layer(image, image.depth, 1);
-    if (depth) {
-        names.emplace_back("Z");
-        layers.emplace_back(&image.depth, 1);
-    }
-    int channels = static_cast<int>(names.size());
-    OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::HALF);
-    spec.channelnames = names;
-    spec.alpha_channel = 3;
-    if (depth) {
-        // Distances need more than half's 11 bits.
-        spec.channelformats.assign(std::size_t(channels), OIIO::TypeDesc::HALF);
-        spec.channelformats.back() = OIIO::TypeDesc::FLOAT;
-        spec.z_channel = channels - 1;
-    }
-    spec.attribute("oiio:ColorSpace", "Linear");
-    spec.attribute("compression", "zip");
-    without_time_stamp(spec);
-    std::size_t n = std::size_t(image.width) * image.height;
-    std::vector<float> pixels(n * std::size_t(channels));
-    for (std::size_t i = 0; i < n; ++i) {
-        float* p = &pixels[i * channels];
-        for (int c = 0; c < 4; ++c)
-            *p++ = image.rgba[i * 4 + c];
-        for (const auto& [layer, count] : layers)
-            for (int c = 0; c < count; ++c)
-                *p++ = (*layer)[i * count + c];
-    }
-    ok = out.open(temp.string(), spec) && out.write_image(OIIO::TypeDesc::FLOAT, pixels.data());
-}
-
-void write_with_oiio(const Image& image, const std::filesystem::path& temp, Format format,
-                     const std::filesystem::path& file, const WriteOptions& options)
-{
-    auto out = OIIO::ImageOutput::create(file.string());  // the format from the real name
-    if (!out)
-        throw Error(file.string() + ": cannot write this format: " + OIIO::geterror());
-    bool ok = false;
-    if (format == Format::exr) {
-        write_exr(*out, image, temp, ok);
-    } else if (format == Format::tiff) {
-        // Opaque renders have no alpha; transparent ones store associated alpha, which
-        // every TIFF reader shows right (unassociated alpha is premultiplied by some
-        // readers and left alone by others).
-        int channels = image.transparent ? 4 : 3;
-        OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::UINT16);
-        spec.attribute("oiio:ColorSpace", "sRGB");
-        without_time_stamp(spec);
-        auto pixels = encode_srgb<std::uint16_t>(image, channels, options,
-                                                 AlphaStorage::associated);
-        ok = out->open(temp.string(), spec) &&
-             out->write_image(OIIO::TypeDesc::UINT16, pixels.data());
-    } else {
-        int channels = format == Format::png && image.transparent ? 4 : 3;
-        OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::UINT8);
-        spec.attribute("oiio:ColorSpace", "sRGB");
-        without_time_stamp(spec);
-        if (channels == 4)
-            spec.attribute("oiio:UnassociatedAlpha", 1);
-        if (format == Format::jpeg)
-            spec.attribute("Compression", "jpeg:95");
-        auto pixels = encode_srgb<std::uint8_t>(image, channels, options);
-        ok = out->open(temp.string(), spec) &&
-             out->write_image(OIIO::TypeDesc::UINT8, pixels.data());
-    }
-    ok = out->close() && ok;
-    if (!ok)
-        throw Error(file.string() + ": cannot write the image: " + out->geterror());
 }
 
 }  // namespace
@@ -179,9 +48,10 @@ void write_image(const Image& image, const std::filesystem::path& file,
     if (image.width <= 0 || image.height <= 0 ||
         image.rgba.size() != std::size_t(image.width) * image.height * 4)
         throw Error(file.string() + ": cannot write an empty or malformed image");
-    Format format = format_of(file);
+    ImageFormat format = format_of(file);
+    const ImageCodec& codec = image_codec();
     write_file_atomically(file, [&](const std::filesystem::path& temporary) {
-        write_with_oiio(image, temporary, format, file, options);
+        codec.write(image, temporary, format, file, options);
     });
 }
 

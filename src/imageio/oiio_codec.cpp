@@ -1,0 +1,62 @@
+// SPDX-License-Identifier: Apache-2.0
+// libcambium_imageio.so's entry point and its environment map reader.
+#include "imageio/oiio_codec.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include "base/diagnostics.h"
+
+namespace cambium::render {
+
+MapTexels read_oiio_map(const std::filesystem::path& file, float scale, std::size_t max_texels)
+{
+    auto in = OIIO::ImageInput::open(file.string());
+    if (!in)
+        throw Error(file.string() + ": cannot read the environment map: " + OIIO::geterror());
+    const OIIO::ImageSpec& spec = in->spec();
+    int w = spec.width, h = spec.height, channels = spec.nchannels;
+    if (w <= 0 || h <= 0 || std::size_t(w) * std::size_t(h) > max_texels || channels <= 0)
+        throw Error(file.string() + ": environment map of " + std::to_string(w) + "x" +
+                    std::to_string(h) + " texels is empty or larger than 2^25 texels");
+    std::vector<float> pixels(std::size_t(w) * h * channels);
+    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data()))
+        throw Error(file.string() + ": cannot read the environment map: " + in->geterror());
+    MapTexels map{w, h, std::vector<float>(std::size_t(w) * h * 3)};
+    for (std::size_t p = 0; p < std::size_t(w) * h; ++p)
+        for (int c = 0; c < 3; ++c)
+            map.rgb[p * 3 + c] = pixels[p * channels + (channels >= 3 ? c : 0)] * scale;
+    return map;
+}
+
+namespace {
+
+class OiioCodec final : public ImageCodec {
+public:
+    void write(const Image& image, const std::filesystem::path& temporary, ImageFormat format,
+               const std::filesystem::path& file, const WriteOptions& options) const override
+    {
+        write_with_oiio(image, temporary, format, file, options);
+    }
+    std::unique_ptr<TextureSource> open_textures(const std::vector<geom::TextureDef>& defs,
+                                                 const std::filesystem::path& base,
+                                                 std::uint64_t max_memory_bytes,
+                                                 const WarnFn& warn) const override
+    {
+        return open_oiio_textures(defs, base, max_memory_bytes, warn);
+    }
+    MapTexels read_map(const std::filesystem::path& file, float scale,
+                       std::size_t max_texels) const override
+    {
+        return read_oiio_map(file, scale, max_texels);
+    }
+};
+
+}  // namespace
+
+const ImageCodec& oiio_codec()
+{
+    static const OiioCodec codec;
+    return codec;
+}
+
+}  // namespace cambium::render
