@@ -162,6 +162,11 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
         ->check(CLI::Range(0, 1024));
     cli.add_option("--seed", options.seed, "Sampling seed (default 0)")
         ->check(CLI::NonNegativeNumber);
+    cli.add_flag("--stats", options.stats,
+                 "Print where the time and memory went: load, derive, interpret, BVH build, "
+                 "time to first pixel, primitives, instances, Embree's and Cambium's memory, "
+                 "peak memory, rays/s and samples/s");
+    cli.add_option("--stats-json", options.stats_json, "Write the --stats figures as JSON to FILE");
     cli.add_option("--max-modules", options.max_modules,
                    "Stop a derivation whose string grows past this many modules (default 1e8)")
         ->check(CLI::Range(std::size_t{1}, std::size_t{1'000'000'000}));

@@ -67,6 +67,9 @@ struct Options {
     std::optional<std::filesystem::path> string_binary;  ///< -strb
     bool homomorphism_in_string = false;                  ///< -homo
     std::optional<std::filesystem::path> view_volume;    ///< -vv
+    // Statistics (app/stats.h): a readable block on stderr, and JSON
+    bool stats = false;                                   ///< --stats
+    std::optional<std::filesystem::path> stats_json;     ///< --stats-json FILE
 
     // Rendering
     int width = 640, height = 480;

@@ -15,6 +15,7 @@
 #include "app/pipeline.h"
 #include "base/atomic_file.h"
 #include "app/sequence.h"
+#include "app/stats.h"
 #include "app/video.h"
 #include "base/diagnostics.h"
 #include "base/subprocess.h"
@@ -130,7 +131,19 @@ void write_strings(const Model& model, const lsys::ModuleString& string, const O
     }
 }
 
-int run(const Options& options)
+/// --stats and --stats-json, once the run's figures are in.
+void report_stats(RunStats& stats, const Options& options)
+{
+    if (!options.stats && !options.stats_json)
+        return;
+    stats.peak_process_bytes = peak_process_bytes();
+    if (options.stats)
+        std::fprintf(stderr, "%s", format_stats(stats).c_str());
+    if (options.stats_json)
+        write_stats_json(stats, *options.stats_json);
+}
+
+int run(const Options& options, Clock::time_point command_start)
 {
     // One sink for the whole command, render threads included; -q keeps warnings quiet.
     Diagnostics diagnostics(options.quiet ? Diagnostics::Output::quiet
@@ -146,6 +159,9 @@ int run(const Options& options)
             render::check_output_format(out);  // fail before the work, not after
     if (options.environment_requested)
         warn("-e: no environmental program is connected; ?E modules keep their parameters");
+    if (is_sequence(options) && (options.stats || options.stats_json))
+        throw Error("--stats and --stats-json are not yet available for sequences (-a, "
+                    "--turntable): give them for a single image");
     if (is_sequence(options)) {
         SequenceOutputs outputs{images, render_settings(options, images), {}, say};
         outputs.write_strings = [&](const Model& model, const lsys::ModuleString& s, int step) {
@@ -154,14 +170,26 @@ int run(const Options& options)
         return run_sequence(options, outputs);
     }
 
+    RunStats stats;
     auto start = Clock::now();
     Model model = load_model(options);
+    stats.load_s = seconds_since(start);
+    auto lap = Clock::now();
     lsys::ModuleString string = derive(model, options);
+    stats.derive_s = seconds_since(lap);
     say(fmt::format("derived {} modules in {:.3f} s", string.size(), seconds_since(start)));
     write_strings(model, string, options,
                   options.steps.value_or(model.lsystem.derivation_length()), say);
+    if (images.empty() && !options.view_volume) {
+        // Only strings are written: the turtle has nothing to do (issue 16.6).
+        report_stats(stats, options);
+        return 0;
+    }
 
+    lap = Clock::now();
     geom::Scene scene = interpret(model, string, options);
+    stats.interpret_s = seconds_since(lap);
+    stats.add_scene(scene);
     const geom::Geometry& g = scene.geometry;
     say(fmt::format("interpreted {} cylinders, {} cylinder curves, {} spheres, {} discs, "
                     "{} triangles, {} instances",
@@ -172,13 +200,17 @@ int run(const Options& options)
         geom::write_view_volume(scene.view.box.value_or(scene.bounds), *options.view_volume);
         say("wrote " + options.view_volume->string());
     }
-    if (images.empty())
+    if (images.empty()) {
+        report_stats(stats, options);
         return 0;
+    }
 
     render::RenderSettings settings = render_settings(options, images);
     apply_camera_options(scene, options);
     render::RenderReport report;
+    double render_start_s = seconds_since(command_start);
     render::Image image = render::render(scene, settings, &report);
+    stats.add_render(report, render_start_s, options.width, options.height);
     say(fmt::format("rendered {}x{}, {:.1f} samples per pixel on average, in {:.2f} s{}",
                     options.width, options.height,
                     double(report.samples) / (double(options.width) * options.height),
@@ -188,6 +220,7 @@ int run(const Options& options)
         render::write_image(image, out, write);
         say("wrote " + out.string());
     }
+    report_stats(stats, options);
     if (report.cancelled)
         return 130;  // the image so far is written; the shell sees the interrupt
     return 0;
@@ -198,12 +231,13 @@ int run(const Options& options)
 
 int main(int argc, char** argv)
 {
+    auto command_start = cambium::app::Clock::now();  // --stats: time to first pixel
     try {
         auto options = cambium::app::parse_command_line(argc, argv);
         if (!options)
             return 0;
         cambium::set_warnings_enabled(!options->quiet);  // -q: nothing but errors
-        return cambium::app::run(*options);
+        return cambium::app::run(*options, command_start);
     } catch (const cambium::Interrupted& e) {
         std::fprintf(stderr, "cambium: %s\n", e.what());
         return 128 + e.signal();  // a helper program was running; it is stopped

@@ -414,6 +414,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         // Embree builds with TBB too, so the build also stays within the arena. One
         // build serves every view (pixel-wide lines take the first view's pixel size).
         EmbreeScene accel(scene, cameras.front(), textures.get());
+        std::uint64_t rays_before = 0;
         PathContext ctx;
         ctx.accel = &accel;
         ctx.textures = textures.get();
@@ -456,6 +457,10 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                         camera.projection() == Camera::Projection::perspective,
                     &nonfinite};
 
+        if (view == 0) {
+            rep.setup_seconds = elapsed();
+            rep.build_seconds = accel.build_seconds();
+        }
         const int tiles_x = (w + tile_size - 1) / tile_size;
         const int tiles_y = (h + tile_size - 1) / tile_size;
         std::vector<int> targets = pass_targets(settings);
@@ -531,6 +536,10 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         rep.cancelled = cancelled;
         rep.out_of_time = out_of_time;
         rep.skipped_rays = accel.skipped_rays();
+        rep.rays = accel.rays_traced() - rays_before;
+        rays_before += rep.rays;
+        rep.embree_bytes = accel.embree_bytes();
+        rep.embree_peak_bytes = accel.embree_peak_bytes();
         rep.nonfinite_samples = nonfinite.exchange(0);
         if (rep.nonfinite_samples > 0)
             warn("render: " + std::to_string(rep.nonfinite_samples) +
