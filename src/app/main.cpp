@@ -187,7 +187,10 @@ int run(const Options& options, Clock::time_point command_start)
     }
 
     lap = Clock::now();
-    geom::Scene scene = interpret(model, string, options);
+    lsys::ModuleString turtle = turtle_string(model, string, options);
+    string = lsys::ModuleString();  // freed before the geometry grows: a lower peak
+    geom::Scene scene = interpret_turtle_string(model, turtle, options);
+    turtle = lsys::ModuleString();
     stats.interpret_s = seconds_since(lap);
     stats.add_scene(scene);
     const geom::Geometry& g = scene.geometry;
