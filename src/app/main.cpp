@@ -13,6 +13,8 @@
 
 #include "app/command_line.h"
 #include "app/pipeline.h"
+#include "app/scene_assembly.h"
+#include "app/scene_file.h"
 #include "base/atomic_file.h"
 #include "app/sequence.h"
 #include "app/video.h"
@@ -38,7 +40,7 @@ std::vector<std::filesystem::path> image_outputs(const Options& options)
 {
     if (!options.outputs.empty() || !options.renders())
         return options.outputs;
-    return {options.lsystem.stem().string() + ".png"};
+    return {(options.scene ? options.scene->stem() : options.lsystem.stem()).string() + ".png"};
 }
 
 render::PixelFilter pixel_filter(const std::string& name)
@@ -130,6 +132,66 @@ void write_strings(const Model& model, const lsys::ModuleString& string, const O
     }
 }
 
+/// Renders a still of `scene` to `images` (the camera options applied first).
+int render_still(geom::Scene& scene, const Options& options,
+                 const std::vector<std::filesystem::path>& images,
+                 const std::function<void(const std::string&)>& say)
+{
+    render::RenderSettings settings = render_settings(options, images);
+    apply_camera_options(scene, options);
+    render::RenderReport report;
+    render::Image image = render::render(scene, settings, &report);
+    say(fmt::format("rendered {}x{}, {:.1f} samples per pixel on average, in {:.2f} s{}",
+                    options.width, options.height,
+                    double(report.samples) / (double(options.width) * options.height),
+                    report.seconds, report.cancelled ? " (interrupted)" : ""));
+    render::WriteOptions write = write_options(options);
+    for (const auto& out : images) {
+        render::write_image(image, out, write);
+        say("wrote " + out.string());
+    }
+    if (report.cancelled)
+        return 130;  // the image so far is written; the shell sees the interrupt
+    return 0;
+}
+
+/// `cambium scene.json`: many plants placed by instances (docs/scenes.md).
+int run_scene(Options options, const std::function<void(const std::string&)>& say)
+{
+    if (options.shot.animate)
+        throw Error("-a animates one L-system; a scene file has no animation (try --turntable)");
+    if (options.string_text || options.string_binary)
+        throw Error("-str and -strb write one L-system's string; not with a scene file");
+    SceneFile file = read_scene_file(*options.scene, options);
+    apply_scene_settings(file, options);
+    std::vector<std::filesystem::path> images = image_outputs(options);
+    for (const auto& out : images)
+        if (!is_video(out))
+            render::check_output_format(out);  // fail before the work, not after
+    auto make_scene = [&]() {
+        AssemblyReport report;
+        geom::Scene scene = assemble_scene(file, options, {}, &report);
+        say(fmt::format("{} plants ({} models, {} derivations) in {:.2f} s: load {:.2f} s, "
+                        "derive {:.2f} s, interpret {:.2f} s; {} instances ({} of organs)",
+                        report.plant_instances, report.models_loaded, report.derivations,
+                        report.wall_s, report.load_s, report.derive_s, report.interpret_s,
+                        scene.instances.size(), report.organ_instances));
+        return scene;
+    };
+    if (is_sequence(options)) {
+        SequenceOutputs outputs{images, render_settings(options, images), {}, say, make_scene};
+        return run_sequence(options, outputs);
+    }
+    geom::Scene scene = make_scene();
+    if (options.view_volume) {
+        geom::write_view_volume(scene.bounds, *options.view_volume);
+        say("wrote " + options.view_volume->string());
+    }
+    if (images.empty())
+        return 0;
+    return render_still(scene, options, images, say);
+}
+
 int run(const Options& options)
 {
     // One sink for the whole command, render threads included; -q keeps warnings quiet.
@@ -140,6 +202,8 @@ int run(const Options& options)
         if (!options.quiet)
             std::printf("%s\n", text.c_str());
     };
+    if (options.scene)
+        return run_scene(options, say);
     std::vector<std::filesystem::path> images = image_outputs(options);
     for (const auto& out : images)
         if (!is_video(out))
@@ -147,7 +211,7 @@ int run(const Options& options)
     if (options.environment_requested)
         warn("-e: no environmental program is connected; ?E modules keep their parameters");
     if (is_sequence(options)) {
-        SequenceOutputs outputs{images, render_settings(options, images), {}, say};
+        SequenceOutputs outputs{images, render_settings(options, images), {}, say, {}};
         outputs.write_strings = [&](const Model& model, const lsys::ModuleString& s, int step) {
             write_strings(model, s, options, step, say);
         };
@@ -175,22 +239,7 @@ int run(const Options& options)
     if (images.empty())
         return 0;
 
-    render::RenderSettings settings = render_settings(options, images);
-    apply_camera_options(scene, options);
-    render::RenderReport report;
-    render::Image image = render::render(scene, settings, &report);
-    say(fmt::format("rendered {}x{}, {:.1f} samples per pixel on average, in {:.2f} s{}",
-                    options.width, options.height,
-                    double(report.samples) / (double(options.width) * options.height),
-                    report.seconds, report.cancelled ? " (interrupted)" : ""));
-    render::WriteOptions write = write_options(options);
-    for (const auto& out : images) {
-        render::write_image(image, out, write);
-        say("wrote " + out.string());
-    }
-    if (report.cancelled)
-        return 130;  // the image so far is written; the shell sees the interrupt
-    return 0;
+    return render_still(scene, options, images, say);
 }
 
 }  // namespace
