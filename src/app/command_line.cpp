@@ -124,6 +124,7 @@ std::vector<std::string> take_cpfg_options(const std::vector<std::string>& args,
             std::vector<std::string> values(args.begin() + static_cast<long>(i) + 1,
                                             args.begin() + static_cast<long>(i) + 1 + option.arguments);
             option.apply(options, values);
+            options.given.push_back(a);
             i += static_cast<std::size_t>(option.arguments);
         } else {
             rest.push_back(a);
@@ -225,7 +226,9 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     cli.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
     add_shot_options(cli, options.shot);
     std::vector<std::string> files;
-    cli.add_option("files", files, "plant.l plant.v [plant.a]")->required()->expected(2, 3);
+    cli.add_option("files", files, "plant.l plant.v [plant.a], or scene.json (docs/scenes.md)")
+        ->required()
+        ->expected(1, 3);
 
     std::vector<std::string> reversed(args.rbegin(), args.rend());
     try {
@@ -258,6 +261,20 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     if (cli.count("--env-rotate") > 0 && !options.sky && !options.environment_map)
         throw Error("--env-rotate turns the --env map or the --sky; give one of them");
     check_shot_options(options);
+    for (const CLI::Option* option : cli.get_options())
+        if (option->count() > 0) {
+            for (const std::string& name : option->get_lnames())
+                options.given.push_back("--" + name);
+            for (const std::string& name : option->get_snames())
+                options.given.push_back("-" + name);
+        }
+    if (files.size() == 1) {
+        if (std::filesystem::path(files[0]).extension() != ".json")
+            throw Error("expected plant.l plant.v [plant.a], or a scene file scene.json; got only '" +
+                        files[0] + "' (see cambium --help)");
+        options.scene = files[0];
+        return options;
+    }
     options.lsystem = files[0];
     options.view = files[1];
     if (files.size() == 3)

@@ -13,6 +13,8 @@
 
 #include "app/command_line.h"
 #include "app/pipeline.h"
+#include "app/scene_assembly.h"
+#include "app/scene_file.h"
 #include "base/atomic_file.h"
 #include "app/sequence.h"
 #include "app/stats.h"
@@ -39,7 +41,7 @@ std::vector<std::filesystem::path> image_outputs(const Options& options)
 {
     if (!options.outputs.empty() || !options.renders())
         return options.outputs;
-    return {options.lsystem.stem().string() + ".png"};
+    return {(options.scene ? options.scene->stem() : options.lsystem.stem()).string() + ".png"};
 }
 
 render::PixelFilter pixel_filter(const std::string& name)
@@ -143,6 +145,76 @@ void report_stats(RunStats& stats, const Options& options)
         write_stats_json(stats, *options.stats_json);
 }
 
+/// Renders a still of `scene` to `images` (the camera options applied first).
+int render_still(geom::Scene& scene, const Options& options,
+                 const std::vector<std::filesystem::path>& images,
+                 const std::function<void(const std::string&)>& say, RunStats& stats,
+                 Clock::time_point command_start)
+{
+    render::RenderSettings settings = render_settings(options, images);
+    apply_camera_options(scene, options);
+    render::RenderReport report;
+    double render_start_s = seconds_since(command_start);
+    render::Image image = render::render(scene, settings, &report);
+    stats.add_render(report, render_start_s, options.width, options.height);
+    say(fmt::format("rendered {}x{}, {:.1f} samples per pixel on average, in {:.2f} s{}",
+                    options.width, options.height,
+                    double(report.samples) / (double(options.width) * options.height),
+                    report.seconds, report.cancelled ? " (interrupted)" : ""));
+    render::WriteOptions write = write_options(options);
+    for (const auto& out : images) {
+        render::write_image(image, out, write);
+        say("wrote " + out.string());
+    }
+    report_stats(stats, options);
+    if (report.cancelled)
+        return 130;  // the image so far is written; the shell sees the interrupt
+    return 0;
+}
+
+/// `cambium scene.json`: many plants placed by instances (docs/scenes.md).
+int run_scene(Options options, const std::function<void(const std::string&)>& say,
+              Clock::time_point command_start)
+{
+    if (options.shot.animate)
+        throw Error("-a animates one L-system; a scene file has no animation (try --turntable)");
+    if (options.string_text || options.string_binary)
+        throw Error("-str and -strb write one L-system's string; not with a scene file");
+    SceneFile file = read_scene_file(*options.scene, options);
+    apply_scene_settings(file, options);
+    std::vector<std::filesystem::path> images = image_outputs(options);
+    for (const auto& out : images)
+        if (!is_video(out))
+            render::check_output_format(out);  // fail before the work, not after
+    RunStats stats;
+    auto make_scene = [&]() {
+        AssemblyReport report;
+        geom::Scene scene = assemble_scene(file, options, {}, &report);
+        stats.add_assembly(report.load_s, report.derive_s, report.interpret_s, report.wall_s);
+        stats.add_scene(scene);
+        say(fmt::format("{} plants ({} models, {} derivations) in {:.2f} s: load {:.2f} s, "
+                        "derive {:.2f} s, interpret {:.2f} s; {} instances ({} of organs)",
+                        report.plant_instances, report.models_loaded, report.derivations,
+                        report.wall_s, report.load_s, report.derive_s, report.interpret_s,
+                        scene.instances.size(), report.organ_instances));
+        return scene;
+    };
+    if (is_sequence(options)) {
+        SequenceOutputs outputs{images, render_settings(options, images), {}, say, make_scene};
+        return run_sequence(options, outputs);
+    }
+    geom::Scene scene = make_scene();
+    if (options.view_volume) {
+        geom::write_view_volume(scene.bounds, *options.view_volume);
+        say("wrote " + options.view_volume->string());
+    }
+    if (images.empty()) {
+        report_stats(stats, options);
+        return 0;
+    }
+    return render_still(scene, options, images, say, stats, command_start);
+}
+
 int run(const Options& options, Clock::time_point command_start)
 {
     // One sink for the whole command, render threads included; -q keeps warnings quiet.
@@ -153,17 +225,19 @@ int run(const Options& options, Clock::time_point command_start)
         if (!options.quiet)
             std::printf("%s\n", text.c_str());
     };
+    if (is_sequence(options) && (options.stats || options.stats_json))
+        throw Error("--stats and --stats-json are not yet available for sequences (-a, "
+                    "--turntable): give them for a single image");
+    if (options.scene)
+        return run_scene(options, say, command_start);
     std::vector<std::filesystem::path> images = image_outputs(options);
     for (const auto& out : images)
         if (!is_video(out))
             render::check_output_format(out);  // fail before the work, not after
     if (options.environment_requested)
         warn("-e: no environmental program is connected; ?E modules keep their parameters");
-    if (is_sequence(options) && (options.stats || options.stats_json))
-        throw Error("--stats and --stats-json are not yet available for sequences (-a, "
-                    "--turntable): give them for a single image");
     if (is_sequence(options)) {
-        SequenceOutputs outputs{images, render_settings(options, images), {}, say};
+        SequenceOutputs outputs{images, render_settings(options, images), {}, say, {}};
         outputs.write_strings = [&](const Model& model, const lsys::ModuleString& s, int step) {
             write_strings(model, s, options, step, say);
         };
@@ -192,6 +266,7 @@ int run(const Options& options, Clock::time_point command_start)
     geom::Scene scene = interpret_turtle_string(model, turtle, options);
     turtle = lsys::ModuleString();
     stats.interpret_s = seconds_since(lap);
+    stats.assemble_s = stats.load_s + stats.derive_s + stats.interpret_s;
     stats.add_scene(scene);
     const geom::Geometry& g = scene.geometry;
     say(fmt::format("interpreted {} cylinders, {} cylinder curves, {} spheres, {} discs, "
@@ -208,25 +283,7 @@ int run(const Options& options, Clock::time_point command_start)
         return 0;
     }
 
-    render::RenderSettings settings = render_settings(options, images);
-    apply_camera_options(scene, options);
-    render::RenderReport report;
-    double render_start_s = seconds_since(command_start);
-    render::Image image = render::render(scene, settings, &report);
-    stats.add_render(report, render_start_s, options.width, options.height);
-    say(fmt::format("rendered {}x{}, {:.1f} samples per pixel on average, in {:.2f} s{}",
-                    options.width, options.height,
-                    double(report.samples) / (double(options.width) * options.height),
-                    report.seconds, report.cancelled ? " (interrupted)" : ""));
-    render::WriteOptions write = write_options(options);
-    for (const auto& out : images) {
-        render::write_image(image, out, write);
-        say("wrote " + out.string());
-    }
-    report_stats(stats, options);
-    if (report.cancelled)
-        return 130;  // the image so far is written; the shell sees the interrupt
-    return 0;
+    return render_still(scene, options, images, say, stats, command_start);
 }
 
 }  // namespace

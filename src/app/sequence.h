@@ -22,6 +22,9 @@ struct SequenceOutputs {
     render::RenderSettings settings;
     std::function<void(const Model&, const lsys::ModuleString&, int step)> write_strings;
     std::function<void(const std::string&)> say;
+    /// A scene file's scene (docs/scenes.md): when set, a turntable renders it instead
+    /// of the options' L-system.
+    std::function<geom::Scene()> make_scene;
 };
 
 /// Whether the command renders a sequence (-a or --turntable) instead of a still.

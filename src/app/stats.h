@@ -30,7 +30,10 @@ PrimitiveCounts count_primitives(const geom::Geometry& g);
 /// of the command (main), so it holds load, derive, interpret and build and whatever lies
 /// between (string outputs, textures, lights).
 struct RunStats {
-    double load_s = 0, derive_s = 0, interpret_s = 0, build_s = 0;
+    /// For a scene file, whose plants are loaded, derived and interpreted in parallel,
+    /// load, derive and interpret are summed over threads and `assemble_s` is the wall
+    /// time of the whole; for one model, `assemble_s` is their sum.
+    double load_s = 0, derive_s = 0, interpret_s = 0, assemble_s = 0, build_s = 0;
     double first_pixel_s = 0;
     double render_s = 0;  ///< sampling, after the first pixel
     bool interpreted = false, rendered = false;
@@ -48,6 +51,8 @@ struct RunStats {
     int width = 0, height = 0;
     std::uint64_t samples = 0, rays = 0;
 
+    /// A scene file's assembly: thread-summed load, derive and interpret, and its wall time.
+    void add_assembly(double load, double derive, double interpret, double wall);
     /// Counts the scene's primitives, instances and buffer bytes.
     void add_scene(const geom::Scene& scene);
     /// Takes the render's build time, rays, samples and Embree memory; `render_start_s`

@@ -58,7 +58,7 @@ void expect_documented_keys(const nlohmann::json& j)
                             "instances", "prototypes", "memory_bytes", "bytes_per_primitive",
                             "render"})
         EXPECT_TRUE(j.contains(key)) << key;
-    for (const char* key : {"load", "derive", "interpret", "build", "first_pixel", "render"})
+    for (const char* key : {"load", "derive", "interpret", "assemble", "build", "first_pixel", "render"})
         EXPECT_TRUE(j["times_s"].contains(key)) << key;
     for (const char* group : {"primitives", "placed_primitives"})
         for (const char* key : {"cylinders", "curve_segments", "spheres", "discs", "triangles", "total"})
@@ -98,6 +98,9 @@ TEST(Stats, JsonCountsTheScenesPrimitivesAndTimesAddUp)
     }
     EXPECT_GT(t["build"].get<double>(), 0);
     EXPECT_LE(parts, t["first_pixel"].get<double>());
+    EXPECT_NEAR(t["assemble"].get<double>(),
+                t["load"].get<double>() + t["derive"].get<double>() + t["interpret"].get<double>(),
+                1e-9);
 
     const nlohmann::json& render = j["render"];
     EXPECT_EQ(render["samples"], 32 * 24 * 2);
