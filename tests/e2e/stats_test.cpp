@@ -154,6 +154,32 @@ TEST(Stats, ViewVolumeRunInterpretsButRendersNothing)
     EXPECT_EQ(j["render"]["rays"], 0);
 }
 
+TEST(Stats, SceneFileCountsPrototypesOnceAndPlacedCopiesPerInstance)
+{
+    RunResult r = run_known_plant("scene", "--version");  // makes the folder and the plant
+    std::ofstream(r.dir / "field.json") << R"({
+  "plants": [{"model": ".", "command": "cpfg p.l p.v",
+              "placements": [{"translate": [0, 0, 0]}, {"translate": [3, 0, 0]},
+                             {"translate": [6, 0, 0]}]}],
+  "camera": {"eye": [3, 2, 12], "look_at": [3, 1, 0], "width": 24, "height": 16},
+  "render": {"spp": 1}
+})";
+    std::string command = "cd '" + r.dir.string() + "' && " + CAMBIUM_EXE +
+                          " field.json -o f.png --stats-json stats.json > out.txt 2>&1";
+    ASSERT_EQ(std::system(command.c_str()), 0);
+    nlohmann::json j = read_json(r.dir / "stats.json");
+    expect_documented_keys(j);
+    EXPECT_EQ(j["instances"], 3);
+    EXPECT_EQ(j["prototypes"], 1);
+    // The known plant once, and three placed copies of it.
+    EXPECT_EQ(j["primitives"]["total"], 7);
+    EXPECT_EQ(j["placed_primitives"]["total"], 21);
+    EXPECT_EQ(j["placed_primitives"]["cylinders"], 9);
+    const nlohmann::json& t = j["times_s"];
+    EXPECT_LE(t["assemble"].get<double>() + t["build"].get<double>(), t["first_pixel"].get<double>());
+    EXPECT_EQ(j["render"]["samples"], 24 * 16);
+}
+
 TEST(Stats, SequencesSayStatsAreNotYetAvailable)
 {
     RunResult r = run_known_plant("seq", "-a -w 8 8 --spp 1 --stats");
