@@ -207,7 +207,8 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
         ->check(CLI::Range(0.0f, 1e6f));
     cli.add_flag("--sky", options.sky, "Light with Preetham's daylight sky and sun");
     cli.add_option("--sun", options.sun_direction, "Direction toward the sun (with --sky)")
-        ->expected(3);
+        ->expected(3)
+        ->allow_extra_args(false);  // with a lone scene file allowed, files must not feed it
     cli.add_option("--turbidity", options.turbidity,
                    "Haze of the --sky, 1.7 (very clear) .. 10 (hazy); default 3")
         ->check(CLI::Range(1.7f, 10.0f));
