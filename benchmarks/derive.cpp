@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
 // Derivation benchmark: derives the corpus bench/ models and prints one JSON line each.
 //
-// Usage: derive [model...]   (default: koch-L6 koch-L7 birch-225k birch-2250k)
+// Usage: derive [--cambium PATH] [model...]   (default: koch-L6 koch-L7 birch-225k birch-2250k)
 // Each model runs in a fresh child process (this program re-executed with --one), so
-// the peak RSS it reports belongs to that model alone.
+// the peak RSS it reports belongs to that model alone. With --cambium, the command at
+// PATH also runs on each model with -str alone and with -vv alone (whole process: start-up,
+// load, derive, and interpretation where it is needed), one JSON line each with its wall
+// time, CPU time and peak RSS.
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -70,7 +73,7 @@ int run_one(const std::string& model)
         auto t1 = clock::now();
         cambium::lsys::ModuleString s = ls.derive();
         auto t2 = clock::now();
-        double peak = peak_rss_mb();
+        double derive_peak = peak_rss_mb();
         // cpfg's -str text output of the same string, written to a sink (no disk)
         NullBuffer sink;
         std::ostream null_stream(&sink);
@@ -83,9 +86,9 @@ int run_one(const std::string& model)
         double wall_s = load_s + derive_s;
         std::printf("{\"model\":\"%s\",\"modules\":%zu,\"wall_s\":%.3f,\"load_s\":%.3f,"
                     "\"derive_s\":%.3f,\"modules_per_s\":%.0f,\"peak_rss_mb\":%.1f,"
-                    "\"str_text_s\":%.3f}\n",
+                    "\"str_text_s\":%.3f,\"peak_rss_after_str_mb\":%.1f}\n",
                     model.c_str(), s.size(), wall_s, load_s, derive_s,
-                    static_cast<double>(s.size()) / derive_s, peak, str_s);
+                    static_cast<double>(s.size()) / derive_s, derive_peak, str_s, peak_rss_mb());
     } catch (const std::exception& e) {
         std::printf("{\"model\":\"%s\",\"error\":\"%s\"}\n", model.c_str(), e.what());
         return 1;
@@ -109,12 +112,58 @@ int run_child(const char* self, const std::string& model)
     return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
 }
 
+double seconds(const timeval& t) { return double(t.tv_sec) + double(t.tv_usec) * 1e-6; }
+
+/// Runs the cambium command at `cambium` on a bench model with `output_option` (-str or
+/// -vv) into a scratch file, and prints its wall time, CPU time and peak RSS.
+int run_command(const std::string& cambium, const std::string& model,
+                const std::string& output_option)
+{
+    fs::path folder = bench_dir() / model;
+    fs::path lsystem = lsystem_file(folder);
+    if (lsystem.empty())
+        return 1;
+    fs::path view = fs::path(lsystem).replace_extension(".v");
+    fs::path output = fs::temp_directory_path() /
+                      ("cambium_derive_bench_" + std::to_string(::getpid()) + ".out");
+    std::fflush(stdout);
+    auto start = std::chrono::steady_clock::now();
+    pid_t pid = fork();
+    if (pid < 0)
+        return 1;
+    if (pid == 0) {
+        if (chdir(folder.c_str()) != 0)
+            _exit(127);
+        execl(cambium.c_str(), cambium.c_str(), "-q", output_option.c_str(), output.c_str(),
+              lsystem.c_str(), view.c_str(), static_cast<char*>(nullptr));
+        _exit(127);
+    }
+    int status = 0;
+    rusage usage{};
+    wait4(pid, &status, 0, &usage);
+    double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    fs::remove(output);
+    bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    std::printf("{\"model\":\"%s\",\"command\":\"cambium %s\",\"ok\":%s,\"wall_s\":%.3f,"
+                "\"cpu_s\":%.3f,\"peak_rss_mb\":%.1f}\n",
+                model.c_str(), output_option.c_str(), ok ? "true" : "false", wall,
+                seconds(usage.ru_utime) + seconds(usage.ru_stime),
+                static_cast<double>(usage.ru_maxrss) / 1024.0);
+    return ok ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv)
 {
     if (argc == 3 && std::string(argv[1]) == "--one")
         return run_one(argv[2]);
+    std::string cambium;
+    if (argc >= 3 && std::string(argv[1]) == "--cambium") {
+        cambium = fs::absolute(argv[2]).string();
+        argv += 2;
+        argc -= 2;
+    }
     if (!fs::is_directory(bench_dir())) {
         std::printf("{\"note\":\"corpus bench folder not found at %s; nothing measured\"}\n",
                     bench_dir().string().c_str());
@@ -124,7 +173,11 @@ int main(int argc, char** argv)
     if (argc > 1)
         models.assign(argv + 1, argv + argc);
     int failures = 0;
-    for (const auto& m : models)
+    for (const auto& m : models) {
         failures += run_child("/proc/self/exe", m) != 0 ? 1 : 0;
+        if (!cambium.empty())
+            for (const char* option : {"-str", "-vv"})
+                failures += run_command(cambium, m, option) != 0 ? 1 : 0;
+    }
     return failures == 0 ? 0 : 1;
 }

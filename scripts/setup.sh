@@ -11,7 +11,7 @@ packages=(
   # tools: build, test runner, and the C preprocessor cambium runs on .l files
   cmake make g++ cpp
   # libraries of the renderer and the command
-  libembree-dev libtbb-dev libcli11-dev libfmt-dev
+  libembree-dev libtbb-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   libopenimageio-dev libopenexr-dev
   # @L labels: FreeType draws the glyphs, fontconfig finds a font for cpfg's font names,
   # DejaVu is the font it finds on a bare system
@@ -20,7 +20,7 @@ packages=(
   # to exist; Debian has them only as a Recommends of libopenimageio-dev.
   openimageio-tools
   # tests and benchmarks
-  libgtest-dev libbenchmark-dev nlohmann-json3-dev
+  libgtest-dev libbenchmark-dev
   # zlib: the conformance tests read cpfg's gzipped rayshade exports (scene.ray.gz)
   zlib1g-dev
   # Open MPI (BSD licence) for --mpi: the module libcambium_mpi.so links it, the tests

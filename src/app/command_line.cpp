@@ -124,6 +124,7 @@ std::vector<std::string> take_cpfg_options(const std::vector<std::string>& args,
             std::vector<std::string> values(args.begin() + static_cast<long>(i) + 1,
                                             args.begin() + static_cast<long>(i) + 1 + option.arguments);
             option.apply(options, values);
+            options.given.push_back(a);
             i += static_cast<std::size_t>(option.arguments);
         } else {
             rest.push_back(a);
@@ -222,6 +223,11 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     cli.add_option("--sampler", options.sampler, "Sample sequence: sobol (default) or white")
         ->check(CLI::IsMember({"sobol", "white"}))
         ->group("");
+    cli.add_flag("--stats", options.stats,
+                 "Print where the time and memory went: load, derive, interpret, BVH build, "
+                 "time to first pixel, primitives, instances, Embree's and Cambium's memory, "
+                 "peak memory, rays/s and samples/s");
+    cli.add_option("--stats-json", options.stats_json, "Write the --stats figures as JSON to FILE");
     cli.add_option("--max-modules", options.max_modules,
                    "Stop a derivation whose string grows past this many modules (default 1e8)")
         ->check(CLI::Range(std::size_t{1}, std::size_t{1'000'000'000}));
@@ -261,7 +267,8 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
         ->check(CLI::Range(0.0f, 1e6f));
     cli.add_flag("--sky", options.sky, "Light with Preetham's daylight sky and sun");
     cli.add_option("--sun", options.sun_direction, "Direction toward the sun (with --sky)")
-        ->expected(3);
+        ->expected(3)
+        ->allow_extra_args(false);  // with a lone scene file allowed, files must not feed it
     cli.add_option("--turbidity", options.turbidity,
                    "Haze of the --sky, 1.7 (very clear) .. 10 (hazy); default 3")
         ->check(CLI::Range(1.7f, 10.0f));
@@ -280,7 +287,9 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     cli.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
     add_shot_options(cli, options.shot);
     std::vector<std::string> files;
-    cli.add_option("files", files, "plant.l plant.v [plant.a]")->required()->expected(2, 3);
+    cli.add_option("files", files, "plant.l plant.v [plant.a], or scene.json (docs/scenes.md)")
+        ->required()
+        ->expected(1, 3);
 
     std::vector<std::string> reversed(args.rbegin(), args.rend());
     try {
@@ -316,6 +325,20 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     if (!tile.empty())
         options.tile = tile_option(tile);
     check_distributed_options(options);
+    for (const CLI::Option* option : cli.get_options())
+        if (option->count() > 0) {
+            for (const std::string& name : option->get_lnames())
+                options.given.push_back("--" + name);
+            for (const std::string& name : option->get_snames())
+                options.given.push_back("-" + name);
+        }
+    if (files.size() == 1) {
+        if (std::filesystem::path(files[0]).extension() != ".json")
+            throw Error("expected plant.l plant.v [plant.a], or a scene file scene.json; got only '" +
+                        files[0] + "' (see cambium --help)");
+        options.scene = files[0];
+        return options;
+    }
     options.lsystem = files[0];
     options.view = files[1];
     if (files.size() == 3)

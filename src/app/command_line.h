@@ -50,6 +50,10 @@ struct ShotOptions {
 
 struct Options {
     std::filesystem::path lsystem, view;
+    /// A scene file (docs/scenes.md) given instead of plant.l plant.v: many plants.
+    std::optional<std::filesystem::path> scene;
+    /// A scene's per-plant seed of the L-system's random streams (not an option).
+    std::optional<long> lsystem_seed;
     std::optional<std::filesystem::path> animation;
     std::vector<ColourFile> colour_files;
     int colour_block = 1;  ///< -c n
@@ -70,6 +74,9 @@ struct Options {
     std::optional<std::filesystem::path> string_binary;  ///< -strb
     bool homomorphism_in_string = false;                  ///< -homo
     std::optional<std::filesystem::path> view_volume;    ///< -vv
+    // Statistics (app/stats.h): a readable block on stderr, and JSON
+    bool stats = false;                                   ///< --stats
+    std::optional<std::filesystem::path> stats_json;     ///< --stats-json FILE
 
     // Rendering
     int width = 640, height = 480;
@@ -104,6 +111,17 @@ struct Options {
     float environment_rotation = 0;    ///< --env-rotate DEG about +y (with --env or --sky)
 
     ShotOptions shot;
+
+    /// The options the command line gave (as spelled: "--spp", "-w"), so that a scene
+    /// file's settings apply only where the command line is silent.
+    std::vector<std::string> given;
+    bool was_given(const std::string& name) const
+    {
+        for (const std::string& g : given)
+            if (g == name)
+                return true;
+        return false;
+    }
 
     /// Whether an image is to be rendered: an -o was given, or no other output was.
     bool renders() const

@@ -18,8 +18,11 @@
 #include "app/distributed.h"
 #include "app/tiles.h"
 #include "app/pipeline.h"
+#include "app/scene_assembly.h"
+#include "app/scene_file.h"
 #include "base/atomic_file.h"
 #include "app/sequence.h"
+#include "app/stats.h"
 #include "app/video.h"
 #include "base/diagnostics.h"
 #include "base/subprocess.h"
@@ -43,7 +46,7 @@ std::vector<std::filesystem::path> image_outputs(const Options& options)
 {
     if (!options.outputs.empty() || !options.renders())
         return options.outputs;
-    return {options.lsystem.stem().string() + ".png"};
+    return {(options.scene ? options.scene->stem() : options.lsystem.stem()).string() + ".png"};
 }
 
 render::PixelFilter pixel_filter(const std::string& name)
@@ -169,7 +172,106 @@ void write_tile(const Options& options, const std::filesystem::path& first_outpu
                     tile.rect.y + tile.rect.height - 1));
 }
 
-int run(const Options& options, Mpi* mpi)
+
+/// --stats and --stats-json, once the run's figures are in.
+void report_stats(RunStats& stats, const Options& options)
+{
+    if (!options.stats && !options.stats_json)
+        return;
+    stats.peak_process_bytes = peak_process_bytes();
+    if (options.stats)
+        std::fprintf(stderr, "%s", format_stats(stats).c_str());
+    if (options.stats_json)
+        write_stats_json(stats, *options.stats_json);
+}
+
+/// Renders a still of `scene` (the camera options applied first) and writes `images`: the
+/// whole image, band I of --tile I/N into its tile file, or shared among --mpi's ranks
+/// (rank 0 writes).
+int render_and_write_still(geom::Scene& scene, const Options& options,
+                           const std::vector<std::filesystem::path>& images,
+                           const std::function<void(const std::string&)>& say, RunStats& stats,
+                           Clock::time_point command_start, Mpi* mpi)
+{
+    render::RenderSettings settings = render_settings(options, images);
+    apply_camera_options(scene, options);
+    if (options.tile) {
+        write_tile(options, images.front(), scene, settings, say);
+        return 0;
+    }
+    render::RenderReport report;
+    if (mpi)
+        mpi->checkpoint();
+    double render_start_s = seconds_since(command_start);
+    render::Image image = mpi ? render_still(*mpi, scene, settings, &report)
+                              : render::render(scene, settings, &report);
+    stats.add_render(report, render_start_s, options.width, options.height);
+    if (mpi && mpi->rank() != 0)
+        return 0;
+    if (mpi)
+        say(fmt::format("rendered {}x{} on {} ranks; rank 0's band in {:.2f} s{}", options.width,
+                        options.height, mpi->size(), report.seconds,
+                        report.cancelled ? " (interrupted)" : ""));
+    else
+        say(fmt::format("rendered {}x{}, {:.1f} samples per pixel on average, in {:.2f} s{}",
+                        options.width, options.height,
+                        double(report.samples) / (double(options.width) * options.height),
+                        report.seconds, report.cancelled ? " (interrupted)" : ""));
+    render::WriteOptions write = write_options(options);
+    for (const auto& out : images) {
+        render::write_image(image, out, write);
+        say("wrote " + out.string());
+    }
+    report_stats(stats, options);
+    if (report.cancelled)
+        return 130;  // the image so far is written; the shell sees the interrupt
+    return 0;
+}
+
+/// `cambium scene.json`: many plants placed by instances (docs/scenes.md).
+int run_scene(Options options, const std::function<void(const std::string&)>& say,
+              Clock::time_point command_start, Mpi* mpi)
+{
+    if (options.shot.animate)
+        throw Error("-a animates one L-system; a scene file has no animation (try --turntable)");
+    if (options.string_text || options.string_binary)
+        throw Error("-str and -strb write one L-system's string; not with a scene file");
+    SceneFile file = read_scene_file(*options.scene, options);
+    apply_scene_settings(file, options);
+    std::vector<std::filesystem::path> images = image_outputs(options);
+    for (const auto& out : images)
+        if (!is_video(out))
+            render::check_output_format(out);  // fail before the work, not after
+    RunStats stats;
+    auto make_scene = [&]() {
+        AssemblyReport report;
+        geom::Scene scene = assemble_scene(file, options, {}, &report);
+        stats.add_assembly(report.load_s, report.derive_s, report.interpret_s, report.wall_s);
+        stats.add_scene(scene);
+        say(fmt::format("{} plants ({} models, {} derivations) in {:.2f} s: load {:.2f} s, "
+                        "derive {:.2f} s, interpret {:.2f} s; {} instances ({} of organs)",
+                        report.plant_instances, report.models_loaded, report.derivations,
+                        report.wall_s, report.load_s, report.derive_s, report.interpret_s,
+                        scene.instances.size(), report.organ_instances));
+        return scene;
+    };
+    if (is_sequence(options)) {
+        SequenceOutputs outputs{images, render_settings(options, images), {}, say, mpi, make_scene};
+        return run_sequence(options, outputs);
+    }
+    geom::Scene scene = make_scene();
+    if (options.view_volume) {
+        geom::write_view_volume(scene.bounds, *options.view_volume);
+        say("wrote " + options.view_volume->string());
+    }
+    if (images.empty()) {
+        report_stats(stats, options);
+        return 0;
+    }
+    return render_and_write_still(scene, options, images, say, stats, command_start, mpi);
+}
+
+int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
 {
     // One sink for the whole command, render threads included; -q keeps warnings quiet.
     Diagnostics diagnostics(options.quiet ? Diagnostics::Output::quiet
@@ -179,6 +281,11 @@ int run(const Options& options, Mpi* mpi)
         if (!options.quiet)
             std::printf("%s\n", text.c_str());
     };
+    if (is_sequence(options) && (options.stats || options.stats_json))
+        throw Error("--stats and --stats-json are not yet available for sequences (-a, "
+                    "--turntable): give them for a single image");
+    if (options.scene)
+        return run_scene(options, say, command_start, mpi);
     std::vector<std::filesystem::path> images = image_outputs(options);
     for (const auto& out : images)
         if (!is_video(out))
@@ -197,15 +304,31 @@ int run(const Options& options, Mpi* mpi)
         return run_sequence(options, outputs);
     }
 
+    RunStats stats;
     auto start = Clock::now();
     Model model = load_model(options);
+    stats.load_s = seconds_since(start);
+    auto lap = Clock::now();
     lsys::ModuleString string = derive(model, options);
+    stats.derive_s = seconds_since(lap);
     say(fmt::format("derived {} modules in {:.3f} s", string.size(), seconds_since(start)));
     if (writes)
         write_strings(model, string, options,
                       options.steps.value_or(model.lsystem.derivation_length()), say);
+    if (images.empty() && !options.view_volume) {
+        // Only strings are written: the turtle has nothing to do (issue 16.6).
+        report_stats(stats, options);
+        return 0;
+    }
 
-    geom::Scene scene = interpret(model, string, options);
+    lap = Clock::now();
+    lsys::ModuleString turtle = turtle_string(model, string, options);
+    string = lsys::ModuleString();  // freed before the geometry grows: a lower peak
+    geom::Scene scene = interpret_turtle_string(model, turtle, options);
+    turtle = lsys::ModuleString();
+    stats.interpret_s = seconds_since(lap);
+    stats.assemble_s = stats.load_s + stats.derive_s + stats.interpret_s;
+    stats.add_scene(scene);
     const geom::Geometry& g = scene.geometry;
     say(fmt::format("interpreted {} cylinders, {} cylinder curves, {} spheres, {} discs, "
                     "{} triangles, {} instances",
@@ -216,39 +339,12 @@ int run(const Options& options, Mpi* mpi)
         geom::write_view_volume(scene.view.box.value_or(scene.bounds), *options.view_volume);
         say("wrote " + options.view_volume->string());
     }
-    if (images.empty())
+    if (images.empty()) {
+        report_stats(stats, options);
         return 0;
+    }
 
-    render::RenderSettings settings = render_settings(options, images);
-    apply_camera_options(scene, options);
-    if (options.tile) {
-        write_tile(options, images.front(), scene, settings, say);
-        return 0;
-    }
-    render::RenderReport report;
-    if (mpi)
-        mpi->checkpoint();
-    render::Image image = mpi ? render_still(*mpi, scene, settings, &report)
-                              : render::render(scene, settings, &report);
-    if (!writes)
-        return 0;
-    if (mpi)
-        say(fmt::format("rendered {}x{} on {} ranks; rank 0's band in {:.2f} s{}", options.width,
-                        options.height, mpi->size(), report.seconds,
-                        report.cancelled ? " (interrupted)" : ""));
-    else
-        say(fmt::format("rendered {}x{}, {:.1f} samples per pixel on average, in {:.2f} s{}",
-                        options.width, options.height,
-                        double(report.samples) / (double(options.width) * options.height),
-                        report.seconds, report.cancelled ? " (interrupted)" : ""));
-    render::WriteOptions write = write_options(options);
-    for (const auto& out : images) {
-        render::write_image(image, out, write);
-        say("wrote " + out.string());
-    }
-    if (report.cancelled)
-        return 130;  // the image so far is written; the shell sees the interrupt
-    return 0;
+    return render_and_write_still(scene, options, images, say, stats, command_start, mpi);
 }
 
 /// Under mpirun with --mpi, before MPI is initialised: whether this is a rank other than
@@ -269,6 +365,7 @@ bool other_mpi_rank(int argc, char** argv)
 
 int main(int argc, char** argv)
 {
+    auto command_start = cambium::app::Clock::now();  // --stats: time to first pixel
     using cambium::app::Mpi;
     std::unique_ptr<Mpi> mpi;
     // With --mpi, an error ends every rank (Mpi::fail), printed once.
@@ -289,7 +386,7 @@ int main(int argc, char** argv)
                 options->quiet = true;  // messages, warnings and progress on rank 0 only
         }
         cambium::set_warnings_enabled(!options->quiet);  // -q: nothing but errors
-        return cambium::app::run(*options, mpi.get());
+        return cambium::app::run(*options, mpi.get(), command_start);
     } catch (const cambium::Interrupted& e) {
         fail(e.what());
         return 128 + e.signal();  // a helper program was running; it is stopped

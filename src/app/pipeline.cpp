@@ -84,6 +84,7 @@ Model load_model(const Options& options)
     load.max_memory_bytes = options.max_memory_bytes;
     load.allow_file_access = options.allow_file_access;
     load.preprocessor = options.preprocessor;
+    load.seed = options.lsystem_seed;
     load.defines = functions->define_names();
     if (!functions->empty())
         load.function = [functions](int id, double x) { return functions->evaluate(id, x); };

@@ -420,13 +420,18 @@ int run_turntable(const Options& options, const SequenceOutputs& out)
 {
     const int n = options.shot.turntable;
     require_numbered_names(Options{}, out.images, static_cast<std::size_t>(n));
-    Model model = load_model(options);
-    lsys::ModuleString derived = derive(model, options);
     const bool writes = !out.mpi || out.mpi->rank() == 0;
-    if (writes)
-        out.write_strings(model, derived,
-                          options.steps.value_or(model.lsystem.derivation_length()));
-    geom::Scene scene = interpret(model, derived, options);
+    geom::Scene scene;
+    if (out.make_scene) {
+        scene = out.make_scene();
+    } else {
+        Model model = load_model(options);
+        lsys::ModuleString derived = derive(model, options);
+        if (writes)
+            out.write_strings(model, derived,
+                              options.steps.value_or(model.lsystem.derivation_length()));
+        scene = interpret(model, derived, options);
+    }
     scene.view = render::apply_overrides(scene.view, view_overrides(options.shot), scene.bounds);
     if (out.mpi)
         out.mpi->checkpoint();
@@ -586,7 +591,8 @@ int run_sequence(const Options& options, const SequenceOutputs& outputs)
     for (const fs::path& out : outputs.images)
         (is_video(out) ? videos : frames.images).push_back(out);
     if (options.shot.video && videos.empty()) {
-        videos.push_back(options.lsystem.stem().string() + ".mp4");
+        videos.push_back((options.scene ? options.scene->stem() : options.lsystem.stem()).string() +
+                         ".mp4");
         if (options.outputs.empty())
             frames.images.clear();  // not the default still's name
     }

@@ -26,6 +26,9 @@ struct SequenceOutputs {
     /// --mpi: the frames are shared among the job's ranks (app/distributed.h); rank 0
     /// writes every file. Null: every frame here.
     Mpi* mpi = nullptr;
+    /// A scene file's scene (docs/scenes.md): when set, a turntable renders it instead
+    /// of the options' L-system.
+    std::function<geom::Scene()> make_scene;
 };
 
 /// Whether the command renders a sequence (-a or --turntable) instead of a still.

@@ -52,28 +52,6 @@ std::vector<TurtleOp> symbol_ops(const lsys::SymbolTable& symbols)
 /// check sums a few dozen capacities, and the Scene grows by a few hundred bytes a module.
 constexpr std::size_t memory_check_interval = 4096;
 
-/// The bytes the vectors have allocated.
-template <class... Vectors>
-std::size_t vector_bytes(const Vectors&... v)
-{
-    return ((v.capacity() * sizeof(typename Vectors::value_type)) + ...);
-}
-
-std::size_t geometry_bytes(const Geometry& g)
-{
-    const LinearCurves& l = g.lines;
-    const HermiteCurves& c = g.curves;
-    const TriangleMesh& m = g.mesh;
-    return vector_bytes(l.keys, l.v, l.segments, l.flags, l.material, l.texture) +
-           vector_bytes(c.points, c.tangents, c.v, c.segments, c.flags, c.material, c.texture,
-                        c.end_material) +
-           vector_bytes(g.spheres.centres, g.spheres.material, g.spheres.texture) +
-           vector_bytes(g.discs.centres, g.discs.normals, g.discs.material,
-                        g.discs.back_material) +
-           vector_bytes(m.positions, m.normals, m.uvs, m.triangles, m.material,
-                        m.back_material, m.texture);
-}
-
 /// `interpretation past %:` (manual 5.2.3): whether the turtle goes on after a cut in
 /// the string (on, cpfg's default) or skips the rest of the cut branch (off).
 bool interprets_past_cut(const ViewFile& view)

@@ -269,4 +269,39 @@ DroppedGeometry drop_unrenderable(Scene& scene)
     return d;
 }
 
+namespace {
+/// The bytes the vectors have allocated.
+template <class... Vectors>
+std::size_t vector_bytes(const Vectors&... v)
+{
+    return ((v.capacity() * sizeof(typename Vectors::value_type)) + ...);
+}
+
+}  // namespace
+
+std::size_t geometry_bytes(const Geometry& g)
+{
+    const LinearCurves& l = g.lines;
+    const HermiteCurves& c = g.curves;
+    const TriangleMesh& m = g.mesh;
+    return vector_bytes(l.keys, l.v, l.segments, l.flags, l.material, l.texture) +
+           vector_bytes(c.points, c.tangents, c.v, c.segments, c.flags, c.material, c.texture,
+                        c.end_material) +
+           vector_bytes(g.spheres.centres, g.spheres.material, g.spheres.texture) +
+           vector_bytes(g.discs.centres, g.discs.normals, g.discs.material,
+                        g.discs.back_material) +
+           vector_bytes(m.positions, m.normals, m.uvs, m.triangles, m.material,
+                        m.back_material, m.texture);
+}
+
+std::size_t scene_buffer_bytes(const Scene& scene)
+{
+    std::size_t bytes = geometry_bytes(scene.geometry) +
+                        scene.instances.capacity() * sizeof(Instance) +
+                        scene.prototypes.capacity() * sizeof(Prototype);
+    for (const Prototype& p : scene.prototypes)
+        bytes += geometry_bytes(p.geometry);
+    return bytes;
+}
+
 }  // namespace cambium::geom

@@ -62,4 +62,11 @@ struct DroppedGeometry {
 /// max_coordinate, since no camera could frame it.
 DroppedGeometry drop_unrenderable(Scene& scene);
 
+/// The bytes a geometry's primitive arrays have allocated (their capacities): what the
+/// memory budget checks during interpretation.
+std::size_t geometry_bytes(const Geometry& g);
+/// The same for a whole Scene: its geometry, its prototypes' and its instances
+/// (Cambium's own share of a render's memory, --stats).
+std::size_t scene_buffer_bytes(const Scene& scene);
+
 }  // namespace cambium::geom

@@ -106,6 +106,12 @@ void Deriver::start()
     // a state that starts at 0 and that cpfg (the build the corpus oracle comes from)
     // never seeds: RandomMoss (seed: 2454) matches cpfg only this way.
     m_stochastic.set_state(0);
+    if (m_limits.seed) {
+        // A scene's seed override: every stream starts from it instead (docs/scenes.md).
+        m_stochastic.seed(mixed_seed(1, *m_limits.seed));
+        m_runtime.function_random.seed(mixed_seed(2, *m_limits.seed));
+        m_runtime.seed_override = m_limits.seed;
+    }
     if (!m_limits.start)
         return;
     in_block("the Start block");
@@ -719,10 +725,12 @@ void Deriver::homomorphism_located(const ModuleString& in, ModuleString& out,
     // Each pass starts the homomorphism's own random stream afresh from its seed:
     const ProductionSet& main_set = m_program.lsystems.front().homomorphism;
     in_block("the homomorphism's 'seed:' or 'maximum depth:'");
-    m_homomorphism_random.seed(
+    long homomorphism_seed =
         main_set.seed ? static_cast<long>(setting(*main_set.seed, main_set.seed_loc,
                                                   "the homomorphism's seed", LONG_MIN, LONG_MAX))
-                      : 0);
+                      : 0;
+    m_homomorphism_random.seed(m_limits.seed ? mixed_seed(homomorphism_seed, *m_limits.seed)
+                                             : homomorphism_seed);
     std::vector<int> depth_of(m_program.lsystems.size(), 1);
     for (std::size_t l = 0; l < m_program.lsystems.size(); ++l) {
         const ProductionSet& set = m_program.lsystems[l].homomorphism;

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "base/limits.h"
@@ -26,6 +27,8 @@ struct DeriveLimits {
     std::function<double(char, int, double)> curve;
     /// false: neither the Start block nor the axiom (a Deriver for interpretation only)
     bool start = true;
+    /// A scene's seed override of every random stream (LoadOptions::seed)
+    std::optional<long> seed;
 };
 
 /// Where the parameters of one module of a string went in its homomorphism expansion:

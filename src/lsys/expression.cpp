@@ -156,7 +156,9 @@ double call(Function f, const double* a, Runtime& rt)
         return count;
     }
     case Function::Srand:
-        rt.function_random.seed(seed_value(a[0], "srand()"));
+        rt.function_random.seed(rt.seed_override
+                                    ? mixed_seed(seed_value(a[0], "srand()"), *rt.seed_override)
+                                    : seed_value(a[0], "srand()"));
         rt.normal_cached = false;
         return 0;
     case Function::Stop:

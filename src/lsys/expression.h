@@ -105,6 +105,8 @@ struct Runtime {
     const std::vector<std::string>* strings = nullptr;  ///< printf formats
     /// ran/nran/bran/biran: cpfg's erand48 state, 0x330E until srand() sets it
     Rand48 function_random = Rand48::from_state(0x330E);
+    /// A scene's seed override: srand(x) then seeds with mixed_seed(x, override).
+    std::optional<long> seed_override;
     double normal_spare = 0;     ///< nran's cached second deviate
     bool normal_cached = true;   ///< cpfg starts "cached" with a spare of 0
     int derivation_length = 0;

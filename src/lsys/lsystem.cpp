@@ -128,6 +128,7 @@ DeriveLimits limits_of(const LoadOptions& options)
     limits.allow_file_access = options.allow_file_access;
     limits.function = options.function;
     limits.curve = options.curve;
+    limits.seed = options.seed;
     return limits;
 }
 

@@ -44,6 +44,10 @@ struct LoadOptions {
     /// interpretation_string() would join them), and may change parameter values only,
     /// not modules or parameter counts.
     std::function<void(ModuleString&)> query;
+    /// A scene's seed override (docs/scenes.md): every random stream of the derivation
+    /// (stochastic productions, ran() and its kin, the homomorphism's) starts from it,
+    /// and srand(x) seeds with x mixed with it.
+    std::optional<long> seed;
     /// Called with the axiom (step 0) and after every step (cpfg's -V output).
     std::function<void(int step, const ModuleString&)> on_step;
 };

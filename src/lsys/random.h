@@ -35,4 +35,16 @@ private:
     std::uint64_t m_state = 0x1234ABCD330Eull;
 };
 
+/// The seed a stream uses when a scene overrides the model's seeds (docs/scenes.md):
+/// the model's own seed and the override, mixed (SplitMix64's finaliser), so that
+/// each override gives another plant while the model's separate streams stay apart.
+inline long mixed_seed(long model_seed, long override_seed)
+{
+    std::uint64_t z = static_cast<std::uint64_t>(model_seed) * 0x9E3779B97F4A7C15ull +
+                      static_cast<std::uint64_t>(override_seed);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return static_cast<long>(z ^ (z >> 31));
+}
+
 }  // namespace cambium::lsys

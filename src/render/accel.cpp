@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <deque>
@@ -21,6 +22,7 @@
 #include "geom/scene_limits.h"
 #include "render/line_geometry.h"
 #include "render/pixel_lines.h"
+#include "render/ray_counter.h"
 #include "render/texture.h"
 
 namespace cambium::render {
@@ -700,6 +702,21 @@ struct EmbreeScene::Impl : HitResolver {
 
     Vec3f traced(const Vec3f& dir) const { return tilt_rays ? off_axis(dir) : dir; }
     mutable std::atomic<std::uint64_t> skipped_rays{0};
+    RayCounter rays;
+    double build_seconds = 0;
+    /// Embree's own allocations, from its memory monitor (called from any thread).
+    std::atomic<std::int64_t> embree_bytes{0}, embree_peak_bytes{0};
+
+    static bool monitor_memory(void* self, ssize_t bytes, bool /*post*/)
+    {
+        // Refused allocations are undone with a negative call, so the sum stays true.
+        Impl& m = *static_cast<Impl*>(self);
+        std::int64_t now = m.embree_bytes.fetch_add(bytes, std::memory_order_relaxed) + bytes;
+        std::int64_t peak = m.embree_peak_bytes.load(std::memory_order_relaxed);
+        while (now > peak && !m.embree_peak_bytes.compare_exchange_weak(peak, now))
+            ;
+        return true;
+    }
 
     ~Impl()
     {
@@ -976,6 +993,7 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
                          const TextureSet* textures)
     : m_impl(std::make_unique<Impl>())
 {
+    auto start = std::chrono::steady_clock::now();
     Impl& m = *m_impl;
     m.textures = textures;
     m.camera = std::make_unique<const Camera>(camera);
@@ -984,6 +1002,7 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
         throw Error(std::string("Embree: cannot create a device: ") +
                     error_name(rtcGetDeviceError(nullptr)));
     rtcSetDeviceErrorFunction(m.device, &ErrorSink::callback, &m.errors);
+    rtcSetDeviceMemoryMonitorFunction(m.device, &Impl::monitor_memory, &m);
     m.scene = m.new_scene();
 
     const geom::Geometry& own = scene.geometry;
@@ -1045,6 +1064,7 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
         m.top_parts.resize(m.placements.size(), nullptr);
     rtcCommitScene(m.scene);
     m.check("building the Embree scene");
+    m.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 EmbreeScene::~EmbreeScene() = default;
@@ -1052,6 +1072,20 @@ EmbreeScene::~EmbreeScene() = default;
 std::size_t EmbreeScene::segment_count() const { return m_impl->segments; }
 
 std::uint64_t EmbreeScene::skipped_rays() const { return m_impl->skipped_rays.load(); }
+
+double EmbreeScene::build_seconds() const { return m_impl->build_seconds; }
+
+std::uint64_t EmbreeScene::rays_traced() const { return m_impl->rays.total(); }
+
+std::uint64_t EmbreeScene::embree_bytes() const
+{
+    return static_cast<std::uint64_t>(std::max<std::int64_t>(0, m_impl->embree_bytes.load()));
+}
+
+std::uint64_t EmbreeScene::embree_peak_bytes() const
+{
+    return static_cast<std::uint64_t>(m_impl->embree_peak_bytes.load());
+}
 
 namespace {
 
@@ -1090,6 +1124,7 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
                                                  float tfar, PrimId skip, bool coherent) const
 {
     const Impl& m = *m_impl;
+    m.rays.add();
     if (!traceable(org, dir, tnear, tfar)) {
         ++m.skipped_rays;
         return std::nullopt;
@@ -1192,6 +1227,7 @@ std::vector<Shape> EmbreeScene::filtered_shapes() const { return m_impl->filtere
 bool EmbreeScene::occluded(const Vec3f& org, const Vec3f& dir, float tnear, float tfar,
                            PrimId skip) const
 {
+    m_impl->rays.add();
     if (!traceable(org, dir, tnear, tfar)) {
         ++m_impl->skipped_rays;
         return false;

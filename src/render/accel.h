@@ -121,6 +121,15 @@ public:
     /// Number of curve segments (linear and Hermite) of the scene's own geometry.
     std::size_t segment_count() const;
 
+    /// What building and using the scene cost (--stats): the constructor's wall time
+    /// (geometry upload and every rtcCommitScene), rays traced so far by intersect() and
+    /// occluded(), and the bytes Embree allocated itself (its memory monitor: BVHs and
+    /// internal copies, not the Scene's buffers it shares), now and at most.
+    double build_seconds() const;
+    std::uint64_t rays_traced() const;
+    std::uint64_t embree_bytes() const;
+    std::uint64_t embree_peak_bytes() const;
+
 private:
     struct Impl;
     std::unique_ptr<Impl> m_impl;

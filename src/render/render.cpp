@@ -508,6 +508,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         // Embree builds with TBB too, so the build also stays within the arena. One
         // build serves every view, except for pixel-wide lines, whose width is the view's.
         auto accel = std::make_unique<EmbreeScene>(scene, cameras.front(), textures.get());
+        std::uint64_t rays_before = 0;
         PathContext ctx;
         ctx.accel = accel.get();
         ctx.textures = textures.get();
@@ -542,6 +543,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
             accel.reset();  // one BVH at a time
             accel = std::make_unique<EmbreeScene>(scene, camera, textures.get());
             ctx.accel = accel.get();
+            rays_before = 0;  // a new scene counts its rays from 0
         }
         // A parallel camera looks along one direction: its misses would all see the same
         // environment radiance, so they keep cpfg's background there.
@@ -559,6 +561,10 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                         camera.projection() == Camera::Projection::perspective,
                     &nonfinite};
 
+        if (view == 0) {
+            rep.setup_seconds = elapsed();
+            rep.build_seconds = accel->build_seconds();
+        }
         const int tiles_x = (w + tile_size - 1) / tile_size;
         const int tiles_y = (h + tile_size - 1) / tile_size;
         ProgressLine progress(settings.progress, start);
@@ -633,6 +639,10 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         rep.cancelled = cancelled;
         rep.out_of_time = out_of_time;
         rep.skipped_rays = accel->skipped_rays();
+        rep.rays = accel->rays_traced() - rays_before;
+        rays_before += rep.rays;
+        rep.embree_bytes = accel->embree_bytes();
+        rep.embree_peak_bytes = accel->embree_peak_bytes();
         rep.nonfinite_samples = nonfinite.exchange(0);
         if (rep.nonfinite_samples > 0)
             warn("render: " + std::to_string(rep.nonfinite_samples) +

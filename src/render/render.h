@@ -171,6 +171,14 @@ struct RenderReport {
     std::uint64_t nonfinite_samples = 0;  ///< samples with NaN or infinite radiance, counted as black
     std::uint64_t skipped_rays = 0;  ///< rays Embree could not take (EmbreeScene::skipped_rays)
     double seconds = 0;         ///< wall time, including the Embree build
+    /// --stats: from the call to the first sample (textures, the Embree build, lights),
+    /// and of it the Embree build alone (the first view's; 0 for later views).
+    double setup_seconds = 0;
+    double build_seconds = 0;
+    std::uint64_t rays = 0;     ///< rays traced in this view: camera, bounce and shadow rays
+    /// Bytes Embree allocated itself (BVHs, internal copies; not the shared buffers):
+    /// after the build and at most so far.
+    std::uint64_t embree_bytes = 0, embree_peak_bytes = 0;
 };
 
 /// Renders the scene as cpfg frames it (make_camera, plus the settings' thin lens) with

@@ -1,0 +1,8 @@
+/* Meadow herb "grass" (SPDX-License-Identifier: Apache-2.0). */
+initial color: 10
+line style: cylinder
+initial line width: 0.01
+projection: parallel
+viewpoint: 0.6, 0.25, 1
+view reference point: 0, 0, 0
+translucency: 10 0.4

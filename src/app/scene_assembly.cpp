@@ -1,0 +1,536 @@
+// SPDX-License-Identifier: Apache-2.0
+// From a scene file to one geom::Scene.
+//
+// Plants are grouped by (model folder, command line, seed): one group loads its model
+// once and derives each of its step counts once; groups run in parallel (a Model keeps
+// the last derivation's globals for its interpretation, so one Model is never shared
+// between threads). Each plant variant becomes a prototype; each placement an
+// instance. Embree (as Debian builds it) has one instance level, so the organs a plant
+// instances itself (objects, surfaces) are either composed with every placement into
+// top-level instances or drawn into the plant's prototype (OrganPlacement).
+#include "app/scene_assembly.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <numbers>
+#include <sstream>
+
+#include <tbb/parallel_for.h>
+
+#include "app/pipeline.h"
+#include "base/diagnostics.h"
+#include "base/subprocess.h"
+#include "geom/background_scene.h"
+#include "geom/placed_geometry.h"
+#include "render/framing.h"
+#include "render/render.h"
+
+namespace cambium::app {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start)
+{
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// Plants that share a model, its command line and seed: loaded once.
+struct Group {
+    const ScenePlant* first = nullptr;          ///< the entry that named it first
+    std::vector<std::optional<int>> steps;      ///< distinct, in order of appearance
+    std::vector<geom::Scene> variants;          ///< per step, interpreted
+};
+
+std::string group_key(const ScenePlant& p)
+{
+    // The command's words, so spacing does not make two groups of one model.
+    std::string key = p.folder.lexically_normal().string() + '\n';
+    std::istringstream words(p.command);
+    for (std::string w; words >> w;)
+        key += w + ' ';
+    return key + '\n' + (p.seed ? std::to_string(*p.seed) : "-");
+}
+
+/// The options a plant of `group` is derived and interpreted with: the command line's
+/// limits and permissions, the model's files.
+Options plant_options(const Options& options, const ScenePlant& plant)
+{
+    Options o = options;
+    o.lsystem = plant.model.lsystem;
+    o.view = plant.model.view;
+    o.colour_files = plant.model.colour_files;
+    o.colour_block = plant.model.colour_block;
+    o.lsystem_seed = plant.seed;
+    o.homomorphism_in_string = false;
+    o.string_text.reset();
+    o.string_binary.reset();
+    o.view_volume.reset();
+    o.verbosity = Verbosity::normal;
+    return o;
+}
+
+struct Timing {
+    std::atomic<std::int64_t> load_us{0}, derive_us{0}, interpret_us{0};
+    std::atomic<std::size_t> models{0}, derivations{0};
+    void add(std::atomic<std::int64_t>& to, Clock::time_point start)
+    {
+        to += std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - start).count();
+    }
+};
+
+void derive_group(Group& g, const SceneFile& file, const Options& options, Timing& t)
+{
+    try {
+        Options o = plant_options(options, *g.first);
+        auto start = Clock::now();
+        Model model = load_model(o);
+        t.add(t.load_us, start);
+        ++t.models;
+        for (const std::optional<int>& steps : g.steps) {
+            o.steps = steps;
+            start = Clock::now();
+            lsys::ModuleString derived = derive(model, o);
+            t.add(t.derive_us, start);
+            ++t.derivations;
+            start = Clock::now();
+            g.variants.push_back(interpret(model, derived, o));
+            t.add(t.interpret_us, start);
+        }
+    } catch (const Interrupted&) {
+        throw;
+    } catch (const Error& e) {
+        throw Error(file.file.string() + ": " + g.first->path + " (" + g.first->command +
+                    "): " + e.what());
+    }
+}
+
+bool same_materials(const std::vector<geom::Material>& a, const std::vector<geom::Material>& b)
+{
+    return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                      [](const geom::Material& x, const geom::Material& y) {
+                          return x.ambient == y.ambient && x.diffuse == y.diffuse &&
+                                 x.emission == y.emission && x.specular == y.specular &&
+                                 x.shininess == y.shininess && x.transparency == y.transparency &&
+                                 x.translucency == y.translucency;
+                      });
+}
+
+bool same_textures(const std::vector<geom::TextureDef>& a, const std::vector<geom::TextureDef>& b)
+{
+    return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                      [](const geom::TextureDef& x, const geom::TextureDef& y) {
+                          return x.file == y.file && x.decal == y.decal &&
+                                 x.linear_filter == y.linear_filter && x.mipmap == y.mipmap;
+                      });
+}
+
+/// A plant variant ready to place: its prototype, its organs' instances in its own
+/// frame, its bounds.
+struct PlacedVariant {
+    std::optional<std::uint32_t> prototype;    ///< none when it drew nothing
+    std::vector<geom::Instance> organs;        ///< compose: placed with every placement
+    geom::Geometry flat;                       ///< inline_plants: everything, organs drawn
+    geom::Bounds3 bounds;
+};
+
+/// Builds the combined scene's tables (materials, textures, prototypes) from the
+/// variants, one palette per distinct palette (plants keep their colours).
+class Combiner {
+public:
+    Combiner(geom::Scene& out, const AssemblyOptions& how, const SceneFile& file)
+        : m_out(out), m_how(how), m_file(file)
+    {
+    }
+
+    PlacedVariant add(geom::Scene& variant, const ScenePlant& plant)
+    {
+        std::uint16_t material_offset = palette_offset(variant.materials);
+        std::int16_t texture_offset = texture_table_offset(variant.textures, plant);
+        auto shift_instance = [&](geom::Instance inst) {
+            if (inst.material != geom::inherit_material)
+                inst.material = static_cast<std::uint16_t>(inst.material + material_offset);
+            if (inst.back_material != geom::inherit_material)
+                inst.back_material = static_cast<std::uint16_t>(inst.back_material + material_offset);
+            if (inst.texture != geom::no_texture)
+                inst.texture = static_cast<std::int16_t>(inst.texture + texture_offset);
+            return inst;
+        };
+        for (geom::Prototype& p : variant.prototypes) {
+            geom::offset_materials(p.geometry, material_offset);
+            geom::offset_textures(p.geometry, texture_offset);
+        }
+        geom::offset_materials(variant.geometry, material_offset);
+        geom::offset_textures(variant.geometry, texture_offset);
+
+        PlacedVariant v;
+        v.bounds = variant.bounds;
+        bool flatten = m_how.organs == OrganPlacement::flatten || m_how.inline_plants;
+        if (flatten) {
+            for (const geom::Instance& i : variant.instances) {
+                geom::Geometry organ = variant.prototypes.at(i.prototype).geometry;
+                geom::place_geometry(organ, shift_instance(i));
+                geom::append_geometry(variant.geometry, organ);
+            }
+        } else {
+            std::vector<std::uint32_t> index(variant.prototypes.size());
+            for (std::size_t k = 0; k < variant.prototypes.size(); ++k) {
+                index[k] = static_cast<std::uint32_t>(m_out.prototypes.size());
+                m_out.prototypes.push_back(std::move(variant.prototypes[k]));
+            }
+            for (const geom::Instance& i : variant.instances) {
+                geom::Instance organ = shift_instance(i);
+                organ.prototype = index.at(i.prototype);
+                v.organs.push_back(organ);
+            }
+        }
+        if (m_how.inline_plants) {
+            v.flat = std::move(variant.geometry);
+        } else if (!variant.geometry.empty()) {
+            v.prototype = static_cast<std::uint32_t>(m_out.prototypes.size());
+            m_out.prototypes.push_back({plant.path, std::move(variant.geometry)});
+        }
+        return v;
+    }
+
+private:
+    /// The offset of `materials` in the combined table: shared with an equal palette
+    /// added before (the variants of one model), appended otherwise.
+    std::uint16_t palette_offset(const std::vector<geom::Material>& materials)
+    {
+        for (const auto& [offset, size] : m_palettes)
+            if (size == materials.size() &&
+                same_materials(materials, {m_out.materials.begin() + offset,
+                                           m_out.materials.begin() + offset + long(size)}))
+                return static_cast<std::uint16_t>(offset);
+        std::size_t offset = m_out.materials.size();
+        // inherit_material (0xffff) is reserved
+        if (offset + materials.size() >= geom::inherit_material)
+            throw Error(m_file.file.string() + ": plants: the plants' palettes need more than " +
+                        std::to_string(geom::inherit_material - 1) +
+                        " materials together (about 250 distinct models or colour blocks)");
+        m_out.materials.insert(m_out.materials.end(), materials.begin(), materials.end());
+        m_palettes.emplace_back(offset, materials.size());
+        return static_cast<std::uint16_t>(offset);
+    }
+
+    /// The same for textures, whose files become absolute (relative to each model's
+    /// view file, as cpfg reads them).
+    std::int16_t texture_table_offset(std::vector<geom::TextureDef> textures, const ScenePlant& plant)
+    {
+        for (geom::TextureDef& t : textures)
+            if (t.file.is_relative())
+                t.file = fs::absolute(plant.model.view.parent_path() / t.file);
+        for (const auto& [offset, size] : m_texture_tables)
+            if (size == textures.size() &&
+                same_textures(textures, {m_out.textures.begin() + offset,
+                                         m_out.textures.begin() + offset + long(size)}))
+                return static_cast<std::int16_t>(offset);
+        std::size_t offset = m_out.textures.size();
+        if (offset + textures.size() > 32767)
+            throw Error(m_file.file.string() + ": plants: the plants name more than 32767 textures");
+        m_out.textures.insert(m_out.textures.end(), textures.begin(), textures.end());
+        m_texture_tables.emplace_back(offset, textures.size());
+        return static_cast<std::int16_t>(offset);
+    }
+
+    geom::Scene& m_out;
+    const AssemblyOptions& m_how;
+    const SceneFile& m_file;
+    std::vector<std::pair<std::size_t, std::size_t>> m_palettes, m_texture_tables;
+};
+
+geom::Bounds3 placed_bounds(const geom::Bounds3& b, const Transform& t)
+{
+    geom::Bounds3 out;
+    if (b.empty())
+        return out;
+    for (int i = 0; i < 8; ++i) {
+        double x = (i & 1) ? b.hi.x : b.lo.x, y = (i & 2) ? b.hi.y : b.lo.y,
+               z = (i & 4) ? b.hi.z : b.lo.z;
+        out.extend(geom::Vec3{t[0] * x + t[3] * y + t[6] * z + t[9], t[1] * x + t[4] * y + t[7] * z + t[10],
+                              t[2] * x + t[5] * y + t[8] * z + t[11]});
+    }
+    return out;
+}
+
+// ---- ground -------------------------------------------------------------------
+
+void add_ground(geom::Scene& out, const SceneGround& ground, const SceneLimits& limits)
+{
+    geom::Material soil;
+    soil.diffuse = ground.texture ? geom::Rgb{1, 1, 1} : ground.colour;
+    soil.ambient = soil.diffuse;
+    soil.specular = {0, 0, 0};
+    if (out.materials.size() + 1 >= geom::inherit_material)
+        throw Error("scene: no material left for the ground");
+    auto material = static_cast<std::uint16_t>(out.materials.size());
+    out.materials.push_back(soil);
+    std::int16_t texture = geom::no_texture;
+    if (ground.texture) {
+        geom::TextureDef def;
+        def.file = fs::absolute(*ground.texture);
+        texture = static_cast<std::int16_t>(out.textures.size());
+        out.textures.push_back(def);
+    }
+
+    GroundMesh mesh;
+    if (ground.size) {
+        float w = float((*ground.size)[0] / 2), d = float((*ground.size)[1] / 2);
+        mesh.positions = {{-w, 0, -d}, {w, 0, -d}, {w, 0, d}, {-w, 0, d}};
+        // counter-clockwise seen from above: the front faces +y
+        mesh.triangles = {{0, 2, 1}, {0, 3, 2}};
+    } else {
+        mesh = read_obj_mesh(*ground.mesh, limits.max_mesh_triangles);
+    }
+    geom::Bounds3 extent;
+    for (const geom::Float3& p : mesh.positions)
+        extent.extend(geom::Vec3{p[0], p[1], p[2]});
+    double size_x = std::max(extent.hi.x - extent.lo.x, 1e-9);
+    double size_z = std::max(extent.hi.z - extent.lo.z, 1e-9);
+    // Flat faces, each with its own corners: the face normal, uv planar over x and z.
+    geom::TriangleMesh& m = out.geometry.mesh;
+    m.texture.resize(m.triangles.size(), geom::no_texture);
+    for (const auto& t : mesh.triangles) {
+        geom::Vec3 c[3];
+        for (int k = 0; k < 3; ++k) {
+            const geom::Float3& p = mesh.positions[t[std::size_t(k)]];
+            c[k] = {p[0], p[1], p[2]};
+        }
+        geom::Vec3 n = geom::normalize(geom::cross(c[1] - c[0], c[2] - c[0]));
+        auto base = static_cast<std::uint32_t>(m.positions.size());
+        for (const geom::Vec3& p : c) {
+            m.positions.push_back({float(p.x), float(p.y), float(p.z)});
+            m.normals.push_back({float(n.x), float(n.y), float(n.z)});
+            m.uvs.push_back({float((p.x - extent.lo.x) / size_x * ground.texture_repeat),
+                             float((p.z - extent.lo.z) / size_z * ground.texture_repeat)});
+        }
+        m.triangles.push_back({base, base + 1, base + 2});
+        m.material.push_back(material);
+        m.back_material.push_back(material);
+        m.texture.push_back(texture);
+    }
+    out.bounds.extend(extent);
+}
+
+// ---- camera and lights ----------------------------------------------------------
+
+/// The view's twist that turns cpfg's up (+y, projected) into `up`.
+double twist_for(const geom::Vec3& forward, const geom::Vec3& up)
+{
+    geom::Vec3 y{0, 1, 0};
+    if (std::abs(geom::dot(forward, y)) > 1 - 1e-12)
+        return 0;  // straight up or down: cpfg's own choice stands
+    geom::Vec3 right = geom::normalize(geom::cross(forward, y));
+    geom::Vec3 up0 = geom::cross(right, forward);
+    geom::Vec3 wanted = up - forward * geom::dot(up, forward);
+    if (geom::length(wanted) < 1e-12)
+        throw Error("scene: camera.up points along the view direction");
+    wanted = geom::normalize(wanted);
+    // positive twist turns up counter-clockwise about -forward (render::view_frame)
+    double angle = std::atan2(geom::dot(geom::cross(up0, wanted), forward * -1.0),
+                              geom::dot(up0, wanted));
+    return angle * 180 / std::numbers::pi;
+}
+
+geom::View scene_view(const SceneFile& file, const geom::Bounds3& bounds)
+{
+    SceneCamera cam = file.camera.value_or(SceneCamera{});
+    geom::View view;
+    view.perspective = cam.perspective;
+    view.viewing_angle_deg = cam.fov_deg;
+    geom::Bounds3 b = bounds;
+    if (b.empty())
+        b.extend(geom::Vec3{0, 0, 0});
+    geom::Vec3 centre = b.center();
+    if (cam.eye && cam.look_at) {
+        view.viewpoint = *cam.eye;
+        view.reference_point = *cam.look_at;
+    } else {
+        // Framed from the front, a little above, unless the file says where.
+        view.reference_point = cam.look_at.value_or(centre);
+        geom::Vec3 from = cam.eye.value_or(view.reference_point + geom::Vec3{0, 0.5, 1});
+        view.viewpoint = from;
+        if (!cam.eye) {
+            render::ViewOverrides fit;
+            fit.fit = true;
+            view = render::apply_overrides(view, fit, b);
+        }
+    }
+    geom::Vec3 forward = geom::normalize(view.reference_point - view.viewpoint);
+    view.twist_deg = twist_for(forward, cam.up);
+    return view;
+}
+
+std::vector<geom::Light> scene_lights(const SceneFile& file)
+{
+    if (!file.lights.empty() || file.sky || file.environment)
+        return file.lights;  // the sky's sun, or the map, lights the scene
+    // A white sun from the front right, high: a daylight default.
+    geom::Light sun;
+    sun.kind = geom::Light::Kind::directional;
+    sun.direction = geom::normalize(geom::Vec3{0.4, 1, 0.6});
+    sun.ambient = {0, 0, 0};
+    return {sun};
+}
+
+}  // namespace
+
+geom::Scene assemble_scene(const SceneFile& file, const Options& options,
+                           const AssemblyOptions& how, AssemblyReport* report)
+{
+    auto start = Clock::now();
+    // Group the entries and their steps: each distinct variant derived once.
+    std::vector<Group> groups;
+    std::map<std::string, std::size_t> group_of_key;
+    struct EntryRef {
+        std::size_t group;
+        std::vector<std::size_t> variants;  ///< per entry step: index in the group
+    };
+    std::vector<EntryRef> entries;
+    for (const ScenePlant& p : file.plants) {
+        auto [it, added] = group_of_key.emplace(group_key(p), groups.size());
+        if (added)
+            groups.push_back(Group{&p, {}, {}});
+        Group& g = groups[it->second];
+        EntryRef e{it->second, {}};
+        for (const std::optional<int>& s : p.steps) {
+            auto found = std::find(g.steps.begin(), g.steps.end(), s);
+            e.variants.push_back(static_cast<std::size_t>(found - g.steps.begin()));
+            if (found == g.steps.end())
+                g.steps.push_back(s);
+        }
+        entries.push_back(std::move(e));
+    }
+
+    Timing timing;
+    tbb::parallel_for(std::size_t{0}, groups.size(), [&](std::size_t i) {
+        derive_group(groups[i], file, options, timing);
+    });
+
+    geom::Scene out;
+    out.materials.clear();
+    Combiner combiner(out, how, file);
+    std::vector<std::vector<PlacedVariant>> placed(groups.size());
+    bool pixel_lines = false;
+    for (std::size_t gi = 0; gi < groups.size(); ++gi) {
+        Group& g = groups[gi];
+        for (geom::Scene& variant : g.variants) {
+            if (gi == 0 && placed[0].empty()) {
+                pixel_lines = variant.line_radius_in_pixels;
+                out.shading = variant.shading;
+                out.background = variant.background;
+            } else if (variant.line_radius_in_pixels != pixel_lines) {
+                throw Error(file.file.string() + ": " + g.first->path +
+                            ": its view file's `line style: pixel` differs from " +
+                            groups[0].first->path + "'s; one scene has one line style");
+            }
+            placed[gi].push_back(combiner.add(variant, *g.first));
+            variant = geom::Scene{};  // its geometry moved; free the rest
+        }
+    }
+    out.line_radius_in_pixels = pixel_lines;
+
+    // Placements: entry e's placement i gets its (i mod steps)-th variant.
+    AssemblyReport r;
+    for (std::size_t e = 0; e < file.plants.size(); ++e) {
+        const ScenePlant& plant = file.plants[e];
+        const EntryRef& ref = entries[e];
+        for (std::size_t i = 0; i < plant.placements.size(); ++i) {
+            const PlacedVariant& v = placed[ref.group][ref.variants[i % ref.variants.size()]];
+            const Transform& t = plant.placements[i];
+            out.bounds.extend(placed_bounds(v.bounds, t));
+            ++r.plant_instances;
+            if (how.inline_plants) {
+                geom::Geometry copy = v.flat;
+                geom::Instance where;
+                where.transform = t;
+                geom::place_geometry(copy, where);
+                geom::append_geometry(out.geometry, copy);
+                continue;
+            }
+            if (v.prototype) {
+                geom::Instance plant_instance;
+                plant_instance.prototype = *v.prototype;
+                plant_instance.transform = t;
+                out.instances.push_back(plant_instance);
+            }
+            for (geom::Instance organ : v.organs) {
+                organ.transform = compose(t, organ.transform);
+                out.instances.push_back(organ);
+                ++r.organ_instances;
+            }
+        }
+    }
+    if (file.ground)
+        add_ground(out, *file.ground, SceneLimits{});
+    out.view = scene_view(file, out.bounds);
+    out.lights = scene_lights(file);
+
+    r.models_loaded = timing.models;
+    r.derivations = timing.derivations;
+    r.load_s = double(timing.load_us) * 1e-6;
+    r.derive_s = double(timing.derive_us) * 1e-6;
+    r.interpret_s = double(timing.interpret_us) * 1e-6;
+    r.wall_s = seconds_since(start);
+    if (report)
+        *report = r;
+    return out;
+}
+
+void apply_scene_settings(const SceneFile& file, Options& o)
+{
+    auto unless = [&](const char* option, auto& field, const auto& value) {
+        if (value && !o.was_given(option))
+            field = *value;
+    };
+    if (file.camera && !o.was_given("-w")) {
+        if (file.camera->width)
+            o.width = *file.camera->width;
+        if (file.camera->height)
+            o.height = *file.camera->height;
+        if (std::int64_t(o.width) * o.height > render::max_image_pixels)
+            throw Error(file.file.string() + ": camera: " + std::to_string(o.width) + " x " +
+                        std::to_string(o.height) + " is more than 8192 x 8192 pixels");
+    }
+    const SceneRender& r = file.render;
+    unless("--spp", o.samples_per_pixel, r.spp);
+    unless("--max-depth", o.max_depth, r.max_depth);
+    unless("--seed", o.seed, r.seed);
+    unless("--noise-target", o.noise_target, r.noise_target);
+    unless("--time-budget", o.time_budget_s, r.time_budget_s);
+    unless("--exposure", o.exposure, r.exposure);
+    unless("--ambient", o.ambient, r.ambient);
+    unless("--filter", o.filter, r.filter);
+    unless("--tonemap", o.shot.tonemap, r.tonemap);
+    if (r.background && !o.was_given("--background"))
+        o.shot.background = r.background;
+    // As on the command line: a budget or a noise target decides when to stop.
+    if (!r.spp && !o.was_given("--spp")) {
+        if (o.time_budget_s > 0 && !o.was_given("--time-budget"))
+            o.samples_per_pixel = 1 << 16;
+        else if (o.noise_target > 0 && !o.was_given("--noise-target"))
+            o.samples_per_pixel = 4096;
+    }
+    // The command line's --sky or --env replaces the file's sky or environment.
+    bool lighting_given = o.was_given("--sky") || o.was_given("--env");
+    if (file.sky && !lighting_given) {
+        o.sky = true;
+        if (file.sky->sun && !o.was_given("--sun"))
+            o.sun_direction.assign(file.sky->sun->begin(), file.sky->sun->end());
+        unless("--turbidity", o.turbidity, std::optional<float>(file.sky->turbidity));
+    }
+    if (file.environment && !lighting_given) {
+        o.environment_map = file.environment->map;
+        unless("--env-scale", o.environment_scale, std::optional<float>(file.environment->scale));
+        unless("--env-rotate", o.environment_rotation,
+               std::optional<float>(file.environment->rotate_deg));
+    }
+}
+
+}  // namespace cambium::app

@@ -1,0 +1,207 @@
+// SPDX-License-Identifier: Apache-2.0
+// --stats and --stats-json.
+#include "app/stats.h"
+
+#include <sys/resource.h>
+
+#include <fstream>
+#include <string>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "base/atomic_file.h"
+#include "base/diagnostics.h"
+#include "geom/scene_limits.h"
+
+namespace cambium::app {
+
+PrimitiveCounts& PrimitiveCounts::operator+=(const PrimitiveCounts& o)
+{
+    cylinders += o.cylinders;
+    curve_segments += o.curve_segments;
+    spheres += o.spheres;
+    discs += o.discs;
+    triangles += o.triangles;
+    return *this;
+}
+
+PrimitiveCounts count_primitives(const geom::Geometry& g)
+{
+    return {g.lines.segment_count(), g.curves.segment_count(), g.spheres.size(), g.discs.size(),
+            g.mesh.size()};
+}
+
+void RunStats::add_assembly(double load, double derive, double interpret, double wall)
+{
+    load_s = load;
+    derive_s = derive;
+    interpret_s = interpret;
+    assemble_s = wall;
+}
+
+void RunStats::add_scene(const geom::Scene& scene)
+{
+    interpreted = true;
+    primitives = count_primitives(scene.geometry);
+    placed_primitives = primitives;
+    std::vector<PrimitiveCounts> per_prototype;
+    for (const geom::Prototype& p : scene.prototypes) {
+        per_prototype.push_back(count_primitives(p.geometry));
+        primitives += per_prototype.back();
+    }
+    for (const geom::Instance& i : scene.instances)
+        if (i.prototype < per_prototype.size())
+            placed_primitives += per_prototype[i.prototype];
+    instances = scene.instances.size();
+    prototypes = scene.prototypes.size();
+    cambium_bytes = geom::scene_buffer_bytes(scene);
+}
+
+void RunStats::add_render(const render::RenderReport& report, double render_start_s, int w, int h)
+{
+    rendered = true;
+    build_s = report.build_seconds;
+    first_pixel_s = render_start_s + report.setup_seconds;
+    render_s = report.seconds - report.setup_seconds;
+    width = w;
+    height = h;
+    samples = report.samples;
+    rays = report.rays;
+    embree_bytes = report.embree_bytes;
+    embree_peak_bytes = report.embree_peak_bytes;
+}
+
+std::uint64_t peak_process_bytes()
+{
+    // VmHWM is the kernel's high-water mark of the resident set, in kB.
+    std::ifstream status("/proc/self/status");
+    std::string key;
+    while (status >> key) {
+        if (key == "VmHWM:") {
+            std::uint64_t kb = 0;
+            status >> kb;
+            return kb * 1024;
+        }
+        status.ignore(1 << 16, '\n');
+    }
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024;  // KiB on Linux
+}
+
+namespace {
+
+double per_second(double count, double seconds) { return seconds > 0 ? count / seconds : 0; }
+
+double per_primitive(std::uint64_t bytes, std::uint64_t primitives)
+{
+    return primitives > 0 ? double(bytes) / double(primitives) : 0;
+}
+
+std::string mib(std::uint64_t bytes) { return fmt::format("{:.1f} MiB", double(bytes) / (1 << 20)); }
+
+nlohmann::json counts_json(const PrimitiveCounts& c)
+{
+    return {{"cylinders", c.cylinders}, {"curve_segments", c.curve_segments},
+            {"spheres", c.spheres},     {"discs", c.discs},
+            {"triangles", c.triangles}, {"total", c.total()}};
+}
+
+std::string counts_line(const PrimitiveCounts& c)
+{
+    return fmt::format("{} ({} cylinders, {} curve segments, {} spheres, {} discs, {} triangles)",
+                       c.total(), c.cylinders, c.curve_segments, c.spheres, c.discs, c.triangles);
+}
+
+/// Primitives Embree holds: each built once, plus one per instance.
+std::uint64_t embree_primitives(const RunStats& s) { return s.primitives.total() + s.instances; }
+
+}  // namespace
+
+std::string format_stats(const RunStats& s)
+{
+    std::string out = "statistics\n";
+    out += fmt::format("  load {:.3f} s, derive {:.3f} s, interpret {:.3f} s (together {:.3f} s), "
+                       "build {:.3f} s\n",
+                       s.load_s, s.derive_s, s.interpret_s, s.assemble_s, s.build_s);
+    if (s.rendered)
+        out += fmt::format("  time to first pixel {:.3f} s, rendering {:.3f} s\n", s.first_pixel_s,
+                           s.render_s);
+    if (s.interpreted) {
+        out += "  primitives " + counts_line(s.primitives) + "\n";
+        out += fmt::format("  {} instances of {} prototypes; placed primitives {}\n", s.instances,
+                           s.prototypes, s.placed_primitives.total());
+    } else {
+        out += "  not interpreted (string outputs only)\n";
+    }
+    std::uint64_t n = embree_primitives(s);
+    if (s.rendered)
+        out += fmt::format("  memory: Embree {} (peak {}, {:.1f} B per primitive), Cambium {} "
+                           "({:.1f} B per primitive)\n",
+                           mib(s.embree_bytes), mib(s.embree_peak_bytes),
+                           per_primitive(s.embree_bytes, n), mib(s.cambium_bytes),
+                           per_primitive(s.cambium_bytes, n));
+    else if (s.interpreted)
+        out += "  memory: Cambium " + mib(s.cambium_bytes) + "\n";
+    out += "  peak process memory " + mib(s.peak_process_bytes) + "\n";
+    if (s.rendered)
+        out += fmt::format("  {}x{}: {} samples, {} rays; {:.3g} samples/s, {:.3g} rays/s\n",
+                           s.width, s.height, s.samples, s.rays,
+                           per_second(double(s.samples), s.render_s),
+                           per_second(double(s.rays), s.render_s));
+    return out;
+}
+
+nlohmann::json stats_json(const RunStats& s)
+{
+    std::uint64_t n = embree_primitives(s);
+    nlohmann::json j;
+    j["interpreted"] = s.interpreted;
+    j["rendered"] = s.rendered;
+    j["times_s"] = {{"load", s.load_s},
+                    {"derive", s.derive_s},
+                    {"interpret", s.interpret_s},
+                    {"assemble", s.assemble_s},
+                    {"build", s.build_s},
+                    {"first_pixel", s.rendered ? nlohmann::json(s.first_pixel_s) : nullptr},
+                    {"render", s.render_s}};
+    j["primitives"] = counts_json(s.primitives);
+    j["placed_primitives"] = counts_json(s.placed_primitives);
+    j["instances"] = s.instances;
+    j["prototypes"] = s.prototypes;
+    j["memory_bytes"] = {{"embree", s.embree_bytes},
+                         {"embree_peak", s.embree_peak_bytes},
+                         {"cambium", s.cambium_bytes},
+                         {"peak_process", s.peak_process_bytes}};
+    // Cambium's buffers are what Embree shares instead of copying: (Embree + Cambium) /
+    // Embree is the memory per primitive relative to Embree's own.
+    j["bytes_per_primitive"] = {
+        {"embree", per_primitive(s.embree_bytes, n)},
+        {"cambium", per_primitive(s.cambium_bytes, n)},
+        {"peak_process", per_primitive(s.peak_process_bytes, n)},
+        {"ratio_to_embree", s.embree_bytes > 0
+                                ? double(s.embree_bytes + s.cambium_bytes) / double(s.embree_bytes)
+                                : 0.0}};
+    j["render"] = {{"width", s.width},
+                   {"height", s.height},
+                   {"samples", s.samples},
+                   {"rays", s.rays},
+                   {"samples_per_s", per_second(double(s.samples), s.render_s)},
+                   {"rays_per_s", per_second(double(s.rays), s.render_s)}};
+    return j;
+}
+
+void write_stats_json(const RunStats& stats, const std::filesystem::path& file)
+{
+    std::string text = stats_json(stats).dump(2) + "\n";
+    write_file_atomically(file, [&](const std::filesystem::path& temporary) {
+        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+        out << text;
+        out.close();
+        if (!out)
+            throw Error(FileLoc{file.string()}, "cannot be written");
+    });
+}
+
+}  // namespace cambium::app

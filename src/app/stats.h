@@ -1,0 +1,75 @@
+// SPDX-License-Identifier: Apache-2.0
+// --stats and --stats-json: where a run's time and memory went, from the files to the
+// first pixel and through the render.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "geom/scene.h"
+#include "render/render.h"
+
+namespace cambium::app {
+
+/// Primitives by kind, as Embree builds them.
+struct PrimitiveCounts {
+    std::uint64_t cylinders = 0;       ///< linear segments (F, G)
+    std::uint64_t curve_segments = 0;  ///< generalized-cylinder Hermite segments
+    std::uint64_t spheres = 0, discs = 0, triangles = 0;
+
+    std::uint64_t total() const { return cylinders + curve_segments + spheres + discs + triangles; }
+    PrimitiveCounts& operator+=(const PrimitiveCounts& o);
+};
+
+PrimitiveCounts count_primitives(const geom::Geometry& g);
+
+/// One run's statistics. Times are wall seconds; `first_pixel_s` counts from the start
+/// of the command (main), so it holds load, derive, interpret and build and whatever lies
+/// between (string outputs, textures, lights).
+struct RunStats {
+    /// For a scene file, whose plants are loaded, derived and interpreted in parallel,
+    /// load, derive and interpret are summed over threads and `assemble_s` is the wall
+    /// time of the whole; for one model, `assemble_s` is their sum.
+    double load_s = 0, derive_s = 0, interpret_s = 0, assemble_s = 0, build_s = 0;
+    double first_pixel_s = 0;
+    double render_s = 0;  ///< sampling, after the first pixel
+    bool interpreted = false, rendered = false;
+
+    /// Built once: the scene's own geometry and its prototypes'.
+    PrimitiveCounts primitives;
+    /// As drawn: the scene's own plus each instance's prototype.
+    PrimitiveCounts placed_primitives;
+    std::uint64_t instances = 0, prototypes = 0;
+
+    std::uint64_t embree_bytes = 0, embree_peak_bytes = 0;
+    std::uint64_t cambium_bytes = 0;  ///< the Scene's primitive buffers (capacities)
+    std::uint64_t peak_process_bytes = 0;
+
+    int width = 0, height = 0;
+    std::uint64_t samples = 0, rays = 0;
+
+    /// A scene file's assembly: thread-summed load, derive and interpret, and its wall time.
+    void add_assembly(double load, double derive, double interpret, double wall);
+    /// Counts the scene's primitives, instances and buffer bytes.
+    void add_scene(const geom::Scene& scene);
+    /// Takes the render's build time, rays, samples and Embree memory; `render_start_s`
+    /// is when render() was called, counted from the start of the command.
+    void add_render(const render::RenderReport& report, double render_start_s, int w, int h);
+};
+
+/// The process's peak resident memory (VmHWM; getrusage's ru_maxrss where /proc is absent).
+std::uint64_t peak_process_bytes();
+
+/// The readable block --stats prints.
+std::string format_stats(const RunStats& stats);
+
+/// The JSON --stats-json writes (keys in docs/architecture.md, "Statistics").
+nlohmann::json stats_json(const RunStats& stats);
+
+/// Writes stats_json() to `file` atomically. Throws cambium::Error naming the file.
+void write_stats_json(const RunStats& stats, const std::filesystem::path& file);
+
+}  // namespace cambium::app

@@ -1,0 +1,190 @@
+// SPDX-License-Identifier: Apache-2.0
+// --stats and --stats-json on a plant whose primitives are known, and string-only runs
+// that interpret nothing (issue 16.6).
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// F[+F]F: 3 cylinders; @O a sphere, @c a disc; a four-corner polygon: 2 triangles.
+const char* known_plant =
+    "lsystem: 1\nderivation length: 1\naxiom: A\n"
+    "A --> F[+F]F@O(0.5)@c(0.5){.f.+f.+f.}\nendlsystem\n";
+
+struct RunResult {
+    fs::path dir;
+    int status = 0;
+    std::string output;
+};
+
+/// Runs cambium on the known plant in a fresh folder with `args`.
+RunResult run_known_plant(const std::string& name, const std::string& args)
+{
+    RunResult r;
+    r.dir = fs::temp_directory_path() / ("cambium_stats_" + name + "_" + std::to_string(::getpid()));
+    fs::remove_all(r.dir);
+    fs::create_directories(r.dir);
+    std::ofstream(r.dir / "p.l") << known_plant;
+    std::ofstream(r.dir / "p.v") << "line style: cylinder\ninitial line width: 0.2\n";
+    std::string command = "cd '" + r.dir.string() + "' && " + CAMBIUM_EXE + " p.l p.v " + args +
+                          " > out.txt 2>&1";
+    r.status = std::system(command.c_str());
+    std::ifstream in(r.dir / "out.txt");
+    r.output.assign(std::istreambuf_iterator<char>(in), {});
+    return r;
+}
+
+nlohmann::json read_json(const fs::path& file)
+{
+    std::ifstream in(file);
+    return nlohmann::json::parse(in);
+}
+
+/// The keys docs/architecture.md ("Statistics") documents.
+void expect_documented_keys(const nlohmann::json& j)
+{
+    for (const char* key : {"interpreted", "rendered", "times_s", "primitives", "placed_primitives",
+                            "instances", "prototypes", "memory_bytes", "bytes_per_primitive",
+                            "render"})
+        EXPECT_TRUE(j.contains(key)) << key;
+    for (const char* key : {"load", "derive", "interpret", "assemble", "build", "first_pixel", "render"})
+        EXPECT_TRUE(j["times_s"].contains(key)) << key;
+    for (const char* group : {"primitives", "placed_primitives"})
+        for (const char* key : {"cylinders", "curve_segments", "spheres", "discs", "triangles", "total"})
+            EXPECT_TRUE(j[group].contains(key)) << group << "." << key;
+    for (const char* key : {"embree", "embree_peak", "cambium", "peak_process"})
+        EXPECT_TRUE(j["memory_bytes"].contains(key)) << key;
+    for (const char* key : {"embree", "cambium", "peak_process", "ratio_to_embree"})
+        EXPECT_TRUE(j["bytes_per_primitive"].contains(key)) << key;
+    for (const char* key : {"width", "height", "samples", "rays", "samples_per_s", "rays_per_s"})
+        EXPECT_TRUE(j["render"].contains(key)) << key;
+}
+
+TEST(Stats, JsonCountsTheScenesPrimitivesAndTimesAddUp)
+{
+    RunResult r = run_known_plant("render", "-w 32 24 --spp 2 -o p.png --stats-json stats.json");
+    ASSERT_EQ(r.status, 0) << r.output;
+    nlohmann::json j = read_json(r.dir / "stats.json");
+    expect_documented_keys(j);
+    EXPECT_TRUE(j["interpreted"].get<bool>());
+    EXPECT_TRUE(j["rendered"].get<bool>());
+    const nlohmann::json& p = j["primitives"];
+    EXPECT_EQ(p["cylinders"], 3);
+    EXPECT_EQ(p["curve_segments"], 0);
+    EXPECT_EQ(p["spheres"], 1);
+    EXPECT_EQ(p["discs"], 1);
+    EXPECT_EQ(p["triangles"], 2);
+    EXPECT_EQ(p["total"], 7);
+    EXPECT_EQ(j["placed_primitives"], p);  // no instances
+    EXPECT_EQ(j["instances"], 0);
+
+    const nlohmann::json& t = j["times_s"];
+    double parts = 0;
+    for (const char* key : {"load", "derive", "interpret", "build", "render"}) {
+        EXPECT_GE(t[key].get<double>(), 0) << key;
+        if (std::string(key) != "render")
+            parts += t[key].get<double>();
+    }
+    EXPECT_GT(t["build"].get<double>(), 0);
+    EXPECT_LE(parts, t["first_pixel"].get<double>());
+    EXPECT_NEAR(t["assemble"].get<double>(),
+                t["load"].get<double>() + t["derive"].get<double>() + t["interpret"].get<double>(),
+                1e-9);
+
+    const nlohmann::json& render = j["render"];
+    EXPECT_EQ(render["samples"], 32 * 24 * 2);
+    // Every sample traces its camera ray; hits trace shadow and bounce rays too.
+    EXPECT_GT(render["rays"].get<std::uint64_t>(), render["samples"].get<std::uint64_t>());
+    EXPECT_GT(render["rays_per_s"].get<double>(), 0);
+
+    const nlohmann::json& m = j["memory_bytes"];
+    EXPECT_GT(m["embree"].get<std::uint64_t>(), 0);
+    EXPECT_GE(m["embree_peak"].get<std::uint64_t>(), m["embree"].get<std::uint64_t>());
+    // 3 cylinders, a sphere, a disc and 2 triangles: some hundreds of bytes of buffers.
+    EXPECT_GT(m["cambium"].get<std::uint64_t>(), 100);
+    EXPECT_LT(m["cambium"].get<std::uint64_t>(), 100'000);
+    EXPECT_GT(m["peak_process"].get<std::uint64_t>(),
+              m["embree"].get<std::uint64_t>() + m["cambium"].get<std::uint64_t>());
+}
+
+TEST(Stats, PrintedBlockNamesEachFigure)
+{
+    RunResult r = run_known_plant("print", "-w 16 12 --spp 1 -o p.png --stats");
+    ASSERT_EQ(r.status, 0) << r.output;
+    for (const char* words : {"time to first pixel", "build", "7 (3 cylinders", "2 triangles",
+                              "Embree", "Cambium", "peak process memory", "rays/s", "samples/s"})
+        EXPECT_NE(r.output.find(words), std::string::npos) << words << " in\n" << r.output;
+}
+
+TEST(Stats, StringOnlyRunInterpretsNothing)
+{
+    RunResult r = run_known_plant("str", "-str p.str -strb p.strb --stats-json stats.json");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(fs::exists(r.dir / "p.str"));
+    EXPECT_TRUE(fs::exists(r.dir / "p.strb"));
+    EXPECT_FALSE(fs::exists(r.dir / "p.png"));
+    nlohmann::json j = read_json(r.dir / "stats.json");
+    expect_documented_keys(j);
+    EXPECT_FALSE(j["interpreted"].get<bool>());
+    EXPECT_FALSE(j["rendered"].get<bool>());
+    EXPECT_EQ(j["primitives"]["total"], 0);
+    EXPECT_EQ(j["memory_bytes"]["cambium"], 0);
+    EXPECT_TRUE(j["times_s"]["first_pixel"].is_null());
+}
+
+TEST(Stats, ViewVolumeRunInterpretsButRendersNothing)
+{
+    RunResult r = run_known_plant("vv", "-vv p.vv --stats-json stats.json");
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(fs::exists(r.dir / "p.vv"));
+    nlohmann::json j = read_json(r.dir / "stats.json");
+    EXPECT_TRUE(j["interpreted"].get<bool>());
+    EXPECT_FALSE(j["rendered"].get<bool>());
+    EXPECT_EQ(j["render"]["rays"], 0);
+}
+
+TEST(Stats, SceneFileCountsPrototypesOnceAndPlacedCopiesPerInstance)
+{
+    RunResult r = run_known_plant("scene", "--version");  // makes the folder and the plant
+    std::ofstream(r.dir / "field.json") << R"({
+  "plants": [{"model": ".", "command": "cpfg p.l p.v",
+              "placements": [{"translate": [0, 0, 0]}, {"translate": [3, 0, 0]},
+                             {"translate": [6, 0, 0]}]}],
+  "camera": {"eye": [3, 2, 12], "look_at": [3, 1, 0], "width": 24, "height": 16},
+  "render": {"spp": 1}
+})";
+    std::string command = "cd '" + r.dir.string() + "' && " + CAMBIUM_EXE +
+                          " field.json -o f.png --stats-json stats.json > out.txt 2>&1";
+    ASSERT_EQ(std::system(command.c_str()), 0);
+    nlohmann::json j = read_json(r.dir / "stats.json");
+    expect_documented_keys(j);
+    EXPECT_EQ(j["instances"], 3);
+    EXPECT_EQ(j["prototypes"], 1);
+    // The known plant once, and three placed copies of it.
+    EXPECT_EQ(j["primitives"]["total"], 7);
+    EXPECT_EQ(j["placed_primitives"]["total"], 21);
+    EXPECT_EQ(j["placed_primitives"]["cylinders"], 9);
+    const nlohmann::json& t = j["times_s"];
+    EXPECT_LE(t["assemble"].get<double>() + t["build"].get<double>(), t["first_pixel"].get<double>());
+    EXPECT_EQ(j["render"]["samples"], 24 * 16);
+}
+
+TEST(Stats, SequencesSayStatsAreNotYetAvailable)
+{
+    RunResult r = run_known_plant("seq", "-a -w 8 8 --spp 1 --stats");
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("not yet available for sequences"), std::string::npos) << r.output;
+}
+
+}  // namespace
