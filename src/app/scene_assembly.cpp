@@ -106,7 +106,7 @@ void derive_group(Group& g, const SceneFile& file, const Options& options, Timin
         throw;
     } catch (const Error& e) {
         throw Error(file.file.string() + ": " + g.first->path + " (" + g.first->command +
-                    "): " + e.what());
+                    "): " + nested_message(e));
     }
 }
 
