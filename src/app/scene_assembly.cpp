@@ -148,7 +148,8 @@ public:
     {
     }
 
-    PlacedVariant add(geom::Scene& variant, const ScenePlant& plant)
+    /// `placements`: how many times the variant is placed (for the automatic choice).
+    PlacedVariant add(geom::Scene& variant, const ScenePlant& plant, std::size_t placements)
     {
         std::uint16_t material_offset = palette_offset(variant.materials);
         std::int16_t texture_offset = texture_table_offset(variant.textures, plant);
@@ -170,7 +171,9 @@ public:
 
         PlacedVariant v;
         v.bounds = variant.bounds;
-        bool flatten = m_how.organs == OrganPlacement::flatten || m_how.inline_plants;
+        bool flatten = m_how.inline_plants || m_how.organs == OrganPlacement::flatten ||
+                       (m_how.organs == OrganPlacement::automatic &&
+                        flattening_is_smaller(variant, placements));
         if (flatten) {
             for (const geom::Instance& i : variant.instances) {
                 geom::Geometry organ = variant.prototypes.at(i.prototype).geometry;
@@ -199,6 +202,25 @@ public:
     }
 
 private:
+    /// Whether drawing the organs into the prototype takes less memory than placing
+    /// them at the top level: a placed organ costs an instance (Embree's ~88 B, its BVH
+    /// share and Cambium's 24 B: ~150 B), a drawn organ primitive about 100 B
+    /// (/work/shared/FACTS.md: 52 to 169 B a primitive); drawn organs are paid once
+    /// per variant, placed ones once per placement.
+    static bool flattening_is_smaller(const geom::Scene& variant, std::size_t placements)
+    {
+        constexpr double instance_bytes = 150, primitive_bytes = 100;
+        double drawn = 0;
+        for (const geom::Instance& i : variant.instances) {
+            const geom::Geometry& g = variant.prototypes.at(i.prototype).geometry;
+            drawn += double(g.lines.segment_count() + g.curves.segment_count() +
+                            g.spheres.size() + g.discs.size() + g.mesh.size()) *
+                     primitive_bytes;
+        }
+        double placed = double(variant.instances.size()) * double(placements) * instance_bytes;
+        return drawn <= placed;
+    }
+
     /// The offset of `materials` in the combined table: shared with an equal palette
     /// added before (the variants of one model), appended otherwise.
     std::uint16_t palette_offset(const std::vector<geom::Material>& materials)
@@ -416,6 +438,16 @@ geom::Scene assemble_scene(const SceneFile& file, const Options& options,
     geom::Scene out;
     out.materials.clear();
     Combiner combiner(out, how, file);
+    // How many times each variant is placed: entry e's placement i gets its
+    // (i mod steps)-th variant.
+    std::vector<std::vector<std::size_t>> uses(groups.size());
+    for (std::size_t e = 0; e < file.plants.size(); ++e) {
+        std::vector<std::size_t>& u = uses[entries[e].group];
+        u.resize(groups[entries[e].group].steps.size(), 0);
+        const std::vector<std::size_t>& v = entries[e].variants;
+        for (std::size_t i = 0; i < file.plants[e].placements.size(); ++i)
+            ++u[v[i % v.size()]];
+    }
     std::vector<std::vector<PlacedVariant>> placed(groups.size());
     bool pixel_lines = false;
     for (std::size_t gi = 0; gi < groups.size(); ++gi) {
@@ -430,13 +462,12 @@ geom::Scene assemble_scene(const SceneFile& file, const Options& options,
                             ": its view file's `line style: pixel` differs from " +
                             groups[0].first->path + "'s; one scene has one line style");
             }
-            placed[gi].push_back(combiner.add(variant, *g.first));
+            placed[gi].push_back(combiner.add(variant, *g.first, uses[gi][placed[gi].size()]));
             variant = geom::Scene{};  // its geometry moved; free the rest
         }
     }
     out.line_radius_in_pixels = pixel_lines;
 
-    // Placements: entry e's placement i gets its (i mod steps)-th variant.
     AssemblyReport r;
     for (std::size_t e = 0; e < file.plants.size(); ++e) {
         const ScenePlant& plant = file.plants[e];

@@ -338,7 +338,8 @@ TEST(SceneAssembly, EachDistinctVariantIsDerivedOnce)
     auto report_of = [&](const std::string& plants) {
         app::SceneFile s = app::read_scene_file(f.scene("{\"plants\": [" + plants + "]}"), app::Options{});
         app::AssemblyReport r;
-        geom::Scene scene = app::assemble_scene(s, app::Options{}, {}, &r);
+        app::AssemblyOptions compose{app::OrganPlacement::compose, false};
+        geom::Scene scene = app::assemble_scene(s, app::Options{}, compose, &r);
         return std::make_pair(r, scene.instances.size());
     };
     const std::string m = R"("model": "m", "command": "cpfg p.l p.v", )";
@@ -471,9 +472,14 @@ TEST(SceneAssembly, InstancedFieldRendersAsTheSamePlantsInline)
     render::Image composed = render_with({app::OrganPlacement::compose, false}, 10);
     render::Image flattened = render_with({app::OrganPlacement::flatten, false}, 3);
     render::Image drawn_inline = render_with({app::OrganPlacement::compose, true}, 0);
+    // automatic: the variant of 2 steps, placed twice, has its 2 flowers drawn in (2 x 3
+    // primitives cost no more than 2 x 2 instances); the one of 3 steps, placed once,
+    // keeps its 3 flowers as instances
+    render::Image automatic = render_with({app::OrganPlacement::automatic, false}, 6);
     // the same picture up to float rounding of the placements
     EXPECT_LT(mean_difference(composed, drawn_inline), 1e-3);
     EXPECT_LT(mean_difference(flattened, drawn_inline), 1e-3);
+    EXPECT_LT(mean_difference(automatic, drawn_inline), 1e-3);
     // ... and not by accident: a plant moved is another picture
     app::SceneFile moved = s;
     moved.plants[0].placements[0][9] += 1.0f;
