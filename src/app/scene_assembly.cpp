@@ -110,25 +110,21 @@ void derive_group(Group& g, const SceneFile& file, const Options& options, Timin
     }
 }
 
-bool same_materials(const std::vector<geom::Material>& a, const std::vector<geom::Material>& b)
+bool same_material(const geom::Material& x, const geom::Material& y)
 {
-    return std::equal(a.begin(), a.end(), b.begin(), b.end(),
-                      [](const geom::Material& x, const geom::Material& y) {
-                          return x.ambient == y.ambient && x.diffuse == y.diffuse &&
-                                 x.emission == y.emission && x.specular == y.specular &&
-                                 x.shininess == y.shininess && x.transparency == y.transparency &&
-                                 x.translucency == y.translucency;
-                      });
+    return x.ambient == y.ambient && x.diffuse == y.diffuse && x.emission == y.emission &&
+           x.specular == y.specular && x.shininess == y.shininess &&
+           x.transparency == y.transparency && x.translucency == y.translucency;
 }
 
-bool same_textures(const std::vector<geom::TextureDef>& a, const std::vector<geom::TextureDef>& b)
+bool same_texture(const geom::TextureDef& x, const geom::TextureDef& y)
 {
-    return std::equal(a.begin(), a.end(), b.begin(), b.end(),
-                      [](const geom::TextureDef& x, const geom::TextureDef& y) {
-                          return x.file == y.file && x.decal == y.decal &&
-                                 x.linear_filter == y.linear_filter && x.mipmap == y.mipmap;
-                      });
+    return x.file == y.file && x.decal == y.decal && x.linear_filter == y.linear_filter &&
+           x.mipmap == y.mipmap;
 }
+
+/// Tables appended to a combined table: (offset, size) each.
+using Tables = std::vector<std::pair<std::size_t, std::size_t>>;
 
 /// A plant variant ready to place: its prototype, its organs' instances in its own
 /// frame, its bounds.
@@ -221,24 +217,33 @@ private:
         return drawn <= placed;
     }
 
-    /// The offset of `materials` in the combined table: shared with an equal palette
-    /// added before (the variants of one model), appended otherwise.
+    /// Where `table` starts in `all`: at an equal table added before (the variants of
+    /// one model share their palette), else appended. `limit`: the most entries `all`
+    /// may hold.
+    template <typename T, typename Same>
+    std::size_t table_offset(std::vector<T>& all, Tables& tables, const std::vector<T>& table,
+                             Same same, std::size_t limit, const char* too_many)
+    {
+        for (const auto& [offset, size] : tables)
+            if (size == table.size() &&
+                std::equal(table.begin(), table.end(), all.begin() + long(offset), same))
+                return offset;
+        std::size_t offset = all.size();
+        if (offset + table.size() > limit)
+            throw Error(m_file.file.string() + ": plants: " + too_many);
+        all.insert(all.end(), table.begin(), table.end());
+        tables.emplace_back(offset, table.size());
+        return offset;
+    }
+
+    /// The offset of `materials` in the combined table (inherit_material, 0xffff, is
+    /// reserved).
     std::uint16_t palette_offset(const std::vector<geom::Material>& materials)
     {
-        for (const auto& [offset, size] : m_palettes)
-            if (size == materials.size() &&
-                same_materials(materials, {m_out.materials.begin() + offset,
-                                           m_out.materials.begin() + offset + long(size)}))
-                return static_cast<std::uint16_t>(offset);
-        std::size_t offset = m_out.materials.size();
-        // inherit_material (0xffff) is reserved
-        if (offset + materials.size() >= geom::inherit_material)
-            throw Error(m_file.file.string() + ": plants: the plants' palettes need more than " +
-                        std::to_string(geom::inherit_material - 1) +
-                        " materials together (about 250 distinct models or colour blocks)");
-        m_out.materials.insert(m_out.materials.end(), materials.begin(), materials.end());
-        m_palettes.emplace_back(offset, materials.size());
-        return static_cast<std::uint16_t>(offset);
+        return static_cast<std::uint16_t>(table_offset(
+            m_out.materials, m_palettes, materials, same_material, geom::inherit_material - 1,
+            "the plants' palettes need more than 65534 materials together (about 250 "
+            "distinct models or colour blocks)"));
     }
 
     /// The same for textures, whose files become absolute (relative to each model's
@@ -248,23 +253,15 @@ private:
         for (geom::TextureDef& t : textures)
             if (t.file.is_relative())
                 t.file = fs::absolute(plant.model.view.parent_path() / t.file);
-        for (const auto& [offset, size] : m_texture_tables)
-            if (size == textures.size() &&
-                same_textures(textures, {m_out.textures.begin() + offset,
-                                         m_out.textures.begin() + offset + long(size)}))
-                return static_cast<std::int16_t>(offset);
-        std::size_t offset = m_out.textures.size();
-        if (offset + textures.size() > 32767)
-            throw Error(m_file.file.string() + ": plants: the plants name more than 32767 textures");
-        m_out.textures.insert(m_out.textures.end(), textures.begin(), textures.end());
-        m_texture_tables.emplace_back(offset, textures.size());
-        return static_cast<std::int16_t>(offset);
+        return static_cast<std::int16_t>(table_offset(m_out.textures, m_texture_tables, textures,
+                                                      same_texture, 32767,
+                                                      "the plants name more than 32767 textures"));
     }
 
     geom::Scene& m_out;
     const AssemblyOptions& m_how;
     const SceneFile& m_file;
-    std::vector<std::pair<std::size_t, std::size_t>> m_palettes, m_texture_tables;
+    Tables m_palettes, m_texture_tables;
 };
 
 geom::Bounds3 placed_bounds(const geom::Bounds3& b, const Transform& t)

@@ -403,7 +403,8 @@ TEST(SceneAssembly, PlantsKeepTheirOwnPalettes)
     // two one-segment plants in colour 1 of colormaps that differ there
     for (const char* name : {"red", "blue"}) {
         f.write(std::string(name) + "/p.l", "lsystem: 1\nderivation length: 0\naxiom: ;(1)F(1)\nendlsystem\n");
-        f.write(std::string(name) + "/p.v", "initial line width: 0.1\nline style: cylinder\n");
+        f.write(std::string(name) + "/p.v", std::string("initial line width: 0.1\nline style: cylinder\n") +
+                                                (name[0] == 'r' ? "texture: F: bark.png\n" : ""));
         std::string map(768, '\0');
         map[3] = name[0] == 'r' ? char(255) : 0;
         map[5] = name[0] == 'b' ? char(255) : 0;
@@ -426,6 +427,9 @@ TEST(SceneAssembly, PlantsKeepTheirOwnPalettes)
         ASSERT_EQ(colours.size(), 2u);
         EXPECT_EQ(colours[0], (geom::Rgb{1, 0, 0}));
         EXPECT_EQ(colours[1], (geom::Rgb{0, 0, 1}));
+        // the red plant's texture is read from its own folder, wherever cambium runs
+        ASSERT_EQ(scene.textures.size(), 1u);
+        EXPECT_EQ(scene.textures[0].file, fs::weakly_canonical(f.dir() / "red") / "bark.png");
     }
 }
 
