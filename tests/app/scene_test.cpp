@@ -207,7 +207,7 @@ TEST(SceneFile, ErrorsNameTheFileAndTheJsonPath)
         {R"({"plants": [{"model": "m", "command": "sh p.l p.v", "placements": []}]})",
          "plants[0].command: must start with 'cpfg'"},
         {R"({"plants": [{"model": "m", "command": "cpfg p.l", "placements": []}]})",
-         "plants[0].command: expected plant.l plant.v"},
+         "plants[0].command: files: At least 2 required"},
         {R"({"plants": [{"model": "nowhere", "command": "cpfg p.l p.v", "placements": []}]})",
          "plants[0].model: 'nowhere' is not a folder"},
         {R"({"plants": [{"model": "m", "command": "cpfg p.l p.v"}]})", "plants[0]: needs a placements"},
