@@ -3,6 +3,7 @@
 #include "app/command_line.h"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <charconv>
 #include <cstdint>
 #include <functional>
@@ -287,9 +288,14 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     cli.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
     add_shot_options(cli, options.shot);
     std::vector<std::string> files;
+    // CLI11 keeps the positionals' least count for them at the end of the line, so that
+    // options of several values (--sun X Y Z) stop before them: one for a scene file.
+    bool scene = std::any_of(args.begin(), args.end(), [](const std::string& a) {
+        return std::filesystem::path(a).extension() == ".json";
+    });
     cli.add_option("files", files, "plant.l plant.v [plant.a], or scene.json (docs/scenes.md)")
         ->required()
-        ->expected(1, 3);
+        ->expected(scene ? 1 : 2, 3);
 
     std::vector<std::string> reversed(args.rbegin(), args.rend());
     try {
@@ -332,10 +338,10 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
             for (const std::string& name : option->get_snames())
                 options.given.push_back("-" + name);
         }
-    if (files.size() == 1) {
-        if (std::filesystem::path(files[0]).extension() != ".json")
-            throw Error("expected plant.l plant.v [plant.a], or a scene file scene.json; got only '" +
-                        files[0] + "' (see cambium --help)");
+    if (scene) {
+        if (files.size() != 1 || std::filesystem::path(files[0]).extension() != ".json")
+            throw Error("a scene file scene.json replaces plant.l plant.v; give one or the "
+                        "other (see cambium --help)");
         options.scene = files[0];
         return options;
     }

@@ -236,8 +236,14 @@ int run_scene(Options options, const std::function<void(const std::string&)>& sa
         throw Error("-a animates one L-system; a scene file has no animation (try --turntable)");
     if (options.string_text || options.string_binary)
         throw Error("-str and -strb write one L-system's string; not with a scene file");
+    if (!options.colour_files.empty())
+        throw Error("-m and -M name one model's colours; each plant of a scene names its own "
+                    "in its command");
     SceneFile file = read_scene_file(*options.scene, options);
     apply_scene_settings(file, options);
+    if (options.steps)  // --steps derives every plant that many steps
+        for (ScenePlant& plant : file.plants)
+            plant.steps = {options.steps};
     std::vector<std::filesystem::path> images = image_outputs(options);
     for (const auto& out : images)
         if (!is_video(out))

@@ -106,29 +106,25 @@ void derive_group(Group& g, const SceneFile& file, const Options& options, Timin
         throw;
     } catch (const Error& e) {
         throw Error(file.file.string() + ": " + g.first->path + " (" + g.first->command +
-                    "): " + e.what());
+                    "): " + nested_message(e));
     }
 }
 
-bool same_materials(const std::vector<geom::Material>& a, const std::vector<geom::Material>& b)
+bool same_material(const geom::Material& x, const geom::Material& y)
 {
-    return std::equal(a.begin(), a.end(), b.begin(), b.end(),
-                      [](const geom::Material& x, const geom::Material& y) {
-                          return x.ambient == y.ambient && x.diffuse == y.diffuse &&
-                                 x.emission == y.emission && x.specular == y.specular &&
-                                 x.shininess == y.shininess && x.transparency == y.transparency &&
-                                 x.translucency == y.translucency;
-                      });
+    return x.ambient == y.ambient && x.diffuse == y.diffuse && x.emission == y.emission &&
+           x.specular == y.specular && x.shininess == y.shininess &&
+           x.transparency == y.transparency && x.translucency == y.translucency;
 }
 
-bool same_textures(const std::vector<geom::TextureDef>& a, const std::vector<geom::TextureDef>& b)
+bool same_texture(const geom::TextureDef& x, const geom::TextureDef& y)
 {
-    return std::equal(a.begin(), a.end(), b.begin(), b.end(),
-                      [](const geom::TextureDef& x, const geom::TextureDef& y) {
-                          return x.file == y.file && x.decal == y.decal &&
-                                 x.linear_filter == y.linear_filter && x.mipmap == y.mipmap;
-                      });
+    return x.file == y.file && x.decal == y.decal && x.linear_filter == y.linear_filter &&
+           x.mipmap == y.mipmap;
 }
+
+/// Tables appended to a combined table: (offset, size) each.
+using Tables = std::vector<std::pair<std::size_t, std::size_t>>;
 
 /// A plant variant ready to place: its prototype, its organs' instances in its own
 /// frame, its bounds.
@@ -148,7 +144,8 @@ public:
     {
     }
 
-    PlacedVariant add(geom::Scene& variant, const ScenePlant& plant)
+    /// `placements`: how many times the variant is placed (for the automatic choice).
+    PlacedVariant add(geom::Scene& variant, const ScenePlant& plant, std::size_t placements)
     {
         std::uint16_t material_offset = palette_offset(variant.materials);
         std::int16_t texture_offset = texture_table_offset(variant.textures, plant);
@@ -170,7 +167,9 @@ public:
 
         PlacedVariant v;
         v.bounds = variant.bounds;
-        bool flatten = m_how.organs == OrganPlacement::flatten || m_how.inline_plants;
+        bool flatten = m_how.inline_plants || m_how.organs == OrganPlacement::flatten ||
+                       (m_how.organs == OrganPlacement::automatic &&
+                        flattening_is_smaller(variant, placements));
         if (flatten) {
             for (const geom::Instance& i : variant.instances) {
                 geom::Geometry organ = variant.prototypes.at(i.prototype).geometry;
@@ -199,24 +198,52 @@ public:
     }
 
 private:
-    /// The offset of `materials` in the combined table: shared with an equal palette
-    /// added before (the variants of one model), appended otherwise.
+    /// Whether drawing the organs into the prototype takes less memory than placing
+    /// them at the top level: a placed organ costs an instance (Embree's ~88 B, its BVH
+    /// share and Cambium's 24 B: ~150 B), a drawn organ primitive about 100 B
+    /// (/work/shared/FACTS.md: 52 to 169 B a primitive); drawn organs are paid once
+    /// per variant, placed ones once per placement.
+    static bool flattening_is_smaller(const geom::Scene& variant, std::size_t placements)
+    {
+        constexpr double instance_bytes = 150, primitive_bytes = 100;
+        double drawn = 0;
+        for (const geom::Instance& i : variant.instances) {
+            const geom::Geometry& g = variant.prototypes.at(i.prototype).geometry;
+            drawn += double(g.lines.segment_count() + g.curves.segment_count() +
+                            g.spheres.size() + g.discs.size() + g.mesh.size()) *
+                     primitive_bytes;
+        }
+        double placed = double(variant.instances.size()) * double(placements) * instance_bytes;
+        return drawn <= placed;
+    }
+
+    /// Where `table` starts in `all`: at an equal table added before (the variants of
+    /// one model share their palette), else appended. `limit`: the most entries `all`
+    /// may hold.
+    template <typename T, typename Same>
+    std::size_t table_offset(std::vector<T>& all, Tables& tables, const std::vector<T>& table,
+                             Same same, std::size_t limit, const char* too_many)
+    {
+        for (const auto& [offset, size] : tables)
+            if (size == table.size() &&
+                std::equal(table.begin(), table.end(), all.begin() + long(offset), same))
+                return offset;
+        std::size_t offset = all.size();
+        if (offset + table.size() > limit)
+            throw Error(m_file.file.string() + ": plants: " + too_many);
+        all.insert(all.end(), table.begin(), table.end());
+        tables.emplace_back(offset, table.size());
+        return offset;
+    }
+
+    /// The offset of `materials` in the combined table (inherit_material, 0xffff, is
+    /// reserved).
     std::uint16_t palette_offset(const std::vector<geom::Material>& materials)
     {
-        for (const auto& [offset, size] : m_palettes)
-            if (size == materials.size() &&
-                same_materials(materials, {m_out.materials.begin() + offset,
-                                           m_out.materials.begin() + offset + long(size)}))
-                return static_cast<std::uint16_t>(offset);
-        std::size_t offset = m_out.materials.size();
-        // inherit_material (0xffff) is reserved
-        if (offset + materials.size() >= geom::inherit_material)
-            throw Error(m_file.file.string() + ": plants: the plants' palettes need more than " +
-                        std::to_string(geom::inherit_material - 1) +
-                        " materials together (about 250 distinct models or colour blocks)");
-        m_out.materials.insert(m_out.materials.end(), materials.begin(), materials.end());
-        m_palettes.emplace_back(offset, materials.size());
-        return static_cast<std::uint16_t>(offset);
+        return static_cast<std::uint16_t>(table_offset(
+            m_out.materials, m_palettes, materials, same_material, geom::inherit_material - 1,
+            "the plants' palettes need more than 65534 materials together (about 250 "
+            "distinct models or colour blocks)"));
     }
 
     /// The same for textures, whose files become absolute (relative to each model's
@@ -226,23 +253,15 @@ private:
         for (geom::TextureDef& t : textures)
             if (t.file.is_relative())
                 t.file = fs::absolute(plant.model.view.parent_path() / t.file);
-        for (const auto& [offset, size] : m_texture_tables)
-            if (size == textures.size() &&
-                same_textures(textures, {m_out.textures.begin() + offset,
-                                         m_out.textures.begin() + offset + long(size)}))
-                return static_cast<std::int16_t>(offset);
-        std::size_t offset = m_out.textures.size();
-        if (offset + textures.size() > 32767)
-            throw Error(m_file.file.string() + ": plants: the plants name more than 32767 textures");
-        m_out.textures.insert(m_out.textures.end(), textures.begin(), textures.end());
-        m_texture_tables.emplace_back(offset, textures.size());
-        return static_cast<std::int16_t>(offset);
+        return static_cast<std::int16_t>(table_offset(m_out.textures, m_texture_tables, textures,
+                                                      same_texture, 32767,
+                                                      "the plants name more than 32767 textures"));
     }
 
     geom::Scene& m_out;
     const AssemblyOptions& m_how;
     const SceneFile& m_file;
-    std::vector<std::pair<std::size_t, std::size_t>> m_palettes, m_texture_tables;
+    Tables m_palettes, m_texture_tables;
 };
 
 geom::Bounds3 placed_bounds(const geom::Bounds3& b, const Transform& t)
@@ -416,6 +435,16 @@ geom::Scene assemble_scene(const SceneFile& file, const Options& options,
     geom::Scene out;
     out.materials.clear();
     Combiner combiner(out, how, file);
+    // How many times each variant is placed: entry e's placement i gets its
+    // (i mod steps)-th variant.
+    std::vector<std::vector<std::size_t>> uses(groups.size());
+    for (std::size_t e = 0; e < file.plants.size(); ++e) {
+        std::vector<std::size_t>& u = uses[entries[e].group];
+        u.resize(groups[entries[e].group].steps.size(), 0);
+        const std::vector<std::size_t>& v = entries[e].variants;
+        for (std::size_t i = 0; i < file.plants[e].placements.size(); ++i)
+            ++u[v[i % v.size()]];
+    }
     std::vector<std::vector<PlacedVariant>> placed(groups.size());
     bool pixel_lines = false;
     for (std::size_t gi = 0; gi < groups.size(); ++gi) {
@@ -430,13 +459,12 @@ geom::Scene assemble_scene(const SceneFile& file, const Options& options,
                             ": its view file's `line style: pixel` differs from " +
                             groups[0].first->path + "'s; one scene has one line style");
             }
-            placed[gi].push_back(combiner.add(variant, *g.first));
+            placed[gi].push_back(combiner.add(variant, *g.first, uses[gi][placed[gi].size()]));
             variant = geom::Scene{};  // its geometry moved; free the rest
         }
     }
     out.line_radius_in_pixels = pixel_lines;
 
-    // Placements: entry e's placement i gets its (i mod steps)-th variant.
     AssemblyReport r;
     for (std::size_t e = 0; e < file.plants.size(); ++e) {
         const ScenePlant& plant = file.plants[e];

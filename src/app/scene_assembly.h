@@ -15,15 +15,19 @@ namespace cambium::app {
 /// How a plant's own instances (`-o>` objects, predefined surfaces) reach Embree's one
 /// instance level when the plant itself is instanced.
 enum class OrganPlacement {
+    /// Per plant variant, whichever of the two takes less memory (the default; the
+    /// measurements are in docs/architecture.md): flatten once a variant is placed
+    /// about as many times as its organs have primitives each.
+    automatic,
     /// Each organ instance becomes a top-level instance, its transform composed with
-    /// each placement of the plant (the default: see docs/architecture.md).
+    /// each placement of the plant.
     compose,
     /// The organs are drawn into the plant's prototype, which is then instanced.
     flatten,
 };
 
 struct AssemblyOptions {
-    OrganPlacement organs = OrganPlacement::compose;
+    OrganPlacement organs = OrganPlacement::automatic;
     /// Draw every placed plant into the scene's own geometry, no instances at all
     /// (tests compare it with the instanced scene; it costs memory per copy).
     bool inline_plants = false;

@@ -235,7 +235,7 @@ Options model_options(const Node& n, const fs::path& folder, bool allow_file_acc
     try {
         parsed = parse_command_line(words);
     } catch (const Error& e) {
-        n.fail(e.what());
+        n.fail(nested_message(e));
     }
     if (!parsed)
         n.fail("is not a command line that renders");
@@ -354,7 +354,7 @@ std::vector<Transform> placements(const Node& n, Context& c)
             try {
                 mesh = read_obj_mesh(*spec.mesh, c.limits.max_mesh_triangles);
             } catch (const Error& e) {
-                sn["mesh"].fail(e.what());
+                sn["mesh"].fail(nested_message(e));
             }
         }
         out = scatter(spec, mesh ? &*mesh : nullptr);
@@ -554,6 +554,12 @@ json parse_document(const fs::path& file, const std::string& name, const SceneLi
 }
 
 }  // namespace
+
+std::string nested_message(const std::exception& e)
+{
+    std::string text = e.what();
+    return text.starts_with("error: ") ? text.substr(7) : text;
+}
 
 SceneFile read_scene_file(const fs::path& file, const Options& options, const SceneLimits& limits)
 {

@@ -125,6 +125,10 @@ GroundMesh read_obj_mesh(const std::filesystem::path& file, std::size_t max_tria
 /// The transform of an explicit placement: scale, then rotation about +y, then translation.
 Transform placement_transform(const geom::Vec3& translate, double rotate_y_deg, double scale);
 
+/// An error's text without the "error: " its unlocated form starts with, to nest it
+/// in a message about the scene.
+std::string nested_message(const std::exception& e);
+
 /// a after b (x -> a(b(x))), both 3x4 column-major.
 Transform compose(const Transform& a, const Transform& b);
 

@@ -1,0 +1,103 @@
+// SPDX-License-Identifier: Apache-2.0
+// `cambium scene.json` as a user runs it: an image from a good scene, with the command
+// line overriding the file; for a bad one a message naming the file and JSON path, a
+// non-zero exit and no image.
+#include <gtest/gtest.h>
+
+#include <OpenImageIO/imageio.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+    int status;
+    std::string output;
+};
+
+Result run(const std::string& args, const fs::path& folder)
+{
+    std::string command = "cd '" + folder.string() + "' && " + CAMBIUM_EXE + " " + args + " 2>&1";
+    Result r{0, {}};
+    FILE* pipe = popen(command.c_str(), "r");
+    std::array<char, 512> buffer{};
+    while (fgets(buffer.data(), buffer.size(), pipe))
+        r.output += buffer.data();
+    r.status = pclose(pipe);
+    return r;
+}
+
+fs::path scratch()
+{
+    fs::path dir = fs::temp_directory_path() / ("cambium_scene_cmd_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir / "m");
+    std::ofstream(dir / "m/p.l") << "lsystem: 1\nderivation length: 2\naxiom: A\n"
+                                    "A --> F(1)[+(40)F(0.5)]/(137)A\nendlsystem\n";
+    std::ofstream(dir / "m/p.v") << "angle factor: 8\ninitial line width: 0.15\nline style: cylinder\n";
+    return dir;
+}
+
+}  // namespace
+
+TEST(SceneCommand, RendersAndTheCommandLineOverridesTheFile)
+{
+    fs::path dir = scratch();
+    std::ofstream(dir / "field.json") << R"({
+      "plants": [{"model": "m", "command": "cpfg p.l p.v",
+                  "placements": [{"translate": [-1, 0, 0]}, {"translate": [1, 0, 0]}]}],
+      "ground": {"size": [6, 6]},
+      "camera": {"width": 300, "height": 200},
+      "render": {"spp": 2}
+    })";
+    // -w overrides the camera's size; without -o the image is named after the scene
+    Result r = run("-w 40 30 field.json", dir);
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("2 plants (1 models, 1 derivations)"), std::string::npos) << r.output;
+    auto in = OIIO::ImageInput::open((dir / "field.png").string());
+    ASSERT_TRUE(in);
+    EXPECT_EQ(in->spec().width, 40);
+    EXPECT_EQ(in->spec().height, 30);
+    fs::remove_all(dir);
+}
+
+TEST(SceneCommand, ABadSceneNamesThePathAndWritesNothing)
+{
+    fs::path dir = scratch();
+    std::ofstream(dir / "bad.json") << R"({"plants": [{"model": "m", "command": "cpfg p.l p.v",
+        "placements": {"scatter": {"rectangle": [0, 0, 1, 1], "count": -3}}}]})";
+    Result r = run("-o out.png bad.json", dir);
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("bad.json: plants[0].placements.scatter.count: must be a positive integer"),
+              std::string::npos)
+        << r.output;
+    EXPECT_FALSE(fs::exists(dir / "out.png"));
+    // an error inside a model names the scene's plant and the model's file and line
+    std::ofstream(dir / "m/p.l") << "lsystem: 1\naxiom: A(\nendlsystem\n";
+    std::ofstream(dir / "model.json") << R"({"plants": [{"model": "m", "command": "cpfg p.l p.v",
+        "placements": [{}]}]})";
+    r = run("-o out.png model.json", dir);
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("model.json: plants[0] (cpfg p.l p.v): "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("p.l:2:"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "out.png"));
+    // a single file that is not a scene
+    r = run("p.l", dir / "m");
+    EXPECT_NE(r.status, 0);
+    EXPECT_NE(r.output.find("files: At least 2 required"), std::string::npos) << r.output;
+    // options of several values stop before a scene file
+    std::ofstream(dir / "m/p.l") << "lsystem: 1\nderivation length: 1\naxiom: F(1)\nendlsystem\n";
+    std::ofstream(dir / "field.json") << R"({"plants": [{"model": "m", "command": "cpfg p.l p.v",
+        "placements": [{}]}]})";
+    r = run("--sun 0 1 0 -w 16 12 --spp 1 -o sun.png field.json", dir);
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_TRUE(fs::exists(dir / "sun.png"));
+    fs::remove_all(dir);
+}

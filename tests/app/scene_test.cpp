@@ -1,0 +1,492 @@
+// SPDX-License-Identifier: Apache-2.0
+// Scene files (docs/scenes.md): reading good and bad files, placements, plants derived
+// once, palettes kept apart, and instanced plants rendering as the same plants drawn
+// inline.
+#include <gtest/gtest.h>
+
+#include <unistd.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "app/scene_assembly.h"
+#include "app/scene_file.h"
+#include "base/diagnostics.h"
+#include "render/camera.h"
+#include "render/render.h"
+
+using namespace cambium;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// A scratch folder holding a scene and its models; removed at the end of the test.
+class SceneFolder {
+public:
+    explicit SceneFolder(const std::string& name)
+        : m_dir(fs::temp_directory_path() /
+                ("cambium_scene_" + name + "_" + std::to_string(::getpid())))
+    {
+        fs::remove_all(m_dir);
+        fs::create_directories(m_dir);
+    }
+    ~SceneFolder() { fs::remove_all(m_dir); }
+
+    const fs::path& dir() const { return m_dir; }
+
+    void write(const fs::path& file, const std::string& text) const
+    {
+        fs::create_directories((m_dir / file).parent_path());
+        std::ofstream(m_dir / file, std::ios::binary) << text;
+    }
+
+    /// A small plant whose flowers K are -o> objects: a stem of `nodes` internodes.
+    void tiny_model(const fs::path& folder, const std::string& arrow = "-o>") const
+    {
+        write(folder / "p.l", "lsystem: 1\nderivation length: 3\naxiom: A\n"
+                              "A --> F(1)[+(40)K]/(137)A\n"
+                              "homomorphism\n"
+                              "K " + arrow + " F(0.5)[;(2)@O(0.3)][&(30)F(0.3)]\n"
+                              "endlsystem\n");
+        write(folder / "p.v", "angle factor: 8\ninitial line width: 0.15\nline style: cylinder\n");
+    }
+
+    fs::path scene(const std::string& text, const std::string& name = "field.json") const
+    {
+        write(name, text);
+        return m_dir / name;
+    }
+
+private:
+    fs::path m_dir;
+};
+
+/// The message read_scene_file throws for `text`, or "" when it reads.
+std::string error_of(const SceneFolder& folder, const std::string& text)
+{
+    try {
+        app::read_scene_file(folder.scene(text), app::Options{});
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "";
+}
+
+const char* tiny_plant = R"("model": "m", "command": "cpfg p.l p.v")";
+
+std::string with_plant(const std::string& plant_rest, const std::string& rest = "")
+{
+    return std::string(R"({"plants": [{)") + tiny_plant + ", " + plant_rest + "}]" + rest + "}";
+}
+
+double distance_xz(const app::Transform& a, const app::Transform& b)
+{
+    return std::hypot(a[9] - b[9], a[11] - b[11]);
+}
+
+double mean_difference(const render::Image& a, const render::Image& b)
+{
+    double d = 0;
+    for (std::size_t i = 0; i < a.rgba.size(); ++i)
+        d += std::fabs(a.rgba[i] - b.rgba[i]);
+    return d / static_cast<double>(a.rgba.size());
+}
+
+}  // namespace
+
+TEST(SceneFile, ReadsPlantsPlacementsAndSettings)
+{
+    SceneFolder f("good");
+    f.tiny_model("models/a");
+    fs::path file = f.scene(R"({
+      // comments are allowed
+      "plants": [
+        {"model": "models/a", "command": "cpfg -w 300 300 p.l p.v", "steps": [1, 2], "seed": 7,
+         "placements": [{"translate": [1, 0, 2], "rotate_y_deg": 90, "scale": 2},
+                        {"matrix": [1,0,0, 0,1,0, 0,0,1, 5,6,7]}]},
+        {"model": "models/a", "command": "cpfg p.l p.v",
+         "placements": {"scatter": {"rectangle": [0, 0, 10, 10], "count": 5, "seed": 3}}}
+      ],
+      "ground": {"size": [20, 30], "colour": "#ff8000"},
+      "camera": {"eye": [0, 5, 20], "look_at": [0, 1, 0], "fov_deg": 30, "width": 320, "height": 200},
+      "lights": [{"direction": [0, 1, 0], "intensity": 2}],
+      "sky": {"sun": [0, 1, 1]},
+      "render": {"spp": 3, "noise_target": 0.1, "filter": "gaussian"}
+    })");
+    app::SceneFile s = app::read_scene_file(file, app::Options{});
+    ASSERT_EQ(s.plants.size(), 2u);
+    const app::ScenePlant& a = s.plants[0];
+    EXPECT_EQ(a.path, "plants[0]");
+    EXPECT_EQ(a.model.lsystem, fs::weakly_canonical(f.dir() / "models/a/p.l"));
+    EXPECT_EQ(a.model.view, fs::weakly_canonical(f.dir() / "models/a/p.v"));
+    ASSERT_EQ(a.steps.size(), 2u);
+    EXPECT_EQ(a.steps[0], 1);
+    EXPECT_EQ(a.steps[1], 2);
+    EXPECT_EQ(a.seed, 7);
+    ASSERT_EQ(a.placements.size(), 2u);
+    // scale 2, turned 90 degrees about +y: x goes to -z, z to +x; then moved
+    const app::Transform& t = a.placements[0];
+    EXPECT_NEAR(t[0], 0, 1e-6);
+    EXPECT_NEAR(t[2], -2, 1e-6);
+    EXPECT_NEAR(t[4], 2, 1e-6);
+    EXPECT_NEAR(t[6], 2, 1e-6);
+    EXPECT_NEAR(t[8], 0, 1e-6);
+    EXPECT_EQ(t[9], 1);
+    EXPECT_EQ(t[11], 2);
+    EXPECT_EQ(a.placements[1][10], 6);
+    EXPECT_EQ(s.plants[1].placements.size(), 5u);
+    EXPECT_FALSE(s.plants[1].steps[0].has_value());  // the L-system's derivation length
+    ASSERT_TRUE(s.ground && s.ground->size);
+    EXPECT_EQ((*s.ground->size)[1], 30);
+    EXPECT_FLOAT_EQ(s.ground->colour.g, 128 / 255.0f);
+    ASSERT_TRUE(s.camera);
+    EXPECT_EQ(s.camera->fov_deg, 30);
+    ASSERT_EQ(s.lights.size(), 1u);
+    EXPECT_EQ(s.lights[0].kind, geom::Light::Kind::directional);
+    EXPECT_GT(s.lights[0].diffuse.r, 1.0f);  // intensity 2
+    ASSERT_TRUE(s.sky);
+
+    // The command line wins where it speaks; the file fills in the rest.
+    app::Options given = *app::parse_command_line({"--spp", "9", "x.json"});
+    app::apply_scene_settings(s, given);
+    EXPECT_EQ(given.samples_per_pixel, 9);
+    EXPECT_EQ(given.width, 320);
+    EXPECT_FLOAT_EQ(given.noise_target, 0.1f);
+    EXPECT_EQ(given.filter, "gaussian");
+    EXPECT_TRUE(given.sky);
+    app::Options plain = *app::parse_command_line({"-w", "64", "48", "x.json"});
+    app::apply_scene_settings(s, plain);
+    EXPECT_EQ(plain.samples_per_pixel, 3);
+    EXPECT_EQ(plain.width, 64);
+    EXPECT_EQ(plain.height, 48);
+}
+
+TEST(SceneFile, ErrorsNameTheFileAndTheJsonPath)
+{
+    SceneFolder f("bad");
+    f.tiny_model("m");
+    struct Case {
+        std::string text, message;
+    };
+    const std::vector<Case> cases = {
+        {R"({"plants": []})", "field.json: plants: must be a non-empty list"},
+        {R"({"plant": []})", "field.json: plant: unknown key"},
+        {with_plant(R"("placements": {"scatter": {"rectangle": [0,0,1,1], "count": 0}})"),
+         "field.json: plants[0].placements.scatter.count: must be a positive integer"},
+        {with_plant(R"("placements": {"scatter": {"rectangle": [0,0,1,1], "count": 2.5}})"),
+         "field.json: plants[0].placements.scatter.count: must be a positive integer"},
+        {with_plant(R"("placements": {"scatter": {"rectangle": [1,0,0,1], "count": 2}})"),
+         "plants[0].placements.scatter.rectangle: must be [xmin, zmin, xmax, zmax]"},
+        {with_plant(R"("placements": {"scatter": {"count": 2}})"),
+         "plants[0].placements.scatter: give one of rectangle"},
+        {with_plant(R"("stesp": 3, "placements": [])"), "plants[0].stesp: unknown key"},
+        {with_plant(R"("steps": [], "placements": [])"), "plants[0].steps: must list 1 to 100"},
+        {with_plant(R"("steps": [2, 2], "placements": [])"), "plants[0].steps[1]: repeats"},
+        {with_plant(R"("steps": -1, "placements": [])"), "plants[0].steps: must be an integer"},
+        {with_plant(R"("placements": [{}, {"matrix": [1,2,3]}])"),
+         "plants[0].placements[1].matrix: must be 12 numbers"},
+        {with_plant(R"("placements": [{"translate": [0, "x", 0]}])"),
+         "plants[0].placements[0].translate[1]: must be a number"},
+        {R"({"plants": [{"model": "../elsewhere", "command": "cpfg p.l p.v", "placements": []}]})",
+         "plants[0].model: '../elsewhere' lies outside the folder"},
+        {R"({"plants": [{"model": "/tmp", "command": "cpfg p.l p.v", "placements": []}]})",
+         "plants[0].model: '/tmp' is an absolute path"},
+        {R"({"plants": [{"model": "m", "command": "cpfg ../../p.l p.v", "placements": []}]})",
+         "plants[0].command: '../../p.l' lies outside the folder"},
+        {R"({"plants": [{"model": "m", "command": "cpfg -P sh p.l p.v", "placements": []}]})",
+         "plants[0].command: option -P is not allowed in a scene"},
+        {R"({"plants": [{"model": "m", "command": "cpfg -str out p.l p.v", "placements": []}]})",
+         "plants[0].command: option -str is not allowed"},
+        {R"({"plants": [{"model": "m", "command": "cpfg p.l p.v; rm x", "placements": []}]})",
+         "plants[0].command: a cpfg command line of words only"},
+        {R"({"plants": [{"model": "m", "command": "sh p.l p.v", "placements": []}]})",
+         "plants[0].command: must start with 'cpfg'"},
+        {R"({"plants": [{"model": "m", "command": "cpfg p.l", "placements": []}]})",
+         "plants[0].command: files: At least 2 required"},
+        {R"({"plants": [{"model": "nowhere", "command": "cpfg p.l p.v", "placements": []}]})",
+         "plants[0].model: 'nowhere' is not a folder"},
+        {R"({"plants": [{"model": "m", "command": "cpfg p.l p.v"}]})", "plants[0]: needs a placements"},
+        {with_plant(R"("placements": [])", R"(, "camera": {"fov_deg": 0})"),
+         "field.json: camera.fov_deg: must be a number from 0.01 to 179"},
+        {with_plant(R"("placements": [])", R"(, "camera": {"projection": "fisheye"})"),
+         "camera.projection: must be \"perspective\" or \"parallel\""},
+        {with_plant(R"("placements": [])", R"(, "lights": [{"direction": [0, 0, 0]}])"),
+         "lights[0].direction: must not be zero"},
+        {with_plant(R"("placements": [])", R"(, "ground": {"size": [1, 1], "colour": "green"})"),
+         "ground.colour: must be #rrggbb"},
+        {with_plant(R"("placements": [])", R"(, "sky": {}, "environment": {"map": "x.exr"})"),
+         "field.json: the document: give sky or environment, not both"},
+        {with_plant(R"("placements": [])", R"(, "render": {"spp": 0})"),
+         "render.spp: must be an integer from 1 to"},
+        {with_plant(R"("placements": {"scatter": {"mesh": "none.obj", "count": 3}})"),
+         "plants[0].placements.scatter.mesh: "},
+    };
+    for (const Case& c : cases) {
+        std::string message = error_of(f, c.text);
+        EXPECT_NE(message.find(c.message), std::string::npos)
+            << "scene: " << c.text << "\nexpected: " << c.message << "\ngot: " << message;
+    }
+    // Syntax errors keep nlohmann's position as line and column.
+    std::string syntax = error_of(f, "{\n  \"plants\": [\n    {\"model\": }\n  ]\n}\n");
+    EXPECT_NE(syntax.find("field.json:3:15:"), std::string::npos) << syntax;
+    // The total of placed plants is bounded before any is placed.
+    app::SceneLimits small;
+    small.max_instances = 10;
+    try {
+        app::read_scene_file(
+            f.scene(with_plant(R"("placements": {"scatter": {"rectangle": [0,0,9,9], "count": 11}})")),
+            app::Options{}, small);
+        ADD_FAILURE() << "11 plants passed a limit of 10";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("plants[0].placements.scatter.count"), std::string::npos)
+            << e.what();
+    }
+}
+
+TEST(SceneFile, FilesOutsideTheFolderNeedFileAccess)
+{
+    SceneFolder f("access");
+    f.tiny_model("outside/m");
+    f.write("inner/.keep", "");
+    fs::path file = f.scene(
+        R"({"plants": [{"model": "../outside/m", "command": "cpfg p.l p.v", "placements": [{}]}]})",
+        "inner/field.json");
+    EXPECT_THROW(app::read_scene_file(file, app::Options{}), Error);
+    app::Options allowed;
+    allowed.allow_file_access = true;
+    EXPECT_EQ(app::read_scene_file(file, allowed).plants.size(), 1u);
+}
+
+TEST(Scatter, SameSeedSamePlacementsAndSpacingHolds)
+{
+    app::ScatterSpec spec;
+    spec.rectangle = {-10, -5, 10, 5};
+    spec.count = 100;
+    spec.seed = 42;
+    spec.min_spacing = 1.0;
+    spec.rotate_y = true;
+    spec.scale = {0.5, 1.5};
+    std::vector<app::Transform> a = app::scatter(spec), b = app::scatter(spec);
+    ASSERT_EQ(a.size(), 100u);
+    EXPECT_EQ(a, b);
+    spec.seed = 43;
+    EXPECT_NE(app::scatter(spec), a);
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        const app::Transform& t = a[i];
+        EXPECT_GE(t[9], -10);
+        EXPECT_LE(t[9], 10);
+        EXPECT_GE(t[11], -5);
+        EXPECT_LE(t[11], 5);
+        EXPECT_EQ(t[10], 0);  // standing on the ground
+        // a turn about +y times a uniform scale: y axis stays up, x axis horizontal
+        EXPECT_EQ(t[3], 0);
+        EXPECT_EQ(t[5], 0);
+        EXPECT_EQ(t[1], 0);
+        EXPECT_GE(t[4], 0.5f - 1e-6f);
+        EXPECT_LE(t[4], 1.5f + 1e-6f);
+        EXPECT_NEAR(std::hypot(t[0], t[2]), t[4], 1e-5);
+        for (std::size_t j = 0; j < i; ++j)
+            ASSERT_GE(distance_xz(t, a[j]), 1.0 - 1e-6) << i << " " << j;
+    }
+    // A full area gives fewer plants, still spaced (a 2 x 2 square holds few at 1.0).
+    spec.rectangle = {0, 0, 2, 2};
+    spec.count = 100;
+    std::vector<app::Transform> crowded = app::scatter(spec);
+    EXPECT_GT(crowded.size(), 3u);
+    EXPECT_LT(crowded.size(), 20u);
+    for (std::size_t i = 0; i < crowded.size(); ++i)
+        for (std::size_t j = 0; j < i; ++j)
+            EXPECT_GE(distance_xz(crowded[i], crowded[j]), 1.0 - 1e-6);
+}
+
+TEST(Scatter, OverAMeshPointsLieOnItsTriangles)
+{
+    SceneFolder f("mesh");
+    // a slope: y = 0.5 x over x in [0, 4], z in [0, 2]; a quad written as one face
+    f.write("slope.obj", "# a slope\nv 0 0 0\nv 4 2 0\nv 4 2 2\nv 0 0 2\nvn 0 1 0\nf 1//1 2//1 3//1 4//1\n");
+    app::GroundMesh mesh = app::read_obj_mesh(f.dir() / "slope.obj", 100);
+    ASSERT_EQ(mesh.triangles.size(), 2u);
+    app::ScatterSpec spec;
+    spec.mesh = f.dir() / "slope.obj";
+    spec.count = 200;
+    spec.seed = 5;
+    std::vector<app::Transform> placed = app::scatter(spec, &mesh);
+    ASSERT_EQ(placed.size(), 200u);
+    double mean_x = 0;
+    for (const app::Transform& t : placed) {
+        EXPECT_NEAR(t[10], 0.5 * t[9], 1e-4);
+        EXPECT_GE(t[11], -1e-6);
+        EXPECT_LE(t[11], 2 + 1e-6);
+        mean_x += t[9] / 200.0;
+    }
+    EXPECT_NEAR(mean_x, 2.0, 0.3);  // uniform over the area, not bunched on one triangle
+    EXPECT_THROW(app::read_obj_mesh(f.dir() / "missing.obj", 100), Error);
+    f.write("bad.obj", "v 0 0 0\nf 1 2 3\n");
+    EXPECT_THROW(app::read_obj_mesh(f.dir() / "bad.obj", 100), Error);
+}
+
+TEST(SceneAssembly, EachDistinctVariantIsDerivedOnce)
+{
+    SceneFolder f("once");
+    f.tiny_model("m");
+    f.tiny_model("n");
+    auto report_of = [&](const std::string& plants) {
+        app::SceneFile s = app::read_scene_file(f.scene("{\"plants\": [" + plants + "]}"), app::Options{});
+        app::AssemblyReport r;
+        app::AssemblyOptions compose{app::OrganPlacement::compose, false};
+        geom::Scene scene = app::assemble_scene(s, app::Options{}, compose, &r);
+        return std::make_pair(r, scene.instances.size());
+    };
+    const std::string m = R"("model": "m", "command": "cpfg p.l p.v", )";
+    const std::string three = R"("placements": [{}, {"translate": [2, 0, 0]}, {"translate": [4, 0, 0]}])";
+    // two entries of one model and steps: one load, one derivation, six plants
+    auto [r1, instances1] = report_of("{" + m + "\"steps\": 2, " + three + "}, {" + m +
+                                      "\"command\": \"cpfg  p.l   p.v\", \"steps\": 2, " + three + "}");
+    EXPECT_EQ(r1.models_loaded, 1u);
+    EXPECT_EQ(r1.derivations, 1u);
+    EXPECT_EQ(r1.plant_instances, 6u);
+    // steps [1, 2] and [2]: two derivations of one model; placements alternate variants
+    auto [r2, instances2] = report_of("{" + m + "\"steps\": [1, 2], " + three + "}, {" + m +
+                                      "\"steps\": 2, " + three + "}");
+    EXPECT_EQ(r2.models_loaded, 1u);
+    EXPECT_EQ(r2.derivations, 2u);
+    // another model, or another seed, is another load
+    auto [r3, instances3] = report_of("{" + m + three + "}, {" + m + "\"seed\": 3, " + three +
+                                      "}, {\"model\": \"n\", \"command\": \"cpfg p.l p.v\", " +
+                                      three + "}");
+    EXPECT_EQ(r3.models_loaded, 3u);
+    EXPECT_EQ(r3.derivations, 3u);
+    EXPECT_EQ(r3.plant_instances, 9u);
+    // each plant of 3 steps has 3 flowers (objects): composed, one instance each
+    EXPECT_EQ(r3.organ_instances, 27u);
+    EXPECT_EQ(instances3, 36u);
+}
+
+TEST(SceneAssembly, SeedOverrideChangesAStochasticPlantReproducibly)
+{
+    SceneFolder f("seed");
+    // a stochastic L-system: each step, A grows straight or turns, chosen at random
+    f.write("m/p.l", "lsystem: 1\nseed: 1\nderivation length: 12\naxiom: A\n"
+                     "A --> F(1)A : 1\nA --> +(60)F(1)A : 1\nendlsystem\n");
+    f.write("m/p.v", "angle factor: 8\ninitial line width: 0.1\nline style: cylinder\n");
+    auto bounds_with = [&](const std::string& seed) {
+        app::SceneFile s = app::read_scene_file(
+            f.scene(R"({"plants": [{"model": "m", "command": "cpfg p.l p.v", )" + seed +
+                    R"("placements": [{}]}]})"),
+            app::Options{});
+        geom::Scene scene = app::assemble_scene(s, app::Options{});
+        return std::array<double, 4>{scene.bounds.lo.x, scene.bounds.hi.x, scene.bounds.lo.y,
+                                     scene.bounds.hi.y};
+    };
+    auto plain = bounds_with(""), seven = bounds_with("\"seed\": 7, "),
+         again = bounds_with("\"seed\": 7, ");
+    EXPECT_EQ(seven, again);
+    // among a few seeds, some plant differs from the unseeded one and from seed 7
+    bool differs_from_plain = seven != plain, differs_from_seven = false;
+    for (int s = 8; s < 12; ++s) {
+        auto other = bounds_with("\"seed\": " + std::to_string(s) + ", ");
+        differs_from_plain |= other != plain;
+        differs_from_seven |= other != seven;
+    }
+    EXPECT_TRUE(differs_from_plain);
+    EXPECT_TRUE(differs_from_seven);
+}
+
+TEST(SceneAssembly, PlantsKeepTheirOwnPalettes)
+{
+    SceneFolder f("palette");
+    // two one-segment plants in colour 1 of colormaps that differ there
+    for (const char* name : {"red", "blue"}) {
+        f.write(std::string(name) + "/p.l", "lsystem: 1\nderivation length: 0\naxiom: ;(1)F(1)\nendlsystem\n");
+        f.write(std::string(name) + "/p.v", std::string("initial line width: 0.1\nline style: cylinder\n") +
+                                                (name[0] == 'r' ? "texture: F: bark.png\n" : ""));
+        std::string map(768, '\0');
+        map[3] = name[0] == 'r' ? char(255) : 0;
+        map[5] = name[0] == 'b' ? char(255) : 0;
+        f.write(std::string(name) + "/p.map", map);
+    }
+    app::SceneFile s = app::read_scene_file(f.scene(R"({"plants": [
+        {"model": "red", "command": "cpfg -m p.map p.l p.v", "placements": [{}]},
+        {"model": "blue", "command": "cpfg -m p.map p.l p.v", "placements": [{"translate": [3, 0, 0]}]}]})"),
+                                            app::Options{});
+    for (app::AssemblyOptions how : {app::AssemblyOptions{}, app::AssemblyOptions{app::OrganPlacement::compose, true}}) {
+        geom::Scene scene = app::assemble_scene(s, app::Options{}, how);
+        std::vector<geom::Rgb> colours;
+        auto colour_of_segments = [&](const geom::Geometry& g) {
+            for (std::uint16_t m : g.lines.material)
+                colours.push_back(scene.materials.at(m).diffuse);
+        };
+        colour_of_segments(scene.geometry);
+        for (const geom::Instance& i : scene.instances)
+            colour_of_segments(scene.prototypes.at(i.prototype).geometry);
+        ASSERT_EQ(colours.size(), 2u);
+        EXPECT_EQ(colours[0], (geom::Rgb{1, 0, 0}));
+        EXPECT_EQ(colours[1], (geom::Rgb{0, 0, 1}));
+        // the red plant's texture is read from its own folder, wherever cambium runs
+        ASSERT_EQ(scene.textures.size(), 1u);
+        EXPECT_EQ(scene.textures[0].file, fs::weakly_canonical(f.dir() / "red") / "bark.png");
+    }
+}
+
+TEST(SceneAssembly, CameraUpIsHonoured)
+{
+    SceneFolder f("camera");
+    f.tiny_model("m");
+    app::SceneFile s = app::read_scene_file(
+        f.scene(with_plant(R"("placements": [{}])",
+                           R"(, "camera": {"eye": [0, 2, 10], "look_at": [0, 2, 0], "up": [1, 1, 0]})")),
+        app::Options{});
+    geom::Scene scene = app::assemble_scene(s, app::Options{});
+    render::Camera camera = render::make_camera(scene.view, scene.bounds, 64, 64);
+    geom::Vec3 up = camera.up();
+    EXPECT_NEAR(up.x, std::sqrt(0.5), 1e-6);
+    EXPECT_NEAR(up.y, std::sqrt(0.5), 1e-6);
+    EXPECT_NEAR(up.z, 0, 1e-6);
+}
+
+TEST(SceneAssembly, InstancedFieldRendersAsTheSamePlantsInline)
+{
+    SceneFolder f("inline");
+    f.tiny_model("m");
+    app::SceneFile s = app::read_scene_file(f.scene(R"({
+      "plants": [{"model": "m", "command": "cpfg p.l p.v", "steps": [2, 3],
+                  "placements": [{"translate": [-2, 0, 0], "rotate_y_deg": 30},
+                                 {"translate": [1, 0, 1], "scale": 0.8},
+                                 {"translate": [2.5, 0, -1], "rotate_y_deg": -70, "scale": 1.1}]}],
+      "ground": {"size": [10, 10]},
+      "camera": {"eye": [0, 3, 9], "look_at": [0, 1.2, 0], "fov_deg": 40}
+    })"),
+                                            app::Options{});
+    render::RenderSettings settings;
+    settings.width = 64;
+    settings.height = 64;
+    settings.samples_per_pixel = 16;
+    settings.max_depth = 2;
+    auto render_with = [&](app::AssemblyOptions how, std::size_t instances) {
+        geom::Scene scene = app::assemble_scene(s, app::Options{}, how);
+        EXPECT_EQ(scene.instances.size(), instances);
+        return render::render(scene, settings);
+    };
+    // 3 plants, 2 + 3 + 2 flowers: composed 3 + 7 instances; flattened 3; inline none
+    render::Image composed = render_with({app::OrganPlacement::compose, false}, 10);
+    render::Image flattened = render_with({app::OrganPlacement::flatten, false}, 3);
+    render::Image drawn_inline = render_with({app::OrganPlacement::compose, true}, 0);
+    // automatic: the variant of 2 steps, placed twice, has its 2 flowers drawn in (2 x 3
+    // primitives cost no more than 2 x 2 instances); the one of 3 steps, placed once,
+    // keeps its 3 flowers as instances
+    render::Image automatic = render_with({app::OrganPlacement::automatic, false}, 6);
+    // the same picture up to float rounding of the placements
+    EXPECT_LT(mean_difference(composed, drawn_inline), 1e-3);
+    EXPECT_LT(mean_difference(flattened, drawn_inline), 1e-3);
+    EXPECT_LT(mean_difference(automatic, drawn_inline), 1e-3);
+    // ... and not by accident: a plant moved is another picture
+    app::SceneFile moved = s;
+    moved.plants[0].placements[0][9] += 1.0f;
+    render::Image other = render::render(app::assemble_scene(moved, app::Options{}), settings);
+    EXPECT_GT(mean_difference(other, drawn_inline), 1e-3);
+}
