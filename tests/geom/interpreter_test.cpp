@@ -167,7 +167,7 @@ TEST(Interpreter, SceneGeometryPastTheMemoryBudgetIsAnError)
 // off: the symbols after it (up to the end of its branch) are not interpreted.
 TEST(Interpreter, InterpretationPastCutOnDrawsTheCutBranch)
 {
-    Scene scene = run("F[F%FF[F]F]F", "");
+    Scene scene = interpret_text("F[F%FF[F]F]F", "");
     EXPECT_EQ(scene.geometry.lines.segment_count(), 7u);
 }
 
@@ -175,13 +175,13 @@ TEST(Interpreter, InterpretationPastCutOffSkipsToTheBranchEnd)
 {
     // F [F %...] F: the skipped branch's ']' still restores the turtle, so the last F
     // starts at y = 1
-    Scene scene = run("F[F%FF[F]F]F", "interpretation past %: off\n");
+    Scene scene = interpret_text("F[F%FF[F]F]F", "interpretation past %: off\n");
     ASSERT_EQ(scene.geometry.lines.segment_count(), 3u);
     EXPECT_NEAR(key_of(scene, 2, 0)[1], 1, 1e-6);
     EXPECT_NEAR(key_of(scene, 2, 1)[1], 2, 1e-6);
     // @mc(1) is a cut, @mc(0) is not; a cut outside any branch ends the string
-    EXPECT_EQ(run("F[@mc(0)F]F@mc(1)FF", "interpretation past %: off\n")
+    EXPECT_EQ(interpret_text("F[@mc(0)F]F@mc(1)FF", "interpretation past %: off\n")
                   .geometry.lines.segment_count(),
               3u);
-    EXPECT_EQ(run("F%(2)F", "interpretation past %: off\n").geometry.lines.segment_count(), 2u);
+    EXPECT_EQ(interpret_text("F%(2)F", "interpretation past %: off\n").geometry.lines.segment_count(), 2u);
 }
