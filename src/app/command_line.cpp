@@ -290,9 +290,12 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     std::vector<std::string> files;
     // CLI11 keeps the positionals' least count for them at the end of the line, so that
     // options of several values (--sun X Y Z) stop before them: one for a scene file.
-    bool scene = std::any_of(args.begin(), args.end(), [](const std::string& a) {
-        return std::filesystem::path(a).extension() == ".json";
-    });
+    // A .json word is a scene file unless it is an option's own value (--stats-json F).
+    bool scene = false;
+    for (std::size_t i = 0; i < args.size(); ++i)
+        if (args[i].rfind('-', 0) != 0 && std::filesystem::path(args[i]).extension() == ".json" &&
+            !(i > 0 && args[i - 1] == "--stats-json"))
+            scene = true;
     cli.add_option("files", files, "plant.l plant.v [plant.a], or scene.json (docs/scenes.md)")
         ->required()
         ->expected(scene ? 1 : 2, 3);
