@@ -185,6 +185,16 @@ void report_stats(RunStats& stats, const Options& options)
         write_stats_json(stats, *options.stats_json);
 }
 
+/// A sequence, then --stats on the process that writes (rank 0 under --mpi, whose
+/// figures are its own frames').
+int run_sequence_with_stats(const Options& options, const SequenceOutputs& outputs)
+{
+    int status = run_sequence(options, outputs);
+    if (!outputs.mpi || outputs.mpi->rank() == 0)
+        report_stats(*outputs.stats, options);
+    return status;
+}
+
 /// Renders a still of `scene` (the camera options applied first) and writes `images`: the
 /// whole image, band I of --tile I/N into its tile file, or shared among --mpi's ranks
 /// (rank 0 writes).
@@ -262,8 +272,9 @@ int run_scene(Options options, const std::function<void(const std::string&)>& sa
         return scene;
     };
     if (is_sequence(options)) {
-        SequenceOutputs outputs{images, render_settings(options, images), {}, say, mpi, make_scene};
-        return run_sequence(options, outputs);
+        SequenceOutputs outputs{images, render_settings(options, images), {},     say,
+                                mpi,    make_scene,                       &stats, command_start};
+        return run_sequence_with_stats(options, outputs);
     }
     geom::Scene scene = make_scene();
     if (options.view_volume) {
@@ -287,9 +298,6 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
         if (!options.quiet)
             std::printf("%s\n", text.c_str());
     };
-    if (is_sequence(options) && (options.stats || options.stats_json))
-        throw Error("--stats and --stats-json are not yet available for sequences (-a, "
-                    "--turntable): give them for a single image");
     if (options.scene)
         return run_scene(options, say, command_start, mpi);
     std::vector<std::filesystem::path> images = image_outputs(options);
@@ -303,11 +311,13 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
     // With --mpi, rank 0 alone writes files.
     const bool writes = !mpi || mpi->rank() == 0;
     if (is_sequence(options)) {
-        SequenceOutputs outputs{images, render_settings(options, images), {}, say, mpi};
-        outputs.write_strings = [&](const Model& model, const lsys::ModuleString& s, int step) {
+        RunStats stats;
+        auto strings = [&](const Model& model, const lsys::ModuleString& s, int step) {
             write_strings(model, s, options, step, say);
         };
-        return run_sequence(options, outputs);
+        SequenceOutputs outputs{images, render_settings(options, images), strings, say, mpi,
+                                {},     &stats,                           command_start};
+        return run_sequence_with_stats(options, outputs);
     }
 
     RunStats stats;
@@ -321,8 +331,17 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
     if (writes)
         write_strings(model, string, options,
                       options.steps.value_or(model.lsystem.derivation_length()), say);
-    if (images.empty() && !options.view_volume) {
-        // Only strings are written: the turtle has nothing to do (issue 16.6).
+    if (images.empty()) {
+        // Only strings and the view volume are written: the turtle walks the string for
+        // -vv without building geometry, and has nothing to do otherwise (issue 16.6).
+        if (options.view_volume && writes) {
+            lap = Clock::now();
+            geom::write_view_volume(view_volume(model, string, options), *options.view_volume);
+            stats.interpret_s = seconds_since(lap);
+            stats.interpreted = true;
+            say("wrote " + options.view_volume->string());
+        }
+        stats.assemble_s = stats.load_s + stats.derive_s + stats.interpret_s;
         report_stats(stats, options);
         return 0;
     }
@@ -345,11 +364,6 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
         geom::write_view_volume(scene.view.box.value_or(scene.bounds), *options.view_volume);
         say("wrote " + options.view_volume->string());
     }
-    if (images.empty()) {
-        report_stats(stats, options);
-        return 0;
-    }
-
     return render_and_write_still(scene, options, images, say, stats, command_start, mpi);
 }
 

@@ -174,28 +174,49 @@ lsys::ModuleString turtle_string(const Model& model, const lsys::ModuleString& d
                                                             : lsys::ObjectHandling::keep);
 }
 
-geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString& string,
-                                    const Options& options)
+namespace {
+
+/// The turtle's hooks and limits for this model and command line.
+geom::InterpretOptions interpret_options(const Model& model, const Options& options)
 {
-    geom::InterpretOptions interpret_options;
-    interpret_options.strings = model.lsystem.program().strings;
-    interpret_options.max_memory_bytes = options.max_memory_bytes;
+    geom::InterpretOptions turtle;
+    turtle.strings = model.lsystem.program().strings;
+    turtle.max_memory_bytes = options.max_memory_bytes;
     std::vector<char> objects = instanced_objects(model, options);
     if (!objects.empty()) {
         const lsys::LSystem& lsystem = model.lsystem;
-        interpret_options.is_object = [objects](lsys::SymbolId s) {
+        turtle.is_object = [objects](lsys::SymbolId s) {
             return s < objects.size() && objects[s] != 0;
         };
-        interpret_options.expand_object = [&lsystem](lsys::ModuleRef m) { return lsystem.expand_object(m); };
+        turtle.expand_object = [&lsystem](lsys::ModuleRef m) { return lsystem.expand_object(m); };
     }
     if (options.allow_system_calls) {
         std::filesystem::path folder = options.lsystem.parent_path();
-        interpret_options.system_call = [folder](const std::string& command) {
+        turtle.system_call = [folder](const std::string& command) {
             run_system_call(command, folder);
         };
     }
-    geom::Scene scene =
-        geom::interpret(string, model.lsystem.symbols(), *model.view, interpret_options);
+    return turtle;
+}
+
+}  // namespace
+
+geom::Bounds3 view_volume(const Model& model, const lsys::ModuleString& derived,
+                          const Options& options, bool box_wins)
+{
+    geom::InterpretOptions bounds_only = interpret_options(model, options);
+    bounds_only.bounds_only = true;
+    geom::Scene scene = geom::interpret(turtle_string(model, derived, options),
+                                        model.lsystem.symbols(), *model.view, bounds_only);
+    geom::drop_unrenderable(scene);  // its check of the view volume's range
+    return box_wins ? scene.view.box.value_or(scene.bounds) : scene.bounds;
+}
+
+geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString& string,
+                                    const Options& options)
+{
+    geom::Scene scene = geom::interpret(string, model.lsystem.symbols(), *model.view,
+                                        interpret_options(model, options));
     scene.shading = render_mode(*model.view);
     scene.materials = model.palette.entries(options.colour_block);
     scene.background = model.palette.background(options.colour_block);

@@ -47,4 +47,10 @@ lsys::ModuleString turtle_string(const Model& model, const lsys::ModuleString& d
 geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString& string,
                                     const Options& options);
 
+/// What -vv writes: the view volume of a derived string (the view file's `box:` wins, as
+/// in cpfg, unless not `box_wins`). The turtle walks the string without storing geometry (issue 16.6), so a
+/// -vv without an image costs the walk alone; the bounds equal interpret()'s.
+geom::Bounds3 view_volume(const Model& model, const lsys::ModuleString& derived,
+                          const Options& options, bool box_wins = true);
+
 }  // namespace cambium::app

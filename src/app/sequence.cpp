@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <map>
 #include <optional>
 
 #include <fmt/format.h>
@@ -31,6 +32,61 @@ namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start)
+{
+    return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// --stats for a sequence: each frame's derivation and interpretation, gathered until it
+/// is rendered (RunStats::add_frame). Work for frames rendered elsewhere (another MPI
+/// rank) or not at all counts in the run's totals only.
+class FrameLedger {
+public:
+    FrameLedger(RunStats* stats, Clock::time_point command_start)
+        : m_stats(stats), m_command_start(command_start)
+    {
+    }
+    void derived(int number, double seconds) { work(number).derive_s += seconds; }
+    void interpreted(int number, double seconds) { work(number).interpret_s += seconds; }
+    /// Derivation or interpretation that belongs to no rendered frame (-vv's own pass).
+    void shared(double derive_s, double interpret_s)
+    {
+        if (m_stats) {
+            m_stats->derive_s += derive_s;
+            m_stats->interpret_s += interpret_s;
+        }
+    }
+    double now() const { return seconds_since(m_command_start); }
+    void rendered(int number, const geom::Scene& scene, const render::RenderReport& report,
+                  double render_start_s, const render::RenderSettings& s)
+    {
+        if (m_stats)
+            m_stats->add_frame(take(number), scene, report, render_start_s, s.width, s.height);
+    }
+    void rendered_elsewhere(int number)
+    {
+        FrameStats f = take(number);
+        shared(f.derive_s, f.interpret_s);
+    }
+
+private:
+    FrameStats& work(int number)
+    {
+        FrameStats& f = m_pending[number];
+        f.number = number;
+        return f;
+    }
+    FrameStats take(int number)
+    {
+        FrameStats f = work(number);
+        m_pending.erase(number);
+        return f;
+    }
+    RunStats* m_stats;
+    Clock::time_point m_command_start;
+    std::map<int, FrameStats> m_pending;
+};
 
 fs::path frame_file(const fs::path& pattern, int number)
 {
@@ -244,7 +300,11 @@ geom::AnimationFrame between_frame(const geom::AnimationFrame& a, const geom::An
 
 int run_animation(const Options& options, const SequenceOutputs& out)
 {
+    FrameLedger ledger(out.stats, out.command_start);
+    auto load_start = Clock::now();
     Model model = load_model(options);
+    if (out.stats)
+        out.stats->load_s = seconds_since(load_start);
     std::vector<geom::AnimationFrame> frames = animation_frames(model, options);
     const FrameNumbering numbering{options.shot.inbetween};
     const std::size_t images_total =
@@ -264,6 +324,8 @@ int run_animation(const Options& options, const SequenceOutputs& out)
             to_render += filter.to_render(numbering.between(i, k)) ? 1 : 0;
     }
     out.say(fmt::format("{} frames, {} to render", images_total, to_render));
+    if (out.stats)
+        out.stats->sequence_frames = images_total;
     if (out.mpi)
         out.mpi->checkpoint();
     std::optional<FrameExchange> exchange;
@@ -286,14 +348,18 @@ int run_animation(const Options& options, const SequenceOutputs& out)
                             const geom::AnimationFrame& f) {
         std::size_t k = reached++;
         numbers.push_back(f.number);
-        if (exchange && !exchange->renders(k))
+        if (exchange && !exchange->renders(k)) {
+            ledger.rendered_elsewhere(f.number);
             return;
+        }
         if (exchange)
             exchange->receive_until(k, write_received);  // rendered while rank 0 rendered its last
         textures.share(scene, settings);
         render::RenderReport report;
+        double render_start_s = ledger.now();
         render::Image image =
             render::render(scene, frame_camera(scene, fixed, f, settings), settings, &report);
+        ledger.rendered(f.number, scene, report, render_start_s, settings);
         auto write = [&](std::size_t, render::Image& done) {
             write_frame_images(done, f.number, options, out);
             progress.frame_done(f.number, report.seconds);
@@ -321,7 +387,9 @@ int run_animation(const Options& options, const SequenceOutputs& out)
     std::optional<geom::View> fixed_view;
     // One frame's turtle string (and image number in `frame`): rendered or kept.
     auto take = [&](lsys::ModuleString turtle, const geom::AnimationFrame& frame) {
+        auto interpret_start = Clock::now();
         geom::Scene scene = interpret_turtle_string(model, turtle, options);
+        ledger.interpreted(frame.number, seconds_since(interpret_start));
         scene.view = render::apply_overrides(scene.view, overrides, scene.bounds);
         bool own_camera = refit || scene.view.perspective;
         if (own_camera && !keep_all) {
@@ -346,14 +414,23 @@ int run_animation(const Options& options, const SequenceOutputs& out)
     const std::vector<lsys::Growth> grows = grown_symbols(model.lsystem);
     lsys::ModuleString before;  // the previous frame's string (--inbetween)
     const geom::AnimationFrame* previous = nullptr;
+    auto derivation_start = Clock::now();  // of this frame's steps: since the last frame
     int derived = derive_frames_with_lineage(
         model, frames, numbering.inbetween > 0,
         [&](const geom::AnimationFrame& f, const lsys::ModuleString& string,
             const std::vector<std::uint32_t>& lineage) {
         std::size_t index = std::size_t(&f - frames.data());
         int number = numbering.anchor(f, index);
+        struct Restart {  // the next frame's derivation starts when this call returns
+            Clock::time_point& start;
+            ~Restart() { start = Clock::now(); }
+        } restart{derivation_start};
         if (status != 0)
             return;
+        if (filter.to_render(number))
+            ledger.derived(number, seconds_since(derivation_start));
+        else
+            ledger.shared(seconds_since(derivation_start), 0);
         if (previous)  // the in-betweens leading to this frame
             for (int k = 1; k <= numbering.inbetween && status == 0; ++k) {
                 geom::AnimationFrame g = between_frame(
@@ -361,8 +438,10 @@ int run_animation(const Options& options, const SequenceOutputs& out)
                     numbering.between(index, k));
                 if (!filter.to_render(g.number))
                     continue;
+                auto blend_start = Clock::now();
                 lsys::ModuleString grown = lsys::inbetween(
                     before, string, lineage, float(k) / float(numbering.inbetween + 1), grows);
+                ledger.derived(g.number, seconds_since(blend_start));
                 take(turtle_string(model, written_string(grown), options), g);
             }
         if (numbering.inbetween > 0) {
@@ -379,10 +458,12 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         if (refit && animation->new_view_between_frames)
             model.view = std::make_shared<const geom::ViewFile>(geom::read_view_file(options.view));
         if (options.view_volume && writes) {
-            geom::Scene scene = interpret(model, written, options);
-            scene.view = render::apply_overrides(scene.view, overrides, scene.bounds);
+            auto vv_start = Clock::now();
+            // --fit drops the view file's box (render::apply_overrides)
+            geom::Bounds3 volume = view_volume(model, written, options, !options.shot.fit);
+            ledger.shared(0, seconds_since(vv_start));
             fs::path file = frame_file(*options.view_volume, f.number);
-            geom::write_view_volume(scene.view.box.value_or(scene.bounds), file);
+            geom::write_view_volume(volume, file);
             out.say("wrote " + file.string());
         }
         if (!filter.to_render(number))
@@ -407,12 +488,16 @@ int run_animation(const Options& options, const SequenceOutputs& out)
     for (const Kept& k : kept) {
         if (status != 0)
             break;
+        auto interpret_start = Clock::now();
         geom::Scene scene = interpret_turtle_string(model, k.turtle, options);
+        ledger.interpreted(k.frame.number, seconds_since(interpret_start));
         scene.view = k.own_view.value_or(*fixed_view);
         render_frame(scene, k.own_view ? std::nullopt : camera, k.frame);
     }
     if (exchange && status == 0)
         exchange->receive_until(reached, write_received);
+    if (out.stats)
+        out.stats->assemble_s = out.stats->load_s + out.stats->derive_s + out.stats->interpret_s;
     return status;
 }
 
@@ -423,15 +508,27 @@ int run_turntable(const Options& options, const SequenceOutputs& out)
     const bool writes = !out.mpi || out.mpi->rank() == 0;
     geom::Scene scene;
     if (out.make_scene) {
-        scene = out.make_scene();
+        scene = out.make_scene();  // times its own assembly into out.stats
     } else {
+        RunStats ignored;
+        RunStats& stats = out.stats ? *out.stats : ignored;
+        auto lap = Clock::now();
         Model model = load_model(options);
+        stats.load_s = seconds_since(lap);
+        lap = Clock::now();
         lsys::ModuleString derived = derive(model, options);
+        stats.derive_s = seconds_since(lap);
         if (writes)
             out.write_strings(model, derived,
                               options.steps.value_or(model.lsystem.derivation_length()));
+        lap = Clock::now();
         scene = interpret(model, derived, options);
+        stats.interpret_s = seconds_since(lap);
+        stats.assemble_s = stats.load_s + stats.derive_s + stats.interpret_s;
     }
+    if (out.stats)
+        out.stats->sequence_frames = std::size_t(n);
+    FrameLedger ledger(out.stats, out.command_start);
     scene.view = render::apply_overrides(scene.view, view_overrides(options.shot), scene.bounds);
     if (out.mpi)
         out.mpi->checkpoint();
@@ -471,9 +568,11 @@ int run_turntable(const Options& options, const SequenceOutputs& out)
         write_frame_images(image, numbers[k], options, out);
         progress.frame_done(numbers[k], -1);
     };
+    double render_start_s = ledger.now();
     render::render_views(scene, mine, s,
                          [&](std::size_t view, render::Image& image, const render::RenderReport& r) {
         std::size_t k = ordinals[view];
+        ledger.rendered(numbers[k], scene, r, render_start_s, s);
         auto write = [&](std::size_t, render::Image& done) {
             write_frame_images(done, numbers[k], options, out);
             progress.frame_done(numbers[k], r.seconds);

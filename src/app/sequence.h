@@ -3,6 +3,7 @@
 // the command line's camera options for stills.
 #pragma once
 
+#include <chrono>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -11,6 +12,7 @@
 #include "app/command_line.h"
 #include "app/distributed.h"
 #include "app/pipeline.h"
+#include "app/stats.h"
 #include "geom/animation_file.h"
 #include "render/render.h"
 
@@ -29,6 +31,10 @@ struct SequenceOutputs {
     /// A scene file's scene (docs/scenes.md): when set, a turntable renders it instead
     /// of the options' L-system.
     std::function<geom::Scene()> make_scene;
+    /// --stats: the figures of every frame rendered here go there (app/stats.h), timed
+    /// from `command_start`.
+    RunStats* stats = nullptr;
+    std::chrono::steady_clock::time_point command_start{};
 };
 
 /// Whether the command renders a sequence (-a or --turntable) instead of a still.

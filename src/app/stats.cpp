@@ -4,6 +4,7 @@
 
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <fstream>
 #include <string>
 
@@ -72,6 +73,41 @@ void RunStats::add_render(const render::RenderReport& report, double render_star
     embree_peak_bytes = report.embree_peak_bytes;
 }
 
+void RunStats::add_frame(FrameStats f, const geom::Scene& scene,
+                         const render::RenderReport& report, double render_start_s, int w, int h)
+{
+    if (!rendered)
+        first_pixel_s = render_start_s + report.setup_seconds;
+    sequence = rendered = interpreted = true;
+    width = w;
+    height = h;
+    f.build_s = report.build_seconds;
+    f.render_s = report.seconds - report.setup_seconds;
+    f.samples = report.samples;
+    f.rays = report.rays;
+    f.embree_bytes = report.embree_bytes;
+    RunStats counted;
+    counted.add_scene(scene);
+    f.primitives = counted.placed_primitives.total();
+    if (frames.empty() || f.primitives > placed_primitives.total()) {  // the largest frame
+        primitives = counted.primitives;
+        placed_primitives = counted.placed_primitives;
+        instances = counted.instances;
+        prototypes = counted.prototypes;
+        cambium_bytes = counted.cambium_bytes;
+    }
+    derive_s += f.derive_s;
+    interpret_s += f.interpret_s;
+    build_s += f.build_s;
+    render_s += f.render_s;
+    samples += f.samples;
+    rays += f.rays;
+    embree_bytes = std::max(embree_bytes, report.embree_bytes);
+    embree_peak_bytes = std::max(embree_peak_bytes, report.embree_peak_bytes);
+    f.peak_process_bytes = app::peak_process_bytes();
+    frames.push_back(f);
+}
+
 std::uint64_t peak_process_bytes()
 {
     // VmHWM is the kernel's high-water mark of the resident set, in kB.
@@ -119,9 +155,34 @@ std::uint64_t embree_primitives(const RunStats& s) { return s.primitives.total()
 
 }  // namespace
 
+namespace {
+
+/// The sequence's lines: how many frames, and the spread of their render times.
+std::string sequence_lines(const RunStats& s)
+{
+    std::string out = fmt::format("  sequence of {} frames, {} rendered here; times below are "
+                                  "sums over them\n",
+                                  s.sequence_frames, s.frames.size());
+    if (s.frames.empty())
+        return out;
+    auto slowest = std::max_element(s.frames.begin(), s.frames.end(),
+                                    [](const FrameStats& a, const FrameStats& b) {
+                                        return a.render_s < b.render_s;
+                                    });
+    out += fmt::format("  per frame: render {:.3f} s on average, slowest frame {} ({:.3f} s); "
+                       "interpret {:.3f} s on average\n",
+                       s.render_s / double(s.frames.size()), slowest->number, slowest->render_s,
+                       s.interpret_s / double(s.frames.size()));
+    return out;
+}
+
+}  // namespace
+
 std::string format_stats(const RunStats& s)
 {
     std::string out = "statistics\n";
+    if (s.sequence)
+        out += sequence_lines(s);
     out += fmt::format("  load {:.3f} s, derive {:.3f} s, interpret {:.3f} s (together {:.3f} s), "
                        "build {:.3f} s\n",
                        s.load_s, s.derive_s, s.interpret_s, s.assemble_s, s.build_s);
@@ -129,7 +190,8 @@ std::string format_stats(const RunStats& s)
         out += fmt::format("  time to first pixel {:.3f} s, rendering {:.3f} s\n", s.first_pixel_s,
                            s.render_s);
     if (s.interpreted) {
-        out += "  primitives " + counts_line(s.primitives) + "\n";
+        out += std::string(s.sequence ? "  largest frame: " : "  ") + "primitives " +
+               counts_line(s.primitives) + "\n";
         out += fmt::format("  {} instances of {} prototypes; placed primitives {}\n", s.instances,
                            s.prototypes, s.placed_primitives.total());
     } else {
@@ -189,6 +251,23 @@ nlohmann::json stats_json(const RunStats& s)
                    {"rays", s.rays},
                    {"samples_per_s", per_second(double(s.samples), s.render_s)},
                    {"rays_per_s", per_second(double(s.rays), s.render_s)}};
+    j["sequence"] = s.sequence;
+    if (s.sequence) {
+        j["sequence_frames"] = s.sequence_frames;
+        nlohmann::json frames = nlohmann::json::array();
+        for (const FrameStats& f : s.frames)
+            frames.push_back({{"number", f.number},
+                              {"times_s", {{"derive", f.derive_s},
+                                           {"interpret", f.interpret_s},
+                                           {"build", f.build_s},
+                                           {"render", f.render_s}}},
+                              {"placed_primitives", f.primitives},
+                              {"samples", f.samples},
+                              {"rays", f.rays},
+                              {"embree_bytes", f.embree_bytes},
+                              {"peak_process_bytes", f.peak_process_bytes}});
+        j["frames"] = std::move(frames);
+    }
     return j;
 }
 

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json_fwd.hpp>
 
@@ -25,6 +26,19 @@ struct PrimitiveCounts {
 };
 
 PrimitiveCounts count_primitives(const geom::Geometry& g);
+
+/// One frame of a sequence (-a, --turntable, --inbetween): what it cost beyond the
+/// work shared by every frame (a turntable's load, derivation and interpretation).
+struct FrameStats {
+    int number = 0;  ///< the image number, as in the file names
+    /// derive: the derivation steps since the previous frame (an in-between's blending);
+    /// interpret: the turtle, including a fixed camera's first pass over the frame.
+    double derive_s = 0, interpret_s = 0, build_s = 0, render_s = 0;
+    std::uint64_t primitives = 0;  ///< as placed
+    std::uint64_t samples = 0, rays = 0;
+    std::uint64_t embree_bytes = 0;
+    std::uint64_t peak_process_bytes = 0;  ///< the process's peak so far, after the frame
+};
 
 /// One run's statistics. Times are wall seconds; `first_pixel_s` counts from the start
 /// of the command (main), so it holds load, derive, interpret and build and whatever lies
@@ -51,6 +65,13 @@ struct RunStats {
     int width = 0, height = 0;
     std::uint64_t samples = 0, rays = 0;
 
+    /// A sequence: its frames rendered by this process, in order. The run's times, samples
+    /// and rays are then sums over them plus the shared work; its primitive counts and
+    /// Embree memory those of the largest frame.
+    bool sequence = false;
+    std::size_t sequence_frames = 0;  ///< frames in the sequence, rendered here or not
+    std::vector<FrameStats> frames;
+
     /// A scene file's assembly: thread-summed load, derive and interpret, and its wall time.
     void add_assembly(double load, double derive, double interpret, double wall);
     /// Counts the scene's primitives, instances and buffer bytes.
@@ -58,6 +79,10 @@ struct RunStats {
     /// Takes the render's build time, rays, samples and Embree memory; `render_start_s`
     /// is when render() was called, counted from the start of the command.
     void add_render(const render::RenderReport& report, double render_start_s, int w, int h);
+    /// A frame of a sequence rendered (its interpretation and derivation in `frame`):
+    /// `scene` is what was rendered, `render_start_s` as for add_render().
+    void add_frame(FrameStats frame, const geom::Scene& scene, const render::RenderReport& report,
+                   double render_start_s, int w, int h);
 };
 
 /// The process's peak resident memory (VmHWM; getrusage's ru_maxrss where /proc is absent).

@@ -352,7 +352,9 @@ private:
             Instance instance{m_root->surface_prototype(slot, texture),
                               surface_instance_transform(def, t.position, t.heading, t.left, t.up, s),
                               material(t.color), material(t.back_color), texture};
-            if (m_root == this)
+            if (m_options.bounds_only)
+                ;  // nothing stored
+            else if (m_root == this)
                 m_scene.instances.push_back(instance);
             else  // inside an object's prototype: instances are one level deep
                 append_placed_mesh(m_scene.geometry.mesh,
@@ -382,7 +384,7 @@ private:
             m_patches.start(p[0], p.size() >= 2 ? whole(p[1]) : 0);
         else if (op == TurtleOp::PatchControl)
             m_patches.set_control_point(p[0], whole(p[1]), whole(p[2]), m_turtle.position, FileLoc{});
-        else
+        else if (!m_options.bounds_only)
             m_patches.draw(p[0], p.size() >= 3 ? whole(p[1]) : 0, p.size() >= 3 ? whole(p[2]) : 0,
                            material(m_turtle.color), material(m_turtle.back_color),
                            static_cast<std::int16_t>(m_turtle.texture), m_scene.geometry.mesh, FileLoc{});
@@ -567,10 +569,12 @@ private:
     void draw_sphere(std::span<const float> p)
     {
         double r = std::abs(0.5 * diameter(p));  // cpfg draws -d as d
-        Spheres& spheres = m_scene.geometry.spheres;
-        spheres.centres.push_back(key(m_turtle.position, static_cast<float>(r)));
-        spheres.material.push_back(material(m_turtle.color));
-        spheres.texture.push_back(no_texture);  // cpfg maps no texture on spheres
+        if (!m_options.bounds_only) {
+            Spheres& spheres = m_scene.geometry.spheres;
+            spheres.centres.push_back(key(m_turtle.position, static_cast<float>(r)));
+            spheres.material.push_back(material(m_turtle.color));
+            spheres.texture.push_back(no_texture);  // cpfg maps no texture on spheres
+        }
         for (int x = -1; x <= 1; x += 2)
             for (int y = -1; y <= 1; y += 2)
                 for (int z = -1; z <= 1; z += 2)
@@ -587,12 +591,14 @@ private:
                                     : normalize(m_turtle.up);
         if (dot(normal, normal) == 0)
             normal = Vec3{0, 0, 1};
-        Discs& discs = m_scene.geometry.discs;
-        discs.centres.push_back(key(m_turtle.position, static_cast<float>(r)));
-        discs.normals.push_back({static_cast<float>(normal.x), static_cast<float>(normal.y),
-                                 static_cast<float>(normal.z)});
-        discs.material.push_back(material(m_turtle.color));
-        discs.back_material.push_back(material(m_turtle.back_color));
+        if (!m_options.bounds_only) {
+            Discs& discs = m_scene.geometry.discs;
+            discs.centres.push_back(key(m_turtle.position, static_cast<float>(r)));
+            discs.normals.push_back({static_cast<float>(normal.x), static_cast<float>(normal.y),
+                                     static_cast<float>(normal.z)});
+            discs.material.push_back(material(m_turtle.color));
+            discs.back_material.push_back(material(m_turtle.back_color));
+        }
         double z = facing_viewer ? 0.0 : m_turtle.position.z;
         for (int x = -1; x <= 1; x += 2)
             for (int y = -1; y <= 1; y += 2)
@@ -641,6 +647,8 @@ private:
     /// R = -L, v along H, each scaled to [0, 1] over the polygon.
     void emit_polygon(const std::vector<PolygonCorner>& corners)
     {
+        if (m_options.bounds_only)
+            return;  // its corners are turtle positions, in the bounds already
         std::vector<Vec3> outline;
         outline.reserve(corners.size());
         for (const PolygonCorner& c : corners)
@@ -809,7 +817,7 @@ private:
         if (width == m_turtle.line_width)
             return;
         m_turtle.line_width = width;
-        if (m_taper_open && tapers())
+        if (m_taper_open && tapers() && !m_options.bounds_only)
             m_scene.geometry.lines.keys.back()[3] = radius();  // the open segment's top
         else
             m_chain_open = false;  // the joint key cannot carry two widths
@@ -916,6 +924,10 @@ private:
         double start_v = m_turtle.texture_v;
         m_turtle.position += m_turtle.heading * distance;
         after_move(distance, polygon_vertex);
+        m_turtle.remember_frame();  // F and G: the reference for twist-free adjustments
+        m_taper_open = true;
+        if (m_options.bounds_only)
+            return;  // the segment's ends are turtle positions, in the bounds at the nodes
         LinearCurves& lines = m_scene.geometry.lines;
         bool joined = m_chain_open;
         if (!joined) {
@@ -931,9 +943,7 @@ private:
         lines.flags.push_back(joined ? LinearCurves::neighbour_left : 0);
         lines.material.push_back(material(m_turtle.color));
         lines.texture.push_back(static_cast<std::int16_t>(m_turtle.texture));
-        m_turtle.remember_frame();  // F and G: the reference for twist-free adjustments
         m_chain_open = true;
-        m_taper_open = true;
     }
 
     static std::array<float, 4> key(const Vec3& p, float radius)

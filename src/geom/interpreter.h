@@ -45,6 +45,11 @@ struct InterpretOptions {
     /// `@S("command")`: called with the command, in string order, when set (the user
     /// allowed system calls); unset, @S is ignored with a warning.
     std::function<void(const std::string&)> system_call;
+    /// Only the view volume (Scene::bounds, what -vv writes) is wanted: the turtle walks
+    /// the string as usual, but segments, spheres, discs, polygons, patches and surface
+    /// instances are not stored (generalized cylinders are, as their sweep makes the
+    /// bounds). The bounds equal a full interpretation's.
+    bool bounds_only = false;
 };
 
 Scene interpret(const lsys::ModuleString& string, const lsys::SymbolTable& symbols,

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The bounding box of every corpus model's interpreted geometry against the original
-// cpfg's view-volume file (-vv), within 1e-3 of the box diagonal.
+// cpfg's view-volume file (-vv), within 1e-3 of the box diagonal; and the bounds-only
+// walk of -vv without an image (app::view_volume) equal to the full interpretation's.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -37,8 +38,15 @@ TEST(ViewVolumeConformance, CorpusBoxesMatchCpfg)
         geom::Bounds3 ref = geom::parse_view_volume(reference, (model.oracle / "view.vv").string());
         app::Options options = model_options(model);
         app::Model loaded = app::load_model(options);
-        geom::Scene scene = app::interpret(loaded, app::derive(loaded, options), options);
+        lsys::ModuleString derived = app::derive(loaded, options);
+        geom::Scene scene = app::interpret(loaded, derived, options);
         geom::Bounds3 ours = scene.view.box.value_or(scene.bounds);  // as cpfg's -vv
+        // -vv without an image walks the turtle without geometry: the same box, exactly
+        geom::Bounds3 walked = app::view_volume(loaded, derived, options);
+        for (int axis = 0; axis < 3; ++axis) {
+            EXPECT_EQ(walked.lo[axis], ours.lo[axis]) << model.id << " axis " << axis;
+            EXPECT_EQ(walked.hi[axis], ours.hi[axis]) << model.id << " axis " << axis;
+        }
         double error = box_error(ours, ref);
         if (error <= 1e-3)
             return std::string();

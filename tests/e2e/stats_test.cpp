@@ -180,11 +180,96 @@ TEST(Stats, SceneFileCountsPrototypesOnceAndPlacedCopiesPerInstance)
     EXPECT_EQ(j["render"]["samples"], 24 * 16);
 }
 
-TEST(Stats, SequencesSayStatsAreNotYetAvailable)
+/// A growing plant: step n has n copies of the known plant's 7 primitives.
+RunResult run_growing_plant(const std::string& name, const std::string& args)
 {
-    RunResult r = run_known_plant("seq", "-a -w 8 8 --spp 1 --stats");
-    EXPECT_NE(r.status, 0);
-    EXPECT_NE(r.output.find("not yet available for sequences"), std::string::npos) << r.output;
+    RunResult r = run_known_plant(name, "--version");  // makes the folder
+    std::ofstream(r.dir / "g.l") << "lsystem: 1\nderivation length: 3\naxiom: A\n"
+                                    "A --> F[+F]F@O(0.5)@c(0.5){.f.+f.+f.}A\nendlsystem\n";
+    std::string command = "cd '" + r.dir.string() + "' && " + CAMBIUM_EXE + " g.l p.v " + args +
+                          " > out.txt 2>&1";
+    r.status = std::system(command.c_str());
+    std::ifstream in(r.dir / "out.txt");
+    r.output.assign(std::istreambuf_iterator<char>(in), {});
+    return r;
+}
+
+/// The sum of one per-frame figure.
+double frame_sum(const nlohmann::json& j, const char* time)
+{
+    double sum = 0;
+    for (const nlohmann::json& f : j["frames"])
+        sum += f["times_s"][time].get<double>();
+    return sum;
+}
+
+TEST(Stats, AnimationReportsEveryFrameAndTotalsThatAddUp)
+{
+    RunResult r = run_growing_plant("anim", "-a -w 16 12 --spp 2 -o g%02d.png --stats-json s.json");
+    ASSERT_EQ(r.status, 0) << r.output;
+    nlohmann::json j = read_json(r.dir / "s.json");
+    expect_documented_keys(j);
+    EXPECT_TRUE(j["sequence"].get<bool>());
+    EXPECT_EQ(j["sequence_frames"], 3);
+    ASSERT_EQ(j["frames"].size(), 3u);
+    std::uint64_t peak_so_far = 0;
+    for (int k = 0; k < 3; ++k) {
+        const nlohmann::json& f = j["frames"][std::size_t(k)];
+        EXPECT_EQ(f["number"], k + 1);
+        EXPECT_EQ(f["placed_primitives"], 7 * (k + 1));  // the plant grows a copy a step
+        EXPECT_EQ(f["samples"], 16 * 12 * 2);
+        EXPECT_GT(f["rays"].get<std::uint64_t>(), f["samples"].get<std::uint64_t>());
+        for (const char* key : {"derive", "interpret", "build", "render"})
+            EXPECT_GE(f["times_s"][key].get<double>(), 0) << key;
+        EXPECT_GT(f["times_s"]["build"].get<double>(), 0);  // a new scene each frame
+        std::uint64_t peak = f["peak_process_bytes"].get<std::uint64_t>();
+        EXPECT_GE(peak, peak_so_far);  // a high-water mark
+        peak_so_far = peak;
+    }
+    // The totals are the frames' sums; the counts are the largest frame's.
+    const nlohmann::json& t = j["times_s"];
+    for (const char* key : {"derive", "interpret", "build", "render"})
+        EXPECT_NEAR(t[key].get<double>(), frame_sum(j, key), 1e-9) << key;
+    EXPECT_EQ(j["render"]["samples"], 3 * 16 * 12 * 2);
+    EXPECT_EQ(j["primitives"]["total"], 21);
+    EXPECT_GE(j["memory_bytes"]["peak_process"].get<std::uint64_t>(), peak_so_far);
+    EXPECT_LE(t["load"].get<double>() + j["frames"][0]["times_s"]["build"].get<double>(),
+              t["first_pixel"].get<double>());
+}
+
+TEST(Stats, TurntableBuildsOnceAndCountsOnlyTheSelectedFrames)
+{
+    RunResult r = run_known_plant(
+        "turn", "--turntable 4 --frames 2-3 -w 16 12 --spp 1 -o t%02d.png --stats --stats-json s.json");
+    ASSERT_EQ(r.status, 0) << r.output;
+    nlohmann::json j = read_json(r.dir / "s.json");
+    EXPECT_EQ(j["sequence_frames"], 4);
+    ASSERT_EQ(j["frames"].size(), 2u);
+    EXPECT_EQ(j["frames"][0]["number"], 2);
+    EXPECT_EQ(j["frames"][1]["number"], 3);
+    // One scene, one BVH: the first view pays for the build.
+    EXPECT_GT(j["frames"][0]["times_s"]["build"].get<double>(), 0);
+    EXPECT_EQ(j["frames"][1]["times_s"]["build"].get<double>(), 0);
+    EXPECT_EQ(j["frames"][1]["placed_primitives"], 7);
+    EXPECT_EQ(j["render"]["samples"], 2 * 16 * 12);
+    for (const char* words : {"sequence of 4 frames, 2 rendered here", "slowest frame",
+                              "time to first pixel", "peak process memory"})
+        EXPECT_NE(r.output.find(words), std::string::npos) << words << " in\n" << r.output;
+}
+
+TEST(Stats, ViewVolumeAloneMatchesTheOneWrittenBesideAnImage)
+{
+    // -vv without an image walks the turtle without building geometry (issue 16.6).
+    RunResult r = run_growing_plant("vvwalk", "-vv alone.vv");
+    ASSERT_EQ(r.status, 0) << r.output;
+    RunResult with_image = run_growing_plant("vvimage", "-vv beside.vv -w 8 8 --spp 1 -o g.png");
+    ASSERT_EQ(with_image.status, 0) << with_image.output;
+    auto text = [](const fs::path& f) {
+        std::ifstream in(f);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    EXPECT_FALSE(text(r.dir / "alone.vv").empty());
+    EXPECT_EQ(text(r.dir / "alone.vv"), text(with_image.dir / "beside.vv"));
 }
 
 }  // namespace

@@ -185,3 +185,33 @@ TEST(Interpreter, InterpretationPastCutOffSkipsToTheBranchEnd)
               3u);
     EXPECT_EQ(interpret_text("F%(2)F", "interpretation past %: off\n").geometry.lines.segment_count(), 2u);
 }
+
+namespace cambium::geom {
+namespace {
+
+TEST(Interpreter, BoundsOnlyWalkStoresNoGeometryAndFindsTheSameBounds)
+{
+    // Segments with a width change, a sphere, both discs and a polygon.
+    const std::string text = "F(2)!(3)F[+(30)F@O(1.5)]@o(2)-(60)f(3)@c(1){.f.+(90)f.+(90)f.}F";
+    const std::string view = "initial line width: 1\n";
+    lsys::SymbolTable symbols;
+    lsys::ModuleString s = text_modules(symbols, text);
+    ViewFile parsed = parse_view_file(view, "t.v");
+    Scene full = interpret(s, symbols, parsed, InterpretOptions{});
+    InterpretOptions walk;
+    walk.bounds_only = true;
+    Scene bounds = interpret(s, symbols, parsed, walk);
+    EXPECT_GT(full.geometry.lines.segment_count(), 0u);
+    EXPECT_GT(full.geometry.mesh.size(), 0u);
+    EXPECT_EQ(bounds.geometry.lines.segment_count(), 0u);
+    EXPECT_EQ(bounds.geometry.spheres.size(), 0u);
+    EXPECT_EQ(bounds.geometry.discs.size(), 0u);
+    EXPECT_EQ(bounds.geometry.mesh.size(), 0u);
+    for (int axis = 0; axis < 3; ++axis) {
+        EXPECT_EQ(bounds.bounds.lo[axis], full.bounds.lo[axis]) << axis;
+        EXPECT_EQ(bounds.bounds.hi[axis], full.bounds.hi[axis]) << axis;
+    }
+}
+
+}  // namespace
+}  // namespace cambium::geom
