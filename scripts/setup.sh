@@ -23,6 +23,8 @@ packages=(
   libgtest-dev libbenchmark-dev
   # zlib: the conformance tests read cpfg's gzipped rayshade exports (scene.ray.gz)
   zlib1g-dev
+  # the scene files' JSON Schema (docs/scene.schema.json) is checked in the suite
+  python3-jsonschema
   # Open MPI (BSD licence) for --mpi: the module libcambium_mpi.so links it, the tests
   # run mpirun (docs/distributed.md)
   libopenmpi-dev openmpi-bin
