@@ -179,9 +179,6 @@ void check_distributed_options(const Options& options)
                     std::to_string(options.height) + " rows; give at most one band per row");
     if ((options.tile || options.assemble) && !options.renders())
         throw Error("--tile and --assemble need an image output (-o)");
-    if (options.mpi && options.shot.resume)
-        throw Error("--resume with --mpi is not supported yet: the ranks must agree on the "
-                    "frames; give --frames A-B instead");
 }
 
 }  // namespace

@@ -7,9 +7,12 @@
 
 #include <dlfcn.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <future>
 #include <vector>
 
 #include <fmt/format.h>
@@ -25,7 +28,11 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr int still_tag = 1;
-constexpr int frame_tag = 2;
+constexpr int frame_tag = 2;     // a rendered frame (FrameExchange, FrameQueue)
+constexpr int request_tag = 3;   // FrameQueue: a rank asks for its first frame
+constexpr int give_tag = 4;      // FrameQueue: rank 0 gives a frame (or none)
+constexpr int finished_tag = 5;  // FrameQueue: a rank is through the sequence
+constexpr int shared_tag = 6;    // Mpi::from_rank0
 
 template <typename F>
 F* symbol(const SharedModule& module, const char* name)
@@ -49,6 +56,7 @@ struct Mpi::Module {
     cambium_mpi_send_fn* send = nullptr;
     cambium_mpi_receive_fn* receive = nullptr;
     cambium_mpi_all_min_fn* all_min = nullptr;
+    cambium_mpi_probe_fn* probe = nullptr;
     char error[512] = {};
 };
 
@@ -79,6 +87,7 @@ Mpi::Mpi(int* argc, char*** argv) : m_module(std::make_unique<Module>())
     m.send = symbol<cambium_mpi_send_fn>(loaded, "cambium_mpi_send");
     m.receive = symbol<cambium_mpi_receive_fn>(loaded, "cambium_mpi_receive");
     m.all_min = symbol<cambium_mpi_all_min_fn>(loaded, "cambium_mpi_all_min");
+    m.probe = symbol<cambium_mpi_probe_fn>(loaded, "cambium_mpi_probe");
     if (init(argc, argv, &m_rank, &m_size, m.error, sizeof m.error) != 0)
         throw Error(std::string("--mpi: ") + m.error);
 }
@@ -102,6 +111,25 @@ std::string Mpi::receive(int from, int tag)
     std::string bytes;
     if (m_module->receive(from, tag, &grow, &bytes, m_module->error, sizeof m_module->error) != 0)
         throw Error(std::string("--mpi: ") + m_module->error);
+    return bytes;
+}
+
+std::optional<Mpi::Message> Mpi::probe(bool wait)
+{
+    int found = 0;
+    Message m;
+    if (m_module->probe(wait ? 1 : 0, &found, &m.from, &m.tag, m_module->error,
+                        sizeof m_module->error) != 0)
+        throw Error(std::string("--mpi: ") + m_module->error);
+    return found ? std::optional<Message>(m) : std::nullopt;
+}
+
+std::string Mpi::from_rank0(const std::string& bytes)
+{
+    if (m_rank != 0)
+        return receive(0, shared_tag);
+    for (int r = 1; r < m_size; ++r)
+        send(bytes, r, shared_tag);
     return bytes;
 }
 
@@ -203,6 +231,105 @@ void FrameExchange::receive_until(std::size_t end, const Write& write)
                                     m_next));
         write(m_next, tile.image);
     }
+}
+
+FrameQueue::FrameQueue(Mpi& mpi, std::size_t frames, Write write)
+    : m_mpi(mpi), m_frames(frames), m_write(std::move(write)),
+      m_given(std::size_t(mpi.size()), none)
+{
+}
+
+bool FrameQueue::renders(std::size_t k)
+{
+    if (writes()) {
+        m_reached = k + 1;
+        serve(false);
+        // Every frame before k was taken by rank 0 as it passed, or given away.
+        if (k < m_next_free)
+            return false;
+        m_next_free = k + 1;
+        return true;
+    }
+    if (!m_mine) {  // the first frame to render: ask for one
+        m_mpi.send({}, 0, request_tag);
+        m_mine = std::stoull(m_mpi.receive(0, give_tag));
+    }
+    return k == *m_mine;
+}
+
+render::Image FrameQueue::render_serving(const std::function<render::Image()>& render)
+{
+    if (!writes())
+        return render();
+    std::future<render::Image> image = std::async(std::launch::async, render);
+    while (image.wait_for(std::chrono::milliseconds(2)) != std::future_status::ready)
+        serve(false);
+    return image.get();
+}
+
+void FrameQueue::rendered(std::size_t k, render::Image image)
+{
+    if (writes()) {
+        m_waiting.emplace(k, std::move(image));
+        write_in_order();
+        return;
+    }
+    m_mpi.send(encode_tile({int(k), int(k) + 1, image.width, image.height,
+                            {0, 0, image.width, image.height}, std::move(image)}),
+               0, frame_tag);
+    m_mine = std::stoull(m_mpi.receive(0, give_tag));
+}
+
+void FrameQueue::finish(std::size_t reached, bool complete)
+{
+    if (!writes()) {
+        m_mpi.send({}, 0, finished_tag);
+        return;
+    }
+    m_reached = std::max(m_reached, reached);
+    while (m_finished < m_mpi.size() - 1)
+        serve(true);
+    write_in_order();
+    if (complete && m_next_write < reached)
+        throw Error(fmt::format("--mpi: frame {} of the sequence was not rendered", m_next_write));
+}
+
+void FrameQueue::serve(bool wait)
+{
+    for (std::optional<Mpi::Message> m; (m = m_mpi.probe(wait)); wait = false) {
+        std::string bytes = m_mpi.receive(m->from, m->tag);
+        if (m->tag == finished_tag) {
+            ++m_finished;
+            continue;
+        }
+        if (m->tag == frame_tag) {
+            Tile tile = decode_tile(bytes, fmt::format("rank {}'s frame", m->from));
+            if (std::size_t(tile.index) != m_given[std::size_t(m->from)])
+                throw Error(fmt::format("--mpi: rank {} sent frame {}, not the frame it was given",
+                                        m->from, tile.index));
+            m_waiting.emplace(std::size_t(tile.index), std::move(tile.image));
+        } else if (m->tag != request_tag) {
+            throw Error(fmt::format("--mpi: an unexpected message (tag {}) from rank {}", m->tag,
+                                    m->from));
+        }
+        give_next(m->from);
+        write_in_order();
+    }
+}
+
+void FrameQueue::give_next(int rank)
+{
+    std::size_t k = m_next_free < m_frames ? m_next_free++ : none;
+    m_given[std::size_t(rank)] = k;
+    m_mpi.send(std::to_string(k), rank, give_tag);
+}
+
+void FrameQueue::write_in_order()
+{
+    for (auto it = m_waiting.begin();
+         it != m_waiting.end() && it->first == m_next_write && it->first < m_reached;
+         it = m_waiting.erase(it), ++m_next_write)
+        m_write(it->first, it->second);
 }
 
 }  // namespace cambium::app

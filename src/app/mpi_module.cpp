@@ -91,6 +91,24 @@ __attribute__((visibility("default"))) int cambium_mpi_receive(
     return 0;
 }
 
+__attribute__((visibility("default"))) int cambium_mpi_probe(int wait, int* found, int* from,
+                                                             int* tag, char* error,
+                                                             size_t error_size)
+{
+    MPI_Status status;
+    int code = wait ? MPI_Probe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &status)
+                    : MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, found, &status);
+    if (code != MPI_SUCCESS)
+        return fail(code, wait ? "MPI_Probe" : "MPI_Iprobe", error, error_size);
+    if (wait)
+        *found = 1;
+    if (*found) {
+        *from = status.MPI_SOURCE;
+        *tag = status.MPI_TAG;
+    }
+    return 0;
+}
+
 __attribute__((visibility("default"))) int cambium_mpi_all_min(int value, int* result,
                                                                char* error, size_t error_size)
 {

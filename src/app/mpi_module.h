@@ -11,7 +11,7 @@
 extern "C" {
 
 /// The interface's version: the loader refuses a module of another version.
-inline constexpr int cambium_mpi_version = 1;
+inline constexpr int cambium_mpi_version = 2;
 
 /// cambium_mpi_interface_version(): the version the module was built with.
 using cambium_mpi_version_fn = int();
@@ -29,6 +29,10 @@ using cambium_mpi_send_fn = int(const void* data, uint64_t bytes, int to, int ta
 /// then `allocate(context, size)` gives the buffer, then the bytes.
 using cambium_mpi_receive_fn = int(int from, int tag, void* (*allocate)(void* context, uint64_t),
                                    void* context, char* error, size_t error_size);
+/// Whether a message from any rank under any tag waits (MPI_Iprobe; MPI_Probe, which
+/// waits for one, when `wait`): its sender and tag then go to `from` and `tag`.
+using cambium_mpi_probe_fn = int(int wait, int* found, int* from, int* tag, char* error,
+                                 size_t error_size);
 /// MPI_Allreduce(MPI_MIN) of one int over every rank.
 using cambium_mpi_all_min_fn = int(int value, int* result, char* error, size_t error_size);
 }

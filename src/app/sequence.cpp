@@ -13,6 +13,9 @@
 #include <chrono>
 #include <limits>
 #include <map>
+#include <set>
+#include <sstream>
+#include <numeric>
 #include <optional>
 
 #include <fmt/format.h>
@@ -153,14 +156,34 @@ public:
             return false;
         if (!m_resume)
             return true;
+        if (m_written)
+            return m_written->count(number) == 0;
         for (const fs::path& image : m_images)
             if (!fs::exists(frame_file(image, number)))
                 return true;
         return false;
     }
 
+    /// --mpi: which of `numbers` --resume finds written is rank 0's to say, for every
+    /// rank (the others may not see its files, or may see them appear as it writes).
+    void agree(Mpi& mpi, const std::vector<int>& numbers)
+    {
+        if (!m_resume)
+            return;
+        std::string written;
+        if (mpi.rank() == 0)
+            for (int n : numbers)
+                if (selected(n) && !to_render(n))
+                    written += std::to_string(n) + " ";
+        std::istringstream in(mpi.from_rank0(written));
+        m_written.emplace();
+        for (int n = 0; in >> n;)
+            m_written->insert(n);
+    }
+
 private:
     std::optional<std::pair<int, int>> m_range;
+    std::optional<std::set<int>> m_written;  ///< agreed among MPI ranks (agree())
     bool m_resume;
     const std::vector<fs::path>& m_images;
 };
@@ -317,21 +340,22 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         animation = geom::read_animation_file(*options.animation);
     const bool refit = animation && (animation->scale_between_frames ||
                                      animation->new_view_between_frames);
-    std::size_t to_render = 0;
+    std::vector<int> image_numbers;  // every image of the sequence, anchors and in-betweens
     for (std::size_t i = 0; i < frames.size(); ++i) {
-        to_render += filter.to_render(numbering.anchor(frames[i], i)) ? 1 : 0;
+        image_numbers.push_back(numbering.anchor(frames[i], i));
         for (int k = 1; i > 0 && k <= numbering.inbetween; ++k)
-            to_render += filter.to_render(numbering.between(i, k)) ? 1 : 0;
+            image_numbers.push_back(numbering.between(i, k));
     }
+    if (out.mpi) {
+        out.mpi->checkpoint();
+        filter.agree(*out.mpi, image_numbers);
+    }
+    const std::size_t to_render = std::size_t(
+        std::count_if(image_numbers.begin(), image_numbers.end(),
+                      [&](int number) { return filter.to_render(number); }));
     out.say(fmt::format("{} frames, {} to render", images_total, to_render));
     if (out.stats)
         out.stats->sequence_frames = images_total;
-    if (out.mpi)
-        out.mpi->checkpoint();
-    std::optional<FrameExchange> exchange;
-    if (out.mpi)
-        exchange.emplace(*out.mpi);
-    const bool writes = !exchange || exchange->writes();
     std::vector<int> numbers;  // image numbers of the frames rendered, in call order
 
     render::ViewOverrides overrides = view_overrides(options.shot);
@@ -339,33 +363,38 @@ int run_animation(const Options& options, const SequenceOutputs& out)
     SequenceTextures textures;
     SequenceProgress progress(to_render, out.say);
     int status = 0;
-    auto write_received = [&](std::size_t k, render::Image& image) {
+    std::map<std::size_t, double> seconds_here;  // render times of the frames rendered here
+    auto write = [&](std::size_t k, render::Image& image) {
         write_frame_images(image, numbers[k], options, out);
-        progress.frame_done(numbers[k], -1);
+        auto here = seconds_here.find(k);
+        progress.frame_done(numbers[k], here == seconds_here.end() ? -1 : here->second);
     };
+    // --mpi: frames on demand (app/distributed.h)
+    std::optional<FrameQueue> queue;
+    if (out.mpi)
+        queue.emplace(*out.mpi, to_render, write);
+    const bool writes = !queue || queue->writes();
     std::size_t reached = 0;  // frames to render reached so far, on every rank alike
     auto render_frame = [&](const geom::Scene& scene, const std::optional<render::Camera>& fixed,
                             const geom::AnimationFrame& f) {
         std::size_t k = reached++;
         numbers.push_back(f.number);
-        if (exchange && !exchange->renders(k)) {
+        if (queue && !queue->renders(k)) {
             ledger.rendered_elsewhere(f.number);
             return;
         }
-        if (exchange)
-            exchange->receive_until(k, write_received);  // rendered while rank 0 rendered its last
         textures.share(scene, settings);
         render::RenderReport report;
         double render_start_s = ledger.now();
-        render::Image image =
-            render::render(scene, frame_camera(scene, fixed, f, settings), settings, &report);
-        ledger.rendered(f.number, scene, report, render_start_s, settings);
-        auto write = [&](std::size_t, render::Image& done) {
-            write_frame_images(done, f.number, options, out);
-            progress.frame_done(f.number, report.seconds);
+        auto render_it = [&] {
+            return render::render(scene, frame_camera(scene, fixed, f, settings), settings,
+                                  &report);
         };
-        if (exchange)
-            exchange->rendered(k, image, write);
+        render::Image image = queue ? queue->render_serving(render_it) : render_it();
+        ledger.rendered(f.number, scene, report, render_start_s, settings);
+        seconds_here[k] = report.seconds;
+        if (queue)
+            queue->rendered(k, std::move(image));
         else
             write(k, image);
         if (report.cancelled)
@@ -494,8 +523,8 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         scene.view = k.own_view.value_or(*fixed_view);
         render_frame(scene, k.own_view ? std::nullopt : camera, k.frame);
     }
-    if (exchange && status == 0)
-        exchange->receive_until(reached, write_received);
+    if (queue)
+        queue->finish(reached, status == 0);
     if (out.stats)
         out.stats->assemble_s = out.stats->load_s + out.stats->derive_s + out.stats->interpret_s;
     return status;
@@ -540,6 +569,11 @@ int run_turntable(const Options& options, const SequenceOutputs& out)
         scene.view, scene.bounds, n, options.shot.turntable_elevation, s.width, s.height);
     // Frames are numbered 1..N; the first looks from the view file's side.
     FrameFilter filter(options.shot, out.images);
+    if (out.mpi) {
+        std::vector<int> all(static_cast<std::size_t>(n));
+        std::iota(all.begin(), all.end(), 1);
+        filter.agree(*out.mpi, all);
+    }
     std::vector<render::Camera> cameras;
     std::vector<int> numbers;
     for (int k = 0; k < n; ++k)

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "app/tiles.h"
@@ -226,6 +227,74 @@ TEST(MpiCommand, SequencesEqualTheSingleRun)
                                  dir / ("grow_np2_" + std::string(number) + ext));
         }
     EXPECT_FALSE(fs::exists(dir / "grow04.png"));
+    fs::remove_all(dir);
+}
+
+/// "%02d" of n.
+std::string two_digits(int n)
+{
+    char number[8];
+    std::snprintf(number, sizeof number, "%02d", n);
+    return number;
+}
+
+TEST(MpiCommand, FramesOnDemandEqualTheSingleRun)
+{
+    // Animations hand frames out on demand (app/distributed.h, FrameQueue): more frames
+    // than ranks, in-betweens, and more ranks than frames must all give the single run's
+    // files, each frame written once.
+    std::string skip = mpirun_or_skip_reason();
+    if (!skip.empty())
+        GTEST_SKIP() << skip;
+    fs::path dir = scratch("mpi_queue");
+    struct Case {
+        std::string name, args;
+        int ranks, frames;
+    };
+    const std::vector<Case> cases = {
+        {"between", "-q -w 16 12 --spp 2 -a --steps 3 --inbetween 1 plant.l plant.v", 3, 5},
+        {"few", "-q -w 16 12 --spp 2 -a --steps 2 plant.l plant.v", 3, 2},
+    };
+    for (const Case& c : cases) {
+        std::string one = " -o " + (dir / (c.name + "%02d.png")).string();
+        std::string many = " -o " + (dir / (c.name + "_mpi%02d.png")).string();
+        ASSERT_EQ(shell(cambium + " " + c.args + one).status, 0) << c.name;
+        Result r = shell(mpirun(c.ranks) + " --threads 1 " + c.args + many);
+        ASSERT_EQ(r.status, 0) << c.name << "\n" << r.output;
+        for (int frame = 1; frame <= c.frames; ++frame)
+            expect_same_file(dir / (c.name + two_digits(frame) + ".png"),
+                             dir / (c.name + "_mpi" + two_digits(frame) + ".png"));
+        EXPECT_FALSE(fs::exists(dir / (c.name + "_mpi" + two_digits(c.frames + 1) + ".png")));
+    }
+    fs::remove_all(dir);
+}
+
+TEST(MpiCommand, ResumeSkipsTheFramesRank0FindsWritten)
+{
+    std::string skip = mpirun_or_skip_reason();
+    if (!skip.empty())
+        GTEST_SKIP() << skip;
+    fs::path dir = scratch("mpi_resume");
+    const std::string growth = "-w 16 12 --spp 2 -a --steps 4 plant.l plant.v";
+    const std::string turntable = "-w 16 12 --spp 2 --turntable 4 plant.l plant.v";
+    for (const auto& [name, args, ranks] :
+         {std::tuple{std::string("grow"), growth, 2}, std::tuple{std::string("turn"), turntable, 3}}) {
+        ASSERT_EQ(shell(cambium + " -q " + args + " -o " + (dir / (name + "%02d.png")).string())
+                      .status,
+                  0);
+        // Frames 2 and 3 are "written already": their stand-ins must stay untouched.
+        for (int frame : {2, 3})
+            std::ofstream(dir / (name + "_mpi" + two_digits(frame) + ".png")) << "kept";
+        Result r = shell(mpirun(ranks) + " --threads 1 --resume " + args + " -o " +
+                         (dir / (name + "_mpi%02d.png")).string());
+        ASSERT_EQ(r.status, 0) << name << "\n" << r.output;
+        EXPECT_NE(r.output.find("4 frames, 2 to render"), std::string::npos) << r.output;
+        for (int frame : {1, 4})
+            expect_same_file(dir / (name + two_digits(frame) + ".png"),
+                             dir / (name + "_mpi" + two_digits(frame) + ".png"));
+        for (int frame : {2, 3})
+            EXPECT_EQ(bytes_of(dir / (name + "_mpi" + two_digits(frame) + ".png")), "kept");
+    }
     fs::remove_all(dir);
 }
 
