@@ -10,13 +10,23 @@
 // and segments are listed only under similarity transforms
 // (Embree draws them as ellipsoids and ellipses otherwise, which we do not sample);
 // left out, they are found by BSDF sampling alone, which stays unbiased.
+//
+// Memory: the lights are kept per distinct geometry, not per placed copy. A field of 100
+// Lilacs whose organs glow listed every primitive of every instance (2.4 GiB); now each
+// prototype's lights are listed once per combination of the materials its instances pass
+// down (inherit_material) and of whether round shapes may be listed (similarity), and an
+// instance costs one Placement. Choosing the placement by its power (the group's power
+// times the transform's area scale) and then the light by its own power is, under
+// similarity transforms, the same density as choosing among all placed lights.
 #include "render/area_light.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <map>
 #include <string>
+#include <tuple>
 
 #include "base/diagnostics.h"
 
@@ -31,44 +41,6 @@ float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f
 Vec3f vec(const geom::Float3& a) { return {a[0], a[1], a[2]}; }
 Vec3f vec(const geom::Float4& a) { return {a[0], a[1], a[2]}; }
 
-/// An instance's affine map x' = A x + t, the cofactor matrix for normals and whether it
-/// is a similarity (uniform scale times a rotation or reflection).
-struct Affine {
-    Vec3f c0{1, 0, 0}, c1{0, 1, 0}, c2{0, 0, 1}, t;
-    float det = 1, scale = 1;
-    bool similarity = true;
-
-    Vec3f point(const Vec3f& p) const { return c0 * p.x + c1 * p.y + c2 * p.z + t; }
-    /// A normal's image, unit (the inverse transpose, up to a positive factor when det > 0).
-    Vec3f normal(const Vec3f& n) const
-    {
-        Vec3f r = cross(c1, c2) * n.x + cross(c2, c0) * n.y + cross(c0, c1) * n.z;
-        return normalize(det < 0 ? -r : r);
-    }
-};
-
-Affine affine(const geom::Instance* inst)
-{
-    Affine a;
-    if (!inst)
-        return a;
-    const auto& m = inst->transform;
-    a.c0 = {m[0], m[1], m[2]};
-    a.c1 = {m[3], m[4], m[5]};
-    a.c2 = {m[6], m[7], m[8]};
-    a.t = {m[9], m[10], m[11]};
-    a.det = dot(a.c0, cross(a.c1, a.c2));
-    float l0 = length(a.c0), l1 = length(a.c1), l2 = length(a.c2);
-    a.scale = (l0 + l1 + l2) / 3;
-    float tol = 1e-4f * a.scale;
-    a.similarity = a.scale > 0 && std::fabs(l0 - a.scale) < tol &&
-                   std::fabs(l1 - a.scale) < tol && std::fabs(l2 - a.scale) < tol &&
-                   std::fabs(dot(a.c0, a.c1)) < tol * a.scale &&
-                   std::fabs(dot(a.c1, a.c2)) < tol * a.scale &&
-                   std::fabs(dot(a.c0, a.c2)) < tol * a.scale;
-    return a;
-}
-
 std::uint16_t resolve(std::uint16_t m, std::uint16_t inherited)
 {
     return m == geom::inherit_material ? inherited : m;
@@ -80,31 +52,84 @@ T at_or(const std::vector<T>& v, std::size_t i, T fallback)
     return i < v.size() ? v[i] : fallback;
 }
 
-}  // namespace
-
-std::uint64_t AreaLights::key(Shape shape, std::uint32_t prim, std::uint32_t instance)
+/// Where u falls in a cumulative distribution (entries 0 .. n, last 1): the entry and
+/// u rescaled to [0, 1) within it, for a second choice from the same number.
+std::pair<std::size_t, float> choose(const std::vector<double>& cdf, float u)
 {
-    return (std::uint64_t{instance} << 32) | (std::uint64_t(shape) << 29) |
-           (prim & 0x1fffffffu);
+    std::size_t n = cdf.size() - 1;
+    auto it = std::upper_bound(cdf.begin(), cdf.end(), double(u));
+    std::size_t i =
+        std::min<std::size_t>(std::size_t(std::max<std::ptrdiff_t>(it - cdf.begin() - 1, 0)), n - 1);
+    double width = cdf[i + 1] - cdf[i];
+    double rest = width > 0 ? (double(u) - cdf[i]) / width : 0.0;
+    return {i, float(std::clamp(rest, 0.0, double(std::nextafter(1.0f, 0.0f))))};
 }
 
-void AreaLights::add(const Light& light, std::uint64_t k)
+/// Cumulative distribution of `weights`, normalised; returns their sum.
+double make_cdf(std::vector<double>& cdf, const std::vector<double>& weights)
 {
-    if (m_lights.size() >= m_max) {
+    cdf.assign(weights.size() + 1, 0.0);
+    for (std::size_t i = 0; i < weights.size(); ++i)
+        cdf[i + 1] = cdf[i] + std::max(weights[i], 0.0);
+    double total = cdf.back();
+    for (std::size_t i = 1; i <= weights.size(); ++i)
+        cdf[i] = total > 0 ? cdf[i] / total : double(i) / double(weights.size());
+    return total;
+}
+
+float probability(const std::vector<double>& cdf, std::size_t i)
+{
+    return static_cast<float>(cdf[i + 1] - cdf[i]);
+}
+
+}  // namespace
+
+AreaLights::Affine::Affine(const geom::Instance* inst)
+{
+    if (!inst)
+        return;
+    const auto& m = inst->transform;
+    c0 = {m[0], m[1], m[2]};
+    c1 = {m[3], m[4], m[5]};
+    c2 = {m[6], m[7], m[8]};
+    t = {m[9], m[10], m[11]};
+    det = dot(c0, cross(c1, c2));
+    float l0 = length(c0), l1 = length(c1), l2 = length(c2);
+    scale = (l0 + l1 + l2) / 3;
+    float tol = 1e-4f * scale;
+    similarity = scale > 0 && std::fabs(l0 - scale) < tol && std::fabs(l1 - scale) < tol &&
+                 std::fabs(l2 - scale) < tol && std::fabs(dot(c0, c1)) < tol * scale &&
+                 std::fabs(dot(c1, c2)) < tol * scale && std::fabs(dot(c0, c2)) < tol * scale;
+}
+
+Vec3f AreaLights::Affine::normal(const Vec3f& n) const
+{
+    // The inverse transpose, up to a positive factor when det > 0.
+    Vec3f r = cross(c1, c2) * n.x + cross(c2, c0) * n.y + cross(c0, c1) * n.z;
+    return normalize(det < 0 ? -r : r);
+}
+
+std::uint64_t AreaLights::key(Shape shape, std::uint32_t prim)
+{
+    return (std::uint64_t(shape) << 29) | (prim & 0x1fffffffu);
+}
+
+void AreaLights::add(Group& group, const Light& light, std::uint64_t k)
+{
+    if (m_stored >= m_max) {
         m_full = true;
         return;
     }
-    m_index.emplace(k, static_cast<std::uint32_t>(m_lights.size()));
-    m_lights.push_back(light);
+    group.index.emplace(k, static_cast<std::uint32_t>(group.lights.size()));
+    group.lights.push_back(light);
+    ++m_stored;
 }
 
-void AreaLights::add_geometry(const geom::Geometry& g, const geom::Instance* inst,
-                              std::uint32_t index, const std::vector<SurfaceMaterial>& materials,
-                              bool lines)
+AreaLights::Group AreaLights::make_group(const geom::Geometry& g, std::uint16_t front_inherited,
+                                         std::uint16_t back_inherited, bool round_shapes,
+                                         const std::vector<SurfaceMaterial>& materials, bool lines)
 {
-    const Affine a = affine(inst);
-    const std::uint16_t front_inherited = inst ? inst->material : 0;
-    const std::uint16_t back_inherited = inst ? inst->back_material : 0;
+    Group group;
     auto emission = [&](std::uint16_t m, std::uint16_t inherited) {
         m = resolve(m, inherited);
         return m < materials.size() ? materials[m].emission : Vec3f();
@@ -132,21 +157,22 @@ void AreaLights::add_geometry(const geom::Geometry& g, const geom::Instance* ins
         float side = dot(cross(p1 - p0, p2 - p0), nsum) < 0 ? -1.0f : 1.0f;
         Light l;
         l.kind = Kind::triangle;
-        l.a = a.point(p0);
-        l.b = a.point(p1);
-        l.c = a.point(p2);
+        l.a = p0;
+        l.b = p1;
+        l.c = p2;
         Vec3f face = cross(l.b - l.a, l.c - l.a);
         l.area = 0.5f * length(face);
         if (!(l.area > 0))
             continue;
-        l.normal = normalize(face) * (a.det < 0 ? -side : side);
+        l.side = side;
+        l.normal = normalize(face) * side;
         l.front = front;
         l.back = back;
-        add(l, key(Shape::triangle, i, index));
+        add(group, l, key(Shape::triangle, i));
     }
 
     const geom::Discs& discs = g.discs;
-    for (std::uint32_t i = 0; i < discs.size() && i <= max_prim && a.similarity; ++i) {
+    for (std::uint32_t i = 0; i < discs.size() && i <= max_prim && round_shapes; ++i) {
         std::uint16_t fm = at_or(discs.material, i, std::uint16_t{0});
         Vec3f front = emission(fm, front_inherited);
         Vec3f back = emission(at_or(discs.back_material, i, fm), back_inherited);
@@ -154,19 +180,19 @@ void AreaLights::add_geometry(const geom::Geometry& g, const geom::Instance* ins
             continue;
         Light l;
         l.kind = Kind::disc;
-        l.a = a.point(vec(discs.centres[i]));
-        l.radius = discs.centres[i][3] * a.scale;
-        l.normal = a.normal(normalize(vec(discs.normals[i])));
+        l.a = vec(discs.centres[i]);
+        l.radius = discs.centres[i][3];
+        l.normal = normalize(vec(discs.normals[i]));
         l.area = pi * l.radius * l.radius;
         if (!(l.area > 0) || length(l.normal) == 0)
             continue;
         l.front = front;
         l.back = back;
-        add(l, key(Shape::disc, i, index));
+        add(group, l, key(Shape::disc, i));
     }
 
     const geom::LinearCurves& segs = g.lines;
-    for (std::uint32_t i = 0; lines && a.similarity && i < segs.segments.size() && i <= max_prim;
+    for (std::uint32_t i = 0; lines && round_shapes && i < segs.segments.size() && i <= max_prim;
          ++i) {
         Vec3f e = emission(at_or(segs.material, i, std::uint16_t{0}), front_inherited);
         std::uint32_t k = segs.segments[i];
@@ -178,32 +204,85 @@ void AreaLights::add_geometry(const geom::Geometry& g, const geom::Instance* ins
             continue;
         Light l;
         l.kind = Kind::cylinder;
-        l.a = a.point(vec(segs.keys[k]));
-        l.b = a.point(vec(segs.keys[k + 1]));
-        l.radius = 0.5f * (r0 + r1) * a.scale;
+        l.a = vec(segs.keys[k]);
+        l.b = vec(segs.keys[k + 1]);
+        l.radius = 0.5f * (r0 + r1);
         l.area = 2 * pi * l.radius * length(l.b - l.a);
         if (!(l.area > 0))
             continue;
         l.normal = normalize(l.b - l.a);  // the axis
         l.front = e;
-        add(l, key(Shape::line, i, index));
+        add(group, l, key(Shape::line, i));
     }
 
     const geom::Spheres& spheres = g.spheres;
-    for (std::uint32_t i = 0; i < spheres.size() && i <= max_prim && a.similarity; ++i) {
+    for (std::uint32_t i = 0; i < spheres.size() && i <= max_prim && round_shapes; ++i) {
         Vec3f e = emission(at_or(spheres.material, i, std::uint16_t{0}), front_inherited);
         if (is_black(e))
             continue;
         Light l;
         l.kind = Kind::sphere;
-        l.a = a.point(vec(spheres.centres[i]));
-        l.radius = spheres.centres[i][3] * a.scale;
+        l.a = vec(spheres.centres[i]);
+        l.radius = spheres.centres[i][3];
         l.area = 4 * pi * l.radius * l.radius;
         if (!(l.area > 0))
             continue;
         l.front = e;
-        add(l, key(Shape::sphere, i, index));
+        add(group, l, key(Shape::sphere, i));
     }
+
+    std::vector<double> power(group.lights.size());
+    for (std::size_t i = 0; i < power.size(); ++i) {
+        const Light& l = group.lights[i];
+        power[i] = double(l.area) * (luminance(l.front) + luminance(l.back));
+    }
+    group.power = make_cdf(group.cdf, power);
+    return group;
+}
+
+void AreaLights::place(std::uint32_t group, std::uint32_t instance, const Affine& transform)
+{
+    if (m_groups[group].lights.empty() || !(m_groups[group].power > 0))
+        return;
+    if (instance != PrimId::none)
+        m_placement_of.emplace(instance, static_cast<std::uint32_t>(m_placements.size()));
+    m_placements.push_back({group, instance, transform});
+    m_placed += m_groups[group].lights.size();
+}
+
+AreaLights::Light AreaLights::placed(const Light& l, const Placement& where)
+{
+    if (where.instance == PrimId::none)
+        return l;  // the scene's own geometry: in world space already
+    const Affine& a = where.transform;
+    Light w = l;
+    w.a = a.point(l.a);
+    switch (l.kind) {
+    case Kind::triangle: {
+        w.b = a.point(l.b);
+        w.c = a.point(l.c);
+        Vec3f face = cross(w.b - w.a, w.c - w.a);
+        w.area = 0.5f * length(face);
+        w.normal = normalize(face) * (a.det < 0 ? -l.side : l.side);
+        break;
+    }
+    case Kind::disc:
+        w.radius = l.radius * a.scale;
+        w.normal = a.normal(l.normal);
+        w.area = pi * w.radius * w.radius;
+        break;
+    case Kind::cylinder:
+        w.b = a.point(l.b);
+        w.radius = l.radius * a.scale;
+        w.area = 2 * pi * w.radius * length(w.b - w.a);
+        w.normal = normalize(w.b - w.a);
+        break;
+    case Kind::sphere:
+        w.radius = l.radius * a.scale;
+        w.area = 4 * pi * w.radius * w.radius;
+        break;
+    }
+    return w;
 }
 
 AreaLights::AreaLights(const geom::Scene& scene, const std::vector<SurfaceMaterial>& materials,
@@ -220,36 +299,42 @@ AreaLights::AreaLights(const geom::Scene& scene, const std::vector<SurfaceMateri
         return;  // the common case: nothing glows, nothing to look at
     // Pixel-width lines are drawn unlit, never shaded: not lights.
     const bool lines = !scene.line_radius_in_pixels;
-    add_geometry(scene.geometry, nullptr, PrimId::none, materials, lines);
+    m_groups.push_back(make_group(scene.geometry, 0, 0, true, materials, lines));
+    place(0, PrimId::none, Affine());
+    // One group per prototype, inherited materials and listing of round shapes.
+    std::map<std::tuple<std::uint32_t, std::uint16_t, std::uint16_t, bool>, std::uint32_t> groups;
     for (std::uint32_t i = 0; i < scene.instances.size(); ++i) {
         const geom::Instance& inst = scene.instances[i];
-        if (inst.prototype < scene.prototypes.size())
-            add_geometry(scene.prototypes[inst.prototype].geometry, &inst, i, materials, lines);
+        if (inst.prototype >= scene.prototypes.size())
+            continue;
+        Affine transform(&inst);
+        auto [it, made] = groups.try_emplace(
+            {inst.prototype, inst.material, inst.back_material, transform.similarity},
+            std::uint32_t(m_groups.size()));
+        if (made)
+            m_groups.push_back(make_group(scene.prototypes[inst.prototype].geometry,
+                                          inst.material, inst.back_material,
+                                          transform.similarity, materials, lines));
+        place(it->second, i, transform);
     }
     if (m_full)
         warn("area lights: more than " + std::to_string(m_max) +
              " emissive primitives; the rest light the scene through BSDF sampling only");
 
-    m_cdf.assign(m_lights.size() + 1, 0.0);
-    for (std::size_t i = 0; i < m_lights.size(); ++i) {
-        const Light& l = m_lights[i];
-        double power = double(l.area) * (luminance(l.front) + luminance(l.back));
-        m_cdf[i + 1] = m_cdf[i] + std::max(power, 0.0);
+    // A placement's power: its group's, times the transform's area scale (exact for
+    // similarities; for other maps |det|^(2/3), which only steers the choice).
+    std::vector<double> power(m_placements.size());
+    for (std::size_t i = 0; i < power.size(); ++i) {
+        const Affine& a = m_placements[i].transform;
+        double area_scale = a.similarity ? double(a.scale) * a.scale
+                                         : std::cbrt(double(a.det) * a.det);
+        power[i] = m_groups[m_placements[i].group].power * area_scale;
     }
-    double total = m_cdf.back();
-    m_power = total;
-    for (std::size_t i = 1; i <= m_lights.size(); ++i)
-        m_cdf[i] = total > 0 ? m_cdf[i] / total : double(i) / double(m_lights.size());
+    m_power = m_placements.empty() ? 0 : make_cdf(m_cdf, power);
 }
 
-float AreaLights::select_probability(std::size_t i) const
+float AreaLights::pdf_of(const Light& l, const Vec3f& p, const Vec3f& x)
 {
-    return static_cast<float>(m_cdf[i + 1] - m_cdf[i]);
-}
-
-float AreaLights::pdf_of(std::size_t i, const Vec3f& p, const Vec3f& x) const
-{
-    const Light& l = m_lights[i];
     Vec3f to_p = p - x;
     float d2 = dot(to_p, to_p);
     if (!(d2 > 0))
@@ -279,15 +364,21 @@ float AreaLights::pdf_of(std::size_t i, const Vec3f& p, const Vec3f& x) const
 std::optional<AreaLightSample> AreaLights::sample(const Vec3f& p, float u_select, float u1,
                                                   float u2) const
 {
-    if (m_lights.empty())
+    if (m_placements.empty())
         return std::nullopt;
-    auto it = std::upper_bound(m_cdf.begin(), m_cdf.end(), double(u_select));
-    std::size_t i = std::min<std::size_t>(
-        std::size_t(std::max<std::ptrdiff_t>(it - m_cdf.begin() - 1, 0)), m_lights.size() - 1);
-    float select = select_probability(i);
+    auto [j, u_light] = choose(m_cdf, u_select);
+    const Placement& where = m_placements[j];
+    const Group& group = m_groups[where.group];
+    std::size_t i = choose(group.cdf, u_light).first;
+    float select = probability(m_cdf, j) * probability(group.cdf, i);
     if (!(select > 0))
         return std::nullopt;
-    const Light& l = m_lights[i];
+    return sample_light(placed(group.lights[i], where), select, p, u1, u2);
+}
+
+std::optional<AreaLightSample> AreaLights::sample_light(const Light& l, float select,
+                                                        const Vec3f& p, float u1, float u2) const
+{
 
     Vec3f x, radiance = l.front;
     float pdf = 0;
@@ -347,7 +438,7 @@ std::optional<AreaLightSample> AreaLights::sample(const Vec3f& p, float u_select
         radiance = l.back;
     if (is_black(radiance))
         return std::nullopt;
-    pdf = pdf_of(i, p, x) * select;
+    pdf = pdf_of(l, p, x) * select;
     if (!(pdf > 0) || !std::isfinite(pdf))
         return std::nullopt;
     Vec3f to_x = x - p;
@@ -360,19 +451,30 @@ std::optional<AreaLightSample> AreaLights::sample(const Vec3f& p, float u_select
 
 float AreaLights::pdf(const Vec3f& p, const SurfaceHit& hit) const
 {
-    if (m_lights.empty())
+    if (m_placements.empty())
         return 0;
-    auto it = m_index.find(key(hit.shape, hit.prim_id, hit.instance));
-    if (it == m_index.end())
+    std::size_t j = 0;  // the scene's own geometry, when it glows
+    if (hit.instance != PrimId::none) {
+        auto found = m_placement_of.find(hit.instance);
+        if (found == m_placement_of.end())
+            return 0;
+        j = found->second;
+    } else if (m_placements[0].instance != PrimId::none) {
         return 0;
-    const Light& l = m_lights[it->second];
+    }
+    const Placement& where = m_placements[j];
+    const Group& group = m_groups[where.group];
+    auto it = group.index.find(key(hit.shape, hit.prim_id));
+    if (it == group.index.end())
+        return 0;
+    const Light l = placed(group.lights[it->second], where);
     if (l.kind == Kind::cylinder) {
         // Only the lateral surface is sampled; the round ends are BSDF sampling's alone.
         float along = dot(hit.position - l.a, l.normal);
         if (along < 0 || along > length(l.b - l.a))
             return 0;
     }
-    return pdf_of(it->second, p, hit.position) * select_probability(it->second);
+    return pdf_of(l, p, hit.position) * probability(m_cdf, j) * probability(group.cdf, it->second);
 }
 
 }  // namespace cambium::render

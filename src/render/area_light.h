@@ -28,9 +28,14 @@ struct AreaLightSample {
 };
 
 /// Every emissive triangle, disc, sphere and cylindrical line segment of the scene, the
-/// instanced ones included (placed in world space), as lights for next-event estimation
-/// (docs: area_light.cpp). A light is chosen in proportion to its power (area times the
-/// luminance of its sides); triangles, discs and cylinders are then sampled uniformly by
+/// instanced ones included, as lights for next-event estimation (docs: area_light.cpp).
+/// Lights are kept once per distinct piece of geometry (the scene's own, each prototype
+/// under the materials its instances give it) in its own space, so their memory follows
+/// the distinct emissive geometry, not the placed copies: a sample chooses a placement
+/// (the scene itself or an instance) in proportion to its power, then a light of it in
+/// proportion to its power, and places that light with the instance's transform. Under
+/// similarity transforms this is exactly the choice of a light by its power among all
+/// placed lights. Triangles, discs and cylinders are then sampled uniformly by
 /// area, spheres uniformly in the cone they subtend. Hermite curves, tapered segments and
 /// pixel-width lines are not in the list: their emission is found by BSDF sampling alone
 /// (pdf() says 0 for them, so their hits keep full weight).
@@ -43,8 +48,11 @@ public:
     AreaLights(const geom::Scene& scene, const std::vector<SurfaceMaterial>& materials,
                std::size_t max_lights = std::size_t{1} << 24);
 
-    bool empty() const { return m_lights.empty(); }
-    std::size_t size() const { return m_lights.size(); }
+    bool empty() const { return m_placements.empty(); }
+    /// Lights kept: each distinct emissive primitive once, however often it is placed.
+    std::size_t size() const { return m_stored; }
+    /// Lights as placed: each instance's copies counted.
+    std::size_t placed_size() const { return m_placed; }
     /// The summed area times luminance of the lights' sides: their emitted power over pi.
     double power() const { return m_power; }
 
@@ -66,21 +74,50 @@ private:
         Vec3f normal;           ///< unit front normal (triangle, disc); cylinder: axis
         float radius = 0;       ///< disc, sphere, cylinder
         float area = 0;
+        float side = 1;         ///< triangle: -1 where the front is against the winding
         Vec3f front, back;      ///< emitted radiance of each side (sphere: front only)
     };
+    /// The lights of one piece of geometry in its own space, chosen by power.
+    struct Group {
+        std::vector<Light> lights;
+        std::vector<double> cdf;  ///< lights.size() + 1 entries, last 1
+        double power = 0;         ///< in the group's own units
+        std::unordered_map<std::uint64_t, std::uint32_t> index;  ///< key() -> light
+    };
+    /// An instance's affine map x' = A x + t, the cofactor matrix for normals and whether
+    /// it is a similarity (uniform scale times a rotation or reflection).
+    struct Affine {
+        Vec3f c0{1, 0, 0}, c1{0, 1, 0}, c2{0, 0, 1}, t;
+        float det = 1, scale = 1;
+        bool similarity = true;
+        explicit Affine(const geom::Instance* instance = nullptr);
+        Vec3f point(const Vec3f& p) const { return c0 * p.x + c1 * p.y + c2 * p.z + t; }
+        Vec3f normal(const Vec3f& n) const;
+    };
+    /// A group where it is drawn: the scene's own geometry, or an instance.
+    struct Placement {
+        std::uint32_t group = 0;
+        std::uint32_t instance = 0;  ///< PrimId::none: the scene's own
+        Affine transform;
+    };
 
-    void add(const Light& light, std::uint64_t key);
-    void add_geometry(const geom::Geometry& g, const geom::Instance* instance,
-                      std::uint32_t instance_index, const std::vector<SurfaceMaterial>& materials,
-                      bool lines);
-    float select_probability(std::size_t i) const;
-    float pdf_of(std::size_t i, const Vec3f& p, const Vec3f& x) const;
-    static std::uint64_t key(Shape shape, std::uint32_t prim, std::uint32_t instance);
+    Group make_group(const geom::Geometry& g, std::uint16_t front_inherited,
+                     std::uint16_t back_inherited, bool round_shapes,
+                     const std::vector<SurfaceMaterial>& materials, bool lines);
+    void add(Group& group, const Light& light, std::uint64_t key);
+    void place(std::uint32_t group, std::uint32_t instance, const Affine& transform);
+    /// The light in world space (its area, normal and radius follow the transform).
+    static Light placed(const Light& light, const Placement& where);
+    std::optional<AreaLightSample> sample_light(const Light& l, float select, const Vec3f& p,
+                                                float u1, float u2) const;
+    static float pdf_of(const Light& l, const Vec3f& p, const Vec3f& x);
+    static std::uint64_t key(Shape shape, std::uint32_t prim);
 
-    std::vector<Light> m_lights;
-    std::vector<double> m_cdf;  ///< m_lights.size() + 1 entries, last 1
-    std::unordered_map<std::uint64_t, std::uint32_t> m_index;  ///< key() -> light
-    std::size_t m_max = 0;
+    std::vector<Group> m_groups;
+    std::vector<Placement> m_placements;
+    std::vector<double> m_cdf;  ///< over m_placements by power: size() + 1 entries, last 1
+    std::unordered_map<std::uint32_t, std::uint32_t> m_placement_of;  ///< instance -> placement
+    std::size_t m_max = 0, m_stored = 0, m_placed = 0;
     double m_power = 0;
     bool m_full = false;
 };

@@ -146,6 +146,70 @@ TEST(AreaLight, InstancedSquareMatchesFormFactor)
     std::printf("[area] instanced square: %.5f expected %.5f\n", got.mean, expect);
 }
 
+/// x' = s R_x(tilt) R_z(turn) x + t, as the rows of its matrix.
+std::array<float, 9> similarity(double s, double tilt, double turn)
+{
+    double cz = std::cos(turn), sz = std::sin(turn), cx = std::cos(tilt), sx = std::sin(tilt);
+    // R_x R_z = [[cz, -sz, 0], [cx sz, cx cz, -sx], [sx sz, sx cz, cx]]
+    return {float(s * cz),      float(-s * sz),     0.0f,
+            float(s * cx * sz), float(s * cx * cz), float(-s * sx),
+            float(s * sx * sz), float(s * sx * cz), float(s * cx)};
+}
+
+geom::Float3 apply(const std::array<float, 9>& m, const geom::Float3& p, const geom::Vec3& t)
+{
+    return {m[0] * p[0] + m[1] * p[1] + m[2] * p[2] + float(t.x),
+            m[3] * p[0] + m[4] * p[1] + m[5] * p[2] + float(t.y),
+            m[6] * p[0] + m[7] * p[1] + m[8] * p[2] + float(t.z)};
+}
+
+// Forty placed copies of a glowing organ (a triangle, a disc and a sphere, facing the
+// plane) light it as the same copies written out in world space do, within noise; the
+// instanced scene keeps the organ's three lights once instead of 120.
+TEST(AreaLight, InstancedEmittersLightAsTheirFlattenedCopiesWithLightsKeptOnce)
+{
+    const std::array<geom::Float3, 3> corners{{{-0.3f, -0.2f, 0}, {0.3f, -0.2f, 0}, {0, 0.3f, 0.1f}}};
+    const geom::Float3 down{0, 0, -1}, sphere{0.5f, 0, 0.2f}, disc{-0.5f, 0, 0};
+    geom::Scene instanced = plane_scene(), flattened = plane_scene();
+    geom::Prototype organ;
+    add_triangle(organ.geometry, corners, {down, down, down}, {{{0, 0}, {1, 0}, {0, 1}}}, 2, 3);
+    add_sphere(organ.geometry, {sphere[0], sphere[1], sphere[2]}, 0.1f, 2);
+    add_disc(organ.geometry, {disc[0], disc[1], disc[2]}, 0.15f, {0, 0, -1}, 2, 3);
+    instanced.prototypes.push_back(organ);
+    const int copies = 40;
+    for (int k = 0; k < copies; ++k) {
+        double s = 0.6 + 0.02 * k;
+        std::array<float, 9> m = similarity(s, 0.3 * std::sin(k), 0.7 * k);
+        geom::Vec3 t{1.2 * std::cos(k), 1.2 * std::sin(1.3 * k), 1.6 + 0.03 * k};
+        geom::Instance inst;
+        inst.transform = transform(m, t);
+        instanced.instances.push_back(inst);
+        geom::Float3 n = apply(m, down, {0, 0, 0});
+        float len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        n = {n[0] / len, n[1] / len, n[2] / len};
+        add_triangle(flattened.geometry,
+                     {apply(m, corners[0], t), apply(m, corners[1], t), apply(m, corners[2], t)},
+                     {n, n, n}, {{{0, 0}, {1, 0}, {0, 1}}}, 2, 3);
+        geom::Float3 c = apply(m, sphere, t);
+        add_sphere(flattened.geometry, {c[0], c[1], c[2]}, float(0.1 * s), 2);
+        c = apply(m, disc, t);
+        add_disc(flattened.geometry, {c[0], c[1], c[2]}, float(0.15 * s), {n[0], n[1], n[2]}, 2, 3);
+    }
+    AreaLights kept(instanced, make_materials(instanced.materials));
+    AreaLights listed(flattened, make_materials(flattened.materials));
+    EXPECT_EQ(kept.size(), 3u);
+    EXPECT_EQ(kept.placed_size(), 3u * copies);
+    EXPECT_EQ(listed.size(), 3u * copies);
+    EXPECT_NEAR(kept.power(), listed.power(), 1e-4 * listed.power());
+
+    Stats a = stats(pixels(instanced, patch_camera(1), 1, 64, true));
+    Stats b = stats(pixels(flattened, patch_camera(1), 1, 64, true));
+    double noise = std::sqrt(a.variance / 64 + b.variance / 64);
+    EXPECT_GT(b.mean, 0.01);
+    EXPECT_NEAR(a.mean, b.mean, 4 * noise + 1e-6);
+    std::printf("[area] instanced %.5f flattened %.5f (noise %.5f)\n", a.mean, b.mean, noise);
+}
+
 // A sphere of radius R with its centre at height d: E = pi L (R / d)^2 below it.
 TEST(AreaLight, SphereMatchesClosedForm)
 {
