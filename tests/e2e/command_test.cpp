@@ -263,7 +263,9 @@ TEST(Command, BackgroundSceneFromInsideTheModelFolder)
     if (!fs::exists(model / "plant.v"))
         GTEST_SKIP() << "corpus not found";
     fs::path dir = scratch("background");
-    Result r = run("-M plant.mat plant.l plant.v -vv " + (dir / "p.vv").string() + " < /dev/null",
+    // a tiny image: -vv alone walks the turtle without building geometry (issue 16.6)
+    Result r = run("-M plant.mat plant.l plant.v -w 8 6 --spp 1 -o " + (dir / "p.png").string() +
+                       " < /dev/null",
                    model);
     EXPECT_EQ(r.status, 0) << r.output;
     // the sphere under `scale 2 1 1` is an ellipsoid of triangles, as cpfg draws it
