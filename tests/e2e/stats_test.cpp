@@ -28,6 +28,16 @@ struct RunResult {
     std::string output;
 };
 
+/// Runs cambium with `args` in r.dir, keeping its status and output in `r`.
+void run_in_folder(RunResult& r, const std::string& args)
+{
+    std::string command = "cd '" + r.dir.string() + "' && " + CAMBIUM_EXE + " " + args +
+                          " > out.txt 2>&1";
+    r.status = std::system(command.c_str());
+    std::ifstream in(r.dir / "out.txt");
+    r.output.assign(std::istreambuf_iterator<char>(in), {});
+}
+
 /// Runs cambium on the known plant in a fresh folder with `args`.
 RunResult run_known_plant(const std::string& name, const std::string& args)
 {
@@ -37,11 +47,7 @@ RunResult run_known_plant(const std::string& name, const std::string& args)
     fs::create_directories(r.dir);
     std::ofstream(r.dir / "p.l") << known_plant;
     std::ofstream(r.dir / "p.v") << "line style: cylinder\ninitial line width: 0.2\n";
-    std::string command = "cd '" + r.dir.string() + "' && " + CAMBIUM_EXE + " p.l p.v " + args +
-                          " > out.txt 2>&1";
-    r.status = std::system(command.c_str());
-    std::ifstream in(r.dir / "out.txt");
-    r.output.assign(std::istreambuf_iterator<char>(in), {});
+    run_in_folder(r, "p.l p.v " + args);
     return r;
 }
 
@@ -186,11 +192,7 @@ RunResult run_growing_plant(const std::string& name, const std::string& args)
     RunResult r = run_known_plant(name, "--version");  // makes the folder
     std::ofstream(r.dir / "g.l") << "lsystem: 1\nderivation length: 3\naxiom: A\n"
                                     "A --> F[+F]F@O(0.5)@c(0.5){.f.+f.+f.}A\nendlsystem\n";
-    std::string command = "cd '" + r.dir.string() + "' && " + CAMBIUM_EXE + " g.l p.v " + args +
-                          " > out.txt 2>&1";
-    r.status = std::system(command.c_str());
-    std::ifstream in(r.dir / "out.txt");
-    r.output.assign(std::istreambuf_iterator<char>(in), {});
+    run_in_folder(r, "g.l p.v " + args);
     return r;
 }
 
