@@ -45,6 +45,10 @@ struct InterpretOptions {
     /// `@S("command")`: called with the command, in string order, when set (the user
     /// allowed system calls); unset, @S is ignored with a warning.
     std::function<void(const std::string&)> system_call;
+    /// Added to the colour indices of predefined surfaces and patches, whose colormap
+    /// lighting differs from other primitives' (pipeline: 256 in colormap mode with
+    /// lighting, where the materials 256..511 are the surface-lit copies).
+    std::uint16_t surface_material_offset = 0;
 };
 
 Scene interpret(const lsys::ModuleString& string, const lsys::SymbolTable& symbols,
