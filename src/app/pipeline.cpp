@@ -145,6 +145,70 @@ geom::Shading render_mode(const geom::ViewFile& view)
     }
     return mode;
 }
+
+/// Whether the view's last `render mode:` / `shade mode:` is cpfg's interpolated fill,
+/// which Cambium shades but cpfg draws without any lighting.
+bool interpolated_fill(const geom::ViewFile& view)
+{
+    bool interpolated = false;
+    for (const geom::ViewCommand& c : view.deferred) {
+        std::istringstream in(c.value);
+        std::string word;
+        in >> word;
+        if (c.name == "render mode" || c.name == "shade mode")
+            interpolated = word == (c.name == "render mode" ? "interpolated" : "2");
+    }
+    return interpolated;
+}
+
+/// Whether cpfg lights this model by moving colour indices (manual 5.2.5): colormap
+/// mode (a -m file or none) in render mode flat or shaded.
+bool lit_by_colour_index(const Model& model)
+{
+    geom::Shading mode = render_mode(*model.view);
+    return model.palette.mode() != geom::Palette::Mode::materials &&
+           (mode == geom::Shading::shaded || mode == geom::Shading::flat) &&
+           !interpolated_fill(*model.view);
+}
+
+/// The number a deferred view command holds (`diffuse reflection: 25`).
+double deferred_number(const geom::ViewCommand& c)
+{
+    std::istringstream in(c.value);
+    double value = 0;
+    if (!(in >> value))
+        throw Error(c.loc, c.name + ": expected a number, found '" + c.value + "'");
+    return value;
+}
+
+/// cpfg's colormap-mode lighting: materials 0..255 move their index by the cosine,
+/// their copies 256..511 (predefined surfaces and patches) by the surface rule.
+void light_by_colour_index(geom::Scene& scene, const geom::ViewFile& view)
+{
+    geom::ColourIndexLight light;
+    // cpfg's light direction is the first light's position or direction, normalised.
+    geom::Light first = geom::effective_lights(view).front();
+    geom::Vec3 to_light = first.kind == geom::Light::Kind::directional ? first.direction : first.position;
+    if (dot(to_light, to_light) > 0)
+        light.to_light = normalize(to_light);
+    for (const geom::ViewCommand& c : view.deferred) {
+        if (c.name == "diffuse reflection")
+            light.diffuse_reflection = static_cast<int>(deferred_number(c));
+        else if (c.name == "surface ambient")
+            light.surface_ambient = static_cast<float>(deferred_number(c));
+        else if (c.name == "surface diffuse")
+            light.surface_diffuse = static_cast<float>(deferred_number(c));
+    }
+    scene.colour_index_light = light;
+    scene.materials.resize(2 * geom::colour_indices);
+    for (std::size_t i = 0; i < geom::colour_indices; ++i) {
+        geom::Material& m = scene.materials[i];
+        m.index_lighting = geom::IndexLighting::cosine;
+        m.colour_index = static_cast<std::uint8_t>(i);
+        scene.materials[i + geom::colour_indices] = m;
+        scene.materials[i + geom::colour_indices].index_lighting = geom::IndexLighting::surface;
+    }
+}
 }  // namespace
 
 geom::Scene interpret(const Model& model, const lsys::ModuleString& derived,
@@ -181,6 +245,8 @@ geom::InterpretOptions interpret_options(const Model& model, const Options& opti
 {
     geom::InterpretOptions turtle;
     turtle.strings = model.lsystem.program().strings;
+    if (lit_by_colour_index(model))
+        turtle.surface_material_offset = geom::colour_indices;
     turtle.max_memory_bytes = options.max_memory_bytes;
     std::vector<char> objects = instanced_objects(model, options);
     if (!objects.empty()) {
@@ -217,6 +283,7 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
 {
     geom::Scene scene = geom::interpret(string, model.lsystem.symbols(), *model.view,
                                         interpret_options(model, options));
+    const bool index_lit = lit_by_colour_index(model);
     scene.shading = render_mode(*model.view);
     scene.materials = model.palette.entries(options.colour_block);
     scene.background = model.palette.background(options.colour_block);
@@ -228,6 +295,8 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
     for (const geom::TranslucencySetting& t : model.view->translucency)
         for (int i = t.first; i <= t.last; ++i)
             scene.materials.at(static_cast<std::size_t>(i)).translucency = t.amount;
+    if (index_lit)
+        light_by_colour_index(scene, *model.view);
 
     geom::BackgroundScene background = geom::load_view_background(*model.view, scene.materials[0]);
     if (!background.geometry.empty()) {

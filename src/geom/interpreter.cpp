@@ -351,7 +351,7 @@ private:
             std::int16_t texture = def.texture ? *def.texture : static_cast<std::int16_t>(t.texture);
             Instance instance{m_root->surface_prototype(slot, texture),
                               surface_instance_transform(def, t.position, t.heading, t.left, t.up, s),
-                              material(t.color), material(t.back_color), texture};
+                              surface_material(t.color), surface_material(t.back_color), texture};
             if (m_options.bounds_only)
                 ;  // nothing stored
             else if (m_root == this)
@@ -386,7 +386,7 @@ private:
             m_patches.set_control_point(p[0], whole(p[1]), whole(p[2]), m_turtle.position, FileLoc{});
         else if (!m_options.bounds_only)
             m_patches.draw(p[0], p.size() >= 3 ? whole(p[1]) : 0, p.size() >= 3 ? whole(p[2]) : 0,
-                           material(m_turtle.color), material(m_turtle.back_color),
+                           surface_material(m_turtle.color), surface_material(m_turtle.back_color),
                            static_cast<std::int16_t>(m_turtle.texture), m_scene.geometry.mesh, FileLoc{});
     }
 
@@ -564,6 +564,11 @@ private:
     }
 
     std::uint16_t material(int color) const { return static_cast<std::uint16_t>(std::clamp(color, 0, 255)); }
+    /// The material of a predefined surface or patch of colour `color`.
+    std::uint16_t surface_material(int color) const
+    {
+        return static_cast<std::uint16_t>(material(color) + m_options.surface_material_offset);
+    }
 
     /// `@O(d)`: a sphere; cpfg's view volume takes the 8 corners of its cube.
     void draw_sphere(std::span<const float> p)

@@ -50,6 +50,10 @@ struct InterpretOptions {
     /// instances are not stored (generalized cylinders are, as their sweep makes the
     /// bounds). The bounds equal a full interpretation's.
     bool bounds_only = false;
+    /// Added to the colour indices of predefined surfaces and patches, whose colormap
+    /// lighting differs from other primitives' (pipeline: 256 in colormap mode with
+    /// lighting, where the materials 256..511 are the surface-lit copies).
+    std::uint16_t surface_material_offset = 0;
 };
 
 Scene interpret(const lsys::ModuleString& string, const lsys::SymbolTable& symbols,

@@ -141,6 +141,16 @@ struct Instance {
     std::int16_t texture = no_texture;
 };
 
+/// How cpfg's colormap mode lights a colour index (manual 5.2.5): it does not light it
+/// (pixel lines, filled modes, material files), it moves the index by `diffuse
+/// reflection:` x N.L (lines, cylinders, polygons, spheres), or it picks the index in
+/// the index's block of 64 by `surface ambient:` + `surface diffuse:` x |N.L|
+/// (predefined surfaces and patches). render keeps the moved entry's hue (docs/materials.md).
+enum class IndexLighting : std::uint8_t { none, cosine, surface };
+
+/// Entries of a colormap or material file: a turtle colour index is 0..255.
+inline constexpr std::size_t colour_indices = 256;
+
 /// A cpfg material (manual 5.4.2) or colormap entry (5.4.1, as diffuse), with the
 /// file's display values in [0, 1]. render decodes them (docs/materials.md).
 struct Material {
@@ -153,6 +163,18 @@ struct Material {
     /// Cambium extension (view file `translucency:`, docs/materials.md): the fraction of
     /// the diffuse albedo transmitted through the surface instead of reflected.
     float translucency = 0;
+    /// Colormap-mode lighting: the rule and the colour index (0..255) it starts from.
+    IndexLighting index_lighting = IndexLighting::none;
+    std::uint8_t colour_index = 0;
+};
+
+/// The settings of cpfg's colormap-mode lighting (manual 5.2.5): the direction toward
+/// its light (the first light's, normalised) and the view file's coefficients.
+struct ColourIndexLight {
+    Vec3 to_light{1, 0, 0};
+    int diffuse_reflection = 10;   ///< `diffuse reflection:`
+    float surface_ambient = 0.15f;  ///< `surface ambient:`
+    float surface_diffuse = 0.75f;  ///< `surface diffuse:`
 };
 
 /// A `texture:` of the view file (manual 5.2.7), in order: `@Tx(i)` and surfaces name
@@ -227,6 +249,10 @@ struct Scene {
     Shading shading = Shading::shaded;  ///< the view file's `render mode:`
 
     std::vector<Material> materials = std::vector<Material>(256);  ///< by colour index
+    /// Set in colormap mode with lighting: materials whose index_lighting is not none
+    /// show the colormap entries cpfg's index lighting picks (their colour_index's
+    /// neighbours in materials[0..255]).
+    std::optional<ColourIndexLight> colour_index_light;
     std::vector<TextureDef> textures;
     Rgb background{0, 0, 0};  ///< display values: colormap entry 0 or material 0's emission
     std::vector<Light> lights;

@@ -343,13 +343,39 @@ void prepare_path_context(PathContext& ctx)
         LightSet(ctx.lights, ctx.area_lights, ctx.environment, env.nee(), ctx.scene_radius)};
 }
 
+namespace {
+
+/// Material `m` at `hit` with cpfg's colour-index lighting applied (a copy in `scratch`),
+/// or the material itself where there is none.
+const SurfaceMaterial& index_lit(const PathContext& ctx, const SurfaceHit& hit, std::uint16_t m,
+                                 SurfaceMaterial& scratch)
+{
+    const SurfaceMaterial& material = material_at(ctx, m);
+    if (m >= ctx.index_ramps.size() || ctx.index_ramps[m].rule == geom::IndexLighting::none ||
+        hit.unlit || ctx.unlit)
+        return material;
+    // cpfg takes the cosine with the primitive's own front (a polygon's up vector, a
+    // cylinder's outward normal), whichever side is seen.
+    Vec3f front = hit.back || hit.inside ? -hit.normal : hit.normal;
+    const geom::Vec3& l = ctx.index_light.to_light;
+    float cos_light = dot(front, Vec3f(static_cast<float>(l.x), static_cast<float>(l.y),
+                                       static_cast<float>(l.z)));
+    scratch = material;
+    scratch.diffuse = index_lit_albedo(ctx.index_ramps[m], ctx.index_light, cos_light);
+    return scratch;
+}
+
+}  // namespace
+
 const SurfaceMaterial& hit_material(const PathContext& ctx, const SurfaceHit& hit,
                                     SurfaceMaterial& scratch)
 {
-    const SurfaceMaterial& start = material_at(ctx, hit.material);
+    const SurfaceMaterial& start = index_lit(ctx, hit, hit.material, scratch);
     if (hit.material_blend <= 0)
         return start;  // the usual case: no copy
-    scratch = mix(start, material_at(ctx, hit.end_material), hit.material_blend);
+    SurfaceMaterial end_scratch;
+    const SurfaceMaterial& end = index_lit(ctx, hit, hit.end_material, end_scratch);
+    scratch = mix(start, end, hit.material_blend);
     return scratch;
 }
 

@@ -52,6 +52,10 @@ struct PathContext {
     bool unlit = false;
     /// `render mode: flat`: shading uses each facet's own normal.
     bool facet_normals = false;
+    /// cpfg's colormap-mode lighting, per material (empty: none): a lit hit's diffuse
+    /// albedo follows the entry its colour index moves to (geom::IndexLighting).
+    std::vector<IndexRamp> index_ramps;
+    geom::ColourIndexLight index_light;
     /// The camera rays' cone (zero: textures are looked up at their finest level).
     RayCone camera_cone;
     /// The ground plane (--ground), beside the Embree scene; none: no ground.
@@ -73,7 +77,8 @@ struct PathContext {
 };
 
 /// The material at `hit`: ctx.materials[hit.material], or, where a generalized
-/// cylinder's colour blends (hit.material_blend > 0), the mix written into `scratch`.
+/// cylinder's colour blends (hit.material_blend > 0), the mix written into `scratch`;
+/// under colour-index lighting (index_ramps) with the albedo cpfg's index gives there.
 /// Out-of-range indices give a default material.
 const SurfaceMaterial& hit_material(const PathContext& ctx, const SurfaceHit& hit,
                                     SurfaceMaterial& scratch);

@@ -168,4 +168,68 @@ std::vector<SurfaceMaterial> make_materials(const std::vector<geom::Material>& m
     return out;
 }
 
+namespace {
+
+constexpr int index_block = 64;  // cpfg's surface rule works within blocks of 64 entries
+
+float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+/// The albedo of display colour `entry` at the brightness of display colour `own`,
+/// scaled down where a channel would pass 1. Scaled in display values, where colormap
+/// ramps are made: a ramp of one colour in several brightnesses gives `own` exactly.
+Vec3f hue_at_luminance(const geom::Rgb& entry, const geom::Rgb& own)
+{
+    Vec3f e(entry.r, entry.g, entry.b), o(own.r, own.g, own.b);
+    float y = luminance(e);
+    if (y <= 0)
+        return decode_display(own);  // black has no hue to keep
+    Vec3f c = e * (luminance(o) / y);
+    float top = std::max({c.x, c.y, c.z});
+    if (top > 1)
+        c = c * (1 / top);
+    return decode_display({c.x, c.y, c.z});
+}
+
+}  // namespace
+
+std::vector<IndexRamp> make_index_ramps(const std::vector<geom::Material>& materials,
+                                        const geom::ColourIndexLight& light)
+{
+    const int last = static_cast<int>(std::min(materials.size(), geom::colour_indices)) - 1;
+    auto entry = [&](int index) {
+        return materials[static_cast<std::size_t>(std::clamp(index, 0, last))].diffuse;
+    };
+    std::vector<IndexRamp> ramps(materials.size());
+    for (std::size_t m = 0; m < materials.size(); ++m) {
+        const geom::Material& material = materials[m];
+        IndexRamp& ramp = ramps[m];
+        ramp.rule = last < 0 ? geom::IndexLighting::none : material.index_lighting;
+        const int own = material.colour_index;
+        const geom::Rgb& own_colour = material.diffuse;
+        if (ramp.rule == geom::IndexLighting::cosine) {
+            ramp.reach = std::abs(light.diffuse_reflection);
+            for (int offset = -ramp.reach; offset <= ramp.reach; ++offset)
+                ramp.albedo.push_back(hue_at_luminance(entry(own + offset), own_colour));
+        } else if (ramp.rule == geom::IndexLighting::surface) {
+            ramp.place = own % index_block;
+            const int block = own - ramp.place;
+            for (int k = 0; k < index_block; ++k)
+                ramp.albedo.push_back(hue_at_luminance(entry(block + k), own_colour));
+        }
+    }
+    return ramps;
+}
+
+Vec3f index_lit_albedo(const IndexRamp& ramp, const geom::ColourIndexLight& light, float cos_light)
+{
+    if (ramp.rule == geom::IndexLighting::cosine) {
+        // C's float-to-int conversion truncates toward zero, as cpfg's index arithmetic.
+        int offset = static_cast<int>(static_cast<float>(light.diffuse_reflection) * cos_light);
+        return ramp.albedo[static_cast<std::size_t>(std::clamp(offset, -ramp.reach, ramp.reach) + ramp.reach)];
+    }
+    float level = light.surface_ambient + light.surface_diffuse * std::fabs(cos_light);
+    int k = static_cast<int>(static_cast<float>(ramp.place) * level);
+    return ramp.albedo[static_cast<std::size_t>(std::clamp(k, 0, index_block - 1))];
+}
+
 }  // namespace cambium::render

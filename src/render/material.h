@@ -71,6 +71,28 @@ BsdfSample bsdf_sample(const Bsdf& bsdf, const Vec3f& n, const Vec3f& wo, float 
 std::vector<SurfaceMaterial> make_materials(const std::vector<geom::Material>& materials,
                                             const geom::Rgb& ambient_light = {0, 0, 0});
 
+/// The albedos one material takes under cpfg's colormap-mode lighting (geom::IndexLighting):
+/// each entry the index can move to, with that entry's chromaticity and the luminance of
+/// the material's own entry (docs/materials.md: the path tracer supplies the shading, the
+/// colormap the change of hue with light).
+struct IndexRamp {
+    geom::IndexLighting rule = geom::IndexLighting::none;
+    int reach = 0;              ///< cosine: |diffuse reflection|; albedo[offset + reach]
+    int place = 0;              ///< surface: the index's place in its block (index mod 64)
+    std::vector<Vec3f> albedo;  ///< cosine: offsets -reach..reach; surface: 0..63 of the block
+};
+
+/// The ramps of `materials` (none where index_lighting is none); entries are read from
+/// materials[0..255], indices past the block clamped to it.
+std::vector<IndexRamp> make_index_ramps(const std::vector<geom::Material>& materials,
+                                        const geom::ColourIndexLight& light);
+
+/// The albedo cpfg's colour index lighting gives a point whose front-side normal has
+/// cosine `cos_light` with the direction toward the light: the index moves by
+/// trunc(diffuse reflection x cos) (cosine rule), or is the hue block's entry
+/// trunc((index mod 64) x (ambient + diffuse |cos|)) (surface rule; manual 5.2.5).
+Vec3f index_lit_albedo(const IndexRamp& ramp, const geom::ColourIndexLight& light, float cos_light);
+
 /// The ambient light of cpfg's OpenGL window: the light model's 0.2 plus each light's
 /// `A:` (default 1); with no `light:` cpfg makes one default light.
 geom::Rgb opengl_ambient_light(const std::vector<geom::Light>& lights);

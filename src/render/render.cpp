@@ -515,6 +515,10 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         ctx.materials = make_materials(scene.materials, settings.opengl_ambient
                                                            ? opengl_ambient_light(scene.lights)
                                                            : geom::Rgb{0, 0, 0});
+        if (scene.colour_index_light) {
+            ctx.index_light = *scene.colour_index_light;
+            ctx.index_ramps = make_index_ramps(scene.materials, ctx.index_light);
+        }
         if (settings.ground.enabled)
             ctx.ground = make_ground(scene, settings, ctx.materials);
         ctx.lights = make_lights(scene.lights);

@@ -249,3 +249,23 @@ TEST(ViewFileTextures, RelativeTextureFilesBecomeAbsolute)
     auto expected = (std::filesystem::absolute(dir) / "images" / "bark.rgb").lexically_normal();
     EXPECT_EQ(v.textures[0].file, expected);
 }
+
+// Colormap-mode lighting lights surfaces by another rule than lines (manual 5.2.5): the
+// pipeline gives them the materials 256..511, the interpreter adds the offset to
+// surfaces' colour indices and to nothing else.
+TEST(SurfaceInterpretation, SurfaceMaterialOffsetMovesOnlySurfaces)
+{
+    ViewFile view = surface_view("offset");
+    lsys::SymbolTable symbols;
+    lsys::ModuleString s = make_string(symbols, {{";", {7}}, {"F", {1}}, {"~a", {1}}});
+    InterpretOptions options;
+    options.surface_material_offset = 256;
+    Scene scene = interpret(s, symbols, view, options);
+    ASSERT_EQ(scene.instances.size(), 1u);
+    EXPECT_EQ(scene.instances[0].material, 256 + 7);
+    EXPECT_EQ(scene.instances[0].back_material, 256 + 7);
+    ASSERT_EQ(scene.geometry.lines.material.size(), 1u);
+    EXPECT_EQ(scene.geometry.lines.material[0], 7);
+    Scene plain = interpret(s, symbols, view);
+    EXPECT_EQ(plain.instances[0].material, 7);
+}

@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: Apache-2.0
+// cpfg's colormap-mode lighting through the app pipeline: which models get it and the
+// view-file settings it reads (manual 5.2.5; docs/materials.md "Colour-index lighting").
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "app/pipeline.h"
+#include "base/diagnostics.h"
+
+using namespace cambium;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// A one-segment plant with `view_lines` in its view file and a colormap whose entry i is
+/// (i, i, i), interpreted as cpfg would with `-m` (or `-M` with a material file).
+geom::Scene interpret_colormap_model(const std::string& name, const std::string& view_lines,
+                                     bool material_file = false)
+{
+    fs::path dir = fs::temp_directory_path() / ("cambium_colour_index_" + name);
+    fs::create_directories(dir);
+    std::ofstream(dir / "plant.l") << "lsystem: 1\nderivation length: 1\naxiom: ;(7)F(1)\nendlsystem\n";
+    std::ofstream(dir / "plant.v") << "line style: cylinder\n" << view_lines;
+    {
+        std::ofstream map(dir / "plant.map", std::ios::binary);
+        for (int i = 0; i < 256; ++i)
+            for (int c = 0; c < 3; ++c)
+                map.put(static_cast<char>(i));
+    }
+    {
+        std::ofstream mat(dir / "plant.mat", std::ios::binary);
+        std::string record(15, '\0');
+        mat.write(record.data(), static_cast<std::streamsize>(record.size()));
+    }
+    app::Options options;
+    options.lsystem = dir / "plant.l";
+    options.view = dir / "plant.v";
+    options.colour_files.push_back(
+        app::ColourFile{1, material_file, material_file ? dir / "plant.mat" : dir / "plant.map"});
+    app::Model model = app::load_model(options);
+    return app::interpret(model, app::derive(model, options), options);
+}
+
+TEST(ColourIndexLighting, ShadedColormapModelsReadTheViewsSettings)
+{
+    geom::Scene scene = interpret_colormap_model(
+        "shaded", "render mode: shaded\nlight direction: 0,0,2\ndiffuse reflection: 25\n"
+                  "surface ambient: 0.3\nsurface diffuse: 0.6\n");
+    ASSERT_TRUE(scene.colour_index_light.has_value());
+    const geom::ColourIndexLight& light = *scene.colour_index_light;
+    EXPECT_DOUBLE_EQ(light.to_light.z, 1);  // normalised
+    EXPECT_EQ(light.diffuse_reflection, 25);
+    EXPECT_FLOAT_EQ(light.surface_ambient, 0.3f);
+    EXPECT_FLOAT_EQ(light.surface_diffuse, 0.6f);
+    // Entries 0..255 move by the cosine; their copies 256..511 (surfaces) by the surface rule.
+    ASSERT_EQ(scene.materials.size(), 2 * geom::colour_indices);
+    EXPECT_EQ(scene.materials[7].index_lighting, geom::IndexLighting::cosine);
+    EXPECT_EQ(scene.materials[7].colour_index, 7);
+    EXPECT_EQ(scene.materials[256 + 7].index_lighting, geom::IndexLighting::surface);
+    EXPECT_EQ(scene.materials[256 + 7].colour_index, 7);
+    EXPECT_EQ(scene.materials[256 + 7].diffuse, scene.materials[7].diffuse);
+    EXPECT_EQ(scene.geometry.lines.material.at(0), 7);
+}
+
+TEST(ColourIndexLighting, DefaultsAreCpfgs)
+{
+    geom::Scene scene = interpret_colormap_model("defaults", "shade mode: 3\n");
+    ASSERT_TRUE(scene.colour_index_light.has_value());
+    EXPECT_DOUBLE_EQ(scene.colour_index_light->to_light.x, 1);
+    EXPECT_EQ(scene.colour_index_light->diffuse_reflection, 10);
+    EXPECT_FLOAT_EQ(scene.colour_index_light->surface_ambient, 0.15f);
+    EXPECT_FLOAT_EQ(scene.colour_index_light->surface_diffuse, 0.75f);
+}
+
+TEST(ColourIndexLighting, NotInFilledModeNorWithMaterials)
+{
+    geom::Scene filled = interpret_colormap_model("filled", "render mode: filled\n");
+    EXPECT_FALSE(filled.colour_index_light.has_value());
+    EXPECT_EQ(filled.materials.size(), geom::colour_indices);
+    EXPECT_EQ(filled.materials[7].index_lighting, geom::IndexLighting::none);
+    geom::Scene materials = interpret_colormap_model("materials", "render mode: shaded\n", true);
+    EXPECT_FALSE(materials.colour_index_light.has_value());
+    // cpfg's interpolated fill (`render mode: interpolated`, `shade mode: 2`) is unlit.
+    EXPECT_FALSE(interpret_colormap_model("interpolated", "render mode: interpolated\n")
+                     .colour_index_light.has_value());
+    EXPECT_FALSE(interpret_colormap_model("shade2", "shade mode: 2\n").colour_index_light.has_value());
+}
+
+TEST(ColourIndexLighting, MalformedCoefficientIsAnErrorNamingTheLine)
+{
+    try {
+        interpret_colormap_model("malformed", "render mode: shaded\ndiffuse reflection: lots\n");
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        std::string what = e.what();
+        EXPECT_NE(what.find("plant.v:3"), std::string::npos) << what;
+        EXPECT_NE(what.find("diffuse reflection"), std::string::npos) << what;
+    }
+}
+
+}  // namespace
