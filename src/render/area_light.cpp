@@ -94,7 +94,7 @@ void AreaLights::add(const Light& light, std::uint64_t k)
         m_full = true;
         return;
     }
-    m_index.emplace(k, static_cast<std::uint32_t>(m_lights.size()));
+    m_index.emplace_back(k, static_cast<std::uint32_t>(m_lights.size()));
     m_lights.push_back(light);
 }
 
@@ -220,11 +220,23 @@ AreaLights::AreaLights(const geom::Scene& scene, const std::vector<SurfaceMateri
         return;  // the common case: nothing glows, nothing to look at
     // Pixel-width lines are drawn unlit, never shaded: not lights.
     const bool lines = !scene.line_radius_in_pixels;
+    // Each placement's lights form one run of m_index, sorted by key: the scene's own
+    // geometry's first, then instance i's as run i + 1.
+    m_runs.reserve(scene.instances.size() + 2);
+    auto close_run = [&] {
+        auto begin = m_index.begin() + (m_runs.empty() ? 0 : m_runs.back());
+        std::sort(begin, m_index.end(),
+                  [](const auto& a, const auto& b) { return a.first < b.first; });
+        m_runs.push_back(static_cast<std::uint32_t>(m_index.size()));
+    };
+    m_runs.push_back(0);
     add_geometry(scene.geometry, nullptr, PrimId::none, materials, lines);
+    close_run();
     for (std::uint32_t i = 0; i < scene.instances.size(); ++i) {
         const geom::Instance& inst = scene.instances[i];
         if (inst.prototype < scene.prototypes.size())
             add_geometry(scene.prototypes[inst.prototype].geometry, &inst, i, materials, lines);
+        close_run();
     }
     if (m_full)
         warn("area lights: more than " + std::to_string(m_max) +
@@ -362,8 +374,14 @@ float AreaLights::pdf(const Vec3f& p, const SurfaceHit& hit) const
 {
     if (m_lights.empty())
         return 0;
-    auto it = m_index.find(key(hit.shape, hit.prim_id, hit.instance));
-    if (it == m_index.end())
+    const std::size_t run = hit.instance == PrimId::none ? 0 : std::size_t{hit.instance} + 1;
+    if (run + 1 >= m_runs.size())
+        return 0;
+    const std::uint64_t k = key(hit.shape, hit.prim_id, hit.instance);
+    auto end = m_index.begin() + m_runs[run + 1];
+    auto it = std::lower_bound(m_index.begin() + m_runs[run], end, k,
+                               [](const auto& entry, std::uint64_t v) { return entry.first < v; });
+    if (it == end || it->first != k)
         return 0;
     const Light& l = m_lights[it->second];
     if (l.kind == Kind::cylinder) {

@@ -4,7 +4,7 @@
 
 #include <cstdint>
 #include <optional>
-#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "geom/scene.h"
@@ -79,7 +79,13 @@ private:
 
     std::vector<Light> m_lights;
     std::vector<double> m_cdf;  ///< m_lights.size() + 1 entries, last 1
-    std::unordered_map<std::uint64_t, std::uint32_t> m_index;  ///< key() -> light
+    /// (key(), light), one run per placement sorted by key: pdf() finds its run through
+    /// m_runs and searches it alone (a hash map cost more to build, with thousands of
+    /// instanced emissive petals, and more to search).
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> m_index;
+    /// The runs' bounds in m_index: run 0 the scene's own geometry, run i + 1 instance i's
+    /// (empty unless something glows).
+    std::vector<std::uint32_t> m_runs;
     std::size_t m_max = 0;
     double m_power = 0;
     bool m_full = false;
