@@ -10,11 +10,17 @@
 //
 //   build/benchmarks/convergence [--plant NAME]... [--sampler sobol|white|both]
 //       [--size WxH] [--threads N] [--max-spp N] [--reference-spp N] [--target NOISE]
+//       [--adaptive NOISE]
 //
 // Defaults: the four plants below, both samplers, 320x240, 2 threads, up to 64 spp, a
 // 1024-spp Sobol reference. The noise target (time_to_target_s) is, unless given, white
 // noise's error at max spp when both samplers run (else Sobol's). Without the corpus
 // (../shared/corpus, or $CAMBIUM_CORPUS) it prints {"skipped": ...} and exits 0.
+//
+// --adaptive NOISE instead renders once with adaptive sampling to that noise target (up
+// to --max-spp) and prints its mean spp, wall and CPU seconds and the error reached:
+// pixel_relative_error is the RMS of each plant pixel's relative luminance error, the
+// quantity the target bounds.
 //
 // Noise: sqrt(mean over plant pixels and RGB of (value - reference)^2) / mean(reference),
 // plant pixels being those the reference's camera rays hit at least half the time.
@@ -29,6 +35,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -93,7 +100,17 @@ struct Settings {
                                                 render::SampleSequence::sobol};
     int width = 320, height = 240, threads = 2, max_spp = 64, reference_spp = 1024;
     double target = 0;
+    double adaptive = 0;  // --adaptive: one adaptive render to this noise target instead
 };
+
+/// CPU seconds of the whole process (all threads): on a shared machine, wall time
+/// measures the neighbours as well.
+double cpu_seconds()
+{
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
 
 double peak_rss_mb()
 {
@@ -128,12 +145,12 @@ cambium::geom::Scene load_plant(const fs::path& folder)
 
 struct Run {
     render::Image image;
-    double seconds = 0;
-    std::uint64_t rays = 0;
+    double seconds = 0, cpu_seconds = 0;
+    std::uint64_t rays = 0, samples = 0;
 };
 
 Run render_at(const cambium::geom::Scene& scene, const Settings& s, int spp,
-              render::SampleSequence sampler, std::uint64_t seed)
+              render::SampleSequence sampler, std::uint64_t seed, double noise_target = 0)
 {
     render::RenderSettings rs;
     rs.width = s.width;
@@ -143,11 +160,16 @@ Run render_at(const cambium::geom::Scene& scene, const Settings& s, int spp,
     rs.sampler = sampler;
     rs.seed = seed;
     rs.aovs = false;
+    rs.noise_target = static_cast<float>(noise_target);
     std::uint64_t rays_before = rays_traced.load();
     auto start = Clock::now();
-    Run run{render::render(scene, rs), 0, 0};
+    double cpu_start = cpu_seconds();
+    render::RenderReport report;
+    Run run{render::render(scene, rs, &report)};
     run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    run.cpu_seconds = cpu_seconds() - cpu_start;
     run.rays = rays_traced.load() - rays_before;
+    run.samples = report.samples;
     return run;
 }
 
@@ -204,7 +226,7 @@ std::pair<double, double> fit_line(const std::vector<double>& x, const std::vect
 struct Curve {
     std::vector<double> spp, rmse, seconds;
     std::uint64_t rays = 0, samples = 0;
-    double render_seconds = 0;
+    double render_seconds = 0, render_cpu_seconds = 0;
 };
 
 /// The time a render of `spp` samples takes (each render's set-up included, as a user's
@@ -251,12 +273,48 @@ void report(const std::string& plant, const Settings& s, render::SampleSequence 
                 "\"reference_spp\":%d,\"spp\":%s,\"relative_rmse\":%s,\"seconds\":%s,"
                 "\"slope\":%.3f,\"target_noise\":%.5f,\"spp_to_target\":%.1f,"
                 "\"time_to_target_s\":%.3f,\"samples_per_s\":%.0f,"
-                "\"rays_per_s\":%.0f,\"peak_rss_mb\":%.0f}\n",
+                "\"samples_per_cpu_s\":%.0f,\"rays_per_s\":%.0f,\"peak_rss_mb\":%.0f}\n",
                 plant.c_str(), name(sampler), s.width, s.height, s.threads, s.reference_spp,
                 json_array(c.spp, "%.0f").c_str(), json_array(c.rmse, "%.5f").c_str(),
                 json_array(c.seconds, "%.3f").c_str(), slope, target, spp_to_target,
                 seconds_at(c, spp_to_target), double(s.width) * s.height * total_spp / c.render_seconds,
+                double(s.width) * s.height * total_spp / c.render_cpu_seconds,
                 double(c.rays) / c.render_seconds, peak_rss_mb());
+    std::fflush(stdout);
+}
+
+/// RMS over the plant's pixels of the relative error of each pixel's luminance, the
+/// quantity adaptive sampling's noise target bounds (render.cpp: relative_error).
+double pixel_relative_error(const std::vector<float>& image, const std::vector<float>& ref)
+{
+    auto luminance = [](const std::vector<float>& v, std::size_t p) {
+        return 0.2126 * v[p] + 0.7152 * v[p + 1] + 0.0722 * v[p + 2];
+    };
+    double sq = 0;
+    std::size_t pixels = 0;
+    for (std::size_t p = 0; p + 3 < ref.size(); p += 4) {
+        if (ref[p + 3] < 0.5f)
+            continue;
+        double r = luminance(ref, p);
+        double e = (luminance(image, p) - r) / std::max(r, 0.01);
+        sq += e * e;
+        ++pixels;
+    }
+    return pixels > 0 ? std::sqrt(sq / double(pixels)) : 0;
+}
+
+/// --adaptive: one render with the noise target (up to --max-spp), against the reference.
+void run_adaptive(const std::string& plant, const cambium::geom::Scene& scene,
+                  const std::vector<float>& ref, const Settings& s)
+{
+    Run run = render_at(scene, s, s.max_spp, render::SampleSequence::sobol, 0, s.adaptive);
+    std::printf("{\"plant\":\"%s\",\"adaptive_target\":%.4f,\"image\":\"%dx%d\","
+                "\"threads\":%d,\"max_spp\":%d,\"mean_spp\":%.1f,\"seconds\":%.3f,"
+                "\"cpu_seconds\":%.3f,\"pixel_relative_error\":%.4f,\"relative_rmse\":%.5f}\n",
+                plant.c_str(), s.adaptive, s.width, s.height, s.threads, s.max_spp,
+                double(run.samples) / (double(s.width) * s.height), run.seconds,
+                run.cpu_seconds, pixel_relative_error(run.image.rgba, ref),
+                relative_rmse(run.image.rgba, ref));
     std::fflush(stdout);
 }
 
@@ -268,6 +326,10 @@ void run_plant(const std::string& plant, const fs::path& folder, const Settings&
         scene, s,
         cache / (plant + "-" + std::to_string(s.width) + "x" + std::to_string(s.height) + "-" +
                  std::to_string(s.reference_spp) + ".f32"));
+    if (s.adaptive > 0) {
+        run_adaptive(plant, scene, ref, s);
+        return;
+    }
     std::map<render::SampleSequence, Curve> curves;
     for (render::SampleSequence sampler : s.samplers) {
         Curve& c = curves[sampler];
@@ -278,6 +340,7 @@ void run_plant(const std::string& plant, const fs::path& folder, const Settings&
             c.seconds.push_back(run.seconds);
             c.rays += run.rays;
             c.render_seconds += run.seconds;
+            c.render_cpu_seconds += run.cpu_seconds;
         }
     }
     double target = s.target;
@@ -325,6 +388,8 @@ Settings parse(int argc, char** argv)
             s.reference_spp = std::stoi(value());
         } else if (arg == "--target") {
             s.target = std::stod(value());
+        } else if (arg == "--adaptive") {
+            s.adaptive = std::stod(value());
         } else {
             throw std::runtime_error("unknown argument " + arg);
         }

@@ -14,7 +14,10 @@
 // rtcIntersect1 / rtcOccluded1 on that same scene and the same threads. The render builds
 // the BVH once: build_s is the time from render() to its first ray. The replay's context
 // carries "skip nothing", so the early-out self-hit filter of round shapes still runs
-// there as in the render (its only cost is the call).
+// there as in the render (its only cost is the call). path_tracer_fraction_of_raw compares
+// wall-clock rates; path_tracer_fraction_of_raw_cpu compares the CPU seconds of the trace
+// with raw Embree's CPU seconds for the same number of rays of each kind, which a loaded
+// machine does not skew.
 #include <embree3/rtcore.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -30,6 +33,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <ctime>
 #include <exception>
 #include <mutex>
 #include <string>
@@ -38,6 +42,7 @@
 #include "geom/scene.h"
 #include "render/accel.h"
 #include "render/render.h"
+#include "render/ray_counter.h"
 #include "render/sampler.h"
 
 namespace {
@@ -49,6 +54,15 @@ double seconds_since(Clock::time_point t)
     return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
+/// CPU seconds of the whole process (all threads): on a loaded machine wall time also
+/// measures the neighbours, CPU time only this process's work.
+double cpu_seconds()
+{
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
 double peak_rss_mb()
 {
     rusage usage{};
@@ -58,17 +72,53 @@ double peak_rss_mb()
 
 // ---- The interposer ------------------------------------------------------------------
 
+/// Slots for recorded rays, handed to each thread a chunk at a time: one atomic add per
+/// chunk rather than per ray (a counter shared by all threads would charge the path tracer
+/// for cache-line contention that only the benchmark causes). Slots never filled keep
+/// the sentinel tnear = -1 and are dropped before the replay.
+struct RayLog {
+    static constexpr std::size_t chunk = 4096;
+    std::vector<RTCRay> rays;
+    std::atomic<std::size_t> chunks_taken{0};
+
+    /// Makes `count` sentinel slots (before the clock starts: they are touched here).
+    void prepare(std::size_t count)
+    {
+        RTCRay sentinel{};
+        sentinel.tnear = -1;
+        rays.assign(count, sentinel);
+    }
+    /// Records r in the calling thread's chunk [next, end), taking a new one when full.
+    void record(const RTCRay& r, std::size_t& next, std::size_t& end)
+    {
+        if (next == end) {
+            next = chunks_taken.fetch_add(1, std::memory_order_relaxed) * chunk;
+            end = std::min(next + chunk, rays.size());
+            if (next >= end) {  // full: record no more
+                next = end = 0;
+                return;
+            }
+        }
+        rays[next++] = r;
+    }
+    /// Drops the slots never filled.
+    void compact()
+    {
+        std::erase_if(rays, [](const RTCRay& r) { return r.tnear < 0; });
+    }
+};
+
 struct Recorder {
-    std::atomic<std::uint64_t> intersections{0}, occlusions{0};
+    cambium::render::RayCounter intersections, occlusions;  // per thread, uncontended
     std::atomic<bool> started{false};
     Clock::time_point first_call;
+    double first_call_cpu = 0;
     double rss_at_first_call = 0;
     std::mutex mutex;
     RTCScene scene = nullptr;          // the render's: alive until render() returns
-    /// The first rays traced, as given: slots filled without a lock (each call takes its
-    /// index from its counter), so recording costs the path tracer one atomic add.
-    std::vector<RTCRay> rays, occlusion_rays;
-    std::size_t capacity = 0;
+    /// The first rays traced, as given.
+    RayLog rays, occlusion_rays;
+    std::atomic<bool> recording{false};
 };
 Recorder recorder;
 
@@ -93,9 +143,10 @@ void note_call(RTCScene scene)
         std::lock_guard lock(recorder.mutex);
         if (!recorder.started) {
             recorder.first_call = Clock::now();
+            recorder.first_call_cpu = cpu_seconds();
             // Less the recorder's own buffers (allocated and touched before the render).
             recorder.rss_at_first_call =
-                peak_rss_mb() - double((recorder.rays.size() + recorder.occlusion_rays.size()) *
+                peak_rss_mb() - double((recorder.rays.rays.size() + recorder.occlusion_rays.rays.size()) *
                                        sizeof(RTCRay)) / (1024.0 * 1024.0);
             recorder.scene = scene;
             recorder.started = true;
@@ -107,22 +158,22 @@ void note_call(RTCScene scene)
 
 extern "C" void rtcIntersect1(RTCScene scene, RTCIntersectContext* context, RTCRayHit* rayhit)
 {
-    if (recorder.capacity > 0) {
+    if (recorder.recording.load(std::memory_order_relaxed)) {
         note_call(scene);
-        std::uint64_t slot = recorder.intersections.fetch_add(1, std::memory_order_relaxed);
-        if (slot < recorder.capacity)
-            recorder.rays[slot] = rayhit->ray;
+        recorder.intersections.add();
+        thread_local std::size_t next = 0, end = 0;
+        recorder.rays.record(rayhit->ray, next, end);
     }
     real_intersect()(scene, context, rayhit);
 }
 
 extern "C" void rtcOccluded1(RTCScene scene, RTCIntersectContext* context, RTCRay* ray)
 {
-    if (recorder.capacity > 0) {
+    if (recorder.recording.load(std::memory_order_relaxed)) {
         note_call(scene);
-        std::uint64_t slot = recorder.occlusions.fetch_add(1, std::memory_order_relaxed);
-        if (slot < recorder.capacity)
-            recorder.occlusion_rays[slot] = *ray;
+        recorder.occlusions.add();
+        thread_local std::size_t next = 0, end = 0;
+        recorder.occlusion_rays.record(*ray, next, end);
     }
     real_occluded()(scene, context, ray);
 }
@@ -319,6 +370,7 @@ double replay(RTCScene scene, const std::vector<RTCRay>& rays, bool occlusion,
 struct RawFigures {
     std::uint64_t hits = 0, occluded = 0;
     double intersect_s = 0, occluded_s = 0;
+    double intersect_cpu_s = 0, occluded_cpu_s = 0;
 };
 
 int run(int argc, char** argv)
@@ -378,23 +430,29 @@ int run(int argc, char** argv)
 
     // The path tracer, counted by the interposer; the raw replay at the end of its pass,
     // while its Embree scene is alive.
-    recorder.rays.resize(2'000'000);  // touched here, before the clock starts
-    recorder.occlusion_rays.resize(2'000'000);
-    recorder.capacity = recorder.rays.size();
+    recorder.rays.prepare(2'000'000);  // touched here, before the clock starts
+    recorder.occlusion_rays.prepare(2'000'000);
+    recorder.recording = true;
     Clock::time_point trace_end;
+    double trace_end_cpu = 0;
     std::uint64_t intersections = 0, occlusions = 0;
     RawFigures raw;
     settings.on_pass = [&](const cambium::render::Image&) {
         trace_end = Clock::now();
-        recorder.capacity = 0;
-        intersections = recorder.intersections;
-        occlusions = recorder.occlusions;
-        recorder.rays.resize(std::min<std::size_t>(recorder.rays.size(), intersections));
-        recorder.occlusion_rays.resize(
-            std::min<std::size_t>(recorder.occlusion_rays.size(), occlusions));
+        trace_end_cpu = cpu_seconds();
+        recorder.recording = false;
+        intersections = recorder.intersections.total();
+        occlusions = recorder.occlusions.total();
+        recorder.rays.compact();
+        recorder.occlusion_rays.compact();
         arena.execute([&] {
-            raw.intersect_s = replay(recorder.scene, recorder.rays, false, raw.hits);
-            raw.occluded_s = replay(recorder.scene, recorder.occlusion_rays, true, raw.occluded);
+            double cpu0 = cpu_seconds();
+            raw.intersect_s = replay(recorder.scene, recorder.rays.rays, false, raw.hits);
+            double cpu1 = cpu_seconds();
+            raw.occluded_s =
+                replay(recorder.scene, recorder.occlusion_rays.rays, true, raw.occluded);
+            raw.intersect_cpu_s = cpu1 - cpu0;
+            raw.occluded_cpu_s = cpu_seconds() - cpu1;
         });
     };
     auto r0 = Clock::now();
@@ -410,11 +468,20 @@ int run(int argc, char** argv)
     double rays = double(intersections + occlusions);
     // Raw Embree's time for the path tracer's mix of rays, at the replayed rates.
     auto rate = [](std::size_t n, double s) { return s > 0 ? double(n) / s : 0.0; };
-    double raw_intersect_rate = rate(recorder.rays.size(), raw.intersect_s);
-    double raw_occluded_rate = rate(recorder.occlusion_rays.size(), raw.occluded_s);
+    double raw_intersect_rate = rate(recorder.rays.rays.size(), raw.intersect_s);
+    double raw_occluded_rate = rate(recorder.occlusion_rays.rays.size(), raw.occluded_s);
     double raw_mix_s = (raw_intersect_rate > 0 ? double(intersections) / raw_intersect_rate : 0) +
                        (raw_occluded_rate > 0 ? double(occlusions) / raw_occluded_rate : 0);
     double raw_rays_per_s = raw_mix_s > 0 ? rays / raw_mix_s : 0;
+    // The same in CPU seconds (the measure that holds on a loaded machine).
+    double trace_cpu_s = trace_end_cpu - recorder.first_call_cpu;
+    double raw_mix_cpu_s =
+        (raw.intersect_cpu_s > 0
+             ? double(intersections) * raw.intersect_cpu_s / double(recorder.rays.rays.size())
+             : 0) +
+        (raw.occluded_cpu_s > 0 ? double(occlusions) * raw.occluded_cpu_s /
+                                      double(recorder.occlusion_rays.rays.size())
+                                : 0);
     std::printf(
         "{\"scale\":%g,\"threads\":%d,\"segments\":%zu,\"embree_segments\":%zu,"
         "\"instances\":%zu,\"instances_in_accel\":%s,\"generate_s\":%.3f,\"build_s\":%.3f,"
@@ -425,19 +492,21 @@ int run(int argc, char** argv)
         "\"intersect_rays_per_s\":%.0f,\"hit_fraction\":%.3f,\"occlusion_rays\":%zu,"
         "\"occlusion_s\":%.3f,\"occlusion_rays_per_s\":%.0f,\"rays_per_s\":%.0f},"
         "\"path_tracer_intersect_rays_per_s\":%.0f,\"path_tracer_fraction_of_raw\":%.3f,"
-        "\"peak_rss_mb\":%.1f}\n",
+        "\"trace_cpu_s\":%.3f,\"raw_embree_cpu_s\":%.3f,"
+        "\"path_tracer_fraction_of_raw_cpu\":%.3f,\"peak_rss_mb\":%.1f}\n",
         scale, threads, scene.geometry.lines.segment_count(), built_segments,
         scene.instances.size(), instances ? "true" : "false", generate_s, build_s,
         recorder.rss_at_first_call, width, height, spp, depth, render_s, trace_s,
         static_cast<unsigned long long>(report.samples), covered / (double(width) * height),
         static_cast<unsigned long long>(intersections),
         static_cast<unsigned long long>(occlusions), rays / trace_s,
-        double(report.samples) / trace_s, recorder.rays.size(), raw.intersect_s,
+        double(report.samples) / trace_s, recorder.rays.rays.size(), raw.intersect_s,
         raw_intersect_rate,
-        recorder.rays.empty() ? 0.0 : double(raw.hits) / double(recorder.rays.size()),
-        recorder.occlusion_rays.size(), raw.occluded_s, raw_occluded_rate, raw_rays_per_s,
+        recorder.rays.rays.empty() ? 0.0 : double(raw.hits) / double(recorder.rays.rays.size()),
+        recorder.occlusion_rays.rays.size(), raw.occluded_s, raw_occluded_rate, raw_rays_per_s,
         double(intersections) / trace_s,
-        raw_rays_per_s > 0 ? rays / trace_s / raw_rays_per_s : 0.0, peak_rss_mb());
+        raw_rays_per_s > 0 ? rays / trace_s / raw_rays_per_s : 0.0, trace_cpu_s, raw_mix_cpu_s,
+        trace_cpu_s > 0 ? raw_mix_cpu_s / trace_cpu_s : 0.0, peak_rss_mb());
     return 0;
 }
 

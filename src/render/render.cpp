@@ -148,7 +148,10 @@ private:
 /// A pixel's running sums.
 struct PixelState {
     Vec3f radiance, albedo, normal;
-    double luminance = 0, luminance_sq = 0;  // for the adaptive error estimate
+    /// Luminance sums of the two independent replicas (even and odd samples), for the
+    /// adaptive error estimate (relative_error).
+    std::array<double, 2> replica_luminance{};
+    double luminance_sq = 0;
     double lit_with = 0, lit_without = 0;    // shadow-catcher samples' light (PathResult)
     float depth = infinity;
     std::uint32_t samples = 0, hits = 0, caught = 0;  // caught: met the shadow catcher
@@ -177,12 +180,32 @@ RayCone camera_cone(const Camera& camera)
     return {0, static_cast<float>(camera.pixel_size_at(camera.origin() + camera.forward()))};
 }
 
+// Adaptive sampling needs each pixel's error, and the error of stratified (Sobol) samples
+// is not the spread of the samples over sqrt(n): that holds for independent samples only
+// and overstates a net's error many times (the render ran on long after its target). So
+// an adaptive render draws two independently scrambled replicas of the sequence, even
+// samples from one and odd from the other: the two replica means are independent and
+// equally good, and half their difference estimates the error of their average without
+// bias, whatever the stratification (randomised quasi-Monte Carlo's replica estimate).
+// Each replica is a net of half the samples; a render without a noise target keeps one.
+
+/// The index of sample i in its replica's sequence.
+std::uint32_t replica_index(std::uint32_t i) { return i >> 1; }
+
+/// The seed of sample i's replica.
+std::uint64_t replica_seed(std::uint64_t seed, std::uint32_t i)
+{
+    return (i & 1u) ? mix64(seed ^ 0x6a09e667f3bcc909ULL) : seed;
+}
+
 /// Sample i of pixel (x, y), added to its sums.
 void take_sample(const RenderState& f, int x, int y, std::uint32_t i, PixelState& st)
 {
     const RenderSettings& s = f.settings;
-    const Sampler sampler(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), i,
-                          s.seed, s.sampler);
+    const bool adaptive = s.noise_target > 0;
+    const Sampler sampler(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                          adaptive ? replica_index(i) : i,
+                          adaptive ? replica_seed(s.seed, i) : s.seed, s.sampler);
     auto [jx, jy] = sampler.get2d(sample_dimension::film);
     double px, py;
     if (f.filter.box()) {
@@ -227,7 +250,7 @@ void take_sample(const RenderState& f, int x, int y, std::uint32_t i, PixelState
     st.lit_without += r.lit_without;
     // Adaptive sampling watches a shadow catcher's light estimate (its colour is 0).
     double l = r.catcher ? r.lit_with : luminance(r.radiance);
-    st.luminance += l;
+    st.replica_luminance[i & 1u] += l;
     st.luminance_sq += l * l;
 }
 
@@ -254,32 +277,42 @@ std::vector<int> pass_targets(const RenderSettings& s)
     return targets;
 }
 
-/// Relative standard error of a pixel's mean luminance (infinite when too few samples).
-double relative_error(const PixelState& st)
+/// The squared relative standard error of a pixel's mean luminance (infinite when too
+/// few samples): the replicas' estimate (see replica_index), but never below the samples'
+/// variance over n^2 (their spread over n, the error of independent samples, times a
+/// stratification gain of 1/sqrt(n), more than nets achieve on an edge). From a few
+/// samples the replicas often agree exactly on an edge (each net's coverage count is an
+/// integer): an estimate of zero, which without the floor would stop the pixel at once.
+double relative_error_squared(const PixelState& st)
 {
     if (st.samples < std::uint32_t(min_adaptive_samples))
         return std::numeric_limits<double>::infinity();
-    double n = st.samples, mean = st.luminance / n;
-    double variance = std::max(0.0, (st.luminance_sq - st.luminance * mean) / (n - 1));
-    return std::sqrt(variance / n) / std::max(mean, 0.01);
+    double n = st.samples, n_even = (st.samples + 1) / 2, n_odd = st.samples / 2;
+    double sum = st.replica_luminance[0] + st.replica_luminance[1], mean = sum / n;
+    double replica_error = (st.replica_luminance[0] / n_even - st.replica_luminance[1] / n_odd) / 2;
+    double variance = std::max(0.0, (st.luminance_sq - sum * mean) / (n - 1));
+    double error_sq = std::max(replica_error * replica_error, variance / (n * n));
+    return error_sq / std::max(mean * mean, 1e-4);
 }
 
 /// Marks pixels whose 3x3 neighbourhood meets the noise target as done (over the sampled
-/// rectangle, w x h: its edges are the image's or lie in the crop's margin).
+/// rectangle, w x h: its edges are the image's or lie in the crop's margin). A pixel's
+/// replica estimate has one degree of freedom; pooled over the neighbourhood (the mean of
+/// the squared errors) it has nine, so a lucky pair of replicas rarely stops a pixel early.
 void mark_converged(std::vector<PixelState>& px, int w, int h, double target)
 {
     std::vector<double> err(px.size());
     for (std::size_t i = 0; i < px.size(); ++i)
-        err[i] = px[i].done ? 0.0 : relative_error(px[i]);
+        err[i] = relative_error_squared(px[i]);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
-            double worst = 0;
+            double pooled = 0;
             for (int dy = -1; dy <= 1; ++dy)
                 for (int dx = -1; dx <= 1; ++dx) {
                     int nx = std::clamp(x + dx, 0, w - 1), ny = std::clamp(y + dy, 0, h - 1);
-                    worst = std::max(worst, err[std::size_t(ny) * w + nx]);
+                    pooled = std::max(pooled, err[std::size_t(ny) * w + nx]);
                 }
-            if (worst <= target)
+            if (pooled <= target * target)
                 px[std::size_t(y) * w + x].done = true;
         }
 }
