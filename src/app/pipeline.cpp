@@ -3,15 +3,16 @@
 // interpreted.
 #include "app/pipeline.h"
 
-#include <sstream>
 
 #include "base/diagnostics.h"
 #include "base/subprocess.h"
 #include "geom/background_scene.h"
 #include "geom/function.h"
+#include "geom/gencyl.h"
 #include "geom/interpreter.h"
 #include "geom/query.h"
 #include "geom/scene_limits.h"
+#include "geom/wireframe.h"
 #include "lsys/program.h"
 
 namespace cambium::app {
@@ -120,32 +121,6 @@ lsys::ModuleString derive(const Model& model, const Options& options)
 }
 
 namespace {
-/// The view file's `render mode:` or `shade mode:` (the last one given). `fast` is
-/// filled (manual 5.2: filled with wireframe spheres); `interpolated` and `shadows` are
-/// shaded (the former's colour blending is the generalized cylinders' concern). The
-/// older `shade mode:` numbers as cpfg converts them: 1 simple fill (filled), 4 and 5
-/// B-spline polygons and 7 wireframe (wireframe), the rest shaded (2 interpolated fill,
-/// 3 Gouraud, 6 two-sided).
-geom::Shading render_mode(const geom::ViewFile& view)
-{
-    geom::Shading mode = geom::Shading::shaded;
-    for (const geom::ViewCommand& c : view.deferred) {
-        std::istringstream in(c.value);
-        std::string word;
-        in >> word;
-        if (c.name == "render mode")
-            mode = word == "flat"        ? geom::Shading::flat
-                   : word == "filled" || word == "fast" ? geom::Shading::filled
-                   : word == "wireframe" ? geom::Shading::wireframe
-                                         : geom::Shading::shaded;
-        else if (c.name == "shade mode")
-            mode = word == "1"                                ? geom::Shading::filled
-                   : word == "4" || word == "5" || word == "7" ? geom::Shading::wireframe
-                                                               : geom::Shading::shaded;
-    }
-    return mode;
-}
-
 /// Whether the view's last `render mode:` / `shade mode:` is cpfg's interpolated fill,
 /// which Cambium shades but cpfg draws without any lighting.
 bool interpolated_fill(const geom::ViewFile& view)
@@ -165,7 +140,7 @@ bool interpolated_fill(const geom::ViewFile& view)
 /// mode (a -m file or none) in render mode flat or shaded.
 bool lit_by_colour_index(const Model& model)
 {
-    geom::Shading mode = render_mode(*model.view);
+    geom::Shading mode = geom::render_mode(*model.view);
     return model.palette.mode() != geom::Palette::Mode::materials &&
            (mode == geom::Shading::shaded || mode == geom::Shading::flat) &&
            !interpolated_fill(*model.view);
@@ -240,6 +215,17 @@ lsys::ModuleString turtle_string(const Model& model, const lsys::ModuleString& d
 
 namespace {
 
+/// cpfg's wireframe: its edge width (from the view volume and the window's width), its
+/// cylinders' sides, and spheres as quadrics with a material file, octahedra without.
+geom::WireframeStyle wireframe_style(const Model& model, const geom::Scene& scene, const Options& options)
+{
+    geom::WireframeStyle style;
+    style.edge_width_px = geom::wireframe_edge_width(scene.view.box.value_or(scene.bounds), options.width);
+    style.sides = geom::contour_sides(*model.view);
+    style.quadric_spheres = model.palette.mode() == geom::Palette::Mode::materials;
+    return style;
+}
+
 /// The turtle's hooks and limits for this model and command line.
 geom::InterpretOptions interpret_options(const Model& model, const Options& options)
 {
@@ -284,7 +270,7 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
     geom::Scene scene = geom::interpret(string, model.lsystem.symbols(), *model.view,
                                         interpret_options(model, options));
     const bool index_lit = lit_by_colour_index(model);
-    scene.shading = render_mode(*model.view);
+    scene.shading = geom::render_mode(*model.view);
     scene.materials = model.palette.entries(options.colour_block);
     scene.background = model.palette.background(options.colour_block);
     // cpfg's window draws every object of the L-system opaque (manual 9.4); only the
@@ -306,6 +292,8 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
                                background.materials.end());
         geom::append_geometry(scene.geometry, background.geometry);
     }
+    if (scene.shading == geom::Shading::wireframe)
+        geom::draw_as_wireframe(scene, wireframe_style(model, scene, options));
     // Non-finite or huge numbers would abort inside Embree: dropped here with a warning.
     geom::drop_unrenderable(scene);
     return scene;

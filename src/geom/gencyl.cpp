@@ -198,19 +198,28 @@ Vec3 rmf_step(const Vec3& x0, const Vec3& t0, const Vec3& up0, const Vec3& x1, c
 
 // ---- settings -------------------------------------------------------------------------
 
+int contour_sides(const ViewFile& view)
+{
+    int sides = 8;
+    for (const ViewCommand& c : view.deferred) {
+        if (c.name == "contour sides")
+            sides = parse_count(c, 8, 3, max_sides);
+        else if (c.name == "polygonization level")  // cpfg: 2^(n+1) polygons around (manual 5.2.4)
+            sides = 1 << (parse_count(c, 2, 1, 16) + 1);
+    }
+    return sides;
+}
+
 CylinderSettings cylinder_settings(const ViewFile& view)
 {
     CylinderSettings s;
     s.draw_surfaces = view.line_style == LineStyle::cylinder;
     s.texture_aspect_ratios = view.texture_aspect_ratios;
+    s.mesh_circles = render_mode(view) == Shading::wireframe;
     std::filesystem::path folder = view.path.parent_path();
+    s.sides = contour_sides(view);
     for (const ViewCommand& c : view.deferred) {
-        if (c.name == "contour sides") {
-            s.sides = parse_count(c, 8, 3, max_sides);
-        } else if (c.name == "polygonization level") {
-            // cpfg: 2^(n+1) polygons around (manual 5.2.4), kept for old view files.
-            s.sides = 1 << (parse_count(c, 2, 1, 16) + 1);
-        } else if (c.name == "render mode") {
+        if (c.name == "render mode") {
             std::istringstream in(c.value);
             std::string word;
             in >> word;
@@ -573,7 +582,7 @@ void CylinderBuilder::draw_segment(const CylinderPoint& from, CylinderPoint& to,
 
     if (!m_settings.draw_surfaces) {
         draw_axis_lines(rings, from, to);
-    } else if (from.contour == 0 && to.contour == 0) {
+    } else if (from.contour == 0 && to.contour == 0 && !m_settings.mesh_circles) {
         draw_round(rings, profile, axis, from, to);
         extend_bounds(rings, from, to, len);
     } else {

@@ -98,8 +98,15 @@ struct CylinderSettings {
     /// point's colour to the end point's (cpfg's Gouraud colours); otherwise it is flat.
     bool interpolate_colours = false;
     bool draw_surfaces = true; ///< `line style: cylinder`; otherwise the axis as lines
+    /// `render mode: wireframe`: the circular contour too is drawn as a triangle mesh
+    /// (`sides` around, cpfg's strips along), so that its tessellation edges can be drawn.
+    bool mesh_circles = false;
     std::vector<double> texture_aspect_ratios;  ///< per texture, `R:` (v = length / (pi width R))
 };
+
+/// Polygons around cylinders and spheres: `contour sides:` or `polygonization level:`
+/// (the last one given), 8 without either.
+int contour_sides(const ViewFile& view);
 
 /// Reads `contour:`, `contour sides:`, `polygonization level:` and `twist of cylinders:`
 /// from the view file's deferred commands and loads the contour files (relative to the

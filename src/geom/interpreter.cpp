@@ -88,6 +88,7 @@ public:
     {
         m_turtle.cylinder.sides = m_cylinders.settings().sides;
         m_past_cut = interprets_past_cut(view);
+        m_polygon_outlines = render_mode(view) == Shading::wireframe;
         m_turtle.line_width = view.initial_line_width;
         m_turtle.color = view.initial_color;
         m_turtle.back_color = view.initial_back_color;
@@ -688,12 +689,43 @@ private:
             mesh.normals.push_back(f3(n));
             mesh.uvs.push_back({unit(dot(q, s_axis), s_lo, s_hi), unit(dot(q, t_axis), t_lo, t_hi)});
         }
+        if (m_polygon_outlines)
+            mesh.hidden_edges.resize(mesh.triangles.size(), 0);
         for (const auto& t : triangles) {
             mesh.triangles.push_back({base + t[0], base + t[1], base + t[2]});
             mesh.material.push_back(material(corners[0].color));
             mesh.back_material.push_back(material(corners[0].back_color));
             mesh.texture.push_back(static_cast<std::int16_t>(corners[0].texture));
+            if (m_polygon_outlines)
+                mesh.hidden_edges.push_back(inner_edges(t, outline));
         }
+    }
+
+    /// cpfg draws a polygon as one GL_POLYGON, whose wireframe is its outline. A
+    /// triangle's edge is on the outline when the outline runs from one end to the
+    /// other (either way round) through repeated or collinear corners only, which the
+    /// triangulation skips; otherwise it is an inner edge.
+    static std::uint8_t inner_edges(const std::array<std::uint32_t, 3>& t, const std::vector<Vec3>& outline)
+    {
+        const std::size_t n = outline.size();
+        auto along_outline = [&](std::size_t from, std::size_t to) {
+            const Vec3 a = outline[from], d = outline[to] - a;
+            const double dd = dot(d, d);
+            for (std::size_t i = (from + 1) % n; i != to; i = (i + 1) % n) {
+                Vec3 p = outline[i] - a;
+                double s = dd > 0 ? dot(p, d) / dd : 0;
+                if (s < -1e-9 || s > 1 + 1e-9 || geom::length(p - d * s) > 1e-6 * std::max(1.0, std::sqrt(dd)))
+                    return false;
+            }
+            return true;
+        };
+        std::uint8_t bits = 0;
+        for (int k = 0; k < 3; ++k) {
+            std::size_t a = t[static_cast<std::size_t>(k)], b = t[static_cast<std::size_t>((k + 1) % 3)];
+            if (!along_outline(a, b) && !along_outline(b, a))
+                bits = static_cast<std::uint8_t>(bits | (1u << k));
+        }
+        return bits;
     }
 
     /// `@Ts(i, e)`, `@Ti(i [, d])`, `@Td(i [, d])`: tropism i (from 1; 0 parameters:
@@ -993,6 +1025,8 @@ private:
     bool m_taper_open = false;  ///< the last segment's top width may still change
     bool m_warned_unbalanced = false;
     bool m_past_cut = true;  ///< `interpretation past %:`
+    /// `render mode: wireframe`: polygons mark their inner edges (TriangleMesh::hidden_edges).
+    bool m_polygon_outlines = false;
     int m_cut_depth = -1;    ///< skipping a cut branch: brackets opened since; -1: not
 };
 

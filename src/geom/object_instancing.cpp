@@ -111,6 +111,11 @@ void append_placed_mesh(TriangleMesh& into, const TriangleMesh& from, const Inst
         std::int16_t texture = t < from.texture.size() ? from.texture[t] : no_texture;
         into.texture.push_back(texture == no_texture ? instance.texture : texture);
     }
+    if (!from.hidden_edges.empty()) {  // keep each placed polygon's outline
+        into.hidden_edges.resize(into.triangles.size() - from.triangles.size(), 0);
+        for (std::size_t t = 0; t < from.triangles.size(); ++t)
+            into.hidden_edges.push_back(t < from.hidden_edges.size() ? from.hidden_edges[t] : 0);
+    }
 }
 
 GeometryCheckpoint::GeometryCheckpoint(const Geometry& g)
@@ -148,7 +153,7 @@ bool GeometryCheckpoint::restore(Geometry& g) const
     TriangleMesh& m = g.mesh;
     cut(m.positions, m_positions), cut(m.normals, m_positions), cut(m.uvs, m_uvs);
     cut(m.triangles, m_triangles), cut(m.material, m_triangles), cut(m.back_material, m_triangles);
-    cut(m.texture, m_mesh_textures);
+    cut(m.texture, m_mesh_textures), cut(m.hidden_edges, m_triangles);
     // the segments before the object are no longer continued by the cut ones
     if (m_line_flag >= 0)
         l.flags.back() = static_cast<std::uint8_t>(m_line_flag);

@@ -104,6 +104,11 @@ struct TriangleMesh {
     std::vector<std::uint16_t> material;       ///< per triangle, front
     std::vector<std::uint16_t> back_material;  ///< per triangle, back
     std::vector<std::int16_t> texture;         ///< per triangle
+    /// Per triangle, optional (missing entries are 0): bit k set when the edge from
+    /// vertex k to vertex k + 1 lies inside its turtle polygon, which
+    /// `render mode: wireframe` draws as its outline only (OpenGL's edge flags). Filled
+    /// only for wireframe views.
+    std::vector<std::uint8_t> hidden_edges;
 
     std::size_t size() const { return triangles.size(); }
 };
@@ -232,7 +237,8 @@ struct LabelFont {
 
 /// `render mode:` (manual 5.2) read by a path tracer: shaded (lit with smooth normals),
 /// flat (lit with each facet's own normal), filled (unlit: every surface in its flat
-/// colour, as OpenGL without lighting), wireframe (drawn as filled: edges are not drawn).
+/// colour, as OpenGL without lighting), wireframe (unlit: only the edges of polygons and
+/// of the tessellated surfaces, as pixel-width lines; geom/wireframe.h).
 enum class Shading { shaded, flat, filled, wireframe };
 
 /// Everything render needs to draw one frame of a plant.

@@ -473,4 +473,29 @@ ViewFile read_view_file(const std::filesystem::path& file)
     return v;
 }
 
+/// `fast` is filled (manual 5.2: filled with wireframe spheres); `interpolated` and
+/// `shadows` are shaded (the former's colour blending is the generalized cylinders'
+/// concern). The older `shade mode:` numbers as cpfg converts them: 1 simple fill
+/// (filled), 4 and 5 B-spline polygons and 7 wireframe (wireframe), the rest shaded
+/// (2 interpolated fill, 3 Gouraud, 6 two-sided).
+Shading render_mode(const ViewFile& view)
+{
+    Shading mode = Shading::shaded;
+    for (const ViewCommand& c : view.deferred) {
+        std::istringstream in(c.value);
+        std::string word;
+        in >> word;
+        if (c.name == "render mode")
+            mode = word == "flat"                        ? Shading::flat
+                   : word == "filled" || word == "fast" ? Shading::filled
+                   : word == "wireframe"                ? Shading::wireframe
+                                                        : Shading::shaded;
+        else if (c.name == "shade mode")
+            mode = word == "1"                                 ? Shading::filled
+                   : word == "4" || word == "5" || word == "7" ? Shading::wireframe
+                                                               : Shading::shaded;
+    }
+    return mode;
+}
+
 }  // namespace cambium::geom

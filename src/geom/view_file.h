@@ -90,4 +90,8 @@ ViewFile read_view_file(const std::filesystem::path& file);
 /// The same from text (tests); `file_name` is used in messages.
 ViewFile parse_view_file(std::string_view text, const std::string& file_name);
 
+/// The view file's `render mode:` or `shade mode:` (the last one given), as a path
+/// tracer draws it (geom::Shading).
+Shading render_mode(const ViewFile& view);
+
 }  // namespace cambium::geom

@@ -16,6 +16,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <sys/wait.h>
@@ -155,6 +156,43 @@ TEST(Command, RendersAPlantToPngAndExr)
     EXPECT_GT(covered, 4);
     EXPECT_LT(covered, 32 * 24 / 2);
     EXPECT_GT(differ, covered / 2);
+}
+
+// `render mode: wireframe` draws a polygon as its outline of 1-pixel lines in its colour
+// (cpfg's grey without a colour file) and leaves the inside, diagonal included, to the
+// background; `filled` fills it. The square spans most of the 64 x 64 image.
+TEST(Command, WireframeSquareIsItsOutlineOfOnePixelLines)
+{
+    fs::path dir = scratch("wireframe");
+    write(dir / "p.l", "lsystem: 1\nderivation length: 0\naxiom: {f+f+f+f}\nendlsystem\n");
+    auto picture = [&](const std::string& mode) {
+        write(dir / "p.v", "angle increment: 90\nscale factor: 0.8\nrender mode: " + mode + "\n");
+        Result r = run("-q -w 64 64 --spp 4 -o " + (dir / "p.png").string() + " " + (dir / "p.l").string() +
+                       " " + (dir / "p.v").string());
+        EXPECT_EQ(r.status, 0) << r.output;
+        return read_picture(dir / "p.png");
+    };
+    const float grey = 200 / 255.0f;
+    Picture filled = picture("filled");
+    ASSERT_EQ(filled.width, 64);
+    EXPECT_NEAR(filled.at(32, 32, 0), grey, 0.01f);
+    Picture wire = picture("wireframe");
+    ASSERT_EQ(wire.width, 64);
+    EXPECT_EQ(wire.at(32, 32, 0), 0.0f);  // the centre, on the diagonal
+    EXPECT_EQ(wire.at(20, 40, 0), 0.0f);
+    // Every column and row through the middle crosses two sides, one pixel each, grey.
+    for (int i = 16; i < 48; ++i) {
+        int column = 0, row = 0;
+        for (int j = 0; j < 64; ++j) {
+            for (auto [x, y, count] : {std::tuple{i, j, &column}, std::tuple{j, i, &row}})
+                if (wire.at(x, y, 0) > 0) {
+                    ++*count;
+                    EXPECT_NEAR(wire.at(x, y, 0), grey, 0.01f) << x << "," << y;
+                }
+        }
+        EXPECT_EQ(column, 2) << "column " << i;
+        EXPECT_EQ(row, 2) << "row " << i;
+    }
 }
 
 TEST(Command, SyntaxErrorNamesFileLineAndColumnAndWritesNothing)
