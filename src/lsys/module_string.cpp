@@ -2,7 +2,15 @@
 // The L-system string: interned module symbols and a compact structure-of-arrays store.
 #include "lsys/module_string.h"
 
+#include <charconv>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <new>
+
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
 
 #include "base/diagnostics.h"
 
@@ -27,6 +35,73 @@ int SymbolTable::find(std::string_view name) const
     return it == m_ids.end() ? -1 : it->second;
 }
 
+namespace detail {
+
+namespace {
+
+#ifdef __linux__
+/// Blocks from this size on are mapped directly (a multiple of the huge page size).
+constexpr std::size_t mapped_block_bytes = std::size_t{4} << 20;
+constexpr std::size_t page_bytes = 4096;
+
+std::size_t mapped_size(std::size_t bytes) { return (bytes + page_bytes - 1) & ~(page_bytes - 1); }
+
+void* map_block(std::size_t bytes)
+{
+    void* block = ::mmap(nullptr, mapped_size(bytes), PROT_READ | PROT_WRITE,
+                         MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (block == MAP_FAILED)
+        throw std::bad_alloc();
+    ::madvise(block, mapped_size(bytes), MADV_HUGEPAGE);  // a hint: failure changes nothing
+    return block;
+}
+#endif
+
+}  // namespace
+
+void* grow_block(void* old, std::size_t old_bytes, std::size_t used, std::size_t new_bytes)
+{
+#ifdef __linux__
+    if (new_bytes >= mapped_block_bytes) {
+        if (old && old_bytes >= mapped_block_bytes) {
+            // The pages move with the mapping: nothing is copied or faulted in again.
+            void* block = ::mremap(old, mapped_size(old_bytes), mapped_size(new_bytes),
+                                   MREMAP_MAYMOVE);
+            if (block == MAP_FAILED)
+                throw std::bad_alloc();
+            ::madvise(block, mapped_size(new_bytes), MADV_HUGEPAGE);
+            return block;
+        }
+        void* block = map_block(new_bytes);
+        if (old) {
+            std::memcpy(block, old, used);
+            std::free(old);
+        }
+        return block;
+    }
+#endif
+    (void)old_bytes;
+    (void)used;
+    void* block = std::realloc(old, new_bytes);
+    if (!block)
+        throw std::bad_alloc();
+    return block;
+}
+
+void free_block(void* block, std::size_t bytes)
+{
+#ifdef __linux__
+    if (bytes >= mapped_block_bytes) {
+        ::munmap(block, mapped_size(bytes));
+        return;
+    }
+#endif
+    (void)bytes;
+    std::free(block);
+}
+
+}  // namespace detail
+
 void ModuleString::reserve(std::size_t modules, std::size_t params)
 {
     if (m_wide)
@@ -47,32 +122,20 @@ void ModuleString::clear()
 
 void ModuleString::widen()
 {
-    m_symbols16.assign(m_symbols8.begin(), m_symbols8.end());
-    m_symbols16.reserve(m_symbols8.capacity());
-    std::vector<std::uint8_t>().swap(m_symbols8);
+    m_symbols16.reserve(std::max(m_symbols8.capacity(), m_symbols8.size() + 1));
+    for (std::uint8_t s : m_symbols8)
+        m_symbols16.push_unchecked(s);
+    m_symbols8 = detail::PodArray<std::uint8_t>();
     m_wide = true;
 }
 
-void ModuleString::append(SymbolId symbol, std::span<const float> params)
+float* ModuleString::append_module_slow(SymbolId symbol, std::size_t count)
 {
-    if (params.size() > max_params)
-        throw Error("a module has " + std::to_string(params.size()) +
+    if (count > max_params)
+        throw Error("a module has " + std::to_string(count) +
                     " parameters; at most 255 are allowed");
-    if (symbol > 0xff && !m_wide)
-        widen();
-    if (m_wide) {
-        make_room(m_symbols16, 1);
-        m_symbols16.push_back(symbol);
-    } else {
-        make_room(m_symbols8, 1);
-        m_symbols8.push_back(static_cast<std::uint8_t>(symbol));
-    }
-    make_room(m_counts, 1);
-    m_counts.push_back(static_cast<std::uint8_t>(params.size()));
-    if (!params.empty()) {
-        make_room(m_params, params.size());
-        m_params.insert(m_params.end(), params.begin(), params.end());
-    }
+    widen();
+    return append_module(symbol, count);
 }
 
 void ModuleString::append(const ModuleString& other)
@@ -89,26 +152,23 @@ void ModuleString::append_range(const ModuleString& other, std::size_t first, st
     if (other.m_wide && !m_wide)
         widen();
     if (m_wide) {
-        make_room(m_symbols16, n);
-        for (std::size_t i = first; i < last; ++i)
-            m_symbols16.push_back(other.symbol(i));
+        m_symbols16.make_room(n);
+        if (other.m_wide)
+            std::memcpy(m_symbols16.extend_unchecked(n), other.m_symbols16.data() + first,
+                        n * sizeof(SymbolId));
+        else
+            for (std::size_t i = first; i < last; ++i)
+                m_symbols16.push_unchecked(other.m_symbols8[i]);
     } else {
-        make_room(m_symbols8, n);
-        m_symbols8.insert(m_symbols8.end(), other.m_symbols8.begin() + static_cast<std::ptrdiff_t>(first),
-                          other.m_symbols8.begin() + static_cast<std::ptrdiff_t>(last));
+        m_symbols8.append(other.m_symbols8.data() + first, other.m_symbols8.data() + last);
     }
-    make_room(m_counts, n);
-    auto counts = other.m_counts.begin();
-    m_counts.insert(m_counts.end(), counts + static_cast<std::ptrdiff_t>(first),
-                    counts + static_cast<std::ptrdiff_t>(last));
+    const std::uint8_t* counts = other.m_counts.data();
+    m_counts.append(counts + first, counts + last);
     std::size_t params = 0;
     for (std::size_t i = first; i < last; ++i)
-        params += other.m_counts[i];
-    if (params) {
-        make_room(m_params, params);
-        auto values = other.m_params.begin() + static_cast<std::ptrdiff_t>(param_offset);
-        m_params.insert(m_params.end(), values, values + static_cast<std::ptrdiff_t>(params));
-    }
+        params += counts[i];
+    const float* values = other.m_params.data() + param_offset;
+    m_params.append(values, values + params);
 }
 
 std::size_t ModuleString::memory_bytes() const
@@ -120,7 +180,7 @@ std::size_t ModuleString::memory_bytes() const
 std::size_t ModuleString::peak_bytes() const
 {
     auto next_block = [](const auto& v, std::size_t extra) -> std::size_t {
-        return v.size() + extra > v.capacity() ? grown_capacity(v, extra) * sizeof(v[0]) : 0;
+        return v.size() + extra > v.capacity() ? v.grown_capacity(extra) * sizeof(v[0]) : 0;
     };
     return memory_bytes() + (m_wide ? next_block(m_symbols16, 1) : next_block(m_symbols8, 1)) +
            next_block(m_counts, 1) + next_block(m_params, max_params);
@@ -145,20 +205,34 @@ void ModuleString::Cursor::prev()
     m_offset -= m_string->m_counts[m_index];
 }
 
+char* format_parameter(char* out, float value)
+{
+    char* end = out + max_parameter_chars;
+    // Whole numbers below 10^6 are what %g prints them as: their digits (and "-0").
+    if (std::abs(value) < 1e6f && value == std::trunc(value)) {
+        if (std::signbit(value))
+            *out++ = '-';
+        return std::to_chars(out, end, static_cast<long>(std::abs(value))).ptr;
+    }
+    if (!std::isfinite(value))
+        return out + std::snprintf(out, max_parameter_chars, "%g", static_cast<double>(value));
+    // The precision overload is specified as printf's %.6g, which is %g.
+    return std::to_chars(out, end, static_cast<double>(value), std::chars_format::general, 6).ptr;
+}
+
 std::string to_text(const ModuleString& s, const SymbolTable& symbols)
 {
     std::string out;
-    char buf[64];
+    char buf[max_parameter_chars];
     s.for_each([&](ModuleRef m) {
         out += symbols.name(m.symbol);
         if (m.params.empty())
             return;
         out += '(';
         for (std::size_t i = 0; i < m.params.size(); ++i) {
-            std::snprintf(buf, sizeof buf, "%g", static_cast<double>(m.params[i]));
             if (i)
                 out += ',';
-            out += buf;
+            out.append(buf, format_parameter(buf, m.params[i]));
         }
         out += ')';
     });
