@@ -146,6 +146,15 @@ void ModuleString::append(const ModuleString& other)
 void ModuleString::append_range(const ModuleString& other, std::size_t first, std::size_t last,
                                 std::size_t param_offset)
 {
+    std::size_t params = 0;
+    for (std::size_t i = first; i < last; ++i)
+        params += other.m_counts[i];
+    append_range(other, first, last, param_offset, params);
+}
+
+void ModuleString::append_range(const ModuleString& other, std::size_t first, std::size_t last,
+                                std::size_t param_offset, std::size_t params)
+{
     if (first >= last)
         return;
     std::size_t n = last - first;
@@ -164,9 +173,6 @@ void ModuleString::append_range(const ModuleString& other, std::size_t first, st
     }
     const std::uint8_t* counts = other.m_counts.data();
     m_counts.append(counts + first, counts + last);
-    std::size_t params = 0;
-    for (std::size_t i = first; i < last; ++i)
-        params += counts[i];
     const float* values = other.m_params.data() + param_offset;
     m_params.append(values, values + params);
 }

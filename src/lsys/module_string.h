@@ -206,6 +206,9 @@ public:
     /// Appends modules [first, last) of `other`, whose parameters start at `param_offset`.
     void append_range(const ModuleString& other, std::size_t first, std::size_t last,
                       std::size_t param_offset);
+    /// The same when the caller knows that those modules have `param_count` parameters.
+    void append_range(const ModuleString& other, std::size_t first, std::size_t last,
+                      std::size_t param_offset, std::size_t param_count);
 
     std::size_t size() const { return m_counts.size(); }
     bool empty() const { return m_counts.empty(); }
