@@ -674,18 +674,20 @@ void Deriver::run_post_block(const Production& p)
 void Deriver::produce(const Production& p, ModuleString& dst)
 {
     in_production(p);
-    if (p.constant_successor) {
-        dst.append(*p.constant_successor);
+    std::size_t first = dst.param_total();
+    dst.append(p.successor_prototype);
+    if (p.computed_params.empty())
         return;
-    }
-    for (const auto& m : p.successor)
-        append_evaluated(m, dst);
+    // Evaluated straight into the string (expressions never read it; a failure ends the
+    // step, whose string is unfinished anyway), in the successor's order.
+    float* values = dst.mutable_params().data() + first;
+    for (const ComputedParam& c : p.computed_params)
+        values[c.index] = static_cast<float>(
+            evaluate(p.successor[c.module].params[c.param], m_frame, m_runtime));
 }
 
 void Deriver::append_evaluated(const ModuleTemplate& m, ModuleString& dst)
 {
-    // Evaluated straight into the string (expressions never read it; a failure ends the
-    // step, whose string is unfinished anyway).
     float* values = dst.append_module(m.symbol, m.params.size());
     for (std::size_t j = 0; j < m.params.size(); ++j)
         values[j] = static_cast<float>(evaluate(m.params[j], m_frame, m_runtime));

@@ -2,6 +2,7 @@
 // The L-system string: interned module symbols and a compact structure-of-arrays store.
 #include "lsys/module_string.h"
 
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -211,17 +212,83 @@ void ModuleString::Cursor::prev()
     m_offset -= m_string->m_counts[m_index];
 }
 
+namespace {
+
+/// 10^k for k = 0 .. 12, all exact in a double.
+constexpr std::array<double, 13> powers_of_ten = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6,
+                                                  1e7, 1e8, 1e9, 1e10, 1e11, 1e12};
+
+/// %g of a float from 10^-4 up to 10^6 that is not whole: six significant digits in fixed
+/// notation without trailing zeros. A float times 10^k (k <= 12) is exact in a double
+/// (24 + 28 bits), so rounding it to an integer rounds the exact value, half to even,
+/// as printf does. Returns nullptr where %g would write an exponent instead.
+char* format_fixed(char* out, double magnitude)
+{
+    // the power of ten of the leading digit: 10^e <= magnitude < 10^(e+1)
+    int e = magnitude >= 1 ? (magnitude >= 1e3 ? (magnitude >= 1e4 ? (magnitude >= 1e5 ? 5 : 4) : 3)
+                                               : (magnitude >= 1e2 ? 2 : magnitude >= 1e1 ? 1 : 0))
+                           : -1;
+    double scaled = magnitude * powers_of_ten[static_cast<std::size_t>(5 - e)];
+    while (scaled < 1e5 && e > -4) {  // below 1, the exact comparison is on the scaled value
+        --e;
+        scaled = magnitude * powers_of_ten[static_cast<std::size_t>(5 - e)];
+    }
+    if (scaled < 1e5)
+        return nullptr;  // below 10^-4
+    auto digits = static_cast<std::uint32_t>(std::nearbyint(scaled));
+    if (digits >= 1000000) {  // rounded up into the next power of ten
+        digits /= 10;
+        if (++e >= 6)
+            return nullptr;
+    }
+    char text[6];
+    for (int k = 5; k >= 0; --k, digits /= 10)
+        text[k] = static_cast<char>('0' + digits % 10);
+    int length = 6;
+    while (length > 0 && text[length - 1] == '0')
+        --length;
+    if (e >= 0) {
+        int whole = e + 1;
+        for (int k = 0; k < whole; ++k)
+            *out++ = text[k];
+        if (length > whole) {
+            *out++ = '.';
+            for (int k = whole; k < length; ++k)
+                *out++ = text[k];
+        }
+        return out;
+    }
+    *out++ = '0';
+    *out++ = '.';
+    for (int k = -1; k > e; --k)
+        *out++ = '0';
+    for (int k = 0; k < length; ++k)
+        *out++ = text[k];
+    return out;
+}
+
+}  // namespace
+
 char* format_parameter(char* out, float value)
 {
     char* end = out + max_parameter_chars;
+    const float magnitude = std::abs(value);
     // Whole numbers below 10^6 are what %g prints them as: their digits (and "-0").
-    if (std::abs(value) < 1e6f && value == std::trunc(value)) {
+    if (magnitude < 1e6f && value == std::trunc(value)) {
         if (std::signbit(value))
             *out++ = '-';
-        return std::to_chars(out, end, static_cast<long>(std::abs(value))).ptr;
+        return std::to_chars(out, end, static_cast<long>(magnitude)).ptr;
     }
     if (!std::isfinite(value))
         return out + std::snprintf(out, max_parameter_chars, "%g", static_cast<double>(value));
+    if (magnitude >= 1e-4f && magnitude < 1e6f) {
+        bool negative = std::signbit(value);
+        if (char* fixed = format_fixed(negative ? out + 1 : out, static_cast<double>(magnitude))) {
+            if (negative)
+                *out = '-';
+            return fixed;
+        }
+    }
     // The precision overload is specified as printf's %.6g, which is %g.
     return std::to_chars(out, end, static_cast<double>(value), std::chars_format::general, 6).ptr;
 }

@@ -68,8 +68,13 @@ TEST(StringIo, ParametersArePrintedAsPrintfPercentGPrintsThem)
         float v;
         std::memcpy(&v, &bits, sizeof v);
         ASSERT_EQ(formatted(v), printf_g(v)) << "bits " << bits;
-        float fraction = static_cast<float>(i % 20000) / 64.0f - 100.0f;
+        float fraction = static_cast<float>(i % 20000) / 64.0f - 100.0f;  // exact ties
         ASSERT_EQ(formatted(fraction), printf_g(fraction));
+        // floats from 10^-5 to 10^7, where most parameters lie
+        std::uint32_t near = 0x37000000u + bits % (0x4b000000u - 0x37000000u);
+        std::memcpy(&v, &near, sizeof v);
+        ASSERT_EQ(formatted(v), printf_g(v)) << "bits " << near;
+        ASSERT_EQ(formatted(-v), printf_g(-v)) << "bits " << near;
     }
 }
 
