@@ -41,59 +41,58 @@ namespace detail {
 namespace {
 
 #ifdef __linux__
-/// Blocks from this size on are mapped directly (a multiple of the huge page size).
-constexpr std::size_t mapped_block_bytes = std::size_t{4} << 20;
-constexpr std::size_t page_bytes = 4096;
+/// Blocks from this size on are mapped directly, in whole huge pages.
+constexpr std::size_t huge_page_bytes = std::size_t{2} << 20;
 
-std::size_t mapped_size(std::size_t bytes) { return (bytes + page_bytes - 1) & ~(page_bytes - 1); }
-
-void* map_block(std::size_t bytes)
+std::size_t mapped_size(std::size_t bytes)
 {
-    void* block = ::mmap(nullptr, mapped_size(bytes), PROT_READ | PROT_WRITE,
-                         MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-    if (block == MAP_FAILED)
-        throw std::bad_alloc();
-    ::madvise(block, mapped_size(bytes), MADV_HUGEPAGE);  // a hint: failure changes nothing
-    return block;
+    return (bytes + huge_page_bytes - 1) & ~(huge_page_bytes - 1);
 }
 #endif
 
 }  // namespace
 
-void* grow_block(void* old, std::size_t old_bytes, std::size_t used, std::size_t new_bytes)
+std::size_t grow_block(void*& block, std::size_t old_bytes, std::size_t used,
+                       std::size_t new_bytes)
 {
 #ifdef __linux__
-    if (new_bytes >= mapped_block_bytes) {
-        if (old && old_bytes >= mapped_block_bytes) {
+    if (new_bytes >= huge_page_bytes) {
+        std::size_t size = mapped_size(new_bytes);
+        void* grown = nullptr;
+        if (block && old_bytes >= huge_page_bytes) {
             // The pages move with the mapping: nothing is copied or faulted in again.
-            void* block = ::mremap(old, mapped_size(old_bytes), mapped_size(new_bytes),
-                                   MREMAP_MAYMOVE);
-            if (block == MAP_FAILED)
+            grown = ::mremap(block, old_bytes, size, MREMAP_MAYMOVE);
+            if (grown == MAP_FAILED)
                 throw std::bad_alloc();
-            ::madvise(block, mapped_size(new_bytes), MADV_HUGEPAGE);
-            return block;
+        } else {
+            grown = ::mmap(nullptr, size, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS,
+                           -1, 0);
+            if (grown == MAP_FAILED)
+                throw std::bad_alloc();
+            if (block) {
+                std::memcpy(grown, block, used);
+                std::free(block);
+            }
         }
-        void* block = map_block(new_bytes);
-        if (old) {
-            std::memcpy(block, old, used);
-            std::free(old);
-        }
-        return block;
+        ::madvise(grown, size, MADV_HUGEPAGE);  // a hint: failure changes nothing
+        block = grown;
+        return size;
     }
 #endif
     (void)old_bytes;
     (void)used;
-    void* block = std::realloc(old, new_bytes);
-    if (!block)
+    void* grown = std::realloc(block, new_bytes);
+    if (!grown)
         throw std::bad_alloc();
-    return block;
+    block = grown;
+    return new_bytes;
 }
 
 void free_block(void* block, std::size_t bytes)
 {
 #ifdef __linux__
-    if (bytes >= mapped_block_bytes) {
-        ::munmap(block, mapped_size(bytes));
+    if (bytes >= huge_page_bytes) {
+        ::munmap(block, bytes);
         return;
     }
 #endif
@@ -176,21 +175,6 @@ void ModuleString::append_range(const ModuleString& other, std::size_t first, st
     m_counts.append(counts + first, counts + last);
     const float* values = other.m_params.data() + param_offset;
     m_params.append(values, values + params);
-}
-
-std::size_t ModuleString::memory_bytes() const
-{
-    return m_symbols8.capacity() + m_symbols16.capacity() * sizeof(SymbolId) +
-           m_counts.capacity() + m_params.capacity() * sizeof(float);
-}
-
-std::size_t ModuleString::peak_bytes() const
-{
-    auto next_block = [](const auto& v, std::size_t extra) -> std::size_t {
-        return v.size() + extra > v.capacity() ? v.grown_capacity(extra) * sizeof(v[0]) : 0;
-    };
-    return memory_bytes() + (m_wide ? next_block(m_symbols16, 1) : next_block(m_symbols8, 1)) +
-           next_block(m_counts, 1) + next_block(m_params, max_params);
 }
 
 ModuleRef ModuleString::Cursor::operator*() const

@@ -35,11 +35,13 @@ private:
 
 namespace detail {
 
-/// Blocks for PodArray: small ones from malloc; large ones (Linux) mapped directly, so
-/// that growing one remaps its pages instead of copying them, and asked for transparent
-/// huge pages (a derivation touches hundreds of megabytes; 4 KiB page faults were a
-/// third of its time). `used` bytes of `old` (of `old_bytes`) are kept.
-void* grow_block(void* old, std::size_t old_bytes, std::size_t used, std::size_t new_bytes);
+/// Blocks for PodArray: small ones from malloc; large ones (Linux) mapped directly in
+/// whole huge pages, so that growing one remaps its pages instead of copying them, and
+/// asked for transparent huge pages (a derivation touches hundreds of megabytes; 4 KiB
+/// page faults were a third of its time). Replaces `block` (of `old_bytes`, `used` of
+/// them kept) by one of at least `new_bytes` and returns its size.
+std::size_t grow_block(void*& block, std::size_t old_bytes, std::size_t used,
+                       std::size_t new_bytes);
 void free_block(void* block, std::size_t bytes);
 
 /// A growable array of trivially copyable values. Unlike std::vector, growing keeps the
@@ -142,9 +144,11 @@ public:
 private:
     void regrow(std::size_t capacity)
     {
-        m_data = static_cast<T*>(grow_block(m_data, m_capacity * sizeof(T), m_size * sizeof(T),
-                                            capacity * sizeof(T)));
-        m_capacity = capacity;
+        void* block = m_data;
+        std::size_t bytes =
+            grow_block(block, m_capacity * sizeof(T), m_size * sizeof(T), capacity * sizeof(T));
+        m_data = static_cast<T*>(block);
+        m_capacity = bytes / sizeof(T);
     }
     void release()
     {
@@ -224,10 +228,22 @@ public:
     /// The symbols of all modules while every id fits in a byte, else nullptr.
     const std::uint8_t* narrow_symbol_data() const { return m_wide ? nullptr : m_symbols8.data(); }
     /// Bytes held by the string's arrays (for memory reports).
-    std::size_t memory_bytes() const;
+    std::size_t memory_bytes() const
+    {
+        return m_symbols8.capacity() + m_symbols16.capacity() * sizeof(SymbolId) +
+               m_counts.capacity() + m_params.capacity() * sizeof(float);
+    }
     /// memory_bytes() plus the block that appending one more module would allocate
     /// while the full one is still held: what the string takes at its next peak.
-    std::size_t peak_bytes() const;
+    std::size_t peak_bytes() const
+    {
+        auto next_block = [](const auto& v, std::size_t extra) -> std::size_t {
+            return v.size() + extra > v.capacity() ? v.grown_capacity(extra) * sizeof(v[0]) : 0;
+        };
+        return memory_bytes() +
+               (m_wide ? next_block(m_symbols16, 1) : next_block(m_symbols8, 1)) +
+               next_block(m_counts, 1) + next_block(m_params, max_params);
+    }
 
     /// A position in the string that knows where its module's parameters start.
     class Cursor {
