@@ -44,6 +44,21 @@ fs::path lsystem_file(const fs::path& folder)
     return {};
 }
 
+double seconds(const timeval& t) { return double(t.tv_sec) + double(t.tv_usec) * 1e-6; }
+
+/// CPU time (user + system) of this process so far, in seconds, and its minor page faults.
+struct CpuMark {
+    double cpu_s = 0;
+    long faults = 0;
+};
+
+CpuMark cpu_mark()
+{
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return {seconds(usage.ru_utime) + seconds(usage.ru_stime), usage.ru_minflt};
+}
+
 double peak_rss_mb()
 {
     rusage usage{};
@@ -69,26 +84,35 @@ int run_one(const std::string& model)
     }
     try {
         auto t0 = clock::now();
+        CpuMark c0 = cpu_mark();
         cambium::lsys::LSystem ls = cambium::lsys::LSystem::load(file);
         auto t1 = clock::now();
+        CpuMark c1 = cpu_mark();
         cambium::lsys::ModuleString s = ls.derive();
         auto t2 = clock::now();
+        CpuMark c2 = cpu_mark();
         double derive_peak = peak_rss_mb();
         // cpfg's -str text output of the same string, written to a sink (no disk)
         NullBuffer sink;
         std::ostream null_stream(&sink);
         auto t3 = clock::now();
+        CpuMark c3 = cpu_mark();
         cambium::lsys::write_string_text(s, ls.symbols(), null_stream);
         auto t4 = clock::now();
+        CpuMark c4 = cpu_mark();
         double load_s = std::chrono::duration<double>(t1 - t0).count();
         double derive_s = std::chrono::duration<double>(t2 - t1).count();
         double str_s = std::chrono::duration<double>(t4 - t3).count();
         double wall_s = load_s + derive_s;
         std::printf("{\"model\":\"%s\",\"modules\":%zu,\"wall_s\":%.3f,\"load_s\":%.3f,"
                     "\"derive_s\":%.3f,\"modules_per_s\":%.0f,\"peak_rss_mb\":%.1f,"
-                    "\"str_text_s\":%.3f,\"peak_rss_after_str_mb\":%.1f}\n",
+                    "\"str_text_s\":%.3f,\"peak_rss_after_str_mb\":%.1f,"
+                    "\"load_cpu_s\":%.3f,\"derive_cpu_s\":%.3f,\"str_text_cpu_s\":%.3f,"
+                    "\"derive_page_faults\":%ld}\n",
                     model.c_str(), s.size(), wall_s, load_s, derive_s,
-                    static_cast<double>(s.size()) / derive_s, derive_peak, str_s, peak_rss_mb());
+                    static_cast<double>(s.size()) / derive_s, derive_peak, str_s, peak_rss_mb(),
+                    c1.cpu_s - c0.cpu_s, c2.cpu_s - c1.cpu_s, c4.cpu_s - c3.cpu_s,
+                    c2.faults - c1.faults);
     } catch (const std::exception& e) {
         std::printf("{\"model\":\"%s\",\"error\":\"%s\"}\n", model.c_str(), e.what());
         return 1;
@@ -111,8 +135,6 @@ int run_child(const char* self, const std::string& model)
     waitpid(pid, &status, 0);
     return WIFEXITED(status) ? WEXITSTATUS(status) : 1;
 }
-
-double seconds(const timeval& t) { return double(t.tv_sec) + double(t.tv_usec) * 1e-6; }
 
 /// Runs the cambium command at `cambium` on a bench model with `output_option` (-str or
 /// -vv) into a scratch file, and prints its wall time, CPU time and peak RSS.

@@ -60,6 +60,16 @@ Deriver::Deriver(const Program& program, DeriveLimits limits)
             ignored[s] = 0;
         m_ignored.push_back(std::move(ignored));
     }
+    // Which symbols each L-system's productions and decomposition leave as they are
+    // (every id a byte can hold has an entry, so a narrow string is looked up unchecked)
+    for (const auto& ls : program.lsystems)
+        for (bool decomposition : {false, true}) {
+            std::vector<char> copied(std::max<std::size_t>(symbols.size(), 256), 0);
+            for (std::size_t sym = 0; sym < symbols.size(); ++sym)
+                copied[sym] = never_rewritten(decomposition ? ls.decomposition : ls.productions,
+                                              static_cast<int>(sym), decomposition);
+            m_copied.push_back(std::move(copied));
+        }
     int frame = 0;
     for (const auto& ls : program.lsystems)
         for (const ProductionSet* set : {&ls.productions, &ls.decomposition, &ls.homomorphism})
@@ -337,18 +347,19 @@ std::size_t Deriver::rewrite(const Indexed& src, ModuleString& dst, bool decompo
         const ProductionSet& set = decomposition ? ls.decomposition : ls.productions;
         bool stochastic = ls.seed && !decomposition;
         // Copy a run of modules that nothing can rewrite in one go
-        std::size_t run = i;
-        std::size_t run_params = 0;
-        while (run < s.size() && never_rewritten(set, s.symbol(run), decomposition)) {
-            run_params += s.param_count(run);
-            ++run;
-        }
+        const std::vector<char>& copied =
+            m_copied[2 * static_cast<std::size_t>(m_lsystem_stack.back()) + (decomposition ? 1 : 0)];
+        std::size_t run = run_end(s, i, copied);
         if (run > i) {
             if (stochastic)
                 for (std::size_t k = i; k < run; ++k)
                     m_stochastic.next_double();  // cpfg draws for every module
             std::size_t first_new = dst.size();
-            dst.append_range(s, i, run, offset);
+            std::size_t run_params = 0;
+            const std::uint8_t* counts = s.count_data();
+            for (std::size_t k = i; k < run; ++k)
+                run_params += counts[k];
+            dst.append_range(s, i, run, offset, run_params);
             record(i, first_new, true);
             offset += run_params;
             i = run;
@@ -381,6 +392,20 @@ std::size_t Deriver::rewrite(const Indexed& src, ModuleString& dst, bool decompo
         check_size(dst);
     }
     return applied;
+}
+
+std::size_t Deriver::run_end(const ModuleString& s, std::size_t i,
+                             const std::vector<char>& copied)
+{
+    std::size_t n = s.size();
+    if (const std::uint8_t* symbols = s.narrow_symbol_data()) {
+        while (i < n && copied[symbols[i]])
+            ++i;
+        return i;
+    }
+    while (i < n && s.symbol(i) < copied.size() && copied[s.symbol(i)])
+        ++i;
+    return i;
 }
 
 bool Deriver::never_rewritten(const ProductionSet& set, int sym, bool decomposition) const
@@ -649,20 +674,23 @@ void Deriver::run_post_block(const Production& p)
 void Deriver::produce(const Production& p, ModuleString& dst)
 {
     in_production(p);
-    if (p.constant_successor) {
-        dst.append(*p.constant_successor);
+    std::size_t first = dst.param_total();
+    dst.append(p.successor_prototype);
+    if (p.computed_params.empty())
         return;
-    }
-    for (const auto& m : p.successor)
-        append_evaluated(m, dst);
+    // Evaluated straight into the string (expressions never read it; a failure ends the
+    // step, whose string is unfinished anyway), in the successor's order.
+    float* values = dst.mutable_params().data() + first;
+    for (const ComputedParam& c : p.computed_params)
+        values[c.index] = static_cast<float>(
+            evaluate(p.successor[c.module].params[c.param], m_frame, m_runtime));
 }
 
 void Deriver::append_evaluated(const ModuleTemplate& m, ModuleString& dst)
 {
-    std::array<float, ModuleString::max_params> values;
+    float* values = dst.append_module(m.symbol, m.params.size());
     for (std::size_t j = 0; j < m.params.size(); ++j)
         values[j] = static_cast<float>(evaluate(m.params[j], m_frame, m_runtime));
-    dst.append(m.symbol, std::span<const float>(values.data(), m.params.size()));
 }
 
 

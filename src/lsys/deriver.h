@@ -118,6 +118,12 @@ private:
     /// Whether no production of `set` can rewrite `sym` (runs of such modules are copied
     /// in bulk).
     bool never_rewritten(const ProductionSet& set, int sym, bool decomposition) const;
+    /// never_rewritten for each symbol: by L-system, then productions (0) or
+    /// decomposition (1)
+    std::vector<std::vector<char>> m_copied;
+    /// The end of the run of modules from `i` on that `copied` says are copied as they are.
+    static std::size_t run_end(const ModuleString& s, std::size_t i,
+                               const std::vector<char>& copied);
     const Production* find_homomorphism(const ProductionSet& set, const LSystemDefinition& ls,
                                         const ModuleString& s, std::size_t k,
                                         std::size_t offset, const Indexed& ctx,

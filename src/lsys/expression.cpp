@@ -734,7 +734,7 @@ double run(const Code& code, std::span<double> frame, Runtime& rt, std::size_t& 
 
 }  // namespace
 
-double evaluate(const Code& code, std::span<double> frame, Runtime& rt)
+double evaluate_code(const Code& code, std::span<double> frame, Runtime& rt)
 {
     std::size_t pc = 0;
     try {

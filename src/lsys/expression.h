@@ -147,9 +147,23 @@ private:
     int m_site;
 };
 
+/// evaluate() for code that is more than a constant or a variable.
+double evaluate_code(const Code& code, std::span<double> frame, Runtime& runtime);
+
 /// Runs `code` with the given local frame. Returns the value left on top of the stack
-/// (0 for statement code).
-double evaluate(const Code& code, std::span<double> frame, Runtime& runtime);
+/// (0 for statement code). Most successor parameters are a constant or a formal
+/// parameter: those are read here without entering the interpreter.
+inline double evaluate(const Code& code, std::span<double> frame, Runtime& runtime)
+{
+    if (code.instrs.size() == 1) {
+        const Instr& in = code.instrs.front();
+        if (in.op == Op::Const)
+            return in.value;
+        if (in.op == Op::LoadLocal)
+            return frame[static_cast<std::size_t>(in.arg)];
+    }
+    return evaluate_code(code, frame, runtime);
+}
 
 /// A printf, fprintf or fscanf format checked when the L-system is compiled (formats are
 /// always literals). printf formats allow only %[flags][width][.precision] followed by

@@ -2,7 +2,16 @@
 // The L-system string: interned module symbols and a compact structure-of-arrays store.
 #include "lsys/module_string.h"
 
+#include <array>
+#include <charconv>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <new>
+
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
 
 #include "base/diagnostics.h"
 
@@ -27,6 +36,72 @@ int SymbolTable::find(std::string_view name) const
     return it == m_ids.end() ? -1 : it->second;
 }
 
+namespace detail {
+
+namespace {
+
+#ifdef __linux__
+/// Blocks from this size on are mapped directly, in whole huge pages.
+constexpr std::size_t huge_page_bytes = std::size_t{2} << 20;
+
+std::size_t mapped_size(std::size_t bytes)
+{
+    return (bytes + huge_page_bytes - 1) & ~(huge_page_bytes - 1);
+}
+#endif
+
+}  // namespace
+
+std::size_t grow_block(void*& block, std::size_t old_bytes, std::size_t used,
+                       std::size_t new_bytes)
+{
+#ifdef __linux__
+    if (new_bytes >= huge_page_bytes) {
+        std::size_t size = mapped_size(new_bytes);
+        void* grown = nullptr;
+        if (block && old_bytes >= huge_page_bytes) {
+            // The pages move with the mapping: nothing is copied or faulted in again.
+            grown = ::mremap(block, old_bytes, size, MREMAP_MAYMOVE);
+            if (grown == MAP_FAILED)
+                throw std::bad_alloc();
+        } else {
+            grown = ::mmap(nullptr, size, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS,
+                           -1, 0);
+            if (grown == MAP_FAILED)
+                throw std::bad_alloc();
+            if (block) {
+                std::memcpy(grown, block, used);
+                std::free(block);
+            }
+        }
+        ::madvise(grown, size, MADV_HUGEPAGE);  // a hint: failure changes nothing
+        block = grown;
+        return size;
+    }
+#endif
+    (void)old_bytes;
+    (void)used;
+    void* grown = std::realloc(block, new_bytes);
+    if (!grown)
+        throw std::bad_alloc();
+    block = grown;
+    return new_bytes;
+}
+
+void free_block(void* block, std::size_t bytes)
+{
+#ifdef __linux__
+    if (bytes >= huge_page_bytes) {
+        ::munmap(block, bytes);
+        return;
+    }
+#endif
+    (void)bytes;
+    std::free(block);
+}
+
+}  // namespace detail
+
 void ModuleString::reserve(std::size_t modules, std::size_t params)
 {
     if (m_wide)
@@ -47,32 +122,20 @@ void ModuleString::clear()
 
 void ModuleString::widen()
 {
-    m_symbols16.assign(m_symbols8.begin(), m_symbols8.end());
-    m_symbols16.reserve(m_symbols8.capacity());
-    std::vector<std::uint8_t>().swap(m_symbols8);
+    m_symbols16.reserve(std::max(m_symbols8.capacity(), m_symbols8.size() + 1));
+    for (std::uint8_t s : m_symbols8)
+        m_symbols16.push_unchecked(s);
+    m_symbols8 = detail::PodArray<std::uint8_t>();
     m_wide = true;
 }
 
-void ModuleString::append(SymbolId symbol, std::span<const float> params)
+float* ModuleString::append_module_slow(SymbolId symbol, std::size_t count)
 {
-    if (params.size() > max_params)
-        throw Error("a module has " + std::to_string(params.size()) +
+    if (count > max_params)
+        throw Error("a module has " + std::to_string(count) +
                     " parameters; at most 255 are allowed");
-    if (symbol > 0xff && !m_wide)
-        widen();
-    if (m_wide) {
-        make_room(m_symbols16, 1);
-        m_symbols16.push_back(symbol);
-    } else {
-        make_room(m_symbols8, 1);
-        m_symbols8.push_back(static_cast<std::uint8_t>(symbol));
-    }
-    make_room(m_counts, 1);
-    m_counts.push_back(static_cast<std::uint8_t>(params.size()));
-    if (!params.empty()) {
-        make_room(m_params, params.size());
-        m_params.insert(m_params.end(), params.begin(), params.end());
-    }
+    widen();
+    return append_module(symbol, count);
 }
 
 void ModuleString::append(const ModuleString& other)
@@ -83,47 +146,35 @@ void ModuleString::append(const ModuleString& other)
 void ModuleString::append_range(const ModuleString& other, std::size_t first, std::size_t last,
                                 std::size_t param_offset)
 {
+    std::size_t params = 0;
+    for (std::size_t i = first; i < last; ++i)
+        params += other.m_counts[i];
+    append_range(other, first, last, param_offset, params);
+}
+
+void ModuleString::append_range(const ModuleString& other, std::size_t first, std::size_t last,
+                                std::size_t param_offset, std::size_t params)
+{
     if (first >= last)
         return;
     std::size_t n = last - first;
     if (other.m_wide && !m_wide)
         widen();
     if (m_wide) {
-        make_room(m_symbols16, n);
-        for (std::size_t i = first; i < last; ++i)
-            m_symbols16.push_back(other.symbol(i));
+        m_symbols16.make_room(n);
+        if (other.m_wide)
+            std::memcpy(m_symbols16.extend_unchecked(n), other.m_symbols16.data() + first,
+                        n * sizeof(SymbolId));
+        else
+            for (std::size_t i = first; i < last; ++i)
+                m_symbols16.push_unchecked(other.m_symbols8[i]);
     } else {
-        make_room(m_symbols8, n);
-        m_symbols8.insert(m_symbols8.end(), other.m_symbols8.begin() + static_cast<std::ptrdiff_t>(first),
-                          other.m_symbols8.begin() + static_cast<std::ptrdiff_t>(last));
+        m_symbols8.append(other.m_symbols8.data() + first, other.m_symbols8.data() + last);
     }
-    make_room(m_counts, n);
-    auto counts = other.m_counts.begin();
-    m_counts.insert(m_counts.end(), counts + static_cast<std::ptrdiff_t>(first),
-                    counts + static_cast<std::ptrdiff_t>(last));
-    std::size_t params = 0;
-    for (std::size_t i = first; i < last; ++i)
-        params += other.m_counts[i];
-    if (params) {
-        make_room(m_params, params);
-        auto values = other.m_params.begin() + static_cast<std::ptrdiff_t>(param_offset);
-        m_params.insert(m_params.end(), values, values + static_cast<std::ptrdiff_t>(params));
-    }
-}
-
-std::size_t ModuleString::memory_bytes() const
-{
-    return m_symbols8.capacity() + m_symbols16.capacity() * sizeof(SymbolId) +
-           m_counts.capacity() + m_params.capacity() * sizeof(float);
-}
-
-std::size_t ModuleString::peak_bytes() const
-{
-    auto next_block = [](const auto& v, std::size_t extra) -> std::size_t {
-        return v.size() + extra > v.capacity() ? grown_capacity(v, extra) * sizeof(v[0]) : 0;
-    };
-    return memory_bytes() + (m_wide ? next_block(m_symbols16, 1) : next_block(m_symbols8, 1)) +
-           next_block(m_counts, 1) + next_block(m_params, max_params);
+    const std::uint8_t* counts = other.m_counts.data();
+    m_counts.append(counts + first, counts + last);
+    const float* values = other.m_params.data() + param_offset;
+    m_params.append(values, values + params);
 }
 
 ModuleRef ModuleString::Cursor::operator*() const
@@ -145,20 +196,100 @@ void ModuleString::Cursor::prev()
     m_offset -= m_string->m_counts[m_index];
 }
 
+namespace {
+
+/// 10^k for k = 0 .. 12, all exact in a double.
+constexpr std::array<double, 13> powers_of_ten = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6,
+                                                  1e7, 1e8, 1e9, 1e10, 1e11, 1e12};
+
+/// %g of a float from 10^-4 up to 10^6 that is not whole: six significant digits in fixed
+/// notation without trailing zeros. A float times 10^k (k <= 12) is exact in a double
+/// (24 + 28 bits), so rounding it to an integer rounds the exact value, half to even,
+/// as printf does. Returns nullptr where %g would write an exponent instead.
+char* format_fixed(char* out, double magnitude)
+{
+    // the power of ten of the leading digit: 10^e <= magnitude < 10^(e+1)
+    int e = magnitude >= 1 ? (magnitude >= 1e3 ? (magnitude >= 1e4 ? (magnitude >= 1e5 ? 5 : 4) : 3)
+                                               : (magnitude >= 1e2 ? 2 : magnitude >= 1e1 ? 1 : 0))
+                           : -1;
+    double scaled = magnitude * powers_of_ten[static_cast<std::size_t>(5 - e)];
+    while (scaled < 1e5 && e > -4) {  // below 1, the exact comparison is on the scaled value
+        --e;
+        scaled = magnitude * powers_of_ten[static_cast<std::size_t>(5 - e)];
+    }
+    if (scaled < 1e5)
+        return nullptr;  // below 10^-4
+    auto digits = static_cast<std::uint32_t>(std::nearbyint(scaled));
+    if (digits >= 1000000) {  // rounded up into the next power of ten
+        digits /= 10;
+        if (++e >= 6)
+            return nullptr;
+    }
+    char text[6];
+    for (int k = 5; k >= 0; --k, digits /= 10)
+        text[k] = static_cast<char>('0' + digits % 10);
+    int length = 6;
+    while (length > 0 && text[length - 1] == '0')
+        --length;
+    if (e >= 0) {
+        int whole = e + 1;
+        for (int k = 0; k < whole; ++k)
+            *out++ = text[k];
+        if (length > whole) {
+            *out++ = '.';
+            for (int k = whole; k < length; ++k)
+                *out++ = text[k];
+        }
+        return out;
+    }
+    *out++ = '0';
+    *out++ = '.';
+    for (int k = -1; k > e; --k)
+        *out++ = '0';
+    for (int k = 0; k < length; ++k)
+        *out++ = text[k];
+    return out;
+}
+
+}  // namespace
+
+char* format_parameter(char* out, float value)
+{
+    char* end = out + max_parameter_chars;
+    const float magnitude = std::abs(value);
+    // Whole numbers below 10^6 are what %g prints them as: their digits (and "-0").
+    if (magnitude < 1e6f && value == std::trunc(value)) {
+        if (std::signbit(value))
+            *out++ = '-';
+        return std::to_chars(out, end, static_cast<long>(magnitude)).ptr;
+    }
+    if (!std::isfinite(value))
+        return out + std::snprintf(out, max_parameter_chars, "%g", static_cast<double>(value));
+    if (magnitude >= 1e-4f && magnitude < 1e6f) {
+        bool negative = std::signbit(value);
+        if (char* fixed = format_fixed(negative ? out + 1 : out, static_cast<double>(magnitude))) {
+            if (negative)
+                *out = '-';
+            return fixed;
+        }
+    }
+    // The precision overload is specified as printf's %.6g, which is %g.
+    return std::to_chars(out, end, static_cast<double>(value), std::chars_format::general, 6).ptr;
+}
+
 std::string to_text(const ModuleString& s, const SymbolTable& symbols)
 {
     std::string out;
-    char buf[64];
+    char buf[max_parameter_chars];
     s.for_each([&](ModuleRef m) {
         out += symbols.name(m.symbol);
         if (m.params.empty())
             return;
         out += '(';
         for (std::size_t i = 0; i < m.params.size(); ++i) {
-            std::snprintf(buf, sizeof buf, "%g", static_cast<double>(m.params[i]));
             if (i)
                 out += ',';
-            out += buf;
+            out.append(buf, format_parameter(buf, m.params[i]));
         }
         out += ')';
     });

@@ -2,6 +2,7 @@
 // Recursive-descent parser of preprocessed cpfg L-system text into a compiled Program.
 #include "lsys/parser.h"
 
+#include <array>
 #include <cstdlib>
 #include <functional>
 #include <optional>
@@ -116,7 +117,6 @@ private:
     FormalModule parse_formal_module(const Token& symbol);
     void parse_conditional(Production& p);
     void parse_successor(Production& p);
-    void build_constant_successor(Production& p);
     std::vector<ModuleTemplate> parse_modules(bool stop_at_colon);
     ModuleTemplate parse_module(const Token& symbol);
 
@@ -603,24 +603,12 @@ void Parser::parse_production(ProductionSet& set)
     p.text = one_line(m_lexer.source(start, m_lexer.offset()));
     for (const auto& [name, loc] : scope.undefined)
         warn_undefined(name, loc, "production '" + p.text + "'");
-    build_constant_successor(p);
+    build_successor_prototype(p);
     p.frame_size = scope.next_slot;
     p.storage = m_program.storage_size;
     m_program.storage_size += static_cast<std::size_t>(p.frame_size);
     m_scope = nullptr;
     set.productions.push_back(std::move(p));
-}
-
-void Parser::build_constant_successor(Production& p)
-{
-    // A successor without parameters is the same every time: keep it ready to copy
-    for (const auto& m : p.successor)
-        if (!m.params.empty())
-            return;
-    ModuleString constant;
-    for (const auto& m : p.successor)
-        constant.append(m.symbol);
-    p.constant_successor = std::move(constant);
 }
 
 void Parser::parse_predecessor(Production& p)
@@ -1349,17 +1337,34 @@ void split_at_commands(Program& program)
                 split_modules(program, p.left_context, &FormalModule::param_slots);
                 split_modules(program, p.right_context, &FormalModule::param_slots);
                 split_modules(program, p.successor, &ModuleTemplate::params);
-                if (p.constant_successor) {
-                    ModuleString constant;
-                    for (const auto& m : p.successor)
-                        constant.append(m.symbol);
-                    p.constant_successor = std::move(constant);
-                }
+                build_successor_prototype(p);
             }
     }
 }
 
 }  // namespace
+
+void build_successor_prototype(Production& p)
+{
+    // The successor's symbols and constants are the same every time: keep them ready to
+    // copy, and note the parameters to evaluate into the copy
+    p.successor_prototype.clear();
+    p.computed_params.clear();
+    std::array<float, ModuleString::max_params> values{};
+    for (std::size_t j = 0; j < p.successor.size(); ++j) {
+        const ModuleTemplate& m = p.successor[j];
+        for (std::size_t k = 0; k < m.params.size(); ++k) {
+            const std::vector<Instr>& code = m.params[k].instrs;
+            bool constant = code.size() == 1 && code.front().op == Op::Const;
+            values[k] = constant ? static_cast<float>(code.front().value) : 0.0f;
+            if (!constant)
+                p.computed_params.push_back(
+                    ComputedParam{static_cast<std::uint32_t>(p.successor_prototype.param_total() + k),
+                                  static_cast<std::uint32_t>(j), static_cast<std::uint32_t>(k)});
+        }
+        p.successor_prototype.append(m.symbol, std::span<const float>(values.data(), m.params.size()));
+    }
+}
 
 void parse_program(std::string_view preprocessed, const std::string& file_name, Program& program)
 {

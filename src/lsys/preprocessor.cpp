@@ -250,6 +250,20 @@ std::string name_from_user_folder(const std::string& text, const std::filesystem
 
 std::string megabytes(std::size_t bytes) { return std::to_string(bytes >> 20) + " MiB"; }
 
+/// Whether cpp (the default one, without -D) would give `source` back unchanged but for
+/// whitespace and line markers: no directive, comment, line splice, character or string
+/// literal, trigraph, or name of cpp's own (__LINE__). Such a file is parsed as it is:
+/// starting cpp costs more than deriving a small model (issue 16.7).
+bool needs_no_preprocessing(std::string_view source, const PreprocessOptions& options)
+{
+    if (options.preprocessor != "cpp" || !options.defines.empty())
+        return false;
+    if (source.find_first_of("#/\\'\"\r\f\v") != std::string_view::npos)
+        return false;
+    return source.find("??") == std::string_view::npos &&
+           source.find("__") == std::string_view::npos;
+}
+
 }  // namespace
 
 std::string protect_cpfg_lines(std::string_view source)
@@ -305,6 +319,8 @@ std::string preprocess(std::string_view source, std::string_view file_name,
         throw Error(FileLoc{name, 0, 0},
                     "the file is " + std::to_string(source.size()) + " bytes; at most " +
                         std::to_string(options.max_input_bytes) + " are accepted");
+    if (needs_no_preprocessing(source, options))
+        return "# 1 " + quoted(file_name) + "\n" + std::string(source);
     const std::filesystem::path folder = absolute_folder(options.folder);
     std::vector<std::filesystem::path> include_dirs{folder};  // as cpp_command's -I list
     for (const auto& dir : options.include_dirs)

@@ -27,6 +27,14 @@ struct ModuleTemplate {
     std::vector<Code> params;
 };
 
+/// A successor parameter that is not a constant: where it goes in the successor's
+/// parameters and the expression (successor[module].params[param]) that computes it.
+struct ComputedParam {
+    std::uint32_t index = 0;
+    std::uint32_t module = 0;
+    std::uint32_t param = 0;
+};
+
 /// lc < pred > rc : {pre} condition {post} --> successor : probability
 struct Production {
     std::vector<FormalModule> left_context;   ///< in reading order
@@ -36,7 +44,10 @@ struct Production {
     std::optional<Code> condition;            ///< none: '*' or absent
     Code post_block;                          ///< {beta}
     std::vector<ModuleTemplate> successor;
-    std::optional<ModuleString> constant_successor;  ///< when no successor module has parameters
+    /// The successor with its constant parameters filled in (build_successor_prototype):
+    /// applying the production copies it and evaluates only `computed_params` into it.
+    ModuleString successor_prototype;
+    std::vector<ComputedParam> computed_params;  ///< in the successor's order
     std::optional<Code> probability;          ///< stochastic productions only
     bool object_production = false;           ///< '-o>'
     int frame_size = 0;                       ///< formal parameters + local variables
@@ -46,6 +57,9 @@ struct Production {
     FileLoc loc;
     std::string text;                         ///< its source on one line, for messages
 };
+
+/// Builds p.successor_prototype and p.computed_params from p.successor.
+void build_successor_prototype(Production& p);
 
 /// An object production geom may instance: -o> with one predecessor module and no
 /// context, so the module alone decides its expansion.

@@ -2,6 +2,7 @@
 // Reading and writing L-system strings in cpfg's text (-str) and binary (-strb) formats.
 #include "lsys/string_io.h"
 
+#include <algorithm>
 #include <array>
 #include <charconv>
 #include <cstdint>
@@ -286,33 +287,54 @@ RawModules parse_binary_bytes(std::string_view bytes, std::string_view source,
 
 void write_string_text(const ModuleString& string, const SymbolTable& symbols, std::ostream& out)
 {
-    BufferedWriter w(out);
+    std::vector<std::string_view> names(symbols.size());
+    std::size_t longest = 0;
+    for (std::size_t id = 0; id < names.size(); ++id) {
+        names[id] = symbols.name(static_cast<SymbolId>(id));
+        longest = std::max(longest, names[id].size());
+    }
+    // Written straight into a block; the most one module can add (a line break before
+    // each name character, parentheses, numbers and commas) is left free before each.
+    const std::size_t module_room =
+        2 * longest + 2 + ModuleString::max_params * (max_parameter_chars + 1);
+    std::vector<char> block(flush_bytes + module_room);
+    char* const first = block.data();
+    char* const flush_at = first + flush_bytes;
+    char* to = first;
+    auto flush = [&] {
+        out.write(first, to - first);
+        to = first;
+    };
     int on_line = 0;
-    char number[64];
-    string.for_each([&](ModuleRef m) {
-        for (char c : symbols.name(m.symbol)) {
+    const float* values = string.param_data();
+    const std::uint8_t* counts = string.count_data();
+    for (std::size_t i = 0, n = string.size(); i < n; ++i) {
+        if (to >= flush_at)
+            flush();
+        for (char c : names[string.symbol(i)]) {
             if (on_line >= 70) {
                 on_line = 0;
-                w.put('\n');
+                *to++ = '\n';
             }
-            w.put(c);
+            *to++ = c;
             ++on_line;
         }
-        if (m.params.empty())
-            return;
-        w.put('(');
-        ++on_line;
-        for (std::size_t i = 0; i < m.params.size(); ++i) {
-            int n = std::snprintf(number, sizeof number, "%g", static_cast<double>(m.params[i]));
-            w.put(std::string_view(number, static_cast<std::size_t>(n)));
-            on_line += n;
-            if (i + 1 != m.params.size())
-                w.put(',');  // cpfg does not count the commas
+        std::size_t count = counts[i];
+        if (count == 0)
+            continue;
+        *to++ = '(';
+        for (std::size_t k = 0; k < count; ++k) {
+            char* number = to;
+            to = format_parameter(to, values[k]);
+            on_line += static_cast<int>(to - number);
+            *to++ = ',';  // cpfg does not count the commas
         }
-        w.put(')');
-        ++on_line;
-    });
-    w.put('\n');
+        to[-1] = ')';
+        on_line += 2;  // the parentheses
+        values += count;
+    }
+    *to++ = '\n';
+    flush();
 }
 
 void write_string_binary(const ModuleString& string, const SymbolTable& symbols,

@@ -51,6 +51,39 @@ TEST(LsysPreprocessor, DefinesFromOptions)
     EXPECT_EQ(ls.derivation_length(), 3);
 }
 
+TEST(LsysPreprocessor, FileWithoutDirectivesParsesAsCppWouldGiveIt)
+{
+    // Not run through cpp (the default, without -D): the same strings as through cpp
+    // (named by its path, so that it runs), tab continuations and odd spacing included.
+    const std::string source =
+        "Lsystem: 1\nderivation length:   3\nAxiom: A(1)  B\n\n\n\n\n\n\n\n\n\n\n"
+        "A(x) : x < 4 --> A(x+1) [+B]   \n\tB(x)\nB --> B-B\t\nendlsystem\n";
+    LoadOptions through_cpp;
+    through_cpp.preprocessor = "/usr/bin/cpp";
+    if (!std::filesystem::exists(through_cpp.preprocessor))
+        GTEST_SKIP() << "no /usr/bin/cpp";
+    std::string direct = to_text(LSystem::from_source(source, "p.l").derive(),
+                                 LSystem::from_source(source, "p.l").symbols());
+    LSystem with_cpp = LSystem::from_source(source, "p.l", through_cpp);
+    EXPECT_EQ(direct, to_text(with_cpp.derive(), with_cpp.symbols()));
+    EXPECT_EQ(direct, "A(4)[+B]B(3)[+B-B]B(2)[+B-B-B-B]B(1)B-B-B-B-B-B-B-B");  // continued line
+    // a syntax error names the same line either way
+    std::string broken = "Lsystem: 1\n\n\nAxiom: A(\nendlsystem\n";
+    std::string direct_error, cpp_error;
+    try {
+        LSystem::from_source(broken, "p.l");
+    } catch (const Error& e) {
+        direct_error = e.what();
+    }
+    try {
+        LSystem::from_source(broken, "p.l", through_cpp);
+    } catch (const Error& e) {
+        cpp_error = e.what();
+    }
+    EXPECT_FALSE(direct_error.empty());
+    EXPECT_EQ(direct_error, cpp_error);
+}
+
 TEST(LsysPreprocessor, MissingPreprocessorIsClearError)
 {
     LoadOptions options;

@@ -2,6 +2,9 @@
 // cpfg's text and binary string formats: exact bytes, round trips, malformed input.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <cstring>
+#include <limits>
 #include <sstream>
 
 #include "base/diagnostics.h"
@@ -33,6 +36,46 @@ TEST(StringIo, TextPrintsParametersWithPercentG)
     ModuleString s = make(symbols, {{"F", {2}}, {"+", {22.5f}}, {"A", {1.44407e-05f, -3}},
                                     {"[", {}}, {"@Gs", {}}, {"]", {}}});
     EXPECT_EQ(text_of(s, symbols), "F(2)+(22.5)A(1.44407e-05,-3)[@Gs]\n");
+}
+
+std::string printf_g(float value)
+{
+    char text[64];
+    int n = std::snprintf(text, sizeof text, "%g", static_cast<double>(value));
+    return std::string(text, static_cast<std::size_t>(n));
+}
+
+std::string formatted(float value)
+{
+    char text[max_parameter_chars];
+    return std::string(text, format_parameter(text, value));
+}
+
+TEST(StringIo, ParametersArePrintedAsPrintfPercentGPrintsThem)
+{
+    // the edges of the whole-number shortcut, of %g's exponent form and of rounding
+    for (float v : {0.0f, -0.0f, 1.0f, -7.0f, 999999.0f, 1e6f, -1e6f, 1234567.0f, 0.5f, 1e-4f,
+                    9.99999e-5f, 123456.5f, 999999.5f, 0.1f, 1.0f / 3, 16777216.0f, 1e-38f,
+                    -3.4028235e38f, 1.17549435e-38f, 1e-45f})
+        EXPECT_EQ(formatted(v), printf_g(v)) << printf_g(v);
+    for (float v : {std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+                    std::numeric_limits<float>::quiet_NaN(), -std::numeric_limits<float>::quiet_NaN()})
+        EXPECT_EQ(formatted(v), printf_g(v));
+    // every kind of float: bit patterns spread over the whole range, and small fractions
+    std::uint32_t bits = 12345;
+    for (int i = 0; i < 200000; ++i) {
+        bits = bits * 1664525u + 1013904223u;
+        float v;
+        std::memcpy(&v, &bits, sizeof v);
+        ASSERT_EQ(formatted(v), printf_g(v)) << "bits " << bits;
+        float fraction = static_cast<float>(i % 20000) / 64.0f - 100.0f;  // exact ties
+        ASSERT_EQ(formatted(fraction), printf_g(fraction));
+        // floats from 10^-5 to 10^7, where most parameters lie
+        std::uint32_t near = 0x37000000u + bits % (0x4b000000u - 0x37000000u);
+        std::memcpy(&v, &near, sizeof v);
+        ASSERT_EQ(formatted(v), printf_g(v)) << "bits " << near;
+        ASSERT_EQ(formatted(-v), printf_g(-v)) << "bits " << near;
+    }
 }
 
 TEST(StringIo, TextBreaksBeforeACharacterOnceSeventyAreOnTheLine)
