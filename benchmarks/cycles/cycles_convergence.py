@@ -1,0 +1,102 @@
+# SPDX-License-Identifier: Apache-2.0
+"""Cycles' side of the convergence benchmark, run inside Blender 3.4 (a measuring tool,
+not part of Cambium):
+
+    blender -b --factory-startup --python benchmarks/cycles/cycles_convergence.py -- \\
+        --scene build/cycles/scenes/WeepingBirch.json [--threads 2] [--max-spp 64] \\
+        [--reference-spp 1024] [--cache build/cycles/cache]
+
+builds the exported scene (import_scene.py), renders it once at 1 spp to sync it (scene
+export, BVH build, shader compilation: reported as `sync_s`, kept out of the render
+times by Cycles' persistent data), renders or reuses a high-spp reference (another
+seed, cached as EXR), then renders at 1, 2, 4, ... max spp and prints one JSON line
+(starting with {"plant") with each render's relative RMSE against the reference,
+computed as benchmarks/convergence does for Cambium: sqrt(mean over plant pixels and RGB
+of (value - reference)^2) / mean(reference), plant pixels being those whose reference
+alpha is at least 0.5; its wall and CPU seconds (the process's user + sys); the slope
+of log RMSE against log spp; and the noise and times at the highest spp.
+"""
+import argparse
+import json
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import import_scene  # noqa: E402  (needs the folder on the path first)
+
+
+def cpu_seconds():
+    t = os.times()
+    return t.user + t.system
+
+
+def timed_render(path, spp, seed):
+    wall, cpu = time.perf_counter(), cpu_seconds()
+    import_scene.render_exr(path, spp, seed)
+    return time.perf_counter() - wall, cpu_seconds() - cpu
+
+
+def relative_rmse(image, reference):
+    plant = reference[:, 3] >= 0.5
+    diff = image[plant, :3].astype(np.float64) - reference[plant, :3]
+    mean = reference[plant, :3].astype(np.float64).mean()
+    return float(math.sqrt((diff * diff).mean()) / mean) if mean > 0 else 0.0
+
+
+def main():
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    parser = argparse.ArgumentParser(prog="cycles_convergence.py")
+    parser.add_argument("--scene", required=True, help="a convergence --export-scene file")
+    parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--max-spp", type=int, default=64)
+    parser.add_argument("--reference-spp", type=int, default=1024)
+    parser.add_argument("--cache", default="build/cycles/cache")
+    args = parser.parse_args(argv)
+
+    plant = os.path.splitext(os.path.basename(args.scene))[0]
+    wall, cpu = time.perf_counter(), cpu_seconds()
+    scene = import_scene.build_scene(args.scene, args.threads)
+    import_seconds = (time.perf_counter() - wall, cpu_seconds() - cpu)
+    os.makedirs(args.cache, exist_ok=True)
+    size = f"{scene['width']}x{scene['height']}"
+    scratch = os.path.join(args.cache, f"{plant}-{size}-run.exr")
+    sync = timed_render(scratch, 1, 0)
+
+    reference_file = os.path.join(args.cache, f"{plant}-{size}-{args.reference_spp}.exr")
+    reference_seconds = None
+    if not os.path.exists(reference_file):
+        reference_seconds = timed_render(reference_file, args.reference_spp, 0x5eed)
+    reference = import_scene.read_exr(reference_file).astype(np.float64)
+
+    spps, rmse, seconds, cpu_s = [], [], [], []
+    spp = 1
+    while spp <= args.max_spp:
+        w, c = timed_render(scratch, spp, 0)
+        spps.append(spp)
+        rmse.append(relative_rmse(import_scene.read_exr(scratch), reference))
+        seconds.append(w)
+        cpu_s.append(c)
+        spp *= 2
+    x, y = np.log(spps), np.log(rmse)
+    slope = float(np.polyfit(x, y, 1)[0])
+    result = {
+        "plant": plant, "renderer": "cycles", "image": size, "threads": args.threads,
+        "reference_spp": args.reference_spp, "spp": spps,
+        "relative_rmse": [round(r, 5) for r in rmse],
+        "seconds": [round(s, 3) for s in seconds], "cpu_seconds": [round(s, 3) for s in cpu_s],
+        "slope": round(slope, 3), "noise_at_max_spp": round(rmse[-1], 5),
+        "seconds_at_max_spp": round(seconds[-1], 3),
+        "cpu_seconds_at_max_spp": round(cpu_s[-1], 3),
+        "samples_per_s": round(scene["width"] * scene["height"] * sum(spps) / sum(seconds)),
+        "import_s": round(import_seconds[0], 3),
+        "sync_s": round(sync[0], 3), "sync_cpu_s": round(sync[1], 3),
+        "reference_s": round(reference_seconds[0], 3) if reference_seconds else None,
+    }
+    print(json.dumps(result), flush=True)
+
+
+main()
