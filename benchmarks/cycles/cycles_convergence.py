@@ -12,8 +12,8 @@ times by Cycles' persistent data), renders or reuses a high-spp reference (anoth
 seed, cached as EXR), then renders at 1, 2, 4, ... max spp and prints one JSON line
 (starting with {"plant") with each render's relative RMSE against the reference,
 computed as benchmarks/convergence does for Cambium: sqrt(mean over plant pixels and RGB
-of (value - reference)^2) / mean(reference), plant pixels being those whose reference
-alpha is at least 0.5; its wall and CPU seconds (the process's user + sys); the slope
+of (value - reference)^2) / mean(reference), over the view's background, plant pixels
+being those whose reference alpha is at least 0.5; its wall and CPU seconds (the process's user + sys); the slope
 of log RMSE against log spp; and the noise and times at the highest spp.
 """
 import argparse
@@ -40,10 +40,19 @@ def timed_render(path, spp, seed):
     return time.perf_counter() - wall, cpu_seconds() - cpu
 
 
+def over_background(rgba, background):
+    """The transparent film's premultiplied pixels over the view's background: the
+    pixels an opaque film gives (camera rays that miss see the background, as in
+    Cambium's images), with the coverage kept in alpha for the plant mask."""
+    out = rgba.astype(np.float64)
+    out[:, :3] += (1 - out[:, 3:4]) * np.asarray(background, dtype=np.float64)
+    return out
+
+
 def relative_rmse(image, reference):
     plant = reference[:, 3] >= 0.5
-    diff = image[plant, :3].astype(np.float64) - reference[plant, :3]
-    mean = reference[plant, :3].astype(np.float64).mean()
+    diff = image[plant, :3] - reference[plant, :3]
+    mean = reference[plant, :3].mean()
     return float(math.sqrt((diff * diff).mean()) / mean) if mean > 0 else 0.0
 
 
@@ -70,14 +79,16 @@ def main():
     reference_seconds = None
     if not os.path.exists(reference_file):
         reference_seconds = timed_render(reference_file, args.reference_spp, 0x5eed)
-    reference = import_scene.read_exr(reference_file).astype(np.float64)
+    background = scene["background"]
+    reference = over_background(import_scene.read_exr(reference_file), background)
 
     spps, rmse, seconds, cpu_s = [], [], [], []
     spp = 1
     while spp <= args.max_spp:
         w, c = timed_render(scratch, spp, 0)
         spps.append(spp)
-        rmse.append(relative_rmse(import_scene.read_exr(scratch), reference))
+        rmse.append(relative_rmse(over_background(import_scene.read_exr(scratch), background),
+                                  reference))
         seconds.append(w)
         cpu_s.append(c)
         spp *= 2

@@ -187,14 +187,18 @@ def _shader(name, emission_class, texture=None, unlit=False):
             link(kd, mul.inputs[1])
             link(image.outputs["Color"], mul.inputs[2])
             kd = mul.outputs[0]
-    if unlit:
+    def emission_plus(colour):
+        """An emission shader of the `em` attribute plus `colour`."""
         total = n("ShaderNodeVectorMath")
         total.operation = "ADD"
-        link(kd, total.inputs[0])
+        link(colour, total.inputs[0])
         link(attr("em").outputs["Color"], total.inputs[1])
         emission = n("ShaderNodeEmission")
         link(total.outputs[0], emission.inputs["Color"])
-        link(emission.outputs[0], n("ShaderNodeOutputMaterial").inputs["Surface"])
+        return emission.outputs[0]
+
+    if unlit:
+        link(emission_plus(kd), n("ShaderNodeOutputMaterial").inputs["Surface"])
         mat.cycles.sample_as_light = False
         return mat
     ks = attr("ks").outputs["Color"]
@@ -225,15 +229,9 @@ def _shader(name, emission_class, texture=None, unlit=False):
     if emission_class:
         camera = n("ShaderNodeLightPath").outputs["Is Camera Ray"]
         glow = scale(attr("glow").outputs["Color"], camera)
-        total = n("ShaderNodeVectorMath")
-        total.operation = "ADD"
-        link(glow, total.inputs[0])
-        link(attr("em").outputs["Color"], total.inputs[1])
-        emission = n("ShaderNodeEmission")
-        link(total.outputs[0], emission.inputs["Color"])
         add = n("ShaderNodeAddShader")
         link(result, add.inputs[0])
-        link(emission.outputs[0], add.inputs[1])
+        link(emission_plus(glow), add.inputs[1])
         result = add.outputs[0]
     out = n("ShaderNodeOutputMaterial")
     link(result, out.inputs["Surface"])
