@@ -61,6 +61,8 @@ def main():
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--build", default="build")
     parser.add_argument("--blender", default="blender")
+    parser.add_argument("--no-mesh-lights", action="store_true",
+                        help="Cycles does not sample emissive primitives as lights")
     args = parser.parse_args()
     convergence = os.path.join(args.build, "benchmarks", "convergence")
     scenes = os.path.join(args.build, "cycles", "scenes")
@@ -76,13 +78,15 @@ def main():
                                  "--scene", os.path.join(scenes, plant + ".json"),
                                  "--threads", str(args.threads), "--reference-spp",
                                  str(args.reference_spp), "--cache",
-                                 os.path.join(cache, args.size)])[0]
+                                 os.path.join(cache, args.size)] +
+                                (["--no-mesh-lights"] if args.no_mesh_lights else []))[0]
             cambium = json_lines([convergence, *common, "--sampler", "sobol",
                                   "--reference-spp", str(args.reference_spp),
                                   "--target", str(cycles["noise_at_max_spp"])])[0]
             result = {
                 "plant": plant, "round": round_index + 1, "image": args.size,
                 "threads": args.threads, "reference_spp": args.reference_spp,
+                "cycles_mesh_lights": cycles["mesh_lights"],
                 "cycles_noise_64": cycles["noise_at_max_spp"],
                 "cycles_slope": cycles["slope"], "cambium_slope": cambium["slope"],
                 "cambium_rmse_64": cambium["relative_rmse"][-1],
@@ -97,8 +101,8 @@ def main():
             result["wall_ratio"] = round(result["cambium_s"] / result["cycles_s"], 3)
             ratios.setdefault(plant, []).append(result)
             print(json.dumps(result), flush=True)
-    summary = {plant: {"cpu_ratio": statistics.median(r["cpu_ratio"] for r in runs),
-                       "wall_ratio": statistics.median(r["wall_ratio"] for r in runs),
+    summary = {plant: {"cpu_ratio": round(statistics.median(r["cpu_ratio"] for r in runs), 3),
+                       "wall_ratio": round(statistics.median(r["wall_ratio"] for r in runs), 3),
                        "rounds": len(runs)}
                for plant, runs in ratios.items()}
     print(json.dumps({"median": summary}), flush=True)

@@ -64,11 +64,13 @@ def main():
     parser.add_argument("--max-spp", type=int, default=64)
     parser.add_argument("--reference-spp", type=int, default=1024)
     parser.add_argument("--cache", default="build/cycles/cache")
+    parser.add_argument("--no-mesh-lights", action="store_true",
+                        help="emissive primitives are not sampled as lights")
     args = parser.parse_args(argv)
 
     plant = os.path.splitext(os.path.basename(args.scene))[0]
     wall, cpu = time.perf_counter(), cpu_seconds()
-    scene = import_scene.build_scene(args.scene, args.threads)
+    scene = import_scene.build_scene(args.scene, args.threads, not args.no_mesh_lights)
     import_seconds = (time.perf_counter() - wall, cpu_seconds() - cpu)
     os.makedirs(args.cache, exist_ok=True)
     size = f"{scene['width']}x{scene['height']}"
@@ -96,7 +98,8 @@ def main():
     slope = float(np.polyfit(x, y, 1)[0])
     result = {
         "plant": plant, "renderer": "cycles", "image": size, "threads": args.threads,
-        "reference_spp": args.reference_spp, "spp": spps,
+        "reference_spp": args.reference_spp, "mesh_lights": not args.no_mesh_lights,
+        "spp": spps,
         "relative_rmse": [round(r, 5) for r in rmse],
         "seconds": [round(s, 3) for s in seconds], "cpu_seconds": [round(s, 3) for s in cpu_s],
         "slope": round(slope, 3), "noise_at_max_spp": round(rmse[-1], 5),

@@ -137,10 +137,11 @@ def _emission_class(m):
     return 1 if any(m["glow"]) else 0
 
 
-def _shader(name, emission_class, texture=None, unlit=False):
+def _shader(name, emission_class, texture=None, unlit=False, emitters_as_lights=True):
     """The one shader of every surface: Cambium's three lobes from attributes, plus
     emission (class 2) and the ambient term for camera rays (classes 1 and 2). Unlit
-    (`render mode: filled`): the diffuse colour plus emission, and the path ends there."""
+    (`render mode: filled`): the diffuse colour plus emission, and the path ends there.
+    emitters_as_lights=False: emissive surfaces are found by BSDF rays only."""
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     nt = mat.node_tree
@@ -236,7 +237,7 @@ def _shader(name, emission_class, texture=None, unlit=False):
     out = n("ShaderNodeOutputMaterial")
     link(result, out.inputs["Surface"])
     # Only truly emissive surfaces are lights; the ambient term lights nothing (Cambium).
-    mat.cycles.sample_as_light = emission_class == 2
+    mat.cycles.sample_as_light = emission_class == 2 and emitters_as_lights
     return mat
 
 
@@ -499,8 +500,9 @@ def configure(scene, threads=2):
     s.render.image_settings.color_mode = "RGBA"
 
 
-def build_scene(path, threads=2):
-    """Empties Blender's scene and builds the exported one in it."""
+def build_scene(path, threads=2, emitters_as_lights=True):
+    """Empties Blender's scene and builds the exported one in it. emitters_as_lights:
+    emissive primitives are sampled as lights (as Cambium's area lights are)."""
     with open(path) as f:
         scene = json.load(f)
     if scene.get("format") != "cambium-scene-1":
@@ -512,11 +514,12 @@ def build_scene(path, threads=2):
     unlit = scene["shading"] == "unlit"
     shaders = {}
     for c in range(3):
-        shaders[(c, None)] = _shader(f"cambium_{c}", c, unlit=unlit)
+        shaders[(c, None)] = _shader(f"cambium_{c}", c, unlit=unlit,
+                                     emitters_as_lights=emitters_as_lights)
     for i, texture in enumerate(scene["textures"]):
         for c in range(3):
             shaders[(c, i)] = _shader(f"cambium_{c}_tex{i}", c, dict(texture, on_curves=True),
-                                      unlit)
+                                      unlit, emitters_as_lights)
     _build_mesh(scene, table, shaders)
     _build_curves(scene, table, shaders)
     _build_camera(scene)
