@@ -63,6 +63,8 @@ def main():
     parser.add_argument("--blender", default="blender")
     parser.add_argument("--no-mesh-lights", action="store_true",
                         help="Cycles does not sample emissive primitives as lights")
+    parser.add_argument("--cycles-tilt", type=float, default=0.0,
+                        help="turn Cycles' camera by this many radians (cycles_convergence.py)")
     args = parser.parse_args()
     convergence = os.path.join(args.build, "benchmarks", "convergence")
     scenes = os.path.join(args.build, "cycles", "scenes")
@@ -79,14 +81,15 @@ def main():
                                  "--threads", str(args.threads), "--reference-spp",
                                  str(args.reference_spp), "--cache",
                                  os.path.join(cache, args.size)] +
-                                (["--no-mesh-lights"] if args.no_mesh_lights else []))[0]
+                                (["--no-mesh-lights"] if args.no_mesh_lights else []) +
+                                ["--tilt", str(args.cycles_tilt)])[0]
             cambium = json_lines([convergence, *common, "--sampler", "sobol",
                                   "--reference-spp", str(args.reference_spp),
                                   "--target", str(cycles["noise_at_max_spp"])])[0]
             result = {
                 "plant": plant, "round": round_index + 1, "image": args.size,
                 "threads": args.threads, "reference_spp": args.reference_spp,
-                "cycles_mesh_lights": cycles["mesh_lights"],
+                "cycles_mesh_lights": cycles["mesh_lights"], "cycles_tilt": cycles["tilt"],
                 "cycles_noise_64": cycles["noise_at_max_spp"],
                 "cycles_slope": cycles["slope"], "cambium_slope": cambium["slope"],
                 "cambium_rmse_64": cambium["relative_rmse"][-1],
