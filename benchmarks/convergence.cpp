@@ -10,20 +10,27 @@
 //
 //   build/benchmarks/convergence [--plant NAME]... [--sampler sobol|white|both]
 //       [--size WxH] [--threads N] [--max-spp N] [--reference-spp N] [--target NOISE]
-//       [--adaptive NOISE]
+//       [--adaptive NOISE] [--export-scene FOLDER]
 //
 // Defaults: the four plants below, both samplers, 320x240, 2 threads, up to 64 spp, a
 // 1024-spp Sobol reference. The noise target (time_to_target_s) is, unless given, white
 // noise's error at max spp when both samplers run (else Sobol's). Without the corpus
 // (../shared/corpus, or $CAMBIUM_CORPUS) it prints {"skipped": ...} and exits 0.
 //
+// Noise: sqrt(mean over plant pixels and RGB of (value - reference)^2) / mean(reference),
+// plant pixels being those the reference's camera rays hit at least half the time.
+//
+// Times: wall (`seconds`), the process's CPU time (user + sys, `cpu_seconds`: the robust
+// figure on a loaded machine) and the set-up inside it (`setup_seconds`: textures, the
+// Embree build, lights), each per render; the time to the target in all three.
+//
 // --adaptive NOISE instead renders once with adaptive sampling to that noise target (up
 // to --max-spp) and prints its mean spp, wall and CPU seconds and the error reached:
 // pixel_relative_error is the RMS of each plant pixel's relative luminance error, the
 // quantity the target bounds.
 //
-// Noise: sqrt(mean over plant pixels and RGB of (value - reference)^2) / mean(reference),
-// plant pixels being those the reference's camera rays hit at least half the time.
+// --export-scene FOLDER renders nothing: it writes each plant's interpreted scene as
+// FOLDER/NAME.json (scene_export.h), which benchmarks/cycles/ builds in Blender.
 #include <embree3/rtcore.h>
 
 #include <dlfcn.h>
@@ -35,7 +42,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <ctime>
 #include <exception>
 #include <filesystem>
 #include <fstream>
@@ -49,6 +55,7 @@
 #include "app/command_line.h"
 #include "app/pipeline.h"
 #include "render/render.h"
+#include "scene_export.h"
 
 namespace fs = std::filesystem;
 
@@ -100,16 +107,17 @@ struct Settings {
                                                 render::SampleSequence::sobol};
     int width = 320, height = 240, threads = 2, max_spp = 64, reference_spp = 1024;
     double target = 0;
-    double adaptive = 0;  // --adaptive: one adaptive render to this noise target instead
+    double adaptive = 0;  ///< --adaptive: one adaptive render to this noise target instead
+    fs::path export_folder;  ///< --export-scene: write the scenes instead of rendering
 };
 
-/// CPU seconds of the whole process (all threads): on a shared machine, wall time
-/// measures the neighbours as well.
+/// The process's CPU time so far, user + sys, in seconds.
 double cpu_seconds()
 {
-    timespec t{};
-    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    auto seconds = [](const timeval& t) { return double(t.tv_sec) + 1e-6 * double(t.tv_usec); };
+    return seconds(usage.ru_utime) + seconds(usage.ru_stime);
 }
 
 double peak_rss_mb()
@@ -145,7 +153,7 @@ cambium::geom::Scene load_plant(const fs::path& folder)
 
 struct Run {
     render::Image image;
-    double seconds = 0, cpu_seconds = 0;
+    double seconds = 0, cpu_seconds = 0, setup_seconds = 0;
     std::uint64_t rays = 0, samples = 0;
 };
 
@@ -168,6 +176,7 @@ Run render_at(const cambium::geom::Scene& scene, const Settings& s, int spp,
     Run run{render::render(scene, rs, &report)};
     run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
     run.cpu_seconds = cpu_seconds() - cpu_start;
+    run.setup_seconds = report.setup_seconds;
     run.rays = rays_traced.load() - rays_before;
     run.samples = report.samples;
     return run;
@@ -224,23 +233,23 @@ std::pair<double, double> fit_line(const std::vector<double>& x, const std::vect
 }
 
 struct Curve {
-    std::vector<double> spp, rmse, seconds;
+    std::vector<double> spp, rmse, seconds, cpu_seconds, setup_seconds;
     std::uint64_t rays = 0, samples = 0;
-    double render_seconds = 0, render_cpu_seconds = 0;
+    double render_seconds = 0;
 };
 
-/// The time a render of `spp` samples takes (each render's set-up included, as a user's
-/// run pays it): interpolated between the measured runs, extrapolated past the last at
-/// the last step's cost per spp.
-double seconds_at(const Curve& c, double spp)
+/// The time a render of `spp` samples takes, `seconds` being the measured runs' (wall,
+/// CPU, or without set-up): interpolated between the measured runs, extrapolated past
+/// the last at the last step's cost per spp.
+double seconds_at(const Curve& c, const std::vector<double>& seconds, double spp)
 {
     if (spp <= c.spp.front())
-        return c.seconds.front() * spp / c.spp.front();
+        return seconds.front() * spp / c.spp.front();
     std::size_t i = 1;
     while (i + 1 < c.spp.size() && c.spp[i] < spp)
         ++i;
-    double per_spp = std::max(0.0, (c.seconds[i] - c.seconds[i - 1]) / (c.spp[i] - c.spp[i - 1]));
-    return c.seconds[i - 1] + per_spp * (spp - c.spp[i - 1]);
+    double per_spp = std::max(0.0, (seconds[i] - seconds[i - 1]) / (c.spp[i] - c.spp[i - 1]));
+    return seconds[i - 1] + per_spp * (spp - c.spp[i - 1]);
 }
 
 std::string json_array(const std::vector<double>& v, const char* format)
@@ -269,16 +278,24 @@ void report(const std::string& plant, const Settings& s, render::SampleSequence 
     double total_spp = 0;
     for (double spp : c.spp)
         total_spp += spp;
+    std::vector<double> render_only;  // wall time less the set-up
+    for (std::size_t i = 0; i < c.spp.size(); ++i)
+        render_only.push_back(c.seconds[i] - c.setup_seconds[i]);
     std::printf("{\"plant\":\"%s\",\"sampler\":\"%s\",\"image\":\"%dx%d\",\"threads\":%d,"
                 "\"reference_spp\":%d,\"spp\":%s,\"relative_rmse\":%s,\"seconds\":%s,"
+                "\"cpu_seconds\":%s,\"setup_seconds\":%s,"
                 "\"slope\":%.3f,\"target_noise\":%.5f,\"spp_to_target\":%.1f,"
-                "\"time_to_target_s\":%.3f,\"samples_per_s\":%.0f,"
-                "\"samples_per_cpu_s\":%.0f,\"rays_per_s\":%.0f,\"peak_rss_mb\":%.0f}\n",
+                "\"time_to_target_s\":%.3f,\"time_to_target_cpu_s\":%.3f,"
+                "\"time_to_target_render_s\":%.3f,\"samples_per_s\":%.0f,"
+                "\"rays_per_s\":%.0f,\"peak_rss_mb\":%.0f}\n",
                 plant.c_str(), name(sampler), s.width, s.height, s.threads, s.reference_spp,
                 json_array(c.spp, "%.0f").c_str(), json_array(c.rmse, "%.5f").c_str(),
-                json_array(c.seconds, "%.3f").c_str(), slope, target, spp_to_target,
-                seconds_at(c, spp_to_target), double(s.width) * s.height * total_spp / c.render_seconds,
-                double(s.width) * s.height * total_spp / c.render_cpu_seconds,
+                json_array(c.seconds, "%.3f").c_str(), json_array(c.cpu_seconds, "%.3f").c_str(),
+                json_array(c.setup_seconds, "%.3f").c_str(), slope, target, spp_to_target,
+                seconds_at(c, c.seconds, spp_to_target),
+                seconds_at(c, c.cpu_seconds, spp_to_target),
+                seconds_at(c, render_only, spp_to_target),
+                double(s.width) * s.height * total_spp / c.render_seconds,
                 double(c.rays) / c.render_seconds, peak_rss_mb());
     std::fflush(stdout);
 }
@@ -338,9 +355,10 @@ void run_plant(const std::string& plant, const fs::path& folder, const Settings&
             c.spp.push_back(spp);
             c.rmse.push_back(relative_rmse(run.image.rgba, ref));
             c.seconds.push_back(run.seconds);
+            c.cpu_seconds.push_back(run.cpu_seconds);
+            c.setup_seconds.push_back(run.setup_seconds);
             c.rays += run.rays;
             c.render_seconds += run.seconds;
-            c.render_cpu_seconds += run.cpu_seconds;
         }
     }
     double target = s.target;
@@ -390,6 +408,8 @@ Settings parse(int argc, char** argv)
             s.target = std::stod(value());
         } else if (arg == "--adaptive") {
             s.adaptive = std::stod(value());
+        } else if (arg == "--export-scene") {
+            s.export_folder = fs::absolute(value());
         } else {
             throw std::runtime_error("unknown argument " + arg);
         }
@@ -416,7 +436,15 @@ int main(int argc, char** argv)
                             plant.c_str(), folder.string().c_str());
                 continue;
             }
-            run_plant(plant, folder, s, cache);
+            if (s.export_folder.empty()) {
+                run_plant(plant, folder, s, cache);
+                continue;
+            }
+            fs::create_directories(s.export_folder);
+            std::ofstream out(s.export_folder / (plant + ".json"));
+            cambium::bench::write_scene_json(load_plant(folder), s.width, s.height, folder, out);
+            if (!out)
+                throw std::runtime_error("cannot write " + (s.export_folder / plant).string());
         }
     } catch (const std::exception& e) {
         std::fprintf(stderr, "convergence: %s\n", e.what());

@@ -1,0 +1,114 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: Apache-2.0
+"""Cambium against Cycles at equal noise, one plant at a time (Blender 3.4 is a measuring
+tool here, not a dependency of Cambium; see README.md beside this file):
+
+    benchmarks/cycles/compare.py --plant WeepingBirch [--plant ...] [--size 160x120]
+        [--reference-spp 1024] [--rounds 2] [--threads 2] [--build build] [--blender blender]
+
+Per round and plant: exports the plant's scene (build/benchmarks/convergence
+--export-scene), runs Cycles' convergence (cycles_convergence.py in Blender: its noise
+and times at 64 spp), then Cambium's (build/benchmarks/convergence --sampler sobol
+--target <Cycles' 64-spp noise>), and prints one JSON line with the ratios:
+
+  cpu_ratio   Cambium's CPU time (user + sys) to reach Cycles' 64-spp noise, its
+              set-up (BVH build) included, / Cycles' CPU time for its 64 spp, its scene
+              sync excluded. The robust figure on a loaded machine.
+  wall_ratio  the same in wall time, both without set-up.
+
+Below 1: Cambium is faster. The rounds interleave the two renderers; the last line is
+each plant's median ratios over the rounds. Both renderers cache their references
+(build/convergence-cache/, build/cycles/cache/), so only the first round renders them.
+"""
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+PLANTS = ["FernLeaf", "WeepingBirch", "Lilac", "GeneralizedCylinder"]
+
+
+def system_python_env():
+    """The environment without a virtualenv's or pyenv's python3 first on PATH: Debian's
+    Blender sets its Python up from the python3 it finds there, and only the system's
+    sees Debian's numpy."""
+    env = dict(os.environ)
+    env["PATH"] = os.pathsep.join(p for p in env.get("PATH", "").split(os.pathsep)
+                                  if ".pyenv" not in p and p != os.path.dirname(sys.executable))
+    for name in ("PYENV_VERSION", "VIRTUAL_ENV", "PYTHONHOME", "PYTHONPATH"):
+        env.pop(name, None)
+    return env
+
+
+def json_lines(command):
+    """The JSON objects a command prints, one per line (other lines ignored)."""
+    run = subprocess.run(command, capture_output=True, text=True, env=system_python_env())
+    if run.returncode != 0:
+        sys.exit(f"compare.py: {' '.join(command)} failed:\n{run.stdout[-2000:]}"
+                 f"{run.stderr[-2000:]}")
+    return [json.loads(line) for line in run.stdout.splitlines() if line.startswith('{"plant"')]
+
+
+def main():
+    parser = argparse.ArgumentParser(prog="compare.py")
+    parser.add_argument("--plant", action="append", choices=PLANTS)
+    parser.add_argument("--size", default="160x120")
+    parser.add_argument("--reference-spp", type=int, default=1024)
+    parser.add_argument("--rounds", type=int, default=2)
+    parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--build", default="build")
+    parser.add_argument("--blender", default="blender")
+    parser.add_argument("--no-mesh-lights", action="store_true",
+                        help="Cycles does not sample emissive primitives as lights")
+    parser.add_argument("--cycles-tilt", type=float, default=0.0,
+                        help="turn Cycles' camera by this many radians (cycles_convergence.py)")
+    args = parser.parse_args()
+    convergence = os.path.join(args.build, "benchmarks", "convergence")
+    scenes = os.path.join(args.build, "cycles", "scenes")
+    cache = os.path.join(args.build, "cycles", "cache")
+    ratios = {}
+    for round_index in range(args.rounds):
+        for plant in args.plant or PLANTS:
+            common = ["--plant", plant, "--size", args.size, "--threads", str(args.threads)]
+            if round_index == 0:
+                json_lines([convergence, *common, "--export-scene", scenes])
+            cycles = json_lines([args.blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
+                                 os.path.join(HERE, "cycles_convergence.py"), "--",
+                                 "--scene", os.path.join(scenes, plant + ".json"),
+                                 "--threads", str(args.threads), "--reference-spp",
+                                 str(args.reference_spp), "--cache",
+                                 os.path.join(cache, args.size)] +
+                                (["--no-mesh-lights"] if args.no_mesh_lights else []) +
+                                ["--tilt", str(args.cycles_tilt)])[0]
+            cambium = json_lines([convergence, *common, "--sampler", "sobol",
+                                  "--reference-spp", str(args.reference_spp),
+                                  "--target", str(cycles["noise_at_max_spp"])])[0]
+            result = {
+                "plant": plant, "round": round_index + 1, "image": args.size,
+                "threads": args.threads, "reference_spp": args.reference_spp,
+                "cycles_mesh_lights": cycles["mesh_lights"], "cycles_tilt": cycles["tilt"],
+                "cycles_noise_64": cycles["noise_at_max_spp"],
+                "cycles_slope": cycles["slope"], "cambium_slope": cambium["slope"],
+                "cambium_rmse_64": cambium["relative_rmse"][-1],
+                "cambium_spp_to_target": cambium["spp_to_target"],
+                "cycles_cpu_s": cycles["cpu_seconds_at_max_spp"],
+                "cambium_cpu_s": cambium["time_to_target_cpu_s"],
+                "cycles_s": cycles["seconds_at_max_spp"],
+                "cambium_s": cambium["time_to_target_render_s"],
+                "cycles_sync_s": cycles["sync_s"],
+            }
+            result["cpu_ratio"] = round(result["cambium_cpu_s"] / result["cycles_cpu_s"], 3)
+            result["wall_ratio"] = round(result["cambium_s"] / result["cycles_s"], 3)
+            ratios.setdefault(plant, []).append(result)
+            print(json.dumps(result), flush=True)
+    summary = {plant: {"cpu_ratio": round(statistics.median(r["cpu_ratio"] for r in runs), 3),
+                       "wall_ratio": round(statistics.median(r["wall_ratio"] for r in runs), 3),
+                       "rounds": len(runs)}
+               for plant, runs in ratios.items()}
+    print(json.dumps({"median": summary}), flush=True)
+
+
+main()

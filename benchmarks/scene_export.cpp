@@ -1,0 +1,159 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "scene_export.h"
+
+#include <cmath>
+
+#include <nlohmann/json.hpp>
+
+#include "render/camera.h"
+#include "render/color.h"
+#include "render/light.h"
+#include "render/material.h"
+#include "render/render.h"
+
+namespace cambium::bench {
+
+namespace {
+
+using nlohmann::json;
+namespace geom = cambium::geom;
+namespace render = cambium::render;
+
+json vec(const geom::Vec3& v) { return json::array({v.x, v.y, v.z}); }
+json vec(const render::Vec3f& v) { return json::array({v.x, v.y, v.z}); }
+
+/// Arrays of fixed-size arrays flattened into one list of numbers (numpy reshapes them).
+template <typename T, std::size_t N>
+json flat(const std::vector<std::array<T, N>>& items)
+{
+    json out = json::array();
+    for (const auto& item : items)
+        for (const T& x : item)
+            out.push_back(x);
+    return out;
+}
+
+json geometry_json(const geom::Geometry& g)
+{
+    json out;
+    out["lines"] = {{"keys", flat(g.lines.keys)},       {"segments", g.lines.segments},
+                    {"material", g.lines.material},     {"texture", g.lines.texture},
+                    {"v", g.lines.v}};
+    out["curves"] = {{"points", flat(g.curves.points)}, {"tangents", flat(g.curves.tangents)},
+                     {"segments", g.curves.segments},   {"material", g.curves.material},
+                     {"end_material", g.curves.end_material},
+                     {"texture", g.curves.texture},     {"v", g.curves.v}};
+    out["spheres"] = {{"centres", flat(g.spheres.centres)}, {"material", g.spheres.material}};
+    out["discs"] = {{"centres", flat(g.discs.centres)}, {"normals", flat(g.discs.normals)},
+                    {"material", g.discs.material},     {"back_material", g.discs.back_material}};
+    out["mesh"] = {{"positions", flat(g.mesh.positions)}, {"normals", flat(g.mesh.normals)},
+                   {"uvs", flat(g.mesh.uvs)},             {"triangles", flat(g.mesh.triangles)},
+                   {"material", g.mesh.material},         {"back_material", g.mesh.back_material},
+                   {"texture", g.mesh.texture}};
+    return out;
+}
+
+json camera_json(const render::Camera& c, const geom::Bounds3& bounds)
+{
+    json out = {{"projection", c.projection() == render::Camera::Projection::parallel
+                                   ? "parallel"
+                                   : "perspective"},
+                {"origin", vec(c.origin())},
+                {"forward", vec(c.forward())},
+                {"up", vec(c.up())},
+                {"right", vec(c.right())},
+                {"pixel_size", c.pixel_size()},
+                {"clip_near", std::isfinite(c.clip_near()) ? json(c.clip_near()) : json()},
+                {"clip_far", std::isfinite(c.clip_far()) ? json(c.clip_far()) : json()}};
+    if (c.projection() == render::Camera::Projection::perspective)
+        // The vertical field of view: the image's height at unit distance from the eye.
+        out["fov_y_rad"] =
+            2 * std::atan(0.5 * c.height() * c.pixel_size_at(c.origin() + c.forward()));
+    // A parallel camera's rays start behind everything: from the bounds' far side.
+    geom::Vec3 extent = bounds.hi - bounds.lo;
+    out["scene_radius"] = 0.5 * std::sqrt(extent.x * extent.x + extent.y * extent.y +
+                                          extent.z * extent.z);
+    out["scene_centre"] = vec((bounds.lo + bounds.hi) * 0.5);
+    return out;
+}
+
+json lights_json(const std::vector<geom::Light>& lights)
+{
+    json out = json::array();
+    for (const render::RenderLight& l : render::make_lights(lights)) {
+        const char* kind = l.kind == render::RenderLight::Kind::directional ? "directional"
+                           : l.kind == render::RenderLight::Kind::point   ? "point"
+                                                                          : "spot";
+        out.push_back({{"kind", kind},
+                       {"position", vec(l.position)},
+                       {"toward_light", vec(l.toward_light)},
+                       {"spot_axis", vec(l.spot_axis)},
+                       {"spot_exponent", l.spot_exponent},
+                       {"spot_cos_cutoff", l.spot_cos_cutoff},
+                       {"attenuation", {l.att_constant, l.att_linear, l.att_quadratic}},
+                       {"colour", vec(l.colour)}});
+    }
+    return out;
+}
+
+json materials_json(const geom::Scene& scene)
+{
+    json out = json::array();
+    for (const render::SurfaceMaterial& m : render::make_materials(
+             scene.materials, render::opengl_ambient_light(scene.lights)))
+        out.push_back({{"diffuse", vec(m.diffuse)},
+                       {"translucency", m.translucency},
+                       {"specular", vec(m.specular)},
+                       {"exponent", m.exponent},
+                       {"emission", vec(m.emission)},
+                       {"opacity", m.opacity},
+                       {"ambient_glow", vec(m.ambient_glow)}});
+    return out;
+}
+
+}  // namespace
+
+void write_scene_json(const geom::Scene& scene, int width, int height,
+                      const std::filesystem::path& model_folder, std::ostream& out)
+{
+    render::RenderSettings defaults;  // the ambient environment render() uses
+    json j;
+    j["format"] = "cambium-scene-1";
+    j["width"] = width;
+    j["height"] = height;
+    j["shading"] = scene.shading == geom::Shading::shaded ? "shaded"
+                   : scene.shading == geom::Shading::flat ? "flat"
+                                                          : "unlit";  // filled, wireframe
+    j["line_radius_in_pixels"] = scene.line_radius_in_pixels;
+    j["camera"] = camera_json(render::make_camera(scene.view, scene.bounds, width, height),
+                              scene.bounds);
+    j["lights"] = lights_json(scene.lights);
+    j["materials"] = materials_json(scene);
+    j["background"] = vec(render::decode_display(scene.background));
+    j["ambient_radiance"] = {defaults.ambient.r, defaults.ambient.g, defaults.ambient.b};
+    j["max_depth"] = defaults.max_depth;
+    json textures = json::array();
+    for (const geom::TextureDef& t : scene.textures)
+        textures.push_back({{"file", (t.file.is_absolute() ? t.file : model_folder / t.file)
+                                         .lexically_normal()
+                                         .string()},
+                            {"decal", t.decal},
+                            {"linear_filter", t.linear_filter}});
+    j["textures"] = textures;
+    j["geometry"] = geometry_json(scene.geometry);
+    json prototypes = json::array();
+    for (const geom::Prototype& p : scene.prototypes)
+        prototypes.push_back({{"name", p.name}, {"geometry", geometry_json(p.geometry)}});
+    j["prototypes"] = prototypes;
+    json instances = json::array();
+    for (const geom::Instance& i : scene.instances)
+        instances.push_back({{"prototype", i.prototype},
+                             {"transform", i.transform},
+                             {"material", i.material},
+                             {"back_material", i.back_material},
+                             {"texture", i.texture}});
+    j["instances"] = instances;
+    out << j.dump() << '\n';
+}
+
+}  // namespace cambium::bench
