@@ -150,7 +150,22 @@ geom::Shading render_mode(const geom::ViewFile& view)
 geom::Scene interpret(const Model& model, const lsys::ModuleString& derived,
                       const Options& options)
 {
+    if (turtle_reads_derived_string(model, options))
+        return interpret_turtle_string(model, derived, options);
     return interpret_turtle_string(model, turtle_string(model, derived, options), options);
+}
+
+bool turtle_reads_derived_string(const Model& model, const Options& options)
+{
+    if (options.homomorphism_in_string)
+        return true;
+    const lsys::Program& program = model.lsystem.program();
+    if (!program.split_commands.empty())
+        return false;
+    for (const auto& ls : program.lsystems)
+        if (!ls.homomorphism.productions.empty())
+            return false;
+    return true;
 }
 
 namespace {
