@@ -667,6 +667,16 @@ struct HitResolver {
     std::vector<const GeometrySource*> top_parts;  ///< by top-level geometry id
     std::vector<std::vector<const GeometrySource*>> proto_parts;  ///< by prototype, geometry id
     std::vector<Placement> placements;  ///< by top-level geometry id
+    /// The caps and the joints of the scene's own shaded lines live in two scenes of their
+    /// own, each placed once, untransformed, by a top-level instance (none: no such scene).
+    /// Embree's leaves hold primitives of one geometry only: caps and joints beside every
+    /// segment in one BVH left most leaves with one primitive, and cost 187 B per segment
+    /// instead of about 70 (issue 15.3).
+    struct PlacedEnds {
+        std::uint32_t instance = PrimId::none;
+        std::vector<const GeometrySource*> parts;  ///< by geometry id in its scene
+    };
+    std::array<PlacedEnds, 2> line_end_scenes;  ///< caps, joints
 
     const Placement* placement(std::uint32_t inst_id) const
     {
@@ -676,6 +686,10 @@ struct HitResolver {
     }
     const GeometrySource* part(std::uint32_t inst_id, std::uint32_t geom_id) const
     {
+        if (inst_id != PrimId::none)
+            for (const PlacedEnds& e : line_end_scenes)
+                if (inst_id == e.instance)
+                    return e.parts[geom_id];
         if (const Placement* p = placement(inst_id))
             return proto_parts[p->instance->prototype][geom_id];
         return top_parts[geom_id];
@@ -690,6 +704,7 @@ struct EmbreeScene::Impl : HitResolver {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     std::vector<RTCScene> prototype_scenes;
+    std::vector<RTCScene> line_end_rtc_scenes;  ///< the scene's own caps and joints (HitResolver)
     std::deque<GeometrySource> parts;  ///< stable addresses (Embree user data)
     std::deque<LineEnds> line_ends;  ///< caps and joints of shaded lines (stable addresses)
     std::vector<Key> world_keys;  ///< line keys with pixel radii converted (else empty)
@@ -723,6 +738,9 @@ struct EmbreeScene::Impl : HitResolver {
         if (scene)
             rtcReleaseScene(scene);
         for (RTCScene s : prototype_scenes)
+            if (s)
+                rtcReleaseScene(s);
+        for (RTCScene s : line_end_rtc_scenes)
             rtcReleaseScene(s);
         if (device)
             rtcReleaseDevice(device);
@@ -744,9 +762,18 @@ struct EmbreeScene::Impl : HitResolver {
         return s;
     }
 
+    /// Where add_geometry() puts the caps and joints of shaded lines: their scenes and
+    /// geometry ids (null: beside the lines).
+    struct LineEndsTarget {
+        RTCScene caps, joints;  // (no member initializers: {} as a default argument zeroes them)
+        std::vector<const GeometrySource*>*cap_ids, *joint_ids;
+    };
     /// Adds every non-empty part of g to s; ids[geomID] = its GeometrySource.
     void add_geometry(RTCScene s, const geom::Geometry& g, std::vector<const GeometrySource*>& ids,
-                      const Key* line_keys, bool unlit, bool alpha, bool lines = true);
+                      const Key* line_keys, bool unlit, bool alpha, bool lines = true,
+                      LineEndsTarget ends = {});
+    /// Places `ends` (the scene's own caps or joints) in the top-level scene, if not empty.
+    void place_line_ends(RTCScene ends, PlacedEnds& e);
     /// Builds the part's Embree geometry (its ShapeKind) and attaches it to s; `alpha`:
     /// hits are cut out where its texture's alpha is below one half.
     void attach(RTCScene s, GeometrySource part, std::vector<const GeometrySource*>& ids,
@@ -961,8 +988,9 @@ void EmbreeScene::Impl::attach(RTCScene s, GeometrySource part,
 
 void EmbreeScene::Impl::add_geometry(RTCScene s, const geom::Geometry& geo,
                                      std::vector<const GeometrySource*>& ids, const Key* line_keys,
-                                     bool unlit, bool alpha, bool lines)
+                                     bool unlit, bool alpha, bool lines, LineEndsTarget ends)
 {
+
     const geom::LinearCurves& l = geo.lines;
     if (lines && !l.segments.empty()) {
         const Key* keys = line_keys ? line_keys : l.keys.data();
@@ -971,9 +999,11 @@ void EmbreeScene::Impl::add_geometry(RTCScene s, const geom::Geometry& geo,
         if (!unlit) {
             const LineEnds& e = line_ends.emplace_back(render::line_ends(l, keys));
             if (!e.caps.empty())
-                attach(s, line_end_source(Shape::cap, geo, keys, e), ids, cut);
+                attach(ends.caps ? ends.caps : s, line_end_source(Shape::cap, geo, keys, e),
+                       ends.cap_ids ? *ends.cap_ids : ids, cut);
             if (!e.joints.empty())
-                attach(s, line_end_source(Shape::joint, geo, keys, e), ids, cut);
+                attach(ends.joints ? ends.joints : s, line_end_source(Shape::joint, geo, keys, e),
+                       ends.joint_ids ? *ends.joint_ids : ids, cut);
         }
     }
     if (!geo.curves.segments.empty()) {
@@ -987,6 +1017,23 @@ void EmbreeScene::Impl::add_geometry(RTCScene s, const geom::Geometry& geo,
         attach(s, discs_source(geo), ids, false);
     if (geo.mesh.size() > 0)
         attach(s, triangles_source(geo), ids, alpha || any_texture(geo.mesh.texture));
+}
+
+void EmbreeScene::Impl::place_line_ends(RTCScene ends, PlacedEnds& e)
+{
+    if (e.parts.empty()) {
+        rtcReleaseScene(ends);
+        return;
+    }
+    line_end_rtc_scenes.push_back(ends);
+    rtcCommitScene(ends);
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(g, ends);
+    const std::array<float, 12> identity{1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, identity.data());
+    rtcCommitGeometry(g);
+    e.instance = rtcAttachGeometry(scene, g);
+    rtcReleaseGeometry(g);
 }
 
 EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
@@ -1008,9 +1055,14 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
     const geom::Geometry& own = scene.geometry;
     if (scene.line_radius_in_pixels && !own.lines.keys.empty())
         m.world_keys = keys_in_world_units(own.lines, camera);
+    RTCScene caps = m.new_scene(), joints = m.new_scene();
+    auto& [cap_scene, joint_scene] = m.line_end_scenes;
     m.add_geometry(m.scene, own, m.top_parts,
                    m.world_keys.empty() ? nullptr : m.world_keys.data(),
-                   scene.line_radius_in_pixels, false);
+                   scene.line_radius_in_pixels, false, true,
+                   {caps, joints, &cap_scene.parts, &joint_scene.parts});
+    m.place_line_ends(caps, cap_scene);
+    m.place_line_ends(joints, joint_scene);
     m.segments = own.lines.segment_count() + own.curves.segment_count();
 
     // Pixel-width lines inside prototypes: each placed copy in world space, drawn unlit
