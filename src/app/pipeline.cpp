@@ -3,6 +3,7 @@
 // interpreted.
 #include "app/pipeline.h"
 
+#include <algorithm>
 #include <sstream>
 
 #include "base/diagnostics.h"
@@ -145,6 +146,26 @@ geom::Shading render_mode(const geom::ViewFile& view)
     }
     return mode;
 }
+/// The scene's own lines: with no texture on any of them, the per-key texture v and the
+/// per-segment texture index say nothing (scene.h lets both be empty), so they go, and
+/// the other buffers give back their growth slack (issue 15.3: a quarter of tree10m's
+/// Scene memory). Prototypes keep theirs: an instance's texture falls on their
+/// untextured primitives.
+void release_unused_line_buffers(geom::LinearCurves& l)
+{
+    if (std::all_of(l.texture.begin(), l.texture.end(),
+                    [](std::int16_t t) { return t == geom::no_texture; })) {
+        l.texture = {};
+        l.v = {};
+    }
+    l.keys.shrink_to_fit();
+    l.v.shrink_to_fit();
+    l.segments.shrink_to_fit();
+    l.flags.shrink_to_fit();
+    l.material.shrink_to_fit();
+    l.texture.shrink_to_fit();
+}
+
 }  // namespace
 
 geom::Scene interpret(const Model& model, const lsys::ModuleString& derived,
@@ -233,6 +254,7 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
     }
     // Non-finite or huge numbers would abort inside Embree: dropped here with a warning.
     geom::drop_unrenderable(scene);
+    release_unused_line_buffers(scene.geometry.lines);
     return scene;
 }
 

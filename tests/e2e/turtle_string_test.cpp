@@ -67,4 +67,27 @@ TEST(TurtleString, ReadingTheDerivedStringGivesTheSameScene)
     EXPECT_GT(applied.geometry.lines.segment_count(), direct.geometry.lines.segment_count());
 }
 
+// Untextured lines carry no texture v or texture index, and no growth slack (issue 15.3).
+TEST(TurtleString, UntexturedLinesKeepNoTextureBuffers)
+{
+    app::Options options = write_model("untextured", plain);
+    app::Model model = app::load_model(options);
+    geom::Scene scene = app::interpret(model, app::derive(model, options), options);
+    const geom::LinearCurves& l = scene.geometry.lines;
+    ASSERT_EQ(l.segment_count(), 7u);
+    EXPECT_TRUE(l.v.empty());
+    EXPECT_TRUE(l.texture.empty());
+    EXPECT_EQ(l.keys.capacity(), l.keys.size());
+    EXPECT_EQ(l.material.size(), 7u);
+
+    // a textured segment keeps both (the texture file need not exist to be named)
+    app::Options t = write_model("textured", "lsystem: 1\nderivation length: 1\naxiom: A\n"
+                                             "A --> F(1)@Tx(1)F(1)\nendlsystem\n");
+    std::ofstream(t.view, std::ios::app) << "texture: F: bark.png\n";
+    app::Model tm = app::load_model(t);
+    geom::Scene textured = app::interpret(tm, app::derive(tm, t), t);
+    EXPECT_EQ(textured.geometry.lines.texture.size(), textured.geometry.lines.segment_count());
+    EXPECT_EQ(textured.geometry.lines.v.size(), textured.geometry.lines.keys.size());
+}
+
 }  // namespace
