@@ -719,6 +719,7 @@ struct EmbreeScene::Impl : HitResolver {
     mutable std::atomic<std::uint64_t> skipped_rays{0};
     RayCounter rays;
     double build_seconds = 0;
+    std::size_t embree_shared_bytes = 0;  ///< shared_bytes() of every part built
     /// Embree's own allocations, from its memory monitor (called from any thread).
     std::atomic<std::int64_t> embree_bytes{0}, embree_peak_bytes{0};
 
@@ -963,10 +964,38 @@ void geometry_filter(const RTCFilterFunctionNArguments* args)
         alpha_filter(args);
 }
 
+namespace {
+
+/// The bytes of the part's buffers that Embree reads in place (rtcSetSharedGeometryBuffer):
+/// part of what Embree needs for it, though Cambium holds them.
+std::size_t bytes_shared_with_embree(const GeometrySource& part)
+{
+    const geom::Geometry& g = *part.geometry;
+    auto flags = [](const auto& v, std::size_t n) { return v.size() == n ? n : 0; };
+    switch (part.shape) {
+    case Shape::line:
+        return g.lines.keys.size() * sizeof(Key) + g.lines.segments.size() * sizeof(std::uint32_t) +
+               (part.unlit ? flags(g.lines.flags, g.lines.segments.size()) : 0);
+    case Shape::curve:
+        return (g.curves.points.size() + g.curves.tangents.size()) * sizeof(Key) +
+               g.curves.segments.size() * sizeof(std::uint32_t) +
+               flags(g.curves.flags, g.curves.segments.size());
+    case Shape::sphere: return g.spheres.centres.size() * sizeof(Key);
+    case Shape::disc: return g.discs.centres.size() * sizeof(Key);  // normals: copied
+    case Shape::triangle: return 0;                                 // copied
+    case Shape::cap: return part.ends->caps.size() * sizeof(Key);
+    case Shape::joint: return part.ends->joints.size() * sizeof(Key);
+    }
+    return 0;
+}
+
+}  // namespace
+
 void EmbreeScene::Impl::attach(RTCScene s, GeometrySource part,
                                std::vector<const GeometrySource*>& ids, bool alpha)
 {
     RTCGeometry g = kind(part.shape).build(device, part);
+    embree_shared_bytes += bytes_shared_with_embree(part);
     part.owner = this;
     part.skips_self = kind(part.shape).self_hits;
     part.pixel_line = part.shape == Shape::line && part.unlit;
@@ -1137,6 +1166,33 @@ std::uint64_t EmbreeScene::embree_bytes() const
 std::uint64_t EmbreeScene::embree_peak_bytes() const
 {
     return static_cast<std::uint64_t>(m_impl->embree_peak_bytes.load());
+}
+
+std::uint64_t EmbreeScene::shared_bytes() const { return m_impl->embree_shared_bytes; }
+
+namespace {
+
+template <class T>
+std::size_t capacity_bytes(const std::vector<T>& v)
+{
+    return v.capacity() * sizeof(T);
+}
+
+}  // namespace
+
+std::uint64_t EmbreeScene::own_bytes() const
+{
+    const Impl& m = *m_impl;
+    std::size_t bytes = capacity_bytes(m.world_keys) + capacity_bytes(m.placements) +
+                        m.parts.size() * sizeof(GeometrySource);
+    for (const LineEnds& e : m.line_ends)
+        bytes += capacity_bytes(e.caps) + capacity_bytes(e.cap_normals) +
+                 capacity_bytes(e.cap_segment) + capacity_bytes(e.cap_at_end) +
+                 capacity_bytes(e.joints) + capacity_bytes(e.joint_segment);
+    const geom::LinearCurves& p = m.placed_lines.lines;
+    bytes += capacity_bytes(p.keys) + capacity_bytes(p.v) + capacity_bytes(p.segments) +
+             capacity_bytes(p.flags) + capacity_bytes(p.material) + capacity_bytes(p.texture);
+    return bytes;
 }
 
 namespace {
