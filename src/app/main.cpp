@@ -347,7 +347,9 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
     }
 
     lap = Clock::now();
-    lsys::ModuleString turtle = turtle_string(model, string, options);
+    lsys::ModuleString turtle = turtle_reads_derived_string(model, options)
+                                    ? std::move(string)
+                                    : turtle_string(model, string, options);
     string = lsys::ModuleString();  // freed before the geometry grows: a lower peak
     geom::Scene scene = interpret_turtle_string(model, turtle, options);
     turtle = lsys::ModuleString();

@@ -3,6 +3,8 @@
 // interpreted.
 #include "app/pipeline.h"
 
+#include <algorithm>
+#include <sstream>
 
 #include "base/diagnostics.h"
 #include "base/subprocess.h"
@@ -184,12 +186,47 @@ void light_by_colour_index(geom::Scene& scene, const geom::ViewFile& view)
         scene.materials[i + geom::colour_indices].index_lighting = geom::IndexLighting::surface;
     }
 }
+/// The scene's own lines: with no texture on any of them, the per-key texture v and the
+/// per-segment texture index say nothing (scene.h lets both be empty), so they go, and
+/// the other buffers give back their growth slack (issue 15.3: a quarter of tree10m's
+/// Scene memory). Prototypes keep theirs: an instance's texture falls on their
+/// untextured primitives.
+void release_unused_line_buffers(geom::LinearCurves& l)
+{
+    if (std::all_of(l.texture.begin(), l.texture.end(),
+                    [](std::int16_t t) { return t == geom::no_texture; })) {
+        l.texture = {};
+        l.v = {};
+    }
+    l.keys.shrink_to_fit();
+    l.v.shrink_to_fit();
+    l.segments.shrink_to_fit();
+    l.flags.shrink_to_fit();
+    l.material.shrink_to_fit();
+    l.texture.shrink_to_fit();
+}
+
 }  // namespace
 
 geom::Scene interpret(const Model& model, const lsys::ModuleString& derived,
                       const Options& options)
 {
+    if (turtle_reads_derived_string(model, options))
+        return interpret_turtle_string(model, derived, options);
     return interpret_turtle_string(model, turtle_string(model, derived, options), options);
+}
+
+bool turtle_reads_derived_string(const Model& model, const Options& options)
+{
+    if (options.homomorphism_in_string)
+        return true;
+    const lsys::Program& program = model.lsystem.program();
+    if (!program.split_commands.empty())
+        return false;
+    for (const auto& ls : program.lsystems)
+        if (!ls.homomorphism.productions.empty())
+            return false;
+    return true;
 }
 
 namespace {
@@ -296,6 +333,7 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
         geom::draw_as_wireframe(scene, wireframe_style(model, scene, options));
     // Non-finite or huge numbers would abort inside Embree: dropped here with a warning.
     geom::drop_unrenderable(scene);
+    release_unused_line_buffers(scene.geometry.lines);
     return scene;
 }
 

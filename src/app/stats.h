@@ -60,6 +60,9 @@ struct RunStats {
 
     std::uint64_t embree_bytes = 0, embree_peak_bytes = 0;
     std::uint64_t cambium_bytes = 0;  ///< the Scene's primitive buffers (capacities)
+    /// The renderer's buffers beside the Scene's (caps, joints, placements), and of all
+    /// Cambium's buffers those Embree reads in place instead of copying.
+    std::uint64_t render_buffer_bytes = 0, embree_shared_bytes = 0;
     std::uint64_t peak_process_bytes = 0;
 
     int width = 0, height = 0;

@@ -667,6 +667,16 @@ struct HitResolver {
     std::vector<const GeometrySource*> top_parts;  ///< by top-level geometry id
     std::vector<std::vector<const GeometrySource*>> proto_parts;  ///< by prototype, geometry id
     std::vector<Placement> placements;  ///< by top-level geometry id
+    /// The caps and the joints of the scene's own shaded lines live in two scenes of their
+    /// own, each placed once, untransformed, by a top-level instance (none: no such scene).
+    /// Embree's leaves hold primitives of one geometry only: caps and joints beside every
+    /// segment in one BVH left most leaves with one primitive, and cost 187 B per segment
+    /// instead of about 70 (issue 15.3).
+    struct PlacedEnds {
+        std::uint32_t instance = PrimId::none;
+        std::vector<const GeometrySource*> parts;  ///< by geometry id in its scene
+    };
+    std::array<PlacedEnds, 2> line_end_scenes;  ///< caps, joints
 
     const Placement* placement(std::uint32_t inst_id) const
     {
@@ -676,6 +686,10 @@ struct HitResolver {
     }
     const GeometrySource* part(std::uint32_t inst_id, std::uint32_t geom_id) const
     {
+        if (inst_id != PrimId::none)
+            for (const PlacedEnds& e : line_end_scenes)
+                if (inst_id == e.instance)
+                    return e.parts[geom_id];
         if (const Placement* p = placement(inst_id))
             return proto_parts[p->instance->prototype][geom_id];
         return top_parts[geom_id];
@@ -690,6 +704,7 @@ struct EmbreeScene::Impl : HitResolver {
     RTCDevice device = nullptr;
     RTCScene scene = nullptr;
     std::vector<RTCScene> prototype_scenes;
+    std::vector<RTCScene> line_end_rtc_scenes;  ///< the scene's own caps and joints (HitResolver)
     std::deque<GeometrySource> parts;  ///< stable addresses (Embree user data)
     std::deque<LineEnds> line_ends;  ///< caps and joints of shaded lines (stable addresses)
     std::vector<Key> world_keys;  ///< line keys with pixel radii converted (else empty)
@@ -704,6 +719,7 @@ struct EmbreeScene::Impl : HitResolver {
     mutable std::atomic<std::uint64_t> skipped_rays{0};
     RayCounter rays;
     double build_seconds = 0;
+    std::size_t embree_shared_bytes = 0;  ///< shared_bytes() of every part built
     /// Embree's own allocations, from its memory monitor (called from any thread).
     std::atomic<std::int64_t> embree_bytes{0}, embree_peak_bytes{0};
 
@@ -723,6 +739,9 @@ struct EmbreeScene::Impl : HitResolver {
         if (scene)
             rtcReleaseScene(scene);
         for (RTCScene s : prototype_scenes)
+            if (s)
+                rtcReleaseScene(s);
+        for (RTCScene s : line_end_rtc_scenes)
             rtcReleaseScene(s);
         if (device)
             rtcReleaseDevice(device);
@@ -744,9 +763,18 @@ struct EmbreeScene::Impl : HitResolver {
         return s;
     }
 
+    /// Where add_geometry() puts the caps and joints of shaded lines: their scenes and
+    /// geometry ids (null: beside the lines).
+    struct LineEndsTarget {
+        RTCScene caps, joints;  // (no member initializers: {} as a default argument zeroes them)
+        std::vector<const GeometrySource*>*cap_ids, *joint_ids;
+    };
     /// Adds every non-empty part of g to s; ids[geomID] = its GeometrySource.
     void add_geometry(RTCScene s, const geom::Geometry& g, std::vector<const GeometrySource*>& ids,
-                      const Key* line_keys, bool unlit, bool alpha, bool lines = true);
+                      const Key* line_keys, bool unlit, bool alpha, bool lines = true,
+                      LineEndsTarget ends = {});
+    /// Places `ends` (the scene's own caps or joints) in the top-level scene, if not empty.
+    void place_line_ends(RTCScene ends, PlacedEnds& e);
     /// Builds the part's Embree geometry (its ShapeKind) and attaches it to s; `alpha`:
     /// hits are cut out where its texture's alpha is below one half.
     void attach(RTCScene s, GeometrySource part, std::vector<const GeometrySource*>& ids,
@@ -936,10 +964,38 @@ void geometry_filter(const RTCFilterFunctionNArguments* args)
         alpha_filter(args);
 }
 
+namespace {
+
+/// The bytes of the part's buffers that Embree reads in place (rtcSetSharedGeometryBuffer):
+/// part of what Embree needs for it, though Cambium holds them.
+std::size_t bytes_shared_with_embree(const GeometrySource& part)
+{
+    const geom::Geometry& g = *part.geometry;
+    auto flags = [](const auto& v, std::size_t n) { return v.size() == n ? n : 0; };
+    switch (part.shape) {
+    case Shape::line:
+        return g.lines.keys.size() * sizeof(Key) + g.lines.segments.size() * sizeof(std::uint32_t) +
+               (part.unlit ? flags(g.lines.flags, g.lines.segments.size()) : 0);
+    case Shape::curve:
+        return (g.curves.points.size() + g.curves.tangents.size()) * sizeof(Key) +
+               g.curves.segments.size() * sizeof(std::uint32_t) +
+               flags(g.curves.flags, g.curves.segments.size());
+    case Shape::sphere: return g.spheres.centres.size() * sizeof(Key);
+    case Shape::disc: return g.discs.centres.size() * sizeof(Key);  // normals: copied
+    case Shape::triangle: return 0;                                 // copied
+    case Shape::cap: return part.ends->caps.size() * sizeof(Key);
+    case Shape::joint: return part.ends->joints.size() * sizeof(Key);
+    }
+    return 0;
+}
+
+}  // namespace
+
 void EmbreeScene::Impl::attach(RTCScene s, GeometrySource part,
                                std::vector<const GeometrySource*>& ids, bool alpha)
 {
     RTCGeometry g = kind(part.shape).build(device, part);
+    embree_shared_bytes += bytes_shared_with_embree(part);
     part.owner = this;
     part.skips_self = kind(part.shape).self_hits;
     part.pixel_line = part.shape == Shape::line && part.unlit;
@@ -961,8 +1017,9 @@ void EmbreeScene::Impl::attach(RTCScene s, GeometrySource part,
 
 void EmbreeScene::Impl::add_geometry(RTCScene s, const geom::Geometry& geo,
                                      std::vector<const GeometrySource*>& ids, const Key* line_keys,
-                                     bool unlit, bool alpha, bool lines)
+                                     bool unlit, bool alpha, bool lines, LineEndsTarget ends)
 {
+
     const geom::LinearCurves& l = geo.lines;
     if (lines && !l.segments.empty()) {
         const Key* keys = line_keys ? line_keys : l.keys.data();
@@ -971,9 +1028,11 @@ void EmbreeScene::Impl::add_geometry(RTCScene s, const geom::Geometry& geo,
         if (!unlit) {
             const LineEnds& e = line_ends.emplace_back(render::line_ends(l, keys));
             if (!e.caps.empty())
-                attach(s, line_end_source(Shape::cap, geo, keys, e), ids, cut);
+                attach(ends.caps ? ends.caps : s, line_end_source(Shape::cap, geo, keys, e),
+                       ends.cap_ids ? *ends.cap_ids : ids, cut);
             if (!e.joints.empty())
-                attach(s, line_end_source(Shape::joint, geo, keys, e), ids, cut);
+                attach(ends.joints ? ends.joints : s, line_end_source(Shape::joint, geo, keys, e),
+                       ends.joint_ids ? *ends.joint_ids : ids, cut);
         }
     }
     if (!geo.curves.segments.empty()) {
@@ -987,6 +1046,23 @@ void EmbreeScene::Impl::add_geometry(RTCScene s, const geom::Geometry& geo,
         attach(s, discs_source(geo), ids, false);
     if (geo.mesh.size() > 0)
         attach(s, triangles_source(geo), ids, alpha || any_texture(geo.mesh.texture));
+}
+
+void EmbreeScene::Impl::place_line_ends(RTCScene ends, PlacedEnds& e)
+{
+    if (e.parts.empty()) {
+        rtcReleaseScene(ends);
+        return;
+    }
+    line_end_rtc_scenes.push_back(ends);
+    rtcCommitScene(ends);
+    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(g, ends);
+    const std::array<float, 12> identity{1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, identity.data());
+    rtcCommitGeometry(g);
+    e.instance = rtcAttachGeometry(scene, g);
+    rtcReleaseGeometry(g);
 }
 
 EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
@@ -1008,9 +1084,14 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
     const geom::Geometry& own = scene.geometry;
     if (scene.line_radius_in_pixels && !own.lines.keys.empty())
         m.world_keys = keys_in_world_units(own.lines, camera);
+    RTCScene caps = m.new_scene(), joints = m.new_scene();
+    auto& [cap_scene, joint_scene] = m.line_end_scenes;
     m.add_geometry(m.scene, own, m.top_parts,
                    m.world_keys.empty() ? nullptr : m.world_keys.data(),
-                   scene.line_radius_in_pixels, false);
+                   scene.line_radius_in_pixels, false, true,
+                   {caps, joints, &cap_scene.parts, &joint_scene.parts});
+    m.place_line_ends(caps, cap_scene);
+    m.place_line_ends(joints, joint_scene);
     m.segments = own.lines.segment_count() + own.curves.segment_count();
 
     // Pixel-width lines inside prototypes: each placed copy in world space, drawn unlit
@@ -1085,6 +1166,33 @@ std::uint64_t EmbreeScene::embree_bytes() const
 std::uint64_t EmbreeScene::embree_peak_bytes() const
 {
     return static_cast<std::uint64_t>(m_impl->embree_peak_bytes.load());
+}
+
+std::uint64_t EmbreeScene::shared_bytes() const { return m_impl->embree_shared_bytes; }
+
+namespace {
+
+template <class T>
+std::size_t capacity_bytes(const std::vector<T>& v)
+{
+    return v.capacity() * sizeof(T);
+}
+
+}  // namespace
+
+std::uint64_t EmbreeScene::own_bytes() const
+{
+    const Impl& m = *m_impl;
+    std::size_t bytes = capacity_bytes(m.world_keys) + capacity_bytes(m.placements) +
+                        m.parts.size() * sizeof(GeometrySource);
+    for (const LineEnds& e : m.line_ends)
+        bytes += capacity_bytes(e.caps) + capacity_bytes(e.cap_normals) +
+                 capacity_bytes(e.cap_segment) + capacity_bytes(e.cap_at_end) +
+                 capacity_bytes(e.joints) + capacity_bytes(e.joint_segment);
+    const geom::LinearCurves& p = m.placed_lines.lines;
+    bytes += capacity_bytes(p.keys) + capacity_bytes(p.v) + capacity_bytes(p.segments) +
+             capacity_bytes(p.flags) + capacity_bytes(p.material) + capacity_bytes(p.texture);
+    return bytes;
 }
 
 namespace {

@@ -129,6 +129,12 @@ public:
     std::uint64_t rays_traced() const;
     std::uint64_t embree_bytes() const;
     std::uint64_t embree_peak_bytes() const;
+    /// The bytes of the buffers Embree reads in place instead of copying (keys, segment
+    /// indices, centres: the Scene's, or this object's own): part of what Embree needs.
+    std::uint64_t shared_bytes() const;
+    /// The bytes this object holds itself beside Embree and the Scene: caps and joints,
+    /// converted and placed pixel-width lines, instances' placements.
+    std::uint64_t own_bytes() const;
 
 private:
     struct Impl;

@@ -179,6 +179,9 @@ struct RenderReport {
     /// Bytes Embree allocated itself (BVHs, internal copies; not the shared buffers):
     /// after the build and at most so far.
     std::uint64_t embree_bytes = 0, embree_peak_bytes = 0;
+    /// Of the buffers Embree reads in place, their bytes (EmbreeScene::shared_bytes), and
+    /// the renderer's own buffers beside the Scene's (EmbreeScene::own_bytes).
+    std::uint64_t embree_shared_bytes = 0, render_buffer_bytes = 0;
 };
 
 /// Renders the scene as cpfg frames it (make_camera, plus the settings' thin lens) with

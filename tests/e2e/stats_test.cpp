@@ -69,9 +69,11 @@ void expect_documented_keys(const nlohmann::json& j)
     for (const char* group : {"primitives", "placed_primitives"})
         for (const char* key : {"cylinders", "curve_segments", "spheres", "discs", "triangles", "total"})
             EXPECT_TRUE(j[group].contains(key)) << group << "." << key;
-    for (const char* key : {"embree", "embree_peak", "cambium", "peak_process"})
+    for (const char* key : {"embree", "embree_peak", "cambium", "scene_buffers", "render_buffers",
+                            "embree_shared", "peak_process"})
         EXPECT_TRUE(j["memory_bytes"].contains(key)) << key;
-    for (const char* key : {"embree", "cambium", "peak_process", "ratio_to_embree"})
+    for (const char* key : {"embree", "cambium", "peak_process", "ratio_to_embree",
+                            "ratio_to_embree_allocations"})
         EXPECT_TRUE(j["bytes_per_primitive"].contains(key)) << key;
     for (const char* key : {"width", "height", "samples", "rays", "samples_per_s", "rays_per_s"})
         EXPECT_TRUE(j["render"].contains(key)) << key;
@@ -122,6 +124,20 @@ TEST(Stats, JsonCountsTheScenesPrimitivesAndTimesAddUp)
     EXPECT_LT(m["cambium"].get<std::uint64_t>(), 100'000);
     EXPECT_GT(m["peak_process"].get<std::uint64_t>(),
               m["embree"].get<std::uint64_t>() + m["cambium"].get<std::uint64_t>());
+
+    // Cambium's memory is the Scene's buffers and the renderer's (the cylinders' caps);
+    // of it, keys and indices Embree reads in place count as what Embree needs.
+    auto bytes = [&](const char* key) { return double(m[key].get<std::uint64_t>()); };
+    EXPECT_EQ(bytes("cambium"), bytes("scene_buffers") + bytes("render_buffers"));
+    EXPECT_GT(bytes("render_buffers"), 0);
+    EXPECT_GT(bytes("embree_shared"), 3 * 16);  // at least the cylinders' keys
+    EXPECT_LT(bytes("embree_shared"), bytes("cambium"));
+    const nlohmann::json& per = j["bytes_per_primitive"];
+    EXPECT_NEAR(per["ratio_to_embree"].get<double>(),
+                (bytes("embree") + bytes("cambium")) / (bytes("embree") + bytes("embree_shared")),
+                1e-9);
+    EXPECT_NEAR(per["ratio_to_embree_allocations"].get<double>(),
+                (bytes("embree") + bytes("cambium")) / bytes("embree"), 1e-9);
 }
 
 TEST(Stats, PrintedBlockNamesEachFigure)
