@@ -377,7 +377,7 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         if (!options.view_volume && !filter.to_render(number))
             return;
         if (refit && animation->new_view_between_frames)
-            model.view = std::make_shared<const geom::ViewFile>(geom::read_view_file(options.view));
+            model.view = read_view(options);
         if (options.view_volume && writes) {
             geom::Scene scene = interpret(model, written, options);
             scene.view = render::apply_overrides(scene.view, overrides, scene.bounds);
