@@ -3,8 +3,9 @@
 # their headers (P/include/cambium/<layer>/...) and a CMake package, so another project can
 #   find_package(cambium 0.1 REQUIRED)
 #   target_link_libraries(app PRIVATE cambium::render)   # or cambium::lsys, ::geom, ...
-# The libraries link Embree, TBB, CLI11, fmt and nlohmann-json privately; the package finds them again for
-# the consumer's link (cmake/cambiumConfig.cmake.in). OpenImageIO is linked only into
+# The libraries link Embree, TBB, FreeType, fontconfig, CLI11, fmt and nlohmann-json
+# privately; the package finds them again for the consumer's link
+# (cmake/cambiumConfig.cmake.in). OpenImageIO is linked only into
 # libcambium_imageio.so, installed into the library folder (src/render/CMakeLists.txt),
 # which image output and textures dlopen on first use.
 include(GNUInstallDirs)

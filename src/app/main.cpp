@@ -8,6 +8,7 @@
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string_view>
 
 #include <unistd.h>
@@ -79,20 +80,21 @@ render::RenderSettings render_settings(const Options& options,
     settings.focus_distance = options.focus_distance;
     settings.transparent_background = options.transparent;
     settings.ambient = {options.ambient, options.ambient, options.ambient};
+    std::optional<render::Environment> environment;
     if (options.sky) {
         render::SkyParameters sky;
         if (!options.sun_direction.empty())
             sky.sun_direction = render::normalize(render::Vec3f(
                 options.sun_direction[0], options.sun_direction[1], options.sun_direction[2]));
         sky.turbidity = options.turbidity;
-        settings.environment = render::make_sky_environment(sky);
+        environment = render::make_sky_environment(sky);
     } else if (options.environment_map) {
-        settings.environment =
+        environment =
             render::make_map_environment(*options.environment_map, options.environment_scale);
     }
-    if (settings.environment && options.environment_rotation != 0)
-        settings.environment =
-            render::make_rotated_environment(settings.environment, options.environment_rotation);
+    if (environment)
+        settings.environment = std::make_shared<const render::Environment>(
+            std::move(*environment).rotated(options.environment_rotation));
     settings.progress = !options.quiet && isatty(fileno(stderr));
     // The albedo, normal and depth layers cost a camera-ray intersection; only EXR keeps them.
     settings.aovs = std::any_of(images.begin(), images.end(), [](const auto& f) {

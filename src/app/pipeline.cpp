@@ -4,6 +4,7 @@
 #include "app/pipeline.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <sstream>
 
 #include "base/diagnostics.h"
@@ -75,10 +76,28 @@ void run_system_call(const std::string& command, const std::filesystem::path& fo
 
 }  // namespace
 
+std::shared_ptr<const geom::ViewFile> read_view(const Options& options)
+{
+    auto view = std::make_shared<const geom::ViewFile>(geom::read_view_file(options.view));
+    if (options.allow_file_access)
+        return view;
+    namespace fs = std::filesystem;
+    const fs::path folder = fs::weakly_canonical(fs::absolute(options.lsystem).parent_path());
+    for (const geom::TextureDef& t : view->textures) {
+        const fs::path file = fs::weakly_canonical(t.file);  // links and .. resolved
+        auto [f, unused] = std::mismatch(folder.begin(), folder.end(), file.begin(), file.end());
+        if (f != folder.end())
+            throw Error(FileLoc{options.view.string()},
+                        "texture '" + t.file.string() + "' lies outside the model's folder " +
+                            folder.string() + " (--allow-file-access lifts this)");
+    }
+    return view;
+}
+
 Model load_model(const Options& options)
 {
     geom::Palette palette = load_palette(options);
-    auto view = std::make_shared<const geom::ViewFile>(geom::read_view_file(options.view));
+    std::shared_ptr<const geom::ViewFile> view = read_view(options);
     auto functions =
         std::make_shared<const geom::FunctionSet>(geom::FunctionSet::from_view_file(*view));
 

@@ -24,6 +24,12 @@ struct Model {
     lsys::LSystem lsystem;
 };
 
+/// The view file, its texture images confined to the model's folder (the .l file's, where
+/// cpfg runs) and below, as the L-system's own files are (docs/security.md): a texture
+/// elsewhere, through `..`, an absolute path or a link, is an error naming the view file,
+/// unless options.allow_file_access. Relative names are the view file's folder's.
+std::shared_ptr<const geom::ViewFile> read_view(const Options& options);
+
 /// Reads the colour files, the view file, its functions and then the L-system, in that
 /// order (a function set defines names for the L-system's preprocessor). Throws
 /// cambium::Error naming file, line and column.

@@ -485,7 +485,7 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         if (!options.view_volume && !filter.to_render(number))
             return;
         if (refit && animation->new_view_between_frames)
-            model.view = std::make_shared<const geom::ViewFile>(geom::read_view_file(options.view));
+            model.view = read_view(options);
         if (options.view_volume && writes) {
             auto vv_start = Clock::now();
             // --fit drops the view file's box (render::apply_overrides)

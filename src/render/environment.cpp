@@ -48,35 +48,7 @@ Vec3f uniform_sphere(float u1, float u2)
 
 float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
-class UniformEnvironment final : public Environment {
-public:
-    explicit UniformEnvironment(const Vec3f& radiance) : m_radiance(radiance) {}
-    Vec3f radiance(const Vec3f&) const override { return m_radiance; }
-    EnvironmentSample sample(float u1, float u2) const override
-    {
-        return {uniform_sphere(u1, u2), m_radiance, inv_4pi};
-    }
-    float pdf(const Vec3f&) const override { return inv_4pi; }
-    bool black() const override
-    {
-        return m_radiance.x <= 0 && m_radiance.y <= 0 && m_radiance.z <= 0;
-    }
-
-private:
-    Vec3f m_radiance;
-};
-
 Vec3f exp(const Vec3f& v) { return {std::exp(v.x), std::exp(v.y), std::exp(v.z)}; }
-
-/// The Perez luminance distribution's five coefficients.
-struct Perez {
-    float a, b, c, d, e;
-    float operator()(float cos_theta, float gamma, float cos_gamma) const
-    {
-        return (1 + a * std::exp(b / std::max(cos_theta, 1e-3f))) *
-               (1 + c * std::exp(d * gamma) + e * cos_gamma * cos_gamma);
-    }
-};
 
 /// Linear sRGB (D65) of CIE xyY.
 Vec3f xyY_to_rgb(float x, float y, float Y)
@@ -89,335 +61,346 @@ Vec3f xyY_to_rgb(float x, float y, float Y)
             std::max(0.0f, 0.0557f * X - 0.2040f * Y + 1.0570f * Z)};
 }
 
-class SkyEnvironment final : public Environment {
-public:
-    explicit SkyEnvironment(const SkyParameters& p)
-    {
-        m_sun = normalize(p.sun_direction);
-        if (length(m_sun) == 0)
-            m_sun = {0, 1, 0};
-        const float t = std::clamp(p.turbidity, sky_min_turbidity, sky_max_turbidity);
-        // Below the horizon the dome is the sunset one, fading out by -6 degrees.
-        float elevation = std::asin(std::clamp(m_sun.y, -1.0f, 1.0f));
-        float fade = std::clamp(1 + elevation / (6 * pi / 180), 0.0f, 1.0f);
-        m_theta_s = std::min(pi / 2 - elevation, pi / 2);
-        m_sun_dome = m_sun.y >= 0 ? m_sun : normalize(Vec3f(m_sun.x, 0, m_sun.z));
-        if (length(m_sun_dome) == 0)
-            m_sun_dome = {0, 1, 0};
-
-        m_Y = {0.1787f * t - 1.4630f, -0.3554f * t + 0.4275f, -0.0227f * t + 5.3251f,
-               0.1206f * t - 2.5771f, -0.0670f * t + 0.3703f};
-        m_x = {-0.0193f * t - 0.2592f, -0.0665f * t + 0.0008f, -0.0004f * t + 0.2125f,
-               -0.0641f * t - 0.8989f, -0.0033f * t + 0.0452f};
-        m_y = {-0.0167f * t - 0.2608f, -0.0950f * t + 0.0092f, -0.0079f * t + 0.2102f,
-               -0.0441f * t - 1.6537f, -0.0109f * t + 0.0529f};
-        float chi = (4.0f / 9 - t / 120) * (pi - 2 * m_theta_s);
-        float zenith_Y = std::max(0.0f, (4.0453f * t - 4.9710f) * std::tan(chi) - 0.2155f * t +
-                                            2.4192f);  // kcd/m^2
-        float th = m_theta_s, th2 = th * th, th3 = th2 * th, t2 = t * t;
-        m_zenith_x = (0.00166f * th3 - 0.00375f * th2 + 0.00209f * th) * t2 +
-                     (-0.02903f * th3 + 0.06377f * th2 - 0.03202f * th + 0.00394f) * t +
-                     (0.11693f * th3 - 0.21196f * th2 + 0.06052f * th + 0.25886f);
-        m_zenith_y = (0.00275f * th3 - 0.00610f * th2 + 0.00317f * th) * t2 +
-                     (-0.04214f * th3 + 0.08970f * th2 - 0.04153f * th + 0.00516f) * t +
-                     (0.15346f * th3 - 0.26756f * th2 + 0.06670f * th + 0.26688f);
-        m_zenith_Y =
-            zenith_Y * 1000 / sky_luminance_unit * std::max(p.sky_intensity, 0.0f) * fade;
-        m_norm_Y = m_Y(1, m_theta_s, std::cos(m_theta_s));
-        m_norm_x = m_x(1, m_theta_s, std::cos(m_theta_s));
-        m_norm_y = m_y(1, m_theta_s, std::cos(m_theta_s));
-
-        // The sun outside the atmosphere gives pi * sun_intensity; the air dims it.
-        m_cos_sun = std::cos(0.2665f * pi / 180);
-        m_sun_solid_angle = 2 * pi * (1 - m_cos_sun);
-        m_sun_up = m_sun.y > 0 && p.sun_intensity > 0;
-        Vec3f colour = sun_transmittance(t, m_sun.y);
-        m_sun_radiance = m_sun_up ? colour * (pi * p.sun_intensity / m_sun_solid_angle) : Vec3f();
-        Vec3f sun_irradiance = m_sun_up ? colour * (pi * p.sun_intensity * m_sun.y) : Vec3f();
-        m_ground = p.ground_albedo * (sun_irradiance + dome_irradiance()) * (1 / pi);
-        m_black = !(m_zenith_Y > 0) && !m_sun_up;
-        m_sun_probability = m_sun_up ? 0.5f : 0.0f;
-    }
-
-    Vec3f radiance(const Vec3f& d) const override
-    {
-        float cos_sun = dot(d, m_sun);
-        Vec3f sky = d.y < 0 ? m_ground : dome(d);
-        if (m_sun_up && cos_sun >= m_cos_sun)
-            sky += m_sun_radiance;
-        return sky;
-    }
-
-    EnvironmentSample sample(float u1, float u2) const override
-    {
-        Vec3f d;
-        if (u1 < m_sun_probability) {
-            // Uniform in the sun's cone.
-            float u = u1 / m_sun_probability;
-            float cos_t = 1 - u * (1 - m_cos_sun);
-            float sin_t = std::sqrt(std::max(0.0f, 1 - cos_t * cos_t));
-            float phi = 2 * pi * u2;
-            Vec3f t, b;
-            make_basis(m_sun, t, b);
-            d = normalize(t * (sin_t * std::cos(phi)) + b * (sin_t * std::sin(phi)) +
-                          m_sun * cos_t);
-        } else {
-            float u = (u1 - m_sun_probability) / (1 - m_sun_probability);
-            d = uniform_sphere(std::min(u, 0x1.fffffep-1f), u2);
-        }
-        return {d, radiance(d), pdf(d)};
-    }
-
-    float pdf(const Vec3f& d) const override
-    {
-        float p = (1 - m_sun_probability) * inv_4pi;
-        if (m_sun_up && dot(d, m_sun) >= m_cos_sun)
-            p += m_sun_probability / m_sun_solid_angle;
-        return p;
-    }
-
-    bool black() const override { return m_black; }
-
-private:
-    /// Preetham's dome along d (d.y >= 0), without the sun disk.
-    Vec3f dome(const Vec3f& d) const
-    {
-        if (!(m_zenith_Y > 0))
-            return {};
-        float cos_gamma = std::clamp(dot(d, m_sun_dome), -1.0f, 1.0f);
-        float gamma = std::acos(cos_gamma);
-        float Y = m_zenith_Y * m_Y(d.y, gamma, cos_gamma) / m_norm_Y;
-        float x = m_zenith_x * m_x(d.y, gamma, cos_gamma) / m_norm_x;
-        float y = m_zenith_y * m_y(d.y, gamma, cos_gamma) / m_norm_y;
-        return xyY_to_rgb(x, y, std::max(Y, 0.0f));
-    }
-
-    /// The dome's irradiance on a horizontal plane: a midpoint rule in (cos theta, phi).
-    Vec3f dome_irradiance() const
-    {
-        constexpr int n_cos = 32, n_phi = 64;
-        Vec3f sum;
-        for (int i = 0; i < n_cos; ++i) {
-            float c = (i + 0.5f) / n_cos, s = std::sqrt(1 - c * c);
-            for (int j = 0; j < n_phi; ++j) {
-                float phi = 2 * pi * (j + 0.5f) / n_phi;
-                sum += dome({s * std::cos(phi), c, s * std::sin(phi)}) * c;
-            }
-        }
-        return sum * (2 * pi / (n_cos * n_phi));
-    }
-
-    /// Rayleigh and Angstrom aerosol transmittance for R, G, B (0.65, 0.55, 0.45 um).
-    static Vec3f sun_transmittance(float turbidity, float cos_zenith)
-    {
-        float zenith_deg = std::acos(std::clamp(cos_zenith, 0.0f, 1.0f)) * 180 / pi;
-        float airmass = 1 / (std::max(cos_zenith, 0.0f) +
-                             0.50572f * std::pow(96.07995f - zenith_deg, -1.6364f));
-        float beta = 0.04608f * turbidity - 0.04586f;
-        auto tau = [&](float um) {
-            return 0.008735f * std::pow(um, -4.08f) + beta * std::pow(um, -1.3f);
-        };
-        return exp(Vec3f(tau(0.65f), tau(0.55f), tau(0.45f)) * -airmass);
-    }
-
-    Vec3f m_sun, m_sun_dome, m_ground, m_sun_radiance;
-    Perez m_Y{}, m_x{}, m_y{};
-    float m_theta_s = 0, m_zenith_Y = 0, m_zenith_x = 0, m_zenith_y = 0;
-    float m_norm_Y = 1, m_norm_x = 1, m_norm_y = 1;
-    float m_cos_sun = 1, m_sun_solid_angle = 0, m_sun_probability = 0;
-    bool m_sun_up = false, m_black = false;
-};
-
-/// Another environment turned about +y.
-class RotatedEnvironment final : public Environment {
-public:
-    RotatedEnvironment(std::shared_ptr<const Environment> inner, float degrees)
-        : m_inner(std::move(inner))
-    {
-        double radians = double(degrees) * std::numbers::pi / 180;
-        m_cos = static_cast<float>(std::cos(radians));
-        m_sin = static_cast<float>(std::sin(radians));
-    }
-    Vec3f radiance(const Vec3f& d) const override { return m_inner->radiance(unturn(d)); }
-    EnvironmentSample sample(float u1, float u2) const override
-    {
-        EnvironmentSample s = m_inner->sample(u1, u2);
-        s.direction = turn(s.direction);
-        return s;
-    }
-    float pdf(const Vec3f& d) const override { return m_inner->pdf(unturn(d)); }
-    bool black() const override { return m_inner->black(); }
-
-private:
-    Vec3f turn(const Vec3f& d) const
-    {
-        return {m_cos * d.x + m_sin * d.z, d.y, -m_sin * d.x + m_cos * d.z};
-    }
-    Vec3f unturn(const Vec3f& d) const
-    {
-        return {m_cos * d.x - m_sin * d.z, d.y, m_sin * d.x + m_cos * d.z};
-    }
-
-    std::shared_ptr<const Environment> m_inner;
-    float m_cos = 1, m_sin = 0;
-};
-
-/// A piecewise-constant 1D distribution over [0, 1) with n equal bins.
-struct Distribution1D {
-    std::vector<float> func;
-    std::vector<double> cdf;  // n + 1 entries, cdf[n] = 1 (or uniform when all zero)
-    double integral = 0;      // mean of func
-
-    explicit Distribution1D(std::vector<float> f) : func(std::move(f)), cdf(func.size() + 1)
-    {
-        std::size_t n = func.size();
-        for (std::size_t i = 0; i < n; ++i)
-            cdf[i + 1] = cdf[i] + func[i] / double(n);
-        integral = cdf[n];
-        for (std::size_t i = 1; i <= n; ++i)
-            cdf[i] = integral > 0 ? cdf[i] / integral : double(i) / double(n);
-    }
-
-    /// A continuous value in [0, 1), its bin and the density there.
-    float sample(float u, std::size_t& bin, float& density) const
-    {
-        std::size_t n = func.size();
-        auto it = std::upper_bound(cdf.begin(), cdf.end(), double(u));
-        std::ptrdiff_t below = std::max<std::ptrdiff_t>(it - cdf.begin() - 1, 0);
-        bin = std::min<std::size_t>(static_cast<std::size_t>(below), n - 1);
-        double width = cdf[bin + 1] - cdf[bin];
-        double t = width > 0 ? (u - cdf[bin]) / width : 0.5;
-        density = integral > 0 ? float(func[bin] / integral) : 1.0f;
-        double x = (double(bin) + std::clamp(t, 0.0, 1.0)) / double(n);
-        return static_cast<float>(std::min(x, 1.0 - 1e-7));
-    }
-
-    float density(std::size_t bin) const
-    {
-        return integral > 0 ? float(func[bin] / integral) : 1.0f;
-    }
-};
-
-/// Texels are drawn in proportion to luminance times solid angle, and uniformly in solid
-/// angle within a texel (uniform in cos(theta) and phi), so the density is constant over
-/// each texel and a constant map has exactly the uniform density.
-class MapEnvironment final : public Environment {
-public:
-    MapEnvironment(int width, int height, std::vector<float> rgb)
-        : m_width(width), m_height(height), m_rgb(std::move(rgb)),
-          m_marginal(std::vector<float>(1))
-    {
-        m_cos.resize(std::size_t(height) + 1);
-        for (int j = 0; j <= height; ++j)
-            m_cos[std::size_t(j)] = std::cos(pi * float(j) / float(height));
-        m_cos.back() = -1;
-        std::vector<float> row_sums(static_cast<std::size_t>(height));
-        m_conditional.reserve(std::size_t(height));
-        for (int j = 0; j < height; ++j) {
-            std::vector<float> f(static_cast<std::size_t>(width));
-            for (int i = 0; i < width; ++i)
-                f[std::size_t(i)] = std::max(0.0f, luminance(texel(i, j)));
-            m_conditional.emplace_back(std::move(f));
-            row_sums[std::size_t(j)] =
-                static_cast<float>(m_conditional.back().integral) * row_band(j);
-        }
-        m_marginal = Distribution1D(std::move(row_sums));
-        m_black = !(m_marginal.integral > 0);
-    }
-
-    Vec3f radiance(const Vec3f& d) const override
-    {
-        auto [i, j] = texel_of(d);
-        return texel(i, j);
-    }
-
-    EnvironmentSample sample(float u1, float u2) const override
-    {
-        std::size_t row = 0, column = 0;
-        float pv = 0, pu = 0;
-        float v = m_marginal.sample(u1, row, pv);
-        float u = m_conditional[row].sample(u2, column, pu);
-        float t = std::clamp(v * float(m_height) - float(row), 0.0f, 1.0f);
-        float cos_t = m_cos[row] + t * (m_cos[row + 1] - m_cos[row]);
-        float sin_t = std::sqrt(std::max(0.0f, 1 - cos_t * cos_t));
-        float phi = 2 * pi * u;
-        Vec3f d{sin_t * std::sin(phi), cos_t, sin_t * std::cos(phi)};
-        return {d, texel(int(column), int(row)), density(int(column), int(row))};
-    }
-
-    float pdf(const Vec3f& d) const override
-    {
-        auto [i, j] = texel_of(d);
-        return density(i, j);
-    }
-
-    bool black() const override { return m_black; }
-
-private:
-    /// The band of cos(theta) that row j covers (its solid angle / 2 pi).
-    float row_band(int j) const { return m_cos[std::size_t(j)] - m_cos[std::size_t(j) + 1]; }
-
-    /// Solid-angle density over texel (i, j): P(texel) / its solid angle.
-    float density(int i, int j) const
-    {
-        float band = row_band(j);
-        if (band <= 0)
-            return 0;
-        return m_marginal.density(std::size_t(j)) *
-               m_conditional[std::size_t(j)].density(std::size_t(i)) /
-               (2 * pi * float(m_height) * band);
-    }
-
-    Vec3f texel(int i, int j) const
-    {
-        const float* p = &m_rgb[(std::size_t(j) * m_width + i) * 3];
-        return {p[0], p[1], p[2]};
-    }
-
-    std::pair<int, int> texel_of(const Vec3f& d) const
-    {
-        float theta = std::acos(std::clamp(d.y, -1.0f, 1.0f));
-        float phi = std::atan2(d.x, d.z);
-        if (phi < 0)
-            phi += 2 * pi;
-        int i = std::clamp(int(phi / (2 * pi) * m_width), 0, m_width - 1);
-        int j = std::clamp(int(theta / pi * m_height), 0, m_height - 1);
-        return {i, j};
-    }
-
-    int m_width, m_height;
-    std::vector<float> m_rgb;
-    std::vector<float> m_cos;  // cos(theta) at the row borders, top to bottom
-    std::vector<Distribution1D> m_conditional;
-    Distribution1D m_marginal;
-    bool m_black = true;
-};
+/// Rayleigh and Angstrom aerosol transmittance for R, G, B (0.65, 0.55, 0.45 um).
+Vec3f sun_transmittance(float turbidity, float cos_zenith)
+{
+    float zenith_deg = std::acos(std::clamp(cos_zenith, 0.0f, 1.0f)) * 180 / pi;
+    float airmass = 1 / (std::max(cos_zenith, 0.0f) +
+                         0.50572f * std::pow(96.07995f - zenith_deg, -1.6364f));
+    float beta = 0.04608f * turbidity - 0.04586f;
+    auto tau = [&](float um) {
+        return 0.008735f * std::pow(um, -4.08f) + beta * std::pow(um, -1.3f);
+    };
+    return exp(Vec3f(tau(0.65f), tau(0.55f), tau(0.45f)) * -airmass);
+}
 
 constexpr std::size_t max_map_texels = std::size_t{1} << 25;
 
 }  // namespace
 
-std::unique_ptr<Environment> make_uniform_environment(const Vec3f& radiance)
+namespace environment_kind {
+
+// ---- Uniform --------------------------------------------------------------------------
+
+EnvironmentSample Uniform::sample(float u1, float u2) const
 {
-    return std::make_unique<UniformEnvironment>(radiance);
+    return {uniform_sphere(u1, u2), value, inv_4pi};
 }
 
-std::unique_ptr<Environment> make_sky_environment(const SkyParameters& parameters)
+float Uniform::pdf(const Vec3f&) const { return inv_4pi; }
+
+// ---- Sky ------------------------------------------------------------------------------
+
+float Sky::Perez::operator()(float cos_theta, float gamma, float cos_gamma) const
 {
-    return std::make_unique<SkyEnvironment>(parameters);
+    return (1 + a * std::exp(b / std::max(cos_theta, 1e-3f))) *
+           (1 + c * std::exp(d * gamma) + e * cos_gamma * cos_gamma);
 }
 
-std::unique_ptr<Environment> make_rotated_environment(std::shared_ptr<const Environment> inner,
-                                                      float degrees)
+Sky::Sky(const SkyParameters& p)
 {
-    if (!inner)
-        throw Error("environment: nothing to rotate");
+    m_sun = normalize(p.sun_direction);
+    if (length(m_sun) == 0)
+        m_sun = {0, 1, 0};
+    const float t = std::clamp(p.turbidity, sky_min_turbidity, sky_max_turbidity);
+    // Below the horizon the dome is the sunset one, fading out by -6 degrees.
+    float elevation = std::asin(std::clamp(m_sun.y, -1.0f, 1.0f));
+    float fade = std::clamp(1 + elevation / (6 * pi / 180), 0.0f, 1.0f);
+    m_theta_s = std::min(pi / 2 - elevation, pi / 2);
+    m_sun_dome = m_sun.y >= 0 ? m_sun : normalize(Vec3f(m_sun.x, 0, m_sun.z));
+    if (length(m_sun_dome) == 0)
+        m_sun_dome = {0, 1, 0};
+
+    m_Y = {0.1787f * t - 1.4630f, -0.3554f * t + 0.4275f, -0.0227f * t + 5.3251f,
+           0.1206f * t - 2.5771f, -0.0670f * t + 0.3703f};
+    m_x = {-0.0193f * t - 0.2592f, -0.0665f * t + 0.0008f, -0.0004f * t + 0.2125f,
+           -0.0641f * t - 0.8989f, -0.0033f * t + 0.0452f};
+    m_y = {-0.0167f * t - 0.2608f, -0.0950f * t + 0.0092f, -0.0079f * t + 0.2102f,
+           -0.0441f * t - 1.6537f, -0.0109f * t + 0.0529f};
+    float chi = (4.0f / 9 - t / 120) * (pi - 2 * m_theta_s);
+    float zenith_Y = std::max(0.0f, (4.0453f * t - 4.9710f) * std::tan(chi) - 0.2155f * t +
+                                        2.4192f);  // kcd/m^2
+    float th = m_theta_s, th2 = th * th, th3 = th2 * th, t2 = t * t;
+    m_zenith_x = (0.00166f * th3 - 0.00375f * th2 + 0.00209f * th) * t2 +
+                 (-0.02903f * th3 + 0.06377f * th2 - 0.03202f * th + 0.00394f) * t +
+                 (0.11693f * th3 - 0.21196f * th2 + 0.06052f * th + 0.25886f);
+    m_zenith_y = (0.00275f * th3 - 0.00610f * th2 + 0.00317f * th) * t2 +
+                 (-0.04214f * th3 + 0.08970f * th2 - 0.04153f * th + 0.00516f) * t +
+                 (0.15346f * th3 - 0.26756f * th2 + 0.06670f * th + 0.26688f);
+    m_zenith_Y = zenith_Y * 1000 / sky_luminance_unit * std::max(p.sky_intensity, 0.0f) * fade;
+    m_norm_Y = m_Y(1, m_theta_s, std::cos(m_theta_s));
+    m_norm_x = m_x(1, m_theta_s, std::cos(m_theta_s));
+    m_norm_y = m_y(1, m_theta_s, std::cos(m_theta_s));
+
+    // The sun outside the atmosphere gives pi * sun_intensity; the air dims it.
+    m_cos_sun = std::cos(0.2665f * pi / 180);
+    m_sun_solid_angle = 2 * pi * (1 - m_cos_sun);
+    m_sun_up = m_sun.y > 0 && p.sun_intensity > 0;
+    Vec3f colour = sun_transmittance(t, m_sun.y);
+    m_sun_radiance = m_sun_up ? colour * (pi * p.sun_intensity / m_sun_solid_angle) : Vec3f();
+    Vec3f sun_irradiance = m_sun_up ? colour * (pi * p.sun_intensity * m_sun.y) : Vec3f();
+    m_ground = p.ground_albedo * (sun_irradiance + dome_irradiance()) * (1 / pi);
+    m_black = !(m_zenith_Y > 0) && !m_sun_up;
+    m_sun_probability = m_sun_up ? 0.5f : 0.0f;
+}
+
+Vec3f Sky::radiance(const Vec3f& d) const
+{
+    float cos_sun = dot(d, m_sun);
+    Vec3f sky = d.y < 0 ? m_ground : dome(d);
+    if (m_sun_up && cos_sun >= m_cos_sun)
+        sky += m_sun_radiance;
+    return sky;
+}
+
+EnvironmentSample Sky::sample(float u1, float u2) const
+{
+    Vec3f d;
+    if (u1 < m_sun_probability) {
+        // Uniform in the sun's cone.
+        float u = u1 / m_sun_probability;
+        float cos_t = 1 - u * (1 - m_cos_sun);
+        float sin_t = std::sqrt(std::max(0.0f, 1 - cos_t * cos_t));
+        float phi = 2 * pi * u2;
+        Vec3f t, b;
+        make_basis(m_sun, t, b);
+        d = normalize(t * (sin_t * std::cos(phi)) + b * (sin_t * std::sin(phi)) + m_sun * cos_t);
+    } else {
+        float u = (u1 - m_sun_probability) / (1 - m_sun_probability);
+        d = uniform_sphere(std::min(u, 0x1.fffffep-1f), u2);
+    }
+    return {d, radiance(d), pdf(d)};
+}
+
+float Sky::pdf(const Vec3f& d) const
+{
+    float p = (1 - m_sun_probability) * inv_4pi;
+    if (m_sun_up && dot(d, m_sun) >= m_cos_sun)
+        p += m_sun_probability / m_sun_solid_angle;
+    return p;
+}
+
+/// Preetham's dome along d (d.y >= 0), without the sun disk.
+Vec3f Sky::dome(const Vec3f& d) const
+{
+    if (!(m_zenith_Y > 0))
+        return {};
+    float cos_gamma = std::clamp(dot(d, m_sun_dome), -1.0f, 1.0f);
+    float gamma = std::acos(cos_gamma);
+    float Y = m_zenith_Y * m_Y(d.y, gamma, cos_gamma) / m_norm_Y;
+    float x = m_zenith_x * m_x(d.y, gamma, cos_gamma) / m_norm_x;
+    float y = m_zenith_y * m_y(d.y, gamma, cos_gamma) / m_norm_y;
+    return xyY_to_rgb(x, y, std::max(Y, 0.0f));
+}
+
+/// The dome's irradiance on a horizontal plane: a midpoint rule in (cos theta, phi).
+Vec3f Sky::dome_irradiance() const
+{
+    constexpr int n_cos = 32, n_phi = 64;
+    Vec3f sum;
+    for (int i = 0; i < n_cos; ++i) {
+        float c = (i + 0.5f) / n_cos, s = std::sqrt(1 - c * c);
+        for (int j = 0; j < n_phi; ++j) {
+            float phi = 2 * pi * (j + 0.5f) / n_phi;
+            sum += dome({s * std::cos(phi), c, s * std::sin(phi)}) * c;
+        }
+    }
+    return sum * (2 * pi / (n_cos * n_phi));
+}
+
+// ---- Map ------------------------------------------------------------------------------
+
+Distribution1D::Distribution1D(std::vector<float> f) : func(std::move(f)), cdf(func.size() + 1)
+{
+    std::size_t n = func.size();
+    for (std::size_t i = 0; i < n; ++i)
+        cdf[i + 1] = cdf[i] + func[i] / double(n);
+    integral = cdf[n];
+    for (std::size_t i = 1; i <= n; ++i)
+        cdf[i] = integral > 0 ? cdf[i] / integral : double(i) / double(n);
+}
+
+float Distribution1D::sample(float u, std::size_t& bin, float& density) const
+{
+    std::size_t n = func.size();
+    auto it = std::upper_bound(cdf.begin(), cdf.end(), double(u));
+    std::ptrdiff_t below = std::max<std::ptrdiff_t>(it - cdf.begin() - 1, 0);
+    bin = std::min<std::size_t>(static_cast<std::size_t>(below), n - 1);
+    double width = cdf[bin + 1] - cdf[bin];
+    double t = width > 0 ? (u - cdf[bin]) / width : 0.5;
+    density = integral > 0 ? float(func[bin] / integral) : 1.0f;
+    double x = (double(bin) + std::clamp(t, 0.0, 1.0)) / double(n);
+    return static_cast<float>(std::min(x, 1.0 - 1e-7));
+}
+
+float Distribution1D::density(std::size_t bin) const
+{
+    return integral > 0 ? float(func[bin] / integral) : 1.0f;
+}
+
+Map::Map(int width, int height, std::vector<float> rgb)
+    : m_width(width), m_height(height), m_rgb(std::move(rgb)), m_marginal(std::vector<float>(1))
+{
+    m_cos.resize(std::size_t(height) + 1);
+    for (int j = 0; j <= height; ++j)
+        m_cos[std::size_t(j)] = std::cos(pi * float(j) / float(height));
+    m_cos.back() = -1;
+    std::vector<float> row_sums(static_cast<std::size_t>(height));
+    m_conditional.reserve(std::size_t(height));
+    for (int j = 0; j < height; ++j) {
+        std::vector<float> f(static_cast<std::size_t>(width));
+        for (int i = 0; i < width; ++i)
+            f[std::size_t(i)] = std::max(0.0f, luminance(texel(i, j)));
+        m_conditional.emplace_back(std::move(f));
+        row_sums[std::size_t(j)] = static_cast<float>(m_conditional.back().integral) * row_band(j);
+    }
+    m_marginal = Distribution1D(std::move(row_sums));
+    m_black = !(m_marginal.integral > 0);
+    // Each texel equal to the one before it (values three floats apart).
+    m_constant = std::equal(m_rgb.begin() + 3, m_rgb.end(), m_rgb.begin());
+}
+
+Vec3f Map::radiance(const Vec3f& d) const
+{
+    auto [i, j] = texel_of(d);
+    return texel(i, j);
+}
+
+EnvironmentSample Map::sample(float u1, float u2) const
+{
+    std::size_t row = 0, column = 0;
+    float pv = 0, pu = 0;
+    float v = m_marginal.sample(u1, row, pv);
+    float u = m_conditional[row].sample(u2, column, pu);
+    float t = std::clamp(v * float(m_height) - float(row), 0.0f, 1.0f);
+    float cos_t = m_cos[row] + t * (m_cos[row + 1] - m_cos[row]);
+    float sin_t = std::sqrt(std::max(0.0f, 1 - cos_t * cos_t));
+    float phi = 2 * pi * u;
+    Vec3f d{sin_t * std::sin(phi), cos_t, sin_t * std::cos(phi)};
+    return {d, texel(int(column), int(row)), density(int(column), int(row))};
+}
+
+float Map::pdf(const Vec3f& d) const
+{
+    auto [i, j] = texel_of(d);
+    return density(i, j);
+}
+
+/// The band of cos(theta) that row j covers (its solid angle / 2 pi).
+float Map::row_band(int j) const { return m_cos[std::size_t(j)] - m_cos[std::size_t(j) + 1]; }
+
+/// Solid-angle density over texel (i, j): P(texel) / its solid angle.
+float Map::density(int i, int j) const
+{
+    float band = row_band(j);
+    if (band <= 0)
+        return 0;
+    return m_marginal.density(std::size_t(j)) *
+           m_conditional[std::size_t(j)].density(std::size_t(i)) /
+           (2 * pi * float(m_height) * band);
+}
+
+Vec3f Map::texel(int i, int j) const
+{
+    const float* p = &m_rgb[(std::size_t(j) * m_width + i) * 3];
+    return {p[0], p[1], p[2]};
+}
+
+std::pair<int, int> Map::texel_of(const Vec3f& d) const
+{
+    float theta = std::acos(std::clamp(d.y, -1.0f, 1.0f));
+    float phi = std::atan2(d.x, d.z);
+    if (phi < 0)
+        phi += 2 * pi;
+    int i = std::clamp(int(phi / (2 * pi) * m_width), 0, m_width - 1);
+    int j = std::clamp(int(theta / pi * m_height), 0, m_height - 1);
+    return {i, j};
+}
+
+}  // namespace environment_kind
+
+// ---- Environment: the closed set, turned ----------------------------------------------
+
+Vec3f Environment::radiance(const Vec3f& direction) const
+{
+    const Vec3f d = m_turned ? unturn(direction) : direction;
+    return std::visit([&](const auto& kind) { return kind.radiance(d); }, m_kind);
+}
+
+EnvironmentSample Environment::sample(float u1, float u2) const
+{
+    EnvironmentSample s = std::visit([&](const auto& kind) { return kind.sample(u1, u2); }, m_kind);
+    if (m_turned)
+        s.direction = turn(s.direction);
+    return s;
+}
+
+float Environment::pdf(const Vec3f& direction) const
+{
+    const Vec3f d = m_turned ? unturn(direction) : direction;
+    return std::visit([&](const auto& kind) { return kind.pdf(d); }, m_kind);
+}
+
+bool Environment::black() const
+{
+    return std::visit([](const auto& kind) { return kind.black(); }, m_kind);
+}
+
+bool Environment::uniform() const
+{
+    switch (kind()) {
+    case Kind::uniform: return true;
+    case Kind::sky: return false;
+    case Kind::map: return std::get<environment_kind::Map>(m_kind).constant();
+    }
+    return false;
+}
+
+Environment Environment::rotated(float degrees) const&
+{
+    Environment e = *this;
+    e.turn_by(degrees);
+    return e;
+}
+
+Environment Environment::rotated(float degrees) &&
+{
+    turn_by(degrees);
+    return std::move(*this);
+}
+
+void Environment::turn_by(float degrees)
+{
     if (!std::isfinite(degrees))
         throw Error("environment: the rotation must be a finite angle");
-    return std::make_unique<RotatedEnvironment>(std::move(inner), degrees);
+    m_degrees += double(degrees);
+    double radians = m_degrees * std::numbers::pi / 180;
+    m_cos = static_cast<float>(std::cos(radians));
+    m_sin = static_cast<float>(std::sin(radians));
+    m_turned = m_degrees != 0;
 }
 
-std::unique_ptr<Environment> make_map_environment(int width, int height, std::vector<float> rgb)
+Vec3f Environment::turn(const Vec3f& d) const
+{
+    return {m_cos * d.x + m_sin * d.z, d.y, -m_sin * d.x + m_cos * d.z};
+}
+
+Vec3f Environment::unturn(const Vec3f& d) const
+{
+    return {m_cos * d.x - m_sin * d.z, d.y, m_sin * d.x + m_cos * d.z};
+}
+
+Environment make_uniform_environment(const Vec3f& radiance)
+{
+    return Environment(environment_kind::Uniform{radiance});
+}
+
+Environment make_sky_environment(const SkyParameters& parameters)
+{
+    return Environment(environment_kind::Sky(parameters));
+}
+
+Environment make_map_environment(int width, int height, std::vector<float> rgb)
 {
     if (width <= 0 || height <= 0 || std::size_t(width) * std::size_t(height) > max_map_texels)
         throw Error("environment map: size " + std::to_string(width) + "x" +
@@ -428,10 +411,10 @@ std::unique_ptr<Environment> make_map_environment(int width, int height, std::ve
     for (float& v : rgb)
         if (!std::isfinite(v) || v < 0)
             v = 0;  // NaN, inf or negative texels would poison the sampling tables
-    return std::make_unique<MapEnvironment>(width, height, std::move(rgb));
+    return Environment(environment_kind::Map(width, height, std::move(rgb)));
 }
 
-std::unique_ptr<Environment> make_map_environment(const std::filesystem::path& file, float scale)
+Environment make_map_environment(const std::filesystem::path& file, float scale)
 {
     MapTexels map = image_codec().read_map(file, scale, max_map_texels);
     return make_map_environment(map.width, map.height, std::move(map.rgb));

@@ -2,8 +2,10 @@
 // What rays that leave the scene see: a uniform ambient, an analytic sky, an HDR map.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
-#include <memory>
+#include <utility>
+#include <variant>
 #include <vector>
 
 #include "render/vecf.h"
@@ -16,25 +18,6 @@ struct EnvironmentSample {
     Vec3f radiance;   ///< linear
     float pdf = 0;    ///< per steradian
 };
-
-/// Radiance arriving from infinitely far away, by direction. Thread-safe after
-/// construction. The integrator samples it for next-event estimation and weights that
-/// against BSDF sampling (multiple importance sampling) with pdf().
-class Environment {
-public:
-    virtual ~Environment() = default;
-    /// Radiance along `direction` (unit, pointing away from the scene).
-    virtual Vec3f radiance(const Vec3f& direction) const = 0;
-    /// A direction drawn in proportion to (roughly) radiance, from two uniform numbers.
-    virtual EnvironmentSample sample(float u1, float u2) const = 0;
-    /// The solid-angle density sample() draws `direction` with.
-    virtual float pdf(const Vec3f& direction) const = 0;
-    /// Whether the environment is black everywhere (the integrator skips it).
-    virtual bool black() const = 0;
-};
-
-/// The same radiance from every direction (the stand-in for cpfg's ambient term).
-std::unique_ptr<Environment> make_uniform_environment(const Vec3f& radiance);
 
 /// Preetham's (1999) analytic daylight sky with a sun disk (docs: render/environment.cpp,
 /// "sky"). World up is +y (cpfg's turtle grows along +y).
@@ -57,7 +40,143 @@ inline constexpr float sky_min_turbidity = 1.7f, sky_max_turbidity = 10;
 /// Luminance (cd/m^2) of radiance 1: 128 000 lux of sunlight outside
 /// the atmosphere (the solar illuminance constant) becomes irradiance pi.
 inline constexpr float sky_luminance_unit = 128000 / 3.14159265f;
-std::unique_ptr<Environment> make_sky_environment(const SkyParameters& parameters = {});
+
+/// The kinds of environment, each a plain value with radiance, sample and pdf in its own
+/// frame (Environment turns them). They are spelled out here so that Environment can hold
+/// them in a std::variant; use them through Environment.
+namespace environment_kind {
+
+/// The same radiance from every direction (the stand-in for cpfg's ambient term),
+/// sampled uniformly over the sphere.
+struct Uniform {
+    Vec3f value;
+    Vec3f radiance(const Vec3f&) const { return value; }
+    EnvironmentSample sample(float u1, float u2) const;
+    float pdf(const Vec3f&) const;
+    bool black() const { return !(value.x > 0 || value.y > 0 || value.z > 0); }
+};
+
+/// Preetham's sky with the sun disk, sampled in the sun's cone with probability 1/2 (when
+/// the sun is up), else uniformly over the sphere.
+class Sky {
+public:
+    explicit Sky(const SkyParameters& parameters);
+    Vec3f radiance(const Vec3f& d) const;
+    EnvironmentSample sample(float u1, float u2) const;
+    float pdf(const Vec3f& d) const;
+    bool black() const { return m_black; }
+
+private:
+    /// The Perez luminance distribution's five coefficients.
+    struct Perez {
+        float a, b, c, d, e;
+        float operator()(float cos_theta, float gamma, float cos_gamma) const;
+    };
+    Vec3f dome(const Vec3f& d) const;
+    Vec3f dome_irradiance() const;
+
+    Vec3f m_sun, m_sun_dome, m_ground, m_sun_radiance;
+    Perez m_Y{}, m_x{}, m_y{};
+    float m_theta_s = 0, m_zenith_Y = 0, m_zenith_x = 0, m_zenith_y = 0;
+    float m_norm_Y = 1, m_norm_x = 1, m_norm_y = 1;
+    float m_cos_sun = 1, m_sun_solid_angle = 0, m_sun_probability = 0;
+    bool m_sun_up = false, m_black = false;
+};
+
+/// A piecewise-constant 1D distribution over [0, 1) with n equal bins.
+struct Distribution1D {
+    std::vector<float> func;
+    std::vector<double> cdf;  ///< n + 1 entries, cdf[n] = 1 (or uniform when all zero)
+    double integral = 0;      ///< mean of func
+
+    explicit Distribution1D(std::vector<float> f);
+    /// A continuous value in [0, 1), its bin and the density there.
+    float sample(float u, std::size_t& bin, float& density) const;
+    float density(std::size_t bin) const;
+};
+
+/// A latitude-longitude map (make_map_environment), texels drawn in proportion to
+/// luminance times solid angle and uniformly in solid angle within one (uniform in
+/// cos(theta) and phi), so the density is constant over each texel.
+class Map {
+public:
+    Map(int width, int height, std::vector<float> rgb);
+    Vec3f radiance(const Vec3f& d) const;
+    EnvironmentSample sample(float u1, float u2) const;
+    float pdf(const Vec3f& d) const;
+    bool black() const { return m_black; }
+    /// Whether every texel has the same colour.
+    bool constant() const { return m_constant; }
+
+private:
+    float row_band(int j) const;
+    float density(int i, int j) const;
+    Vec3f texel(int i, int j) const;
+    std::pair<int, int> texel_of(const Vec3f& d) const;
+
+    int m_width, m_height;
+    std::vector<float> m_rgb;
+    std::vector<float> m_cos;  ///< cos(theta) at the row borders, top to bottom
+    std::vector<Distribution1D> m_conditional;
+    Distribution1D m_marginal;
+    bool m_black = true, m_constant = false;
+};
+
+}  // namespace environment_kind
+
+/// Radiance arriving from infinitely far away, by direction: one of a closed set of kinds
+/// (uniform, sky, map) dispatched by switch, as the lights are (LightSet), turned about the
+/// world up axis +y by a stored angle. A value, safe to read from many threads. The
+/// integrator samples it for next-event estimation through LightSet (sample, pdf) and
+/// weights that against BSDF sampling (multiple importance sampling).
+class Environment {
+public:
+    enum class Kind : std::uint8_t { uniform, sky, map };  ///< in the variant's order
+
+    /// Radiance along `direction` (unit, pointing away from the scene).
+    Vec3f radiance(const Vec3f& direction) const;
+    /// A direction drawn in proportion to (roughly) radiance, from two uniform numbers.
+    EnvironmentSample sample(float u1, float u2) const;
+    /// The solid-angle density sample() draws `direction` with.
+    float pdf(const Vec3f& direction) const;
+    /// Whether the environment is black everywhere (the integrator skips it).
+    bool black() const;
+    /// Whether radiance is the same from every direction (a uniform environment or a
+    /// constant map): BSDF sampling alone is then perfect (exactly, for a Lambertian
+    /// surface), so the integrator does not sample it for next-event estimation.
+    bool uniform() const;
+    Kind kind() const { return static_cast<Kind>(m_kind.index()); }
+
+    /// This environment turned by `degrees` more about +y (right-handed: +90 takes what
+    /// was seen along +z to +x). Radiance, sampling and pdf all follow the turn exactly.
+    /// Throws cambium::Error for a non-finite angle.
+    Environment rotated(float degrees) const&;
+    Environment rotated(float degrees) &&;
+    /// The whole turn about +y, in degrees.
+    double rotation_degrees() const { return m_degrees; }
+
+private:
+    using Kinds = std::variant<environment_kind::Uniform, environment_kind::Sky,
+                               environment_kind::Map>;
+    friend Environment make_uniform_environment(const Vec3f& radiance);
+    friend Environment make_sky_environment(const SkyParameters& parameters);
+    friend Environment make_map_environment(int width, int height, std::vector<float> rgb);
+    explicit Environment(Kinds kind) : m_kind(std::move(kind)) {}
+    void turn_by(float degrees);
+    Vec3f turn(const Vec3f& d) const;
+    Vec3f unturn(const Vec3f& d) const;
+
+    Kinds m_kind;
+    double m_degrees = 0;
+    bool m_turned = false;  ///< directions go through turn / unturn (m_degrees != 0)
+    float m_cos = 1, m_sin = 0;
+};
+
+/// The same radiance from every direction (the stand-in for cpfg's ambient term).
+Environment make_uniform_environment(const Vec3f& radiance);
+
+/// Preetham's daylight sky and sun.
+Environment make_sky_environment(const SkyParameters& parameters = {});
 
 /// A latitude-longitude HDR map (EXR, HDR or anything OpenImageIO reads), linear RGB,
 /// times `scale`. Texel coordinates (u, v) in [0, 1)^2, v down from the top row, look
@@ -67,16 +186,10 @@ std::unique_ptr<Environment> make_sky_environment(const SkyParameters& parameter
 /// in proportion to luminance times solid angle (marginal and conditional CDFs), and
 /// uniformly in solid angle within one. Throws cambium::Error naming the file when it
 /// cannot be read or is larger than 2^25 texels.
-std::unique_ptr<Environment> make_map_environment(const std::filesystem::path& file,
-                                                  float scale = 1);
+Environment make_map_environment(const std::filesystem::path& file, float scale = 1);
 
-/// `inner` turned by `degrees` about the world up axis +y (right-handed: +90 takes what
-/// was seen along +z to +x). Radiance, sampling and pdf all follow the turn exactly.
-std::unique_ptr<Environment> make_rotated_environment(std::shared_ptr<const Environment> inner,
-                                                      float degrees);
-
-/// The same from texels in memory (rows top to bottom, 3 floats each): tests, generated maps.
-std::unique_ptr<Environment> make_map_environment(int width, int height,
-                                                  std::vector<float> rgb);
+/// The same from texels in memory (rows top to bottom, 3 floats each): tests, generated
+/// maps. Non-finite and negative texels count as 0.
+Environment make_map_environment(int width, int height, std::vector<float> rgb);
 
 }  // namespace cambium::render

@@ -19,54 +19,6 @@ namespace cambium::render {
 
 namespace {
 
-/// Probe directions spread over the sphere (a Fibonacci lattice).
-struct Probes {
-    std::array<Vec3f, 16> d;
-    Probes()
-    {
-        for (int i = 0; i < 16; ++i) {
-            float z = 1 - (i + 0.5f) / 8;
-            float r = std::sqrt(std::fmax(0.0f, 1 - z * z)), phi = 2.39996323f * i;
-            d[i] = Vec3f(r * std::cos(phi), r * std::sin(phi), z);
-        }
-    }
-};
-
-/// What escaping rays see: the Environment, or the uniform `ambient` colour.
-class EnvironmentView {
-public:
-    explicit EnvironmentView(const PathContext& ctx)
-    {
-        const Environment* env = ctx.environment;
-        m_black = env ? env->black() : is_black(ctx.ambient);
-        // A uniform environment is sampled perfectly by the BSDF alone (exactly, for a
-        // Lambertian surface), so NEE toward it would only add noise. Sixteen probes tell;
-        // a wrong "uniform" costs variance only, never bias. Non-uniform ones fail fast.
-        m_nee = env && !m_black && !looks_uniform(*env);
-    }
-    bool black() const { return m_black; }
-    /// Whether to sample it for next-event estimation (and weight BSDF hits by MIS).
-    bool nee() const { return m_nee; }
-
-private:
-    static bool looks_uniform(const Environment& env)
-    {
-        static const Probes probes;
-        Vec3f first = env.radiance(probes.d[0]);
-        float pdf = env.pdf(probes.d[0]);
-        for (const Vec3f& d : probes.d)
-            if (env.pdf(d) != pdf || !(env.radiance(d) == first))
-                return false;
-        return true;
-    }
-
-    bool m_black = true, m_nee = false;
-};
-
-}  // namespace
-
-namespace {
-
 constexpr float infinity = std::numeric_limits<float>::infinity();
 /// Transparent surfaces a ray may pass through before it counts as blocked.
 constexpr int max_pass_throughs = 64;
@@ -91,6 +43,15 @@ float power_heuristic(float a, float b)
 {
     float a2 = a * a, b2 = b * b;
     return a2 + b2 > 0 ? a2 / (a2 + b2) : 0;
+}
+
+/// The one MIS rule for light a BSDF-sampled ray (drawn with `bsdf_pdf`) finds on an
+/// emissive surface or the environment, which light sampling would find with `light_pdf`
+/// (choice included; 0 when that light is not sampled): the power heuristic, full weight
+/// where light sampling cannot find it.
+float bsdf_hit_weight(float bsdf_pdf, float light_pdf)
+{
+    return light_pdf > 0 ? power_heuristic(bsdf_pdf, light_pdf) : 1.0f;
 }
 
 /// Where a ray leaving the hit toward wi starts, and which primitive it must ignore:
@@ -334,13 +295,17 @@ TextureFootprint texture_footprint(const SurfaceHit& hit, const Vec3f& dir, floa
 
 void prepare_path_context(PathContext& ctx)
 {
-    const EnvironmentView env(ctx);
+    const Environment* env = ctx.environment;
+    const bool black = env ? env->black() : is_black(ctx.ambient);
+    // A uniform environment is sampled perfectly by the BSDF alone (exactly, for a
+    // Lambertian surface), so next-event estimation toward it would only add noise.
+    const bool nee = env && !black && !env->uniform();
     std::vector<float> opacity;
     for (const SurfaceMaterial& m : ctx.materials)
         opacity.push_back(m.opacity);
     ctx.prepared = PathContext::SceneFlags{
-        any_transparent(ctx), std::move(opacity), env.black(), env.nee(),
-        LightSet(ctx.lights, ctx.area_lights, ctx.environment, env.nee(), ctx.scene_radius)};
+        any_transparent(ctx), std::move(opacity), black, nee,
+        LightSet(ctx.lights, ctx.area_lights, env, nee, ctx.scene_radius)};
 }
 
 namespace {
@@ -418,9 +383,7 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             } else if (depth == 0) {
                 result.radiance += beta * ctx.background;
             } else if (!facts.environment_black) {
-                float w = facts.environment_nee
-                              ? power_heuristic(bsdf_pdf_prev, lights.pdf_li(dir))
-                              : 1.0f;
+                float w = bsdf_hit_weight(bsdf_pdf_prev, lights.pdf_li(dir));
                 result.radiance += beta * env_radiance(dir) * w;
             }
             break;
@@ -472,12 +435,8 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             result.radiance += beta * material.ambient_glow * tint;
         if (!is_black(material.emission)) {
             // A BSDF-sampled hit on a listed light: weighted against sampling the light.
-            float w = 1;
-            if (depth > 0) {
-                float light_pdf = lights.pdf_li(scatter_prev, *hit);
-                if (light_pdf > 0)
-                    w = power_heuristic(bsdf_pdf_prev, light_pdf);
-            }
+            float w = depth > 0 ? bsdf_hit_weight(bsdf_pdf_prev, lights.pdf_li(scatter_prev, *hit))
+                                : 1.0f;
             result.radiance += beta * material.emission * w;
         }
         Bsdf bsdf = make_bsdf(material, diffuse);

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// The render layer's entry points: render a Scene to an Image (film.h writes it to a file).
+// The render layer's entry points: render a Scene to an Image (image_io.h writes it to a file).
 //
 // Every pixel keeps its own running sums; a pass adds samples i = n .. target-1 to each
 // pixel still sampled, in order, so the image is a pure function of (scene, settings,

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// The render layer's entry points: render a Scene to an Image (film.h writes it to a file).
+// The render layer's entry points: render a Scene to an Image (image_io.h writes it to a file).
 #pragma once
 
 #include <atomic>

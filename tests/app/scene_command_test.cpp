@@ -13,25 +13,17 @@
 #include <fstream>
 #include <string>
 
+#include "shell_output.h"
+
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-    int status;
-    std::string output;
-};
+using Result = cambium::test::CommandResult;
 
 Result run(const std::string& args, const fs::path& folder)
 {
-    std::string command = "cd '" + folder.string() + "' && " + CAMBIUM_EXE + " " + args + " 2>&1";
-    Result r{0, {}};
-    FILE* pipe = popen(command.c_str(), "r");
-    std::array<char, 512> buffer{};
-    while (fgets(buffer.data(), buffer.size(), pipe))
-        r.output += buffer.data();
-    r.status = pclose(pipe);
-    return r;
+    return cambium::test::run_shell(std::string(CAMBIUM_EXE) + " " + args, folder);
 }
 
 fs::path scratch()

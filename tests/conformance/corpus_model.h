@@ -40,6 +40,13 @@ std::string string_difference(const std::string& ours, const std::string& cpfg);
 /// The text of a file (empty when it cannot be read).
 std::string read_text(const std::filesystem::path& file);
 
+/// Calls visit(model, reference) for every corpus model whose oracle folder holds
+/// `oracle_file` (reference: that file), warnings silenced meanwhile. Returns how many models
+/// it visited, or nullopt when the corpus is not found.
+std::optional<int> for_each_oracle_model(
+    const std::string& oracle_file,
+    const std::function<void(const CorpusModel&, const std::filesystem::path&)>& visit);
+
 /// Runs `compare(model, reference text)` on every model whose oracle folder holds
 /// `oracle_file`; compare returns "" when the model matches, else what differs (an
 /// exception counts as a difference). Prints each difference and "N of M models match",

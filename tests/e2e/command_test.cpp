@@ -21,28 +21,18 @@
 
 #include <sys/wait.h>
 
+#include "shell_output.h"
+
 namespace fs = std::filesystem;
 
 namespace {
 
-struct Result {
-    int status;
-    std::string output;  // stdout and stderr
-};
+using Result = cambium::test::CommandResult;
 
 /// Runs cambium with `args` (in `folder` when given).
 Result run(const std::string& args, const fs::path& folder = {})
 {
-    std::string command = std::string(CAMBIUM_EXE) + " " + args + " 2>&1";
-    if (!folder.empty())
-        command = "cd '" + folder.string() + "' && " + command;
-    Result r{0, {}};
-    FILE* pipe = popen(command.c_str(), "r");
-    std::array<char, 512> buffer{};
-    while (fgets(buffer.data(), buffer.size(), pipe))
-        r.output += buffer.data();
-    r.status = pclose(pipe);
-    return r;
+    return cambium::test::run_shell(std::string(CAMBIUM_EXE) + " " + args, folder);
 }
 
 fs::path scratch(const std::string& name)
@@ -192,6 +182,43 @@ TEST(Command, WireframeSquareIsItsOutlineOfOnePixelLines)
         }
         EXPECT_EQ(column, 2) << "column " << i;
         EXPECT_EQ(row, 2) << "row " << i;
+    }
+}
+
+// The view file's texture images are read from the model's folder and below, as the
+// L-system's own files are (docs/security.md): one elsewhere, through "..", an absolute
+// path or a link, is refused with the view file named and nothing written, unless
+// --allow-file-access. Cambium runs here from the model's parent folder: relative names
+// are the view file's folder's, not the current folder's.
+TEST(Command, TexturesStayInTheModelsFolderUnlessAllowed)
+{
+    fs::path dir = scratch("texture"), model = dir / "model";
+    fs::create_directories(model / "maps");
+    write(model / "p.l", "lsystem: 1\nderivation length: 1\naxiom: F\nendlsystem\n");
+    write(dir / "outside.png", "not looked at");
+    write(model / "maps" / "inside.png", "not looked at");
+    fs::create_symlink(dir / "outside.png", model / "link.png");
+    auto render_with = [&](const std::string& texture, const std::string& options) {
+        write(model / "p.v", "line style: cylinder\ntexture: F: " + texture + "\n");
+        fs::remove(dir / "out.png");
+        return run("-q -w 8 6 --spp 1 " + options + " -o out.png model/p.l model/p.v", dir);
+    };
+    const std::vector<std::string> outside_names{"../outside.png", (dir / "outside.png").string(),
+                                                 "link.png", "maps/../../outside.png"};
+    for (const std::string& outside : outside_names) {
+        Result r = render_with(outside, "");
+        EXPECT_NE(r.status, 0) << outside;
+        EXPECT_NE(r.output.find("p.v: error: texture '"), std::string::npos) << r.output;
+        EXPECT_NE(r.output.find("outside the model's folder"), std::string::npos) << r.output;
+        EXPECT_FALSE(fs::exists(dir / "out.png")) << outside;
+        Result allowed = render_with(outside, "--allow-file-access");
+        EXPECT_EQ(allowed.status, 0) << outside << ": " << allowed.output;
+        EXPECT_TRUE(fs::exists(dir / "out.png")) << outside;
+    }
+    for (const char* inside : {"maps/inside.png", "maps/../maps/inside.png"}) {
+        Result r = render_with(inside, "");
+        EXPECT_EQ(r.status, 0) << inside << ": " << r.output;
+        EXPECT_TRUE(fs::exists(dir / "out.png")) << inside;
     }
 }
 

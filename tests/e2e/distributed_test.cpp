@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "app/tiles.h"
+#include "shell_output.h"
 #include "base/diagnostics.h"
 
 namespace fs = std::filesystem;
@@ -24,22 +25,12 @@ namespace fs = std::filesystem;
 namespace cambium::app {
 namespace {
 
-struct Result {
-    int status;
-    std::string output;  // stdout and stderr
-};
+using Result = cambium::test::CommandResult;
 
 /// Runs `command` in scenes/default (the model the runs render).
 Result shell(const std::string& command)
 {
-    std::string line = "cd '" CAMBIUM_SOURCE_DIR "/scenes/default' && " + command + " 2>&1";
-    Result r{0, {}};
-    FILE* pipe = popen(line.c_str(), "r");
-    std::array<char, 512> buffer{};
-    while (fgets(buffer.data(), buffer.size(), pipe))
-        r.output += buffer.data();
-    r.status = pclose(pipe);
-    return r;
+    return cambium::test::run_shell(command, CAMBIUM_SOURCE_DIR "/scenes/default");
 }
 
 const std::string cambium = CAMBIUM_EXE;

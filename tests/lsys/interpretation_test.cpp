@@ -192,9 +192,12 @@ endlsystem
         "endlsystem\n",
         "test.l", options);
     EXPECT_EQ(to_text(curves.derive(), curves.symbols()), "F(1.5)G(200)");
-    set_warnings_enabled(false);
-    EXPECT_EQ(testing::derive_text(source), "F(0)");  // unset: 0 (and one warning)
-    set_warnings_enabled(true);
+    Diagnostics sink(Diagnostics::Output::quiet);
+    {
+        ScopedDiagnostics install(sink);
+        EXPECT_EQ(testing::derive_text(source), "F(0)");  // unset: 0, and one warning
+    }
+    EXPECT_EQ(sink.count(Severity::warning), 1u) << sink.text();
 }
 
 TEST(Interpretation, QueryPassRunsBeforeEveryStepNotAfterTheLast)
@@ -238,11 +241,15 @@ TEST(Interpretation, NoQueryPassWithoutQueryModules)
 
 TEST(Interpretation, CommunicationModulesStayInTheString)
 {
-    set_warnings_enabled(false);
-    EXPECT_EQ(testing::derive_text("lsystem: 1\nderivation length: 1\naxiom: A?E(1,2)\n"
-                                   "A > ?E(x,y) --> B(x+y)\nendlsystem\n"),
-              "B(3)?E(1,2)");
-    set_warnings_enabled(true);
+    Diagnostics sink(Diagnostics::Output::quiet);
+    {
+        ScopedDiagnostics install(sink);
+        EXPECT_EQ(testing::derive_text("lsystem: 1\nderivation length: 1\naxiom: A?E(1,2)\n"
+                                       "A > ?E(x,y) --> B(x+y)\nendlsystem\n"),
+                  "B(3)?E(1,2)");
+    }
+    // No environmental program is connected: said once.
+    EXPECT_EQ(sink.count(Severity::warning), 1u) << sink.text();
 }
 
 TEST(Interpretation, AtCommandLettersAreRewrittenAsCpfgDoes)

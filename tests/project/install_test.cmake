@@ -11,6 +11,18 @@ endfunction()
 
 file(REMOVE_RECURSE "${WORK}")
 run(install ${CMAKE_COMMAND} --install "${BUILD}" --prefix "${WORK}/prefix")
+# A consumer needs what the exported targets link, and OpenImageIO is not among them (only
+# the dlopen'ed image module links it): neither the targets nor the package may ask for it.
+file(GLOB package_files "${WORK}/prefix/lib*/cmake/cambium/*.cmake")
+if(NOT package_files)
+  message(FATAL_ERROR "no CMake package files installed under ${WORK}/prefix")
+endif()
+foreach(f ${package_files})
+  file(STRINGS "${f}" oiio REGEX "^[^#]*(OpenImageIO|Imath)")
+  if(oiio)
+    message(FATAL_ERROR "${f} asks a consumer for OpenImageIO: ${oiio}")
+  endif()
+endforeach()
 run(configure ${CMAKE_COMMAND} -S "${CONSUMER}" -B "${WORK}/build" -DCMAKE_BUILD_TYPE=Release
     "-DCMAKE_PREFIX_PATH=${WORK}/prefix")
 run(build ${CMAKE_COMMAND} --build "${WORK}/build")

@@ -105,8 +105,8 @@ TEST(ColourBlend, TubeRadianceFollowsTheBlendedAlbedo)
     PathContext ctx;
     ctx.accel = &accel;
     ctx.materials = make_materials(s.materials);
-    std::unique_ptr<Environment> uniform = make_uniform_environment(Vec3f(1));
-    ctx.environment = uniform.get();
+    const Environment uniform = make_uniform_environment(Vec3f(1));
+    ctx.environment = &uniform;
     ctx.ambient = Vec3f(1);
     ctx.max_depth = 4;
     ctx.roulette_depth = 100;

@@ -43,7 +43,7 @@ float patchy_texel(int i, int j, int c)
 }
 
 /// A map with a smooth gradient and a brighter patch: not constant, not too peaky.
-std::unique_ptr<Environment> patchy_map()
+Environment patchy_map()
 {
     int w = 32, h = 16;
     std::vector<float> rgb(std::size_t(w) * h * 3);
@@ -57,18 +57,20 @@ std::unique_ptr<Environment> patchy_map()
 TEST(Environment, UniformIsConstantWithTheSpherePdf)
 {
     auto env = make_uniform_environment({0.1f, 0.2f, 0.3f});
-    EXPECT_NEAR(pdf_integral(*env, 1000), 1.0, 1e-6);
-    EnvironmentSample s = env->sample(0.3f, 0.7f);
+    EXPECT_NEAR(pdf_integral(env, 1000), 1.0, 1e-6);
+    EnvironmentSample s = env.sample(0.3f, 0.7f);
     EXPECT_NEAR(length(s.direction), 1.0f, 1e-6f);
     EXPECT_FLOAT_EQ(s.pdf, 1 / (4 * pi));
     EXPECT_EQ(s.radiance, Vec3f(0.1f, 0.2f, 0.3f));
-    EXPECT_FALSE(env->black());
-    EXPECT_TRUE(make_uniform_environment(Vec3f())->black());
+    EXPECT_FALSE(env.black());
+    EXPECT_TRUE(make_uniform_environment(Vec3f()).black());
+    EXPECT_TRUE(env.uniform());
+    EXPECT_EQ(env.kind(), Environment::Kind::uniform);
 }
 
 TEST(MapEnvironment, PdfIntegratesToOne)
 {
-    EXPECT_NEAR(pdf_integral(*patchy_map(), 400000), 1.0, 0.01);
+    EXPECT_NEAR(pdf_integral(patchy_map(), 400000), 1.0, 0.01);
 }
 
 TEST(MapEnvironment, SamplesCarryTheirOwnPdfAndRadiance)
@@ -77,12 +79,12 @@ TEST(MapEnvironment, SamplesCarryTheirOwnPdfAndRadiance)
     Sampler s(9, 9, 9, 9);
     int mismatched = 0, n = 20000, patch_hits = 0;
     for (int i = 0; i < n; ++i) {
-        EnvironmentSample e = env->sample(s.next(), s.next());
+        EnvironmentSample e = env.sample(s.next(), s.next());
         ASSERT_NEAR(length(e.direction), 1.0f, 1e-4f);
         ASSERT_GT(e.pdf, 0.0f);
         // A sample on a texel border may be looked up in the neighbour texel.
-        if (std::abs(env->pdf(e.direction) - e.pdf) > 1e-3f * e.pdf ||
-            !(env->radiance(e.direction) == e.radiance))
+        if (std::abs(env.pdf(e.direction) - e.pdf) > 1e-3f * e.pdf ||
+            !(env.radiance(e.direction) == e.radiance))
             ++mismatched;
         patch_hits += e.radiance.x > 3.0f ? 1 : 0;
     }
@@ -118,14 +120,18 @@ TEST(MapEnvironment, ConstantMapEqualsTheUniformEnvironment)
     int n = 50000;
     for (int i = 0; i < n; ++i) {
         Vec3f d = uniform_direction(s);
-        ASSERT_EQ(map->radiance(d), uniform->radiance(d));
+        ASSERT_EQ(map.radiance(d), uniform.radiance(d));
         // Uniform in solid angle within each texel: exactly the sphere's density.
-        ASSERT_NEAR(map->pdf(d), uniform->pdf(d), 1e-3f * uniform->pdf(d)) << d.y;
-        EnvironmentSample e = map->sample(s.next(), s.next());
+        ASSERT_NEAR(map.pdf(d), uniform.pdf(d), 1e-3f * uniform.pdf(d)) << d.y;
+        EnvironmentSample e = map.sample(s.next(), s.next());
         integral += e.radiance.y / e.pdf;
     }
     EXPECT_NEAR(integral / n, 4 * std::numbers::pi * L.y, 0.01 * 4 * std::numbers::pi * L.y);
-    EXPECT_FALSE(map->black());
+    EXPECT_FALSE(map.black());
+    EXPECT_TRUE(map.uniform());  // so the integrator leaves it to BSDF sampling
+    EXPECT_EQ(map.kind(), Environment::Kind::map);
+    EXPECT_FALSE(patchy_map().uniform());
+    EXPECT_FALSE(make_sky_environment().uniform());
 }
 
 TEST(MapEnvironment, ReadsLatLongFilesWithUpAtTheTopAndMinusZInTheCentre)
@@ -154,37 +160,86 @@ TEST(MapEnvironment, ReadsLatLongFilesWithUpAtTheTopAndMinusZInTheCentre)
         out->close();
     }
     auto env = make_map_environment(file, 2.0f);
-    EXPECT_EQ(env->radiance({0, 1, 0}), Vec3f(10, 0, 0));
+    EXPECT_EQ(env.radiance({0, 1, 0}), Vec3f(10, 0, 0));
     // Row 1 covers polar angles 45..90 deg; (0, 0.5, -1) is at 63 deg, column 4 of 8.
-    EXPECT_EQ(env->radiance(normalize({0, 0.5f, -1})), Vec3f(0, 14, 0));
-    EXPECT_EQ(env->radiance(normalize({0, 0.5f, 1})), Vec3f(2, 2, 2));
-    EXPECT_EQ(env->radiance({0, -1, 0}), Vec3f(2, 2, 2));
+    EXPECT_EQ(env.radiance(normalize({0, 0.5f, -1})), Vec3f(0, 14, 0));
+    EXPECT_EQ(env.radiance(normalize({0, 0.5f, 1})), Vec3f(2, 2, 2));
+    EXPECT_EQ(env.radiance({0, -1, 0}), Vec3f(2, 2, 2));
     std::filesystem::remove_all(dir);
     EXPECT_THROW(make_map_environment(dir / "missing.exr"), Error);
     EXPECT_THROW(make_map_environment(0, 4, {}), Error);
     EXPECT_THROW(make_map_environment(2, 2, std::vector<float>(5)), Error);
 }
 
+/// A Monte Carlo estimate and its standard error.
+struct Estimate {
+    double mean = 0, se = 0;
+};
+
+/// The mean of f over n draws and its standard error.
+template <typename F>
+Estimate estimate(int n, F f)
+{
+    double sum = 0, sum2 = 0;
+    for (int i = 0; i < n; ++i) {
+        double v = f();
+        sum += v;
+        sum2 += v * v;
+    }
+    double mean = sum / n, var = std::max(0.0, sum2 / n - mean * mean);
+    return {mean, std::sqrt(var / (n - 1))};
+}
+
+/// A direction drawn uniformly in the cone of half-angle acos(cos_max) about the unit axis.
+Vec3f uniform_in_cone(const Vec3f& axis, float cos_max, Sampler& s)
+{
+    float cos_t = 1 - s.next() * (1 - cos_max), sin_t = std::sqrt(1 - cos_t * cos_t);
+    float phi = 2 * pi * s.next();
+    Vec3f t, b;
+    make_basis(axis, t, b);
+    return normalize(t * (sin_t * std::cos(phi)) + b * (sin_t * std::sin(phi)) + axis * cos_t);
+}
+
+// The sun's cone is 7e-5 sr: uniform sampling of the sphere finds it about once in
+// 100 000 draws, so the density is integrated over the cone and over the rest of the
+// sphere separately (each by uniform samples of its own domain), with a tolerance of
+// 5 standard errors of those very estimates. The sampled directions' share in the cone
+// is checked against that integral (binomial, 5 standard errors), for several seeds.
 TEST(SkyEnvironment, PdfIsTheSunAndSphereMixtureAndSamplesAgree)
 {
     SkyParameters p;
     p.sun_direction = normalize({0.3f, 0.8f, 0.2f});
-    auto sky = make_sky_environment(p);
-    // Uniform Monte Carlo misses the tiny sun cone: it sees (1 - 1/2) of the mass.
-    EXPECT_NEAR(pdf_integral(*sky, 100000), 0.5, 1e-3);
-    Sampler s(1, 1, 1, 1, SampleSequence::white);
-    int in_sun = 0, n = 20000;
-    float cos_sun = std::cos(0.2665f * pi / 180);
-    for (int i = 0; i < n; ++i) {
-        EnvironmentSample e = sky->sample(s.next(), s.next());
-        ASSERT_NEAR(e.pdf, sky->pdf(e.direction), 1e-3f * e.pdf);
-        in_sun += dot(e.direction, p.sun_direction) >= cos_sun ? 1 : 0;
+    Environment sky = make_sky_environment(p);
+    const Vec3f sun = p.sun_direction;
+    const float cos_sun = std::cos(0.2665f * pi / 180);
+    const double cone = 2 * std::numbers::pi * (1 - double(cos_sun));
+    for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+        Sampler s(1, 2, 3, seed, SampleSequence::white);
+        Estimate in_cone =
+            estimate(20000, [&] { return sky.pdf(uniform_in_cone(sun, cos_sun, s)); });
+        Estimate outside = estimate(100000, [&] {
+            Vec3f d = uniform_direction(s);
+            return dot(d, sun) >= cos_sun ? 0.0 : double(sky.pdf(d));
+        });
+        double sun_mass = in_cone.mean * cone;
+        double integral = sun_mass + outside.mean * 4 * std::numbers::pi;
+        double se = std::hypot(in_cone.se * cone, outside.se * 4 * std::numbers::pi);
+        EXPECT_NEAR(integral, 1.0, 5 * se + 1e-5) << "seed " << seed;
+        // Half of the samples go to the sun's cone, and the density says so.
+        EXPECT_NEAR(sun_mass, 0.5, 5 * in_cone.se * cone + 1e-5) << "seed " << seed;
+
+        int in_sun = 0, n = 100000;
+        for (int i = 0; i < n; ++i) {
+            EnvironmentSample e = sky.sample(s.next(), s.next());
+            ASSERT_NEAR(length(e.direction), 1.0f, 1e-5f);
+            ASSERT_NEAR(e.pdf, sky.pdf(e.direction), 1e-3f * e.pdf);
+            ASSERT_EQ(e.radiance, sky.radiance(e.direction));
+            in_sun += dot(e.direction, sun) >= cos_sun ? 1 : 0;
+        }
+        double share = double(in_sun) / n;
+        EXPECT_NEAR(share, sun_mass, 5 * std::sqrt(sun_mass * (1 - sun_mass) / n))
+            << "seed " << seed;
     }
-    EXPECT_NEAR(double(in_sun) / n, 0.5, 0.02);
-    // The sun's share of the density integrates to 1/2 over its cone.
-    float solid_angle = 2 * pi * (1 - cos_sun);
-    float sun_share = (sky->pdf(p.sun_direction) - sky->pdf(-p.sun_direction)) * solid_angle;
-    EXPECT_NEAR(sun_share, 0.5f, 1e-3f);
 }
 
 // Sun at the zenith, turbidity 3: outside the atmosphere it gives irradiance
@@ -200,8 +255,8 @@ TEST(SkyEnvironment, SunDiskDeliversTheStatedIrradiance)
     auto sky = make_sky_environment(p);
     float cos_sun = std::cos(0.2665f * pi / 180);
     float solid_angle = 2 * pi * (1 - cos_sun);
-    Vec3f inside = sky->radiance({0, 1, 0});
-    Vec3f outside = sky->radiance(normalize({0.01f, 1, 0}));  // 0.57 deg off: sky only
+    Vec3f inside = sky.radiance({0, 1, 0});
+    Vec3f outside = sky.radiance(normalize({0.01f, 1, 0}));  // 0.57 deg off: sky only
     Vec3f sun = (inside - outside) * solid_angle;
     double airmass = 1 / (1 + 0.50572 * std::pow(96.07995, -1.6364));
     double beta = 0.04608 * 3 - 0.04586;
@@ -214,12 +269,12 @@ TEST(SkyEnvironment, SunDiskDeliversTheStatedIrradiance)
     EXPECT_GT(sun.x, sun.z);  // the direct sun is yellowish
     // Zenith bluer than red.
     EXPECT_GT(outside.z, outside.x);
-    EXPECT_FALSE(sky->black());
+    EXPECT_FALSE(sky.black());
     // A sun below the horizon has no disk and is never sampled.
     p.sun_direction = {0, -1, 0};
     auto night = make_sky_environment(p);
-    EXPECT_FLOAT_EQ(night->pdf({0, -1, 0}), 1 / (4 * pi));
-    EXPECT_TRUE(night->black());  // 90 degrees down: past civil twilight
+    EXPECT_FLOAT_EQ(night.pdf({0, -1, 0}), 1 / (4 * pi));
+    EXPECT_TRUE(night.black());  // 90 degrees down: past civil twilight
 }
 
 float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
@@ -253,7 +308,7 @@ TEST(SkyEnvironment, ZenithMatchesPreethamFormulas)
             p.sun_direction = {float(std::cos(e)), float(std::sin(e)), 0};
             p.turbidity = float(turbidity);
             auto sky = make_sky_environment(p);
-            Vec3f zenith = sky->radiance({0, 1, 0});
+            Vec3f zenith = sky.radiance({0, 1, 0});
             double expect = yz * 1000 / (128000 / std::numbers::pi);
             EXPECT_NEAR(luminance(zenith), expect, 2e-3 * expect)
                 << "T " << turbidity << " elevation " << elevation_deg;
@@ -272,15 +327,15 @@ TEST(SkyEnvironment, BrighterNearTheSunAndWhiterWhenHazy)
     auto sky = make_sky_environment(p);
     auto at = [&](float azimuth_deg) {
         float a = azimuth_deg * pi / 180;
-        return luminance(sky->radiance({std::cos(e) * std::cos(a), std::sin(e),
+        return luminance(sky.radiance({std::cos(e) * std::cos(a), std::sin(e),
                                         std::cos(e) * std::sin(a)}));
     };
     EXPECT_GT(at(5), 2 * at(90));
     EXPECT_GT(at(90), 0.0f);
     EXPECT_GT(at(5), at(20));
-    Vec3f away = sky->radiance(normalize({-1, 0.5f, 0}));
+    Vec3f away = sky.radiance(normalize({-1, 0.5f, 0}));
     p.turbidity = 8;
-    Vec3f hazy = make_sky_environment(p)->radiance(normalize({-1, 0.5f, 0}));
+    Vec3f hazy = make_sky_environment(p).radiance(normalize({-1, 0.5f, 0}));
     EXPECT_GT(away.z / away.x, hazy.z / hazy.x);
 }
 
@@ -297,28 +352,32 @@ TEST(RotatedEnvironment, LightComesFromTheTurnedDirection)
     float theta = pi * (bj + 0.5f) / h, phi = 2 * pi * (bi + 0.5f) / w;
     Vec3f d0{std::sin(theta) * std::sin(phi), std::cos(theta),
              std::sin(theta) * std::cos(phi)};
-    std::shared_ptr<const Environment> map = make_map_environment(w, h, rgb);
-    EXPECT_GT(map->radiance(d0).x, 100.0f);
-    auto turned = make_rotated_environment(map, 90);
+    Environment map = make_map_environment(w, h, rgb);
+    EXPECT_GT(map.radiance(d0).x, 100.0f);
+    Environment turned = map.rotated(90);
+    EXPECT_EQ(turned.rotation_degrees(), 90);
+    EXPECT_EQ(map.rotation_degrees(), 0);  // a turned copy: the map itself is as it was
     Vec3f d1{d0.z, d0.y, -d0.x};
-    EXPECT_GT(turned->radiance(d1).x, 100.0f);
-    EXPECT_LT(turned->radiance(d0).x, 1.0f);
-    EXPECT_NEAR(turned->pdf(d1), map->pdf(d0), 1e-6f * map->pdf(d0));
-    EXPECT_NEAR(pdf_integral(*turned, 20000), 1.0, 0.05);
+    EXPECT_GT(turned.radiance(d1).x, 100.0f);
+    EXPECT_LT(turned.radiance(d0).x, 1.0f);
+    EXPECT_NEAR(turned.pdf(d1), map.pdf(d0), 1e-6f * map.pdf(d0));
+    EXPECT_NEAR(pdf_integral(turned, 20000), 1.0, 0.05);
     // Nearly all samples come from around d1, and agree with pdf().
     Sampler s(3, 3, 3, 3, SampleSequence::white);
     int near = 0, n = 2000;
     for (int i = 0; i < n; ++i) {
-        EnvironmentSample e = turned->sample(s.next(), s.next());
-        ASSERT_NEAR(e.pdf, turned->pdf(e.direction), 1e-3f * e.pdf);
+        EnvironmentSample e = turned.sample(s.next(), s.next());
+        ASSERT_NEAR(e.pdf, turned.pdf(e.direction), 1e-3f * e.pdf);
         near += dot(e.direction, d1) > 0.95f ? 1 : 0;
     }
     EXPECT_GT(near, n * 9 / 10);
-    // +90 then -90 is the identity.
-    std::shared_ptr<const Environment> shared = std::move(turned);
-    auto back = make_rotated_environment(shared, -90);
-    EXPECT_GT(back->radiance(d0).x, 100.0f);
-    EXPECT_THROW(make_rotated_environment(nullptr, 10), Error);
+    // +90 then -90 is the identity: the angles add up to no turn at all.
+    Environment back = std::move(turned).rotated(-90);
+    EXPECT_EQ(back.rotation_degrees(), 0);
+    EXPECT_EQ(back.radiance(d0), map.radiance(d0));
+    EXPECT_EQ(back.pdf(d0), map.pdf(d0));
+    EXPECT_THROW((void)map.rotated(std::nanf("")), Error);
+    EXPECT_THROW((void)map.rotated(INFINITY), Error);
 }
 
 }  // namespace

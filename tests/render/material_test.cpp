@@ -69,9 +69,10 @@ TEST(Material, LambertianSampleWeightIsTheAlbedo)
 TEST(Material, SamplingMatchesQuadrature)
 {
     SurfaceMaterial m;
-    m.diffuse = {0.6f, 0.6f, 0.6f};
+    // Coloured lobes, so that each channel weighs diffuse and glossy differently.
+    m.diffuse = {0.6f, 0.3f, 0.1f};
     m.translucency = 0.3f;
-    m.specular = {0.3f, 0.3f, 0.3f};
+    m.specular = {0.3f, 0.2f, 0.4f};
     m.exponent = 8;
     Bsdf b = make_bsdf(m);
     for (float theta : {0.0f, 0.7f, 1.3f}) {
@@ -79,7 +80,10 @@ TEST(Material, SamplingMatchesQuadrature)
         Vec3f q = quadrature_albedo(b, incidence(theta), &pdf_integral);
         Vec3f s = sampled_albedo(b, incidence(theta));
         EXPECT_NEAR(s.x, q.x, 0.01f) << theta;
-        // The pdf integrates to 1 less the glossy samples that fall below the surface.
+        EXPECT_NEAR(s.y, q.y, 0.01f) << theta;
+        EXPECT_NEAR(s.z, q.z, 0.01f) << theta;
+        // The pdf integrates to 1 less the glossy samples that fall below the surface
+        // (exactly that loss: Chi2.PdfIntegratesToOneLessTheGlossyLossBelowTheSurface).
         EXPECT_LE(pdf_integral, 1.01);
         EXPECT_GT(pdf_integral, 0.7);
     }

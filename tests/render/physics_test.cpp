@@ -43,8 +43,8 @@ float furnace(const geom::Scene& s, const Camera& camera, int x0, int y0, int x1
     EmbreeScene accel(s, camera);
     PathContext ctx = context(s, accel, 1, 200);
     // The uniform environment as an object: the integrator must see it needs no NEE.
-    std::unique_ptr<Environment> uniform = make_uniform_environment(Vec3f(1));
-    ctx.environment = env ? env : uniform.get();
+    const Environment uniform = make_uniform_environment(Vec3f(1));
+    ctx.environment = env ? env : &uniform;
     ctx.background = Vec3f(1);
     ctx.roulette_depth = roulette_depth;
     prepare_path_context(ctx);
@@ -339,55 +339,42 @@ TEST(Physics, EmissiveSphereLightsByBsdfRays)
     std::printf("[emission] %.5f expected %.5f (standard error %.5f)\n", got, expect, se);
 }
 
-/// Radiance L above the horizon, none below; sampled cosine-weighted about +z.
-class Sky final : public Environment {
-public:
-    explicit Sky(float l) : m_l(l) {}
-    Vec3f radiance(const Vec3f& d) const override { return Vec3f(d.z > 0 ? m_l : 0.0f); }
-    EnvironmentSample sample(float u1, float u2) const override
-    {
-        float r = std::sqrt(u1), phi = 2 * pi * u2;
-        Vec3f d(r * std::cos(phi), r * std::sin(phi), std::sqrt(std::fmax(0.0f, 1 - u1)));
-        return {d, radiance(d), pdf(d)};
-    }
-    float pdf(const Vec3f& d) const override { return std::fmax(d.z, 0.0f) / pi; }
-    bool black() const override { return m_l <= 0; }
+/// A latitude-longitude map (up +y) of width columns: column i looks along azimuth
+/// phi = 2 pi (i + 1/2) / width, i.e. toward (sin phi, ., cos phi).
+Environment map_by_column(int width, int height, float (*r)(int, int), float (*g)(int, int))
+{
+    std::vector<float> rgb;
+    for (int j = 0; j < height; ++j)
+        for (int i = 0; i < width; ++i)
+            rgb.insert(rgb.end(), {r(i, j), g(i, j), g(i, j)});
+    return make_map_environment(width, height, std::move(rgb));
+}
 
-private:
-    float m_l;
-};
+/// Radiance 2 over the half-space z > 0, none below: of 4 columns the first and last,
+/// whose azimuths (cos phi > 0) look toward +z. The map samples that hemisphere
+/// uniformly (its texels by luminance), the BSDF by cosine: MIS weighs the two.
+Environment sky_over_plus_z()
+{
+    auto hemisphere = [](int i, int) { return i == 0 || i == 3 ? 2.0f : 0.0f; };
+    return map_by_column(4, 1, hemisphere, hemisphere);
+}
 
-/// Radiance 1 everywhere, but sampled half uniformly, half toward +z: not "uniform" to the
-/// integrator, so NEE and BSDF sampling are weighted against each other.
-class LopsidedWhite final : public Environment {
-public:
-    Vec3f radiance(const Vec3f&) const override { return Vec3f(1); }
-    EnvironmentSample sample(float u1, float u2) const override
-    {
-        Vec3f d;
-        if (u1 < 0.5f) {
-            float z = 1 - 4 * u1, r = std::sqrt(std::fmax(0.0f, 1 - z * z));
-            d = {r * std::cos(2 * pi * u2), r * std::sin(2 * pi * u2), z};
-        } else {
-            float u = 2 * u1 - 1, r = std::sqrt(u);
-            d = {r * std::cos(2 * pi * u2), r * std::sin(2 * pi * u2),
-                 std::sqrt(std::fmax(0.0f, 1 - u))};
-        }
-        return {d, Vec3f(1), pdf(d)};
-    }
-    float pdf(const Vec3f& d) const override
-    {
-        return 0.5f / (4 * pi) + 0.5f * std::fmax(d.z, 0.0f) / pi;
-    }
-    bool black() const override { return false; }
-};
+/// Green radiance 1 from everywhere, red 1 but 40 from a quarter of the directions:
+/// a white furnace in the green channel whose map samples by luminance, so next-event
+/// estimation draws lopsidedly and MIS against BSDF sampling must still add up to 1.
+Environment lopsided_green_furnace()
+{
+    auto red = [](int i, int j) { return i == 1 && j < 2 ? 40.0f : 1.0f; };
+    return map_by_column(2, 4, red, [](int, int) { return 1.0f; });
+}
 
 TEST(Physics, EnvironmentSamplingWithMis)
 {
     geom::Scene s = lit_plane(0.5f);
     Camera c = top_camera(0, 0, 0.2, 20, 20);
     EmbreeScene accel(s, c);
-    Sky sky(2);
+    const Environment sky = sky_over_plus_z();
+    ASSERT_FALSE(sky.uniform());
     PathContext ctx = context(s, accel, 0, 1);
     ctx.environment = &sky;
     ctx.max_depth = 2;
@@ -405,7 +392,8 @@ TEST(Physics, EnvironmentSamplingWithMis)
     for (float tr : {0.0f, 0.3f}) {
         geom::Scene ball = white(tr);
         add_sphere(ball.geometry, {0, 0, 0}, 3);
-        LopsidedWhite lop;
+        const Environment lop = lopsided_green_furnace();
+        ASSERT_FALSE(lop.uniform());  // so it is sampled for next-event estimation
         float v = furnace(ball, top_camera(0, 0, 8, 16, 16), 5, 5, 11, 11, 512, 1000, &lop);
         EXPECT_NEAR(v, 1.0f, 0.02f);
         std::printf("[furnace] sphere (translucency %.1f) under a non-uniformly sampled white "

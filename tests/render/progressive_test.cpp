@@ -432,7 +432,8 @@ TEST(EnvironmentSetting, ConstantMapLightsAWhiteFurnace)
     float bg = decode_display(s.background).x;
     RenderSettings set = small(32, 24, 16, 32);
     set.roulette_depth = 1000;
-    set.environment = make_map_environment(4, 2, std::vector<float>(4 * 2 * 3, bg));
+    set.environment = std::make_shared<const Environment>(
+        make_map_environment(4, 2, std::vector<float>(4 * 2 * 3, bg)));
     Image img = render(s, set);
     double sum = 0;
     int covered = 0;

@@ -163,16 +163,15 @@ TEST(Chi2, EnvironmentSampleLiFollowsPdfLi)
         for (int x = 40; x < 46; ++x)
             for (int c = 0; c < 3; ++c)
                 rgb[(y * 64 + x) * 3 + c] = 20;
-    std::shared_ptr<const Environment> map = make_map_environment(64, 32, rgb);
+    Environment map = make_map_environment(64, 32, rgb);
     // No sun disc: half a degree across, no bin grid here could integrate its density.
     SkyParameters no_sun;
     no_sun.sun_intensity = 0;
-    std::shared_ptr<const Environment> sky = make_sky_environment(no_sun);
-    std::vector<std::shared_ptr<const Environment>> envs{
-        map, make_rotated_environment(map, 30), sky, make_rotated_environment(sky, -70)};
+    Environment sky = make_sky_environment(no_sun);
+    std::vector<Environment> envs{map, map.rotated(30), sky, sky.rotated(-70)};
     std::vector<RenderLight> none;
     for (std::size_t i = 0; i < envs.size(); ++i) {
-        LightSet set(none, nullptr, envs[i].get(), true, 1);
+        LightSet set(none, nullptr, &envs[i], true, 1);
         Chi2Result r = chi2_sphere(
             [&](Sampler& s) { return light_direction(set, Vec3f(), s); },
             [&](const Vec3f& wi) { return double(set.pdf_li(wi)); }, 200000, 23, 20, 40, 32);
