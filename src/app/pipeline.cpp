@@ -83,13 +83,31 @@ std::shared_ptr<const geom::ViewFile> read_view(const Options& options)
         return view;
     namespace fs = std::filesystem;
     const fs::path folder = fs::weakly_canonical(fs::absolute(options.lsystem).parent_path());
-    for (const geom::TextureDef& t : view->textures) {
-        const fs::path file = fs::weakly_canonical(t.file);  // links and .. resolved
+    auto refuse_outside = [&](const fs::path& named, const std::string& what, const FileLoc& loc) {
+        const fs::path file = fs::weakly_canonical(named);  // links and .. resolved
         auto [f, unused] = std::mismatch(folder.begin(), folder.end(), file.begin(), file.end());
         if (f != folder.end())
-            throw Error(FileLoc{options.view.string()},
-                        "texture '" + t.file.string() + "' lies outside the model's folder " +
-                            folder.string() + " (--allow-file-access lifts this)");
+            throw Error(loc, what + " '" + named.string() + "' lies outside the model's folder " +
+                                 folder.string() + " (--allow-file-access lifts this)");
+    };
+    for (const geom::TextureDef& t : view->textures)
+        refuse_outside(t.file, "texture", FileLoc{options.view.string()});
+    // Surfaces, contours, functions, background scenes...: the commands that name files
+    // are many and their syntaxes differ, so every word of every such command that names
+    // an existing file (or a link), read as the readers read it (relative to the view
+    // file's folder), must lie inside the model's folder. Words that name nothing are
+    // left to the readers, which fail on them.
+    const fs::path view_folder = fs::absolute(view->path).parent_path();
+    for (const geom::ViewCommand& c : view->deferred) {
+        std::istringstream words(c.value);
+        for (std::string word; words >> word;) {
+            const fs::path named = fs::path(word).is_absolute() ? fs::path(word) : view_folder / word;
+            std::error_code ec;
+            const fs::file_status status = fs::status(named, ec);
+            if (fs::is_symlink(fs::symlink_status(named, ec)) ||
+                (fs::exists(status) && !fs::is_directory(status)))
+                refuse_outside(named, "file", c.loc);
+        }
     }
     return view;
 }

@@ -222,6 +222,37 @@ TEST(Command, TexturesStayInTheModelsFolderUnlessAllowed)
     }
 }
 
+// The other files a view file names (surfaces, contours, functions, background scenes)
+// are confined like its textures: a name that reaches outside the model's folder,
+// through "..", an absolute path or a link, is refused before anything is read, with
+// the view file's line; --allow-file-access lifts it (the reader then fails on the
+// stand-in file's contents instead).
+TEST(Command, FilesAViewFileNamesStayInTheModelsFolder)
+{
+    fs::path dir = scratch("named-files"), model = dir / "model";
+    fs::create_directories(model);
+    write(model / "p.l", "lsystem: 1\nderivation length: 1\naxiom: F\nendlsystem\n");
+    write(dir / "outside.s", "not a surface");
+    fs::create_symlink(dir / "outside.s", model / "link.s");
+    auto render_with = [&](const std::string& command, const std::string& options) {
+        write(model / "p.v", "line style: cylinder\n" + command + "\n");
+        fs::remove(dir / "out.png");
+        return run("-q -w 8 6 --spp 1 " + options + " -o out.png model/p.l model/p.v", dir);
+    };
+    for (const std::string& command :
+         {std::string("surface: S ../outside.s 1"), "surface: S " + (dir / "outside.s").string() + " 1",
+          std::string("surface: S link.s 1"), std::string("function: ../outside.s 20")}) {
+        Result r = render_with(command, "");
+        EXPECT_NE(r.status, 0) << command;
+        EXPECT_NE(r.output.find("p.v:2"), std::string::npos) << r.output;
+        EXPECT_NE(r.output.find("outside the model's folder"), std::string::npos) << r.output;
+        EXPECT_FALSE(fs::exists(dir / "out.png")) << command;
+        Result allowed = render_with(command, "--allow-file-access");
+        EXPECT_EQ(allowed.output.find("outside the model's folder"), std::string::npos)
+            << command << ": " << allowed.output;
+    }
+}
+
 TEST(Command, SyntaxErrorNamesFileLineAndColumnAndWritesNothing)
 {
     fs::path dir = scratch("bad");
