@@ -4,6 +4,7 @@
 #include "app/pipeline.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <sstream>
 
@@ -190,7 +191,7 @@ double deferred_number(const geom::ViewCommand& c)
 {
     std::istringstream in(c.value);
     double value = 0;
-    if (!(in >> value))
+    if (!(in >> value) || !std::isfinite(value))
         throw Error(c.loc, c.name + ": expected a number, found '" + c.value + "'");
     return value;
 }
@@ -207,7 +208,10 @@ void light_by_colour_index(geom::Scene& scene, const geom::ViewFile& view)
         light.to_light = normalize(to_light);
     for (const geom::ViewCommand& c : view.deferred) {
         if (c.name == "diffuse reflection")
-            light.diffuse_reflection = static_cast<int>(deferred_number(c));
+            // Beyond the 256 colour indices a shift means nothing; bounded, as the
+            // ramps it sizes must be.
+            light.diffuse_reflection =
+                static_cast<int>(std::clamp(deferred_number(c), -255.0, 255.0));
         else if (c.name == "surface ambient")
             light.surface_ambient = static_cast<float>(deferred_number(c));
         else if (c.name == "surface diffuse")

@@ -228,8 +228,10 @@ Vec3f index_lit_albedo(const IndexRamp& ramp, const geom::ColourIndexLight& ligh
         return ramp.albedo[static_cast<std::size_t>(std::clamp(offset, -ramp.reach, ramp.reach) + ramp.reach)];
     }
     float level = light.surface_ambient + light.surface_diffuse * std::fabs(cos_light);
-    int k = static_cast<int>(static_cast<float>(ramp.place) * level);
-    return ramp.albedo[static_cast<std::size_t>(std::clamp(k, 0, index_block - 1))];
+    float place = static_cast<float>(ramp.place) * level;
+    // Clamped as a float first: a huge or NaN level must not reach the int conversion.
+    place = place >= 0 ? std::min(place, static_cast<float>(index_block - 1)) : 0.0f;
+    return ramp.albedo[static_cast<std::size_t>(place)];
 }
 
 }  // namespace cambium::render

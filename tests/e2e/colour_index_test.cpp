@@ -101,4 +101,20 @@ TEST(ColourIndexLighting, MalformedCoefficientIsAnErrorNamingTheLine)
     }
 }
 
+// A model file sizes the colour ramps with `diffuse reflection:`: a huge value is bounded
+// to the 256 indices (no multi-gigabyte ramp), and a non-finite one is an error.
+TEST(ColourIndexLighting, HugeOrNonFiniteCoefficientsAreBounded)
+{
+    geom::Scene scene = interpret_colormap_model("huge", "render mode: shaded\ndiffuse reflection: 1e12\n");
+    ASSERT_TRUE(scene.colour_index_light);
+    EXPECT_EQ(scene.colour_index_light->diffuse_reflection, 255);
+    for (const char* bad : {"diffuse reflection: nan", "surface ambient: inf"}) {
+        try {
+            interpret_colormap_model("nonfinite", std::string("render mode: shaded\n") + bad + "\n");
+            ADD_FAILURE() << "no error for " << bad;
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("plant.v:3"), std::string::npos) << e.what();
+        }
+    }
+}
 }  // namespace
