@@ -79,7 +79,7 @@ TEST(BenchmarkScenes, EveryPlantOfTheScenesHasWoodOrStemsAndLeaves)
 {
     Diagnostics quiet(Diagnostics::Output::quiet);
     ScopedDiagnostics install(quiet);
-    for (const char* scene : {"meadow.json", "forest.json"})
+    for (const char* scene : {"meadow.json", "forest.json"}) {
         for (const std::string& model : summarise(suite / scene).models) {
             geom::Scene s = interpret_model(suite / model);
             const geom::Geometry& g = s.geometry;
@@ -88,6 +88,7 @@ TEST(BenchmarkScenes, EveryPlantOfTheScenesHasWoodOrStemsAndLeaves)
             if (model != "models/grass")
                 EXPECT_GT(g.lines.segment_count(), 0u) << model;
         }
+    }
 }
 
 TEST(BenchmarkScenes, BigTreeHasTheSegmentCountItsCommentPromisesAtASmallScale)

@@ -224,7 +224,7 @@ TEST(MpiCommand, SequencesEqualTheSingleRun)
 /// "%02d" of n.
 std::string two_digits(int n)
 {
-    char number[8];
+    char number[16];  // room for any int
     std::snprintf(number, sizeof number, "%02d", n);
     return number;
 }
