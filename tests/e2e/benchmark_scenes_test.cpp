@@ -85,8 +85,9 @@ TEST(BenchmarkScenes, EveryPlantOfTheScenesHasWoodOrStemsAndLeaves)
             const geom::Geometry& g = s.geometry;
             // Leaves are polygons (triangles) or, for clover, discs.
             EXPECT_GT(g.mesh.size() + g.discs.size(), 0u) << model;
-            if (model != "models/grass")
+            if (model != "models/grass") {
                 EXPECT_GT(g.lines.segment_count(), 0u) << model;
+            }
         }
     }
 }
