@@ -116,7 +116,8 @@ Tile decode_tile(const std::string& bytes, const std::string& source)
     const char* p = bytes.data() + magic.size() + sizeof h;
     for (std::vector<float>* layer : {&tile.image.rgba, &tile.image.albedo, &tile.image.normal,
                                       &tile.image.depth}) {
-        std::memcpy(layer->data(), p, layer->size() * sizeof(float));
+        if (!layer->empty())  // an absent layer has no data() to copy into
+            std::memcpy(layer->data(), p, layer->size() * sizeof(float));
         p += layer->size() * sizeof(float);
     }
     return tile;
