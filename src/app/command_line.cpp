@@ -281,8 +281,9 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
                  "Run the commands of @S modules (never done by default)");
     cli.add_flag("--allow-file-access", options.allow_file_access,
                  "Let the L-system's fopen read and write files outside the model's folder, "
-                 "and the view file name textures, surfaces, contours, functions and "
-                 "background scenes there (never done by default)");
+                 "its #include and the background scenes' read files there, and the view "
+                 "file name textures, surfaces, contours, functions and background scenes "
+                 "there (never done by default)");
     cli.add_flag("-q,--quiet", options.quiet, "Print nothing but errors");
     add_shot_options(cli, options.shot);
     std::vector<std::string> files;

@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <sstream>
 
+#include "base/confinement.h"
 #include "base/diagnostics.h"
 #include "base/subprocess.h"
 #include "geom/background_scene.h"
@@ -77,17 +78,20 @@ void run_system_call(const std::string& command, const std::filesystem::path& fo
 
 }  // namespace
 
+std::filesystem::path model_folder(const Options& options)
+{
+    return std::filesystem::weakly_canonical(std::filesystem::absolute(options.lsystem).parent_path());
+}
+
 std::shared_ptr<const geom::ViewFile> read_view(const Options& options)
 {
     auto view = std::make_shared<const geom::ViewFile>(geom::read_view_file(options.view));
     if (options.allow_file_access)
         return view;
     namespace fs = std::filesystem;
-    const fs::path folder = fs::weakly_canonical(fs::absolute(options.lsystem).parent_path());
+    const fs::path folder = model_folder(options);
     auto refuse_outside = [&](const fs::path& named, const std::string& what, const FileLoc& loc) {
-        const fs::path file = fs::weakly_canonical(named);  // links and .. resolved
-        auto [f, unused] = std::mismatch(folder.begin(), folder.end(), file.begin(), file.end());
-        if (f != folder.end())
+        if (!lies_within(named, folder))
             throw Error(loc, what + " '" + named.string() + "' lies outside the model's folder " +
                                  folder.string() + " (--allow-file-access lifts this)");
     };
@@ -362,7 +366,9 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
     if (index_lit)
         light_by_colour_index(scene, *model.view);
 
-    geom::BackgroundScene background = geom::load_view_background(*model.view, scene.materials[0]);
+    geom::BackgroundScene background = geom::load_view_background(
+        *model.view, scene.materials[0],
+        options.allow_file_access ? std::nullopt : std::optional(model_folder(options)));
     if (!background.geometry.empty()) {
         geom::offset_materials(background.geometry,
                                static_cast<std::uint16_t>(scene.materials.size()));

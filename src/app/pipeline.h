@@ -3,6 +3,7 @@
 // interpreted. The `cambium` command and the corpus tests share this path to a Scene.
 #pragma once
 
+#include <filesystem>
 #include <memory>
 
 #include "app/command_line.h"
@@ -23,6 +24,10 @@ struct Model {
     std::shared_ptr<const geom::FunctionSet> functions;
     lsys::LSystem lsystem;
 };
+
+/// The folder every file a model names must lie in unless options.allow_file_access: the
+/// .l file's, where cpfg runs (absolute, `..` and links resolved).
+std::filesystem::path model_folder(const Options& options);
 
 /// The view file, its texture images confined to the model's folder (the .l file's, where
 /// cpfg runs) and below, as the L-system's own files are (docs/security.md): a texture

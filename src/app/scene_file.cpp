@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/shot_options.h"
+#include "base/confinement.h"
 #include "base/diagnostics.h"
 
 namespace cambium::app {
@@ -157,8 +158,7 @@ fs::path resolve_under(const Node& n, const fs::path& folder, const std::string&
                "(or give --allow-file-access)");
     fs::path base = fs::weakly_canonical(folder);
     fs::path full = fs::weakly_canonical(base / p);
-    auto [b, f] = std::mismatch(base.begin(), base.end(), full.begin(), full.end());
-    if (b != base.end())
+    if (!is_within(base, full))
         n.fail("'" + name + "' lies outside the folder " + folder.string() +
                " (give --allow-file-access to allow it)");
     return full;

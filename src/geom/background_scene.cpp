@@ -487,7 +487,8 @@ bool has_directive(std::string_view text)
 }  // namespace
 
 BackgroundScene read_background_scene(std::string_view list, const std::filesystem::path& base_dir,
-                                      const Material& initial_material, const FileLoc& loc)
+                                      const Material& initial_material, const FileLoc& loc,
+                                      const std::optional<std::filesystem::path>& confine_to)
 {
     std::vector<BackgroundStatement> statements;
     std::size_t pos = 0;
@@ -512,6 +513,7 @@ BackgroundScene read_background_scene(std::string_view list, const std::filesyst
         if (has_directive(text)) {  // cpfg runs background files through cpp
             lsys::PreprocessOptions options;
             options.folder = file.parent_path();  // "" (the current folder) is fine here
+            options.confine_to = confine_to;
             text = lsys::preprocess(text, file.string(), options);
         }
         std::vector<BackgroundStatement> more = parse_background_text(text, file.string());
@@ -523,13 +525,15 @@ BackgroundScene read_background_scene(std::string_view list, const std::filesyst
     return build_background_scene(statements, initial_material);
 }
 
-BackgroundScene load_view_background(const ViewFile& view, const Material& initial_material)
+BackgroundScene load_view_background(const ViewFile& view, const Material& initial_material,
+                                     const std::optional<std::filesystem::path>& confine_to)
 {
     BackgroundScene scene;
     for (const ViewCommand& c : view.deferred) {
         if (c.name != "background scene")
             continue;
-        BackgroundScene more = read_background_scene(c.value, view.path.parent_path(), initial_material, c.loc);
+        BackgroundScene more = read_background_scene(c.value, view.path.parent_path(), initial_material, c.loc,
+                                                     confine_to);
         auto offset = static_cast<std::uint16_t>(scene.materials.size());
         offset_materials(more.geometry, offset);
         append_geometry(scene.geometry, more.geometry);

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -71,12 +72,16 @@ BackgroundScene build_background_scene(const std::vector<BackgroundStatement>& s
                                        const Material& initial_material);
 
 /// `background scene: list`: every file of the list (separated by blanks, ',' or ';',
-/// relative to `base_dir`), in order. A missing file is an Error.
+/// relative to `base_dir`), in order. A missing file is an Error. Files run through
+/// cpp may #include only files inside `confine_to` when it is set (the model's folder,
+/// docs/security.md); the listed files themselves are checked by the view's reader.
 BackgroundScene read_background_scene(std::string_view list, const std::filesystem::path& base_dir,
-                                      const Material& initial_material, const FileLoc& loc);
+                                      const Material& initial_material, const FileLoc& loc,
+                                      const std::optional<std::filesystem::path>& confine_to);
 
 /// All `background scene:` commands of the view file (usually one), or an empty scene.
-BackgroundScene load_view_background(const ViewFile& view, const Material& initial_material);
+BackgroundScene load_view_background(const ViewFile& view, const Material& initial_material,
+                                     const std::optional<std::filesystem::path>& confine_to);
 
 /// Appends `from` to `into` (index arrays shifted; missing optional attributes of either
 /// side filled with v = 0 / no_texture so the arrays stay parallel).

@@ -18,6 +18,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "base/confinement.h"
 #include "base/diagnostics.h"
 
 namespace cambium::lsys {
@@ -477,13 +478,6 @@ OpenFiles::~OpenFiles()
 }
 
 namespace {
-
-/// Whether `path` is `folder` or lies below it (both canonical).
-bool is_within(const std::filesystem::path& folder, const std::filesystem::path& path)
-{
-    auto [f, p] = std::mismatch(folder.begin(), folder.end(), path.begin(), path.end());
-    return f == folder.end();
-}
 
 /// The file `name` names in the model's folder `base_dir`, links and ".." resolved,
 /// or an EvaluationError when it lies outside.

@@ -93,6 +93,8 @@ LSystem LSystem::load(const std::filesystem::path& file, const LoadOptions& opti
     pp.defines = options.defines;
     pp.preprocessor = options.preprocessor;
     pp.folder = file.parent_path();
+    if (!options.allow_file_access)
+        pp.confine_to = std::filesystem::weakly_canonical(std::filesystem::absolute(pp.folder.empty() ? "." : pp.folder));
     std::string source = read_source(file, pp.max_input_bytes);
     return LSystem(compile(source, file.string(), pp), options);
 }
@@ -103,6 +105,8 @@ LSystem LSystem::from_source(std::string_view source, std::string_view file_name
     PreprocessOptions pp;
     pp.defines = options.defines;
     pp.preprocessor = options.preprocessor;
+    if (!options.allow_file_access)
+        pp.confine_to = std::filesystem::current_path();  // where cpp runs
     return LSystem(compile(source, std::string(file_name), pp), options);
 }
 

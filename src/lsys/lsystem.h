@@ -26,7 +26,7 @@ struct LoadOptions {
     std::size_t max_modules = 100'000'000; ///< derivation fails past this string length
     /// derivation fails when its strings take more (--max-memory; base/limits.h)
     std::uint64_t max_memory_bytes = default_max_memory_bytes();
-    /// fopen may open files outside the model's folder (--allow-file-access)
+    /// fopen may open, and #include may read, files outside the model's folder (--allow-file-access)
     bool allow_file_access = false;
     /// func(id, x): the view file's function set (geom's FunctionSet::evaluate, which
     /// owns the clamping). Unset: func() evaluates to 0 with one warning.

@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "base/confinement.h"
 #include "base/diagnostics.h"
 #include "base/subprocess.h"
 
@@ -96,12 +97,14 @@ std::vector<IncludeDirective> scan_includes(std::string_view text, bool tab_line
     return found;
 }
 
-/// Refuses, before cpp opens them, included names that are not regular files: reading
-/// /dev/zero, a FIFO or a terminal never ends. Follows the includes it can resolve
-/// (as cpp: the including file's folder for quoted names, then the -I folders).
+/// Refuses, before cpp opens them, included names that are not regular files (reading
+/// /dev/zero, a FIFO or a terminal never ends) or that lie outside `confine_to`.
+/// Follows the includes it can resolve (as cpp: the including file's folder for quoted
+/// names, then the -I folders).
 void check_includes(std::string_view source, const std::string& file_name,
                     const std::filesystem::path& folder,
-                    const std::vector<std::filesystem::path>& include_dirs)
+                    const std::vector<std::filesystem::path>& include_dirs,
+                    const std::optional<std::filesystem::path>& confine_to)
 {
     struct Pending {
         std::string text;
@@ -133,6 +136,11 @@ void check_includes(std::string_view source, const std::string& file_name,
                     throw Error(FileLoc{current.name, d.line, d.column},
                                 "#include names " + candidate.string() +
                                     ", which is a device, FIFO or folder, not a file");
+                if (confine_to && !lies_within(candidate, *confine_to))
+                    throw Error(FileLoc{current.name, d.line, d.column},
+                                "#include names " + candidate.string() +
+                                    ", which lies outside the model's folder " +
+                                    confine_to->string() + " (--allow-file-access lifts this)");
                 std::error_code ec;
                 auto canonical = std::filesystem::weakly_canonical(candidate, ec);
                 if (!seen.insert(ec ? candidate : canonical).second)
@@ -151,6 +159,35 @@ void check_includes(std::string_view source, const std::string& file_name,
             }
         }
     }
+}
+
+/// Refuses cpp's output when its line markers show it read a file outside `confine_to`:
+/// an `#include MACRO` whose name check_includes could not see. cpp runs in `folder`,
+/// so relative names are that folder's; `<built-in>` and the like name no file, and
+/// the model's own file (`main_name`, as the user named it) was checked by its reader.
+void check_included_files(const std::string& output, const std::filesystem::path& folder,
+                          const std::filesystem::path& confine_to, const std::string& main_name)
+{
+    std::set<std::string> checked;
+    for_each_line(output, [&](std::string_view line) {
+        if (line.size() < 4 || line[0] != '#' || line[1] != ' ' ||
+            !std::isdigit(static_cast<unsigned char>(line[2])))
+            return;
+        std::size_t open = line.find('"');
+        if (open == std::string_view::npos)
+            return;
+        std::string name;
+        for (std::size_t i = open + 1; i < line.size() && line[i] != '"'; ++i)
+            name += line[i] == '\\' && i + 1 < line.size() ? line[++i] : line[i];
+        if (name.empty() || name.front() == '<' || name == main_name || !checked.insert(name).second)
+            return;
+        std::filesystem::path file(name);
+        if (!lies_within(file.is_absolute() ? file : folder / file, confine_to))
+            throw Error(FileLoc{main_name, 0, 0},
+                        "the C preprocessor read " + name + ", which lies outside the model's folder " +
+                            confine_to.string() +
+                            " (an #include whose name a macro computes?); --allow-file-access lifts this");
+    });
 }
 
 /// `name` as a C string literal for a line marker.
@@ -326,7 +363,7 @@ std::string preprocess(std::string_view source, std::string_view file_name,
     for (const auto& dir : options.include_dirs)
         if (!dir.empty())
             include_dirs.push_back(absolute_folder(dir));
-    check_includes(source, name, folder, include_dirs);
+    check_includes(source, name, folder, include_dirs, options.confine_to);
 
     // The line marker makes cpp's messages and markers name the model's file.
     std::string input = "# 1 " + quoted(file_name) + "\n" + protect_cpfg_lines(source);
@@ -362,6 +399,8 @@ std::string preprocess(std::string_view source, std::string_view file_name,
     }
     if (r.exit_code != 0)
         throw Error(FileLoc{name, 0, 0}, "the C preprocessor failed:\n" + messages);
+    if (options.confine_to)
+        check_included_files(r.output, folder, *options.confine_to, name);
     forward_messages(messages);
     std::string text = replace_all(r.output, "\"<stdin>\"", quoted(file_name));
     return restore_cpfg_lines(name_from_user_folder(text, options.folder, name));

@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -23,13 +24,18 @@ struct PreprocessOptions {
     std::size_t max_output_bytes = 64u << 20;  ///< larger preprocessed text stops cpp
     double max_seconds = 20;                  ///< cpp is stopped after this long
     std::size_t max_memory_bytes = 1u << 30;  ///< cpp's address space
+    /// When set, every file cpp includes must lie in this folder or below once `..` and
+    /// links are resolved (the model's folder: a model file reads nothing outside it,
+    /// docs/security.md). Unset (--allow-file-access): includes may name any file.
+    std::optional<std::filesystem::path> confine_to;
 };
 
 /// Preprocesses `source`, read from `file_name`. The result keeps cpp's line markers
 /// (`# 12 "plant.l"`) naming `file_name`, a leading tab on every line that had one, and
 /// every line whose first non-blank characters are `#(`. Throws cambium::Error (at the
 /// line of the directive where known) when the preprocessor is missing, reports an
-/// error, runs past a limit, or an `#include` names a device, FIFO or folder.
+/// error, runs past a limit, or an `#include` names a device, FIFO or folder, or a file
+/// outside options.confine_to.
 std::string preprocess(std::string_view source, std::string_view file_name,
                        const PreprocessOptions& options);
 

@@ -472,7 +472,9 @@ std::shared_ptr<const TextureSet> load_textures(const geom::Scene& scene,
     std::vector<geom::TextureDef> defs = scene.textures;
     if (settings.ground.enabled && !settings.ground.texture.empty())
         defs.push_back({settings.ground.texture, false, true, true});
-    return std::make_shared<const TextureSet>(defs, settings.texture_folder,
+    // The readers made every texture path absolute (view files, scene files) or left
+    // it as the user gave it on the command line (the ground's: the current folder's).
+    return std::make_shared<const TextureSet>(defs, std::filesystem::path{},
                                               settings.max_memory_bytes);
 }
 

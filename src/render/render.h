@@ -76,9 +76,6 @@ struct RenderSettings {
     /// weighted against BSDF sampling by MIS). Off: only BSDF rays find them (the same
     /// image on average, noisier).
     bool area_lights = true;
-    /// The folder that relative texture paths (Scene::textures) are taken from: the
-    /// view file's folder.
-    std::filesystem::path texture_folder;
     /// What one decoded texture may take (--max-memory): larger ones are refused from
     /// their header, before loading.
     std::uint64_t max_memory_bytes = default_max_memory_bytes();

@@ -253,6 +253,41 @@ TEST(Command, FilesAViewFileNamesStayInTheModelsFolder)
     }
 }
 
+// Files included by the model's own files are confined too: an L-system's or a
+// background scene's `#include` of a file outside the model's folder is an error naming
+// the directive, and nothing is written; --allow-file-access lifts it.
+TEST(Command, IncludesStayInTheModelsFolder)
+{
+    fs::path dir = scratch("includes"), model = dir / "model";
+    fs::create_directories(model);
+    write(dir / "steps.h", "#define STEPS 1\n");
+    write(dir / "ground.h", "\n");
+    write(model / "bg.dat", "#include \"../ground.h\"\n");
+    auto render_with = [&](const std::string& lsystem, const std::string& view,
+                           const std::string& options) {
+        write(model / "p.l", lsystem);
+        write(model / "p.v", "line style: cylinder\n" + view);
+        fs::remove(dir / "out.png");
+        return run("-q -w 8 6 --spp 1 " + options + " -o out.png model/p.l model/p.v", dir);
+    };
+    const std::string plain = "lsystem: 1\nderivation length: 1\naxiom: F\nendlsystem\n";
+    const std::string including = "#include \"../steps.h\"\nlsystem: 1\nderivation length: STEPS\naxiom: F\nendlsystem\n";
+    struct Case {
+        std::string lsystem, view, where;
+    };
+    for (const Case& c : {Case{including, "", "p.l:1:1: error: #include names"},
+                          Case{plain, "background scene: bg.dat\n", "bg.dat:1:1: error: #include names"}}) {
+        Result r = render_with(c.lsystem, c.view, "");
+        EXPECT_NE(r.status, 0) << c.where;
+        EXPECT_NE(r.output.find(c.where), std::string::npos) << r.output;
+        EXPECT_NE(r.output.find("lies outside the model's folder"), std::string::npos) << r.output;
+        EXPECT_FALSE(fs::exists(dir / "out.png")) << c.where;
+        Result allowed = render_with(c.lsystem, c.view, "--allow-file-access");
+        EXPECT_EQ(allowed.status, 0) << c.where << ": " << allowed.output;
+        EXPECT_TRUE(fs::exists(dir / "out.png")) << c.where;
+    }
+}
+
 TEST(Command, SyntaxErrorNamesFileLineAndColumnAndWritesNothing)
 {
     fs::path dir = scratch("bad");

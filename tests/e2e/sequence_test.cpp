@@ -56,7 +56,6 @@ app::SequenceOutputs outputs_for(const app::Options& options, const fs::path& pa
     out.settings.width = options.width;
     out.settings.height = options.height;
     out.settings.samples_per_pixel = options.samples_per_pixel;
-    out.settings.texture_folder = options.view.parent_path();
     app::apply_staging(out.settings, options);
     out.write_strings = [](const app::Model&, const lsys::ModuleString&, int) {};
     out.say = [](const std::string&) {};

@@ -224,6 +224,41 @@ TEST(LsysPreprocessor, QuotedIncludesStartFromTheModelFolder)
     fs::remove(fs::temp_directory_path() / "cambium_planted.h");
 }
 
+// A model file reads nothing outside its model's folder (docs/security.md): with
+// confine_to set, an #include of a file outside it (written out, through a link, from an
+// included file, or computed by a macro) is an error, and none of its text comes back.
+TEST(LsysPreprocessor, IncludesStayInTheConfinedFolder)
+{
+    constexpr auto npos = std::string::npos;
+    fs::path dir = scratch("confined");
+    fs::create_directories(dir / "model" / "sub");
+    std::ofstream(dir / "secret.h") << "secret_text\n";
+    std::ofstream(dir / "model" / "own.h") << "own_text\n";
+    std::ofstream(dir / "model" / "sub" / "deeper.h") << "#include \"../own.h\"\n";
+    std::ofstream(dir / "model" / "sneaky.h") << "#include \"../secret.h\"\n";
+    fs::create_symlink(dir / "secret.h", dir / "model" / "link.h");
+    PreprocessOptions options;
+    options.folder = dir / "model";
+    options.confine_to = dir / "model";
+    std::string out = preprocess("#include \"own.h\"\n#include \"sub/deeper.h\"\n", "p.l", options);
+    EXPECT_NE(out.find("own_text"), npos) << out;
+    const std::string absolute = "\"" + (dir / "secret.h").string() + "\"";
+    for (const std::string& include : {std::string("\"../secret.h\""), absolute, std::string("\"link.h\"")}) {
+        std::string message = preprocess_error("\n#include " + include + "\n", "p.l", options);
+        EXPECT_NE(message.find("p.l:2:1: error: #include names"), npos) << include << ": " << message;
+        EXPECT_NE(message.find("lies outside the model's folder"), npos) << message;
+        EXPECT_EQ(message.find("secret_text"), npos) << message;
+    }
+    std::string message = preprocess_error("#include \"sneaky.h\"\n", "p.l", options);
+    EXPECT_NE(message.find("sneaky.h:1:1: error: #include names"), npos) << message;
+    message = preprocess_error("#define S \"../secret.h\"\n#include S\n", "p.l", options);
+    EXPECT_NE(message.find("p.l: error: the C preprocessor read ../secret.h, which lies outside"), npos)
+        << message;
+    EXPECT_EQ(message.find("secret_text"), npos) << message;
+    options.confine_to.reset();  // --allow-file-access
+    EXPECT_NE(preprocess("#include \"../secret.h\"\n", "p.l", options).find("secret_text"), npos);
+}
+
 // cpp runs in the model's folder; included files are still named as the user reaches
 // them (the folder they gave), in line markers and in cpp's messages.
 TEST(LsysPreprocessor, IncludedFilesAreNamedFromTheUsersFolder)
