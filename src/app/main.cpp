@@ -359,10 +359,12 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
     stats.assemble_s = stats.load_s + stats.derive_s + stats.interpret_s;
     stats.add_scene(scene);
     const geom::Geometry& g = scene.geometry;
-    say(fmt::format("interpreted {} cylinders, {} cylinder curves, {} spheres, {} discs, "
+    say(fmt::format("interpreted {} {}, {} cylinder curves, {} spheres, {} discs, "
                     "{} triangles, {} instances",
-                    g.lines.segment_count(), g.curves.segment_count(), g.spheres.size(),
-                    g.discs.size(), g.mesh.size(), scene.instances.size()));
+                    g.lines.segment_count(),
+                    scene.line_radius_in_pixels ? "pixel-width lines" : "cylinders",
+                    g.curves.segment_count(), g.spheres.size(), g.discs.size(), g.mesh.size(),
+                    scene.instances.size()));
     if (options.view_volume && writes) {
         // As cpfg, the view file's `box:` wins over the computed bounds.
         geom::write_view_volume(scene.view.box.value_or(scene.bounds), *options.view_volume);

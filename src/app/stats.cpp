@@ -20,6 +20,7 @@ namespace cambium::app {
 PrimitiveCounts& PrimitiveCounts::operator+=(const PrimitiveCounts& o)
 {
     cylinders += o.cylinders;
+    lines += o.lines;
     curve_segments += o.curve_segments;
     spheres += o.spheres;
     discs += o.discs;
@@ -27,10 +28,15 @@ PrimitiveCounts& PrimitiveCounts::operator+=(const PrimitiveCounts& o)
     return *this;
 }
 
-PrimitiveCounts count_primitives(const geom::Geometry& g)
+PrimitiveCounts count_primitives(const geom::Geometry& g, bool pixel_lines)
 {
-    return {g.lines.segment_count(), g.curves.segment_count(), g.spheres.size(), g.discs.size(),
-            g.mesh.size()};
+    PrimitiveCounts c;
+    (pixel_lines ? c.lines : c.cylinders) = g.lines.segment_count();
+    c.curve_segments = g.curves.segment_count();
+    c.spheres = g.spheres.size();
+    c.discs = g.discs.size();
+    c.triangles = g.mesh.size();
+    return c;
 }
 
 void RunStats::add_assembly(double load, double derive, double interpret, double wall)
@@ -44,11 +50,11 @@ void RunStats::add_assembly(double load, double derive, double interpret, double
 void RunStats::add_scene(const geom::Scene& scene)
 {
     interpreted = true;
-    primitives = count_primitives(scene.geometry);
+    primitives = count_primitives(scene.geometry, scene.line_radius_in_pixels);
     placed_primitives = primitives;
     std::vector<PrimitiveCounts> per_prototype;
     for (const geom::Prototype& p : scene.prototypes) {
-        per_prototype.push_back(count_primitives(p.geometry));
+        per_prototype.push_back(count_primitives(p.geometry, scene.line_radius_in_pixels));
         primitives += per_prototype.back();
     }
     for (const geom::Instance& i : scene.instances)
@@ -141,15 +147,17 @@ std::string mib(std::uint64_t bytes) { return fmt::format("{:.1f} MiB", double(b
 
 nlohmann::json counts_json(const PrimitiveCounts& c)
 {
-    return {{"cylinders", c.cylinders}, {"curve_segments", c.curve_segments},
-            {"spheres", c.spheres},     {"discs", c.discs},
-            {"triangles", c.triangles}, {"total", c.total()}};
+    return {{"cylinders", c.cylinders}, {"lines", c.lines},
+            {"curve_segments", c.curve_segments}, {"spheres", c.spheres},
+            {"discs", c.discs}, {"triangles", c.triangles}, {"total", c.total()}};
 }
 
 std::string counts_line(const PrimitiveCounts& c)
 {
-    return fmt::format("{} ({} cylinders, {} curve segments, {} spheres, {} discs, {} triangles)",
-                       c.total(), c.cylinders, c.curve_segments, c.spheres, c.discs, c.triangles);
+    return fmt::format(
+        "{} ({} cylinders, {} pixel-width lines, {} curve segments, {} spheres, {} discs, "
+        "{} triangles)",
+        c.total(), c.cylinders, c.lines, c.curve_segments, c.spheres, c.discs, c.triangles);
 }
 
 /// Primitives Embree holds: each built once, plus one per instance.

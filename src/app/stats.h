@@ -17,15 +17,23 @@ namespace cambium::app {
 
 /// Primitives by kind, as Embree builds them.
 struct PrimitiveCounts {
-    std::uint64_t cylinders = 0;       ///< linear segments (F, G)
+    std::uint64_t cylinders = 0;       ///< shaded linear segments (F, G)
+    /// Linear segments drawn as lines a number of pixels wide (`line style: pixel`, and
+    /// every edge of `render mode: wireframe`): unlit, with no caps or joints.
+    std::uint64_t lines = 0;
     std::uint64_t curve_segments = 0;  ///< generalized-cylinder Hermite segments
     std::uint64_t spheres = 0, discs = 0, triangles = 0;
 
-    std::uint64_t total() const { return cylinders + curve_segments + spheres + discs + triangles; }
+    std::uint64_t total() const
+    {
+        return cylinders + lines + curve_segments + spheres + discs + triangles;
+    }
     PrimitiveCounts& operator+=(const PrimitiveCounts& o);
 };
 
-PrimitiveCounts count_primitives(const geom::Geometry& g);
+/// `pixel_lines`: the geometry's linear segments are pixel-width lines
+/// (geom::Scene::line_radius_in_pixels), counted as lines, not cylinders.
+PrimitiveCounts count_primitives(const geom::Geometry& g, bool pixel_lines);
 
 /// One frame of a sequence (-a, --turntable, --inbetween): what it cost beyond the
 /// work shared by every frame (a turntable's load, derivation and interpretation).

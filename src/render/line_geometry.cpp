@@ -4,8 +4,11 @@
 // prototypes' pixel-width lines placed in world space (their width depends on depth).
 #include "render/line_geometry.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+
+#include <tbb/parallel_for.h>
 
 #include "base/diagnostics.h"
 #include "render/pixel_lines.h"
@@ -93,36 +96,69 @@ LineEnds line_ends(const geom::LinearCurves& l, const geom::Float4* keys)
         float length = std::sqrt(dot(d, d));
         return length > 0 ? d * (1 / length) : Vec3f();
     };
-    LineEnds e;
-    auto add_cap = [&](const geom::Float4& at, const Vec3f& out, std::size_t segment, bool end) {
-        if (!(at[3] > 0) || dot(out, out) == 0)
-            return;  // tapered to nothing, or no direction: no end to close
-        e.caps.push_back(at);
-        e.cap_normals.push_back({out.x, out.y, out.z});
-        e.cap_segment.push_back(static_cast<std::uint32_t>(segment));
-        e.cap_at_end.push_back(end ? 1 : 0);
-    };
-    for (std::size_t i = 0; i < n; ++i) {
+    // Segment i's ends in order: cap(at, outward normal, at its second key?) for each free
+    // end that has a radius and a direction, joint() for a bent joint.
+    auto visit = [&](std::size_t i, auto&& cap, auto&& joint) {
         const std::uint32_t k = l.segments[i];
         const std::uint8_t f = flags_of(i);
         Vec3f dir = direction(k);
+        auto add_cap = [&](const geom::Float4& at, const Vec3f& out, bool end) {
+            if (at[3] > 0 && dot(out, out) != 0)  // else tapered to nothing or no direction
+                cap(at, out, end);
+        };
         if (!(f & left))
-            add_cap(keys[k], -dir, i, false);
+            add_cap(keys[k], -dir, false);
         if (!(f & right)) {
-            add_cap(keys[k + 1], dir, i, true);
+            add_cap(keys[k + 1], dir, true);
         } else if (k + 2 < l.keys.size() && keys[k + 1][3] > 0 &&
                    dot(dir, direction(k + 1)) < straight) {
-            e.joints.push_back(keys[k + 1]);
-            e.joint_segment.push_back(static_cast<std::uint32_t>(i));
+            joint(keys[k + 1]);
         }
+    };
+    // Two passes over blocks of segments on all cores: count each block's caps and
+    // joints, then write them at the block's offsets, in the order one pass would make.
+    // The arrays get their exact size, not grown and trimmed (copied twice). On tree10m
+    // (13.8 M caps and joints) this took 0.65 s of wall time before, 0.25 s after.
+    constexpr std::size_t block = std::size_t{1} << 16;
+    const std::size_t blocks = (n + block - 1) / block;
+    std::vector<std::size_t> cap_start(blocks + 1, 0), joint_start(blocks + 1, 0);
+    tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+        std::size_t caps = 0, joints = 0;
+        for (std::size_t i = b * block; i < std::min(n, (b + 1) * block); ++i)
+            visit(i, [&](const geom::Float4&, const Vec3f&, bool) { ++caps; },
+                  [&](const geom::Float4&) { ++joints; });
+        cap_start[b + 1] = caps;
+        joint_start[b + 1] = joints;
+    });
+    for (std::size_t b = 0; b < blocks; ++b) {
+        cap_start[b + 1] += cap_start[b];
+        joint_start[b + 1] += joint_start[b];
     }
-    // Kept while the scene is drawn: without their growth slack (a third of tree10m's).
-    e.caps.shrink_to_fit();
-    e.cap_normals.shrink_to_fit();
-    e.cap_segment.shrink_to_fit();
-    e.cap_at_end.shrink_to_fit();
-    e.joints.shrink_to_fit();
-    e.joint_segment.shrink_to_fit();
+    LineEnds e;
+    e.caps.resize(cap_start[blocks]);
+    e.cap_normals.resize(cap_start[blocks]);
+    e.cap_segment.resize(cap_start[blocks]);
+    e.cap_at_end.resize(cap_start[blocks]);
+    e.joints.resize(joint_start[blocks]);
+    e.joint_segment.resize(joint_start[blocks]);
+    tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
+        std::size_t c = cap_start[b], j = joint_start[b];
+        for (std::size_t i = b * block; i < std::min(n, (b + 1) * block); ++i) {
+            auto segment = static_cast<std::uint32_t>(i);
+            visit(
+                i,
+                [&](const geom::Float4& at, const Vec3f& out, bool end) {
+                    e.caps[c] = at;
+                    e.cap_normals[c] = {out.x, out.y, out.z};
+                    e.cap_segment[c] = segment;
+                    e.cap_at_end[c++] = end ? 1 : 0;
+                },
+                [&](const geom::Float4& at) {
+                    e.joints[j] = at;
+                    e.joint_segment[j++] = segment;
+                });
+        }
+    });
     return e;
 }
 

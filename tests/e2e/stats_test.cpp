@@ -38,15 +38,17 @@ void run_in_folder(RunResult& r, const std::string& args)
     r.output.assign(std::istreambuf_iterator<char>(in), {});
 }
 
-/// Runs cambium on the known plant in a fresh folder with `args`.
-RunResult run_known_plant(const std::string& name, const std::string& args)
+/// Runs cambium on the known plant in a fresh folder with `args`, under the view file
+/// `view`.
+RunResult run_known_plant(const std::string& name, const std::string& args,
+                          const std::string& view = "line style: cylinder\ninitial line width: 0.2\n")
 {
     RunResult r;
     r.dir = fs::temp_directory_path() / ("cambium_stats_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(r.dir);
     fs::create_directories(r.dir);
     std::ofstream(r.dir / "p.l") << known_plant;
-    std::ofstream(r.dir / "p.v") << "line style: cylinder\ninitial line width: 0.2\n";
+    std::ofstream(r.dir / "p.v") << view;
     run_in_folder(r, "p.l p.v " + args);
     return r;
 }
@@ -67,7 +69,8 @@ void expect_documented_keys(const nlohmann::json& j)
     for (const char* key : {"load", "derive", "interpret", "assemble", "build", "first_pixel", "render"})
         EXPECT_TRUE(j["times_s"].contains(key)) << key;
     for (const char* group : {"primitives", "placed_primitives"})
-        for (const char* key : {"cylinders", "curve_segments", "spheres", "discs", "triangles", "total"})
+        for (const char* key :
+             {"cylinders", "lines", "curve_segments", "spheres", "discs", "triangles", "total"})
             EXPECT_TRUE(j[group].contains(key)) << group << "." << key;
     for (const char* key : {"embree", "embree_peak", "cambium", "scene_buffers", "render_buffers",
                             "embree_shared", "peak_process"})
@@ -147,6 +150,37 @@ TEST(Stats, PrintedBlockNamesEachFigure)
     for (const char* words : {"time to first pixel", "build", "7 (3 cylinders", "2 triangles",
                               "Embree", "Cambium", "peak process memory", "rays/s", "samples/s"})
         EXPECT_NE(r.output.find(words), std::string::npos) << words << " in\n" << r.output;
+}
+
+// Pixel-width lines are lines, not cylinders: under `line style: pixel` the three F, and
+// under `render mode: wireframe` every edge of every primitive.
+TEST(Stats, PixelWidthLinesAndWireframeEdgesCountAsLines)
+{
+    RunResult pixel = run_known_plant("pixel", "-w 16 12 --spp 1 -o p.png --stats-json stats.json",
+                                      "line style: pixel\n");
+    ASSERT_EQ(pixel.status, 0) << pixel.output;
+    nlohmann::json p = read_json(pixel.dir / "stats.json")["primitives"];
+    EXPECT_EQ(p["cylinders"], 0);
+    EXPECT_EQ(p["lines"], 3);
+    EXPECT_EQ(p["spheres"], 1);
+    EXPECT_EQ(p["total"], 7);
+    EXPECT_NE(pixel.output.find("interpreted 3 pixel-width lines"), std::string::npos)
+        << pixel.output;
+
+    RunResult wire = run_known_plant("wire", "-w 16 12 --spp 1 -o p.png --stats --stats-json stats.json",
+                                     "line style: cylinder\nrender mode: wireframe\n");
+    ASSERT_EQ(wire.status, 0) << wire.output;
+    nlohmann::json w = read_json(wire.dir / "stats.json")["primitives"];
+    EXPECT_EQ(w["cylinders"], 0);
+    // at least the 8 sides of each cylinder's strip, and the two triangles' edges
+    EXPECT_GT(w["lines"].get<std::uint64_t>(), 3 * 8 + 5);
+    for (const char* key : {"curve_segments", "spheres", "discs", "triangles"})
+        EXPECT_EQ(w[key], 0) << key;
+    EXPECT_EQ(w["total"], w["lines"]);
+    EXPECT_NE(wire.output.find("0 cylinders, " + std::to_string(w["lines"].get<std::uint64_t>()) +
+                               " pixel-width lines"),
+              std::string::npos)
+        << wire.output;
 }
 
 TEST(Stats, StringOnlyRunInterpretsNothing)

@@ -7,6 +7,7 @@
 
 #include "base/diagnostics.h"
 #include "render/accel.h"
+#include "render/line_geometry.h"
 #include "render/material.h"
 #include "render/sampler.h"
 #include "test_scenes.h"
@@ -329,6 +330,55 @@ TEST(CylinderEnds, BentJointsAreRound)
     auto mid = line.intersect({0.1f, 1.0001f, 5}, {0, 0, -1}, 0, inf);
     ASSERT_TRUE(mid);
     EXPECT_EQ(mid->shape, Shape::line);
+}
+
+// line_ends works on blocks of segments in parallel: its caps and joints still come in
+// segment order, each with its segment, over many blocks (150 000 segments).
+TEST(CylinderEnds, ListedInSegmentOrderOverManyBlocks)
+{
+    constexpr std::uint32_t chains = 50'000;
+    geom::LinearCurves l;
+    // chain j: up 1, up 1 (straight: no joint), then right 1 (a bend: a joint); every
+    // seventh chain tapers to nothing at its end (no cap there)
+    for (std::uint32_t j = 0; j < chains; ++j) {
+        float x = static_cast<float>(j), end_radius = j % 7 == 0 ? 0.0f : 0.1f;
+        auto first = static_cast<std::uint32_t>(l.keys.size());
+        l.keys.insert(l.keys.end(),
+                      {{x, 0, 0, 0.1f}, {x, 1, 0, 0.1f}, {x, 2, 0, 0.1f}, {x + 1, 2, 0, end_radius}});
+        l.segments.insert(l.segments.end(), {first, first + 1, first + 2});
+        l.flags.insert(l.flags.end(),
+                       {geom::LinearCurves::neighbour_right,
+                        geom::LinearCurves::neighbour_left | geom::LinearCurves::neighbour_right,
+                        geom::LinearCurves::neighbour_left});
+    }
+    LineEnds e = line_ends(l, l.keys.data());
+    std::size_t tapered = (chains + 6) / 7;
+    ASSERT_EQ(e.caps.size(), 2 * chains - tapered);
+    ASSERT_EQ(e.cap_normals.size(), e.caps.size());
+    ASSERT_EQ(e.cap_segment.size(), e.caps.size());
+    ASSERT_EQ(e.cap_at_end.size(), e.caps.size());
+    ASSERT_EQ(e.joints.size(), chains);
+    ASSERT_EQ(e.joint_segment.size(), chains);
+    std::size_t c = 0;
+    for (std::uint32_t j = 0; j < chains; ++j) {
+        auto x = static_cast<float>(j);
+        ASSERT_EQ(e.cap_segment[c], 3 * j) << j;
+        EXPECT_EQ(e.cap_at_end[c], 0) << j;
+        EXPECT_EQ(e.caps[c][0], x) << j;
+        EXPECT_EQ(e.caps[c][1], 0.0f) << j;
+        EXPECT_EQ(e.cap_normals[c][1], -1.0f) << j;  // out of the bottom
+        ++c;
+        if (j % 7 != 0) {
+            ASSERT_EQ(e.cap_segment[c], 3 * j + 2) << j;
+            EXPECT_EQ(e.cap_at_end[c], 1) << j;
+            EXPECT_EQ(e.caps[c][0], x + 1) << j;
+            EXPECT_EQ(e.cap_normals[c][0], 1.0f) << j;  // out along +x
+            ++c;
+        }
+        EXPECT_EQ(e.joint_segment[j], 3 * j + 1) << j;
+        EXPECT_EQ(e.joints[j][0], x) << j;
+        EXPECT_EQ(e.joints[j][1], 2.0f) << j;
+    }
 }
 
 }  // namespace
