@@ -9,6 +9,7 @@
 #include "geom/function.h"
 #include "geom/palette.h"
 #include "geom/scene.h"
+#include "geom/turtle.h"
 #include "geom/view_file.h"
 #include "lsys/lsystem.h"
 
@@ -22,6 +23,9 @@ struct Model {
     geom::Palette palette;
     std::shared_ptr<const geom::FunctionSet> functions;
     lsys::LSystem lsystem;
+    /// The turtles the last derivation saved at fragment starts `%(par)` (manual 5.1.9),
+    /// by index, for drawing `%(par, index)`: derive() refills them.
+    std::shared_ptr<std::vector<geom::Turtle>> fragment_turtles;
 };
 
 /// The view file, its texture images confined to the model's folder (the .l file's, where
