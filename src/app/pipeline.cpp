@@ -52,6 +52,9 @@ std::vector<char> object_symbols(const lsys::LSystem& lsystem)
     return any ? objects : std::vector<char>{};
 }
 
+/// Sides of a background cylinder drawn as triangles (as its ellipsoids' 32 slices).
+constexpr int background_cylinder_sides = 32;
+
 /// The longest an allowed @S command may run.
 constexpr double max_system_call_seconds = 300;
 
@@ -385,6 +388,10 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
     if (!background.geometry.empty()) {
         geom::offset_materials(background.geometry,
                                static_cast<std::uint16_t>(scene.materials.size()));
+        // every line of the Scene is read in pixels under `line style: pixel`; the
+        // background's cylinders keep their world radius as triangles
+        if (scene.line_radius_in_pixels)
+            geom::cylinders_as_mesh(background.geometry, background_cylinder_sides);
         scene.materials.insert(scene.materials.end(), background.materials.begin(),
                                background.materials.end());
         geom::append_geometry(scene.geometry, background.geometry);
