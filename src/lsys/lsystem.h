@@ -56,8 +56,9 @@ struct LoadOptions {
     std::function<std::vector<std::uint32_t>(const ModuleString&, std::uint32_t first_turtle)>
         fragment_pass;
     /// The most turtles fragment starts may save in one derivation run (each is drawn
-    /// with one): past it, derivation fails naming the .l file.
-    std::uint32_t max_saved_turtles = 1'000'000;
+    /// with one; geom's turtle takes 824 bytes, so 82 MB at most): past it, derivation
+    /// fails naming the .l file.
+    std::uint32_t max_saved_turtles = 100'000;
     /// A scene's seed override (docs/scenes.md): every random stream of the derivation
     /// (stochastic productions, ran() and its kin, the homomorphism's) starts from it,
     /// and srand(x) seeds with x mixed with it.
