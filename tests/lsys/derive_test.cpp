@@ -287,6 +287,30 @@ TEST(DeriveFragment, SavedTurtlesAreBounded)
     }
 }
 
+// The turtle pass reads the string through the homomorphism; the fragment starts it
+// reaches are found again in the derived string. A %(par) that the homomorphism writes
+// takes a turtle index in the pass but has no fragment to move (docs/deviations.md).
+TEST(DeriveFragment, TurtlePassThroughTheHomomorphism)
+{
+    std::vector<std::uint32_t> firsts;
+    LoadOptions options;
+    options.fragment_pass = [&](const ModuleString& s, std::uint32_t first) {
+        firsts.push_back(first);
+        std::vector<std::uint32_t> reached;
+        // every one-parameter module the turtle meets is a `%` here
+        for (std::size_t i = 0; i < s.size(); ++i)
+            if (s.param_count(i) == 1)
+                reached.push_back(static_cast<std::uint32_t>(i));
+        return reached;
+    };
+    LSystem ls = LSystem::from_source("lsystem: 1\nderivation length: 1\naxiom: B[A%(3)C]D\n"
+                                      "homomorphism\nB --> FFF\nA --> %(9)G\nendlsystem\n",
+                                      "test.l", options);
+    // interpreted: F F F [ %(9) G %(3) C ] D: %(9) takes turtle 0, %(3) turtle 1
+    EXPECT_EQ(to_text(ls.derive(), ls.symbols()), "B[A]D%(3,1)C");
+    EXPECT_EQ(firsts, std::vector<std::uint32_t>{0});
+}
+
 TEST(DeriveFragment, ContextStopsAtPercentWithParameters)
 {
     // right context too; a context that names % itself still matches it
