@@ -53,6 +53,9 @@ std::vector<char> object_symbols(const lsys::LSystem& lsystem)
     return any ? objects : std::vector<char>{};
 }
 
+/// Sides of a background cylinder drawn as triangles (as its ellipsoids' 32 slices).
+constexpr int background_cylinder_sides = 32;
+
 /// The longest an allowed @S command may run.
 constexpr double max_system_call_seconds = 300;
 
@@ -144,6 +147,22 @@ Model load_model(const Options& options)
         if (queries->symbols)
             geom::answer_queries(string, *queries->symbols, *queries->view);
     };
+    // Fragmentation (manual 5.1.9): the turtles saved at `%(par)` before each step are
+    // the model's, for drawing `%(par, index)`; each derivation run starts them afresh.
+    auto fragments = std::make_shared<std::vector<geom::Turtle>>();
+    const std::string lsystem_file = options.lsystem.string();
+    load.fragment_pass = [queries, fragments, lsystem_file,
+                          limit = load.max_saved_turtles](const lsys::ModuleString& string,
+                                                          std::uint32_t first) {
+        if (!queries->symbols)
+            return std::vector<std::uint32_t>{};
+        try {
+            return geom::save_fragment_turtles(string, *queries->symbols, *queries->view,
+                                               *fragments, first, limit);
+        } catch (const Error& e) {
+            throw Error(FileLoc{lsystem_file, 0, 0}, e.what());
+        }
+    };
     if (options.verbosity == Verbosity::verbose)
         load.on_step = [](int step, const lsys::ModuleString& s) {
             std::printf("step %d: %zu modules\n", step, s.size());
@@ -153,7 +172,8 @@ Model load_model(const Options& options)
     // The program (and its symbol table) lives behind a pointer: moving the LSystem
     // into the Model keeps this address.
     queries->symbols = &lsystem.symbols();
-    return Model{std::move(view), std::move(palette), std::move(functions), std::move(lsystem)};
+    return Model{std::move(view), std::move(palette), std::move(functions), std::move(lsystem),
+                 std::move(fragments)};
 }
 
 lsys::ModuleString derive(const Model& model, const Options& options)
@@ -316,6 +336,8 @@ geom::InterpretOptions interpret_options(const Model& model, const Options& opti
     if (lit_by_colour_index(model))
         turtle.surface_material_offset = geom::colour_indices;
     turtle.max_memory_bytes = options.max_memory_bytes;
+    if (model.fragment_turtles)
+        turtle.fragment_turtles = *model.fragment_turtles;
     std::vector<char> objects = instanced_objects(model, options);
     if (!objects.empty()) {
         const lsys::LSystem& lsystem = model.lsystem;
@@ -372,6 +394,10 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
     if (!background.geometry.empty()) {
         geom::offset_materials(background.geometry,
                                static_cast<std::uint16_t>(scene.materials.size()));
+        // every line of the Scene is read in pixels under `line style: pixel`; the
+        // background's cylinders keep their world radius as triangles
+        if (scene.line_radius_in_pixels)
+            geom::cylinders_as_mesh(background.geometry, background_cylinder_sides);
         scene.materials.insert(scene.materials.end(), background.materials.begin(),
                                background.materials.end());
         geom::append_geometry(scene.geometry, background.geometry);

@@ -10,6 +10,7 @@
 #include "geom/function.h"
 #include "geom/palette.h"
 #include "geom/scene.h"
+#include "geom/turtle.h"
 #include "geom/view_file.h"
 #include "lsys/lsystem.h"
 
@@ -23,6 +24,9 @@ struct Model {
     geom::Palette palette;
     std::shared_ptr<const geom::FunctionSet> functions;
     lsys::LSystem lsystem;
+    /// The turtles the last derivation saved at fragment starts `%(par)` (manual 5.1.9),
+    /// by index, for drawing `%(par, index)`: derive() refills them.
+    std::shared_ptr<std::vector<geom::Turtle>> fragment_turtles;
 };
 
 /// The folder every file a model names must lie in unless options.allow_file_access: the

@@ -586,6 +586,51 @@ void append_curves(Curves& a, const Curves& b, std::vector<Float4>& a_keys,
 
 }  // namespace
 
+void cylinders_as_mesh(Geometry& geometry, int sides)
+{
+    LinearCurves& lines = geometry.lines;
+    TriangleMesh& mesh = geometry.mesh;
+    auto f3 = [](const Vec3& v) {
+        return Float3{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
+    };
+    for (std::size_t s = 0; s < lines.segment_count(); ++s) {
+        const Float4& ka = lines.keys[lines.segments[s]];
+        const Float4& kb = lines.keys[lines.segments[s] + 1];
+        const Vec3 a{ka[0], ka[1], ka[2]}, b{kb[0], kb[1], kb[2]};
+        const double length = std::sqrt(dot(b - a, b - a));
+        if (!(length > 0))
+            continue;
+        const Vec3 axis = (b - a) * (1 / length);
+        // any two unit vectors perpendicular to the axis and to each other
+        const Vec3 hint = std::abs(axis.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+        const Vec3 u = normalize(cross(axis, hint)), v = cross(axis, u);
+        const auto first = static_cast<std::uint32_t>(mesh.positions.size());
+        for (int i = 0; i < sides; ++i) {
+            const double angle = 2 * std::numbers::pi * i / sides;
+            const Vec3 radial = u * std::cos(angle) + v * std::sin(angle);
+            // the frustum's outward normal leans toward the narrower end
+            const Vec3 normal = normalize(radial * length + axis * (double(ka[3]) - kb[3]));
+            mesh.positions.push_back(f3(a + radial * ka[3]));
+            mesh.positions.push_back(f3(b + radial * kb[3]));
+            mesh.normals.push_back(f3(normal));
+            mesh.normals.push_back(f3(normal));
+            mesh.uvs.push_back({0, 0});
+            mesh.uvs.push_back({0, 0});
+        }
+        for (int i = 0; i < sides; ++i) {
+            const std::uint32_t a0 = first + 2 * static_cast<std::uint32_t>(i), b0 = a0 + 1;
+            const std::uint32_t a1 = first + 2 * static_cast<std::uint32_t>((i + 1) % sides), b1 = a1 + 1;
+            for (const std::array<std::uint32_t, 3>& t : {std::array{a0, a1, b1}, std::array{a0, b1, b0}}) {
+                mesh.triangles.push_back(t);
+                mesh.material.push_back(lines.material[s]);
+                mesh.back_material.push_back(lines.material[s]);
+                mesh.texture.push_back(s < lines.texture.size() ? lines.texture[s] : no_texture);
+            }
+        }
+    }
+    lines = LinearCurves{};
+}
+
 void append_geometry(Geometry& into, const Geometry& from)
 {
     append_curves(into.lines, from.lines, into.lines.keys, from.lines.keys);

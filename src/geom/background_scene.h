@@ -87,6 +87,12 @@ BackgroundScene load_view_background(const ViewFile& view, const Material& initi
 /// side filled with v = 0 / no_texture so the arrays stay parallel).
 void append_geometry(Geometry& into, const Geometry& from);
 
+/// Background cylinders and cones as smooth-shaded triangle frustums of `sides` sides (their
+/// end discs stay discs), in place of `geometry.lines`: for a scene whose own lines are
+/// pixel-width (`line style: pixel`), where every line of the Scene is read in pixels,
+/// while a background object keeps its world size.
+void cylinders_as_mesh(Geometry& geometry, int sides);
+
 /// Adds `offset` to every material index of `geometry` (mesh, lines, curves, spheres,
 /// discs), leaving inherit_material alone.
 void offset_materials(Geometry& geometry, std::uint16_t offset);

@@ -119,8 +119,13 @@ public:
     {
         prepare(symbols);
         string.for_each([&](lsys::ModuleRef m) {
-            if (!skipped_after_cut(m))
+            if (skipped_after_cut(m)) {
+            } else if (static_cast<int>(m.symbol) == m_tables->cut && !m.params.empty() &&
+                       m_root == this) {
+                fragment_module(m);
+            } else {
                 interpret_module(m, m_root == this);
+            }
             ++m_module_index;
             if (m_root == this && m_module_index % memory_check_interval == 0)
                 check_memory();
@@ -145,6 +150,16 @@ public:
                         " modules of the string, more than the memory budget of " +
                         byte_size_text(m_options.max_memory_bytes) +
                         " (--max-memory); reduce the derivation length or raise --max-memory");
+    }
+
+    /// Saves the turtle at each one-parameter `%` into `fresh` (at most `limit`) and
+    /// records those modules' indices into `starts` (save_fragment_turtles).
+    void collect_fragments(std::vector<Turtle>* fresh, std::vector<std::uint32_t>* starts,
+                           std::size_t limit)
+    {
+        m_fresh_turtles = fresh;
+        m_fragment_starts = starts;
+        m_fresh_limit = limit;
     }
 
     /// Records the answers of query modules (?P ?H ?L ?U) while interpreting.
@@ -183,6 +198,35 @@ private:
         m_tables = std::move(tables);
     }
 
+    /// `%` with parameters (manual 5.1.9): `%(par, index)` sets the turtle saved at its
+    /// fragment's start, as `]` sets the one saved at `[`; the fragment pass saves the
+    /// turtle at each `%(par)`.
+    void fragment_module(lsys::ModuleRef m)
+    {
+        if (m.params.size() == 1) {
+            if (!m_fresh_turtles)
+                return;
+            if (m_fresh_turtles->size() >= m_fresh_limit)
+                throw Error("more than " + std::to_string(m_fresh_limit) +
+                            " turtles saved at fragment starts %(par) (manual 5.1.9)");
+            m_fresh_turtles->push_back(m_turtle);
+            m_fragment_starts->push_back(static_cast<std::uint32_t>(m_module_index));
+            return;
+        }
+        const std::span<const Turtle> saved = m_options.fragment_turtles;
+        const double index = m.params[1];
+        if (!(index >= 0 && index < static_cast<double>(saved.size())) || index != std::floor(index)) {
+            if (!m_warned_fragment)
+                warn("%(par, index): no turtle was saved under index " + std::to_string(index) +
+                     " (only a fragment moved by derivation has one); the turtle is kept");
+            m_warned_fragment = true;
+            return;
+        }
+        end_node();
+        m_turtle = saved[static_cast<std::size_t>(index)];
+        m_chain_open = false;
+    }
+
     /// Under `interpretation past %: off`, a cut (`%`, or `@mc(1)`: manual 5.1.9) and
     /// everything after it up to the ']' that ends its branch are skipped; that ']' is
     /// interpreted, so the turtle state comes back as after the whole branch.
@@ -191,6 +235,10 @@ private:
         const SymbolTables& t = *m_tables;
         if (m_cut_depth >= 0) {
             TurtleOp op = t.ops[m.symbol];
+            if (static_cast<int>(m.symbol) == t.cut && !m.params.empty()) {
+                m_cut_depth = -1;  // cpfg's skip also ends at a `%` with parameters
+                return false;
+            }
             if (op == TurtleOp::Push)
                 ++m_cut_depth;
             else if (op == TurtleOp::Pop && m_cut_depth-- == 0)
@@ -1003,6 +1051,10 @@ private:
     std::vector<std::vector<PolygonCorner>> m_polygons;  ///< cpfg's polygon stack
     std::vector<double> m_sub_scales;                    ///< cpfg's sub-L-system scale stack
     std::vector<QueryAnswer>* m_answers = nullptr;
+    std::vector<Turtle>* m_fresh_turtles = nullptr;           ///< the fragment pass's
+    std::vector<std::uint32_t>* m_fragment_starts = nullptr;  ///< ... and their modules
+    std::size_t m_fresh_limit = 0;
+    bool m_warned_fragment = false;
     std::vector<SurfaceDef> m_surfaces;                  ///< their prototypes moved out
     struct SurfacePrototypes {
         std::uint32_t per_patch;  ///< uvs per patch (cpfg's default)
@@ -1055,6 +1107,24 @@ Scene interpret(const lsys::ModuleString& string, const lsys::SymbolTable& symbo
     Interpreter interpreter(view, options);
     interpreter.run(string, symbols);
     return interpreter.take();
+}
+
+std::vector<std::uint32_t> save_fragment_turtles(const lsys::ModuleString& string,
+                                                 const lsys::SymbolTable& symbols,
+                                                 const ViewFile& view, std::vector<Turtle>& saved,
+                                                 std::uint32_t first, std::uint32_t limit)
+{
+    saved.resize(std::min<std::size_t>(first, saved.size()));
+    InterpretOptions options;
+    options.bounds_only = true;  // only the turtle matters
+    options.fragment_turtles = saved;
+    std::vector<Turtle> fresh;
+    std::vector<std::uint32_t> starts;
+    Interpreter interpreter(view, options);
+    interpreter.collect_fragments(&fresh, &starts, limit > first ? limit - first : 0);
+    interpreter.run(string, symbols);
+    saved.insert(saved.end(), fresh.begin(), fresh.end());
+    return starts;
 }
 
 std::vector<QueryAnswer> collect_query_answers(const lsys::ModuleString& string,

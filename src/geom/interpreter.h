@@ -8,6 +8,7 @@
 
 #include "base/limits.h"
 #include "geom/scene.h"
+#include "geom/turtle.h"
 #include "geom/view_file.h"
 #include "lsys/module_string.h"
 
@@ -54,10 +55,24 @@ struct InterpretOptions {
     /// lighting differs from other primitives' (pipeline: 256 in colormap mode with
     /// lighting, where the materials 256..511 are the surface-lit copies).
     std::uint16_t surface_material_offset = 0;
+    /// The turtles saved at fragment starts over the derivation (manual 5.1.9), by index:
+    /// `%(par, index)` sets the turtle to fragment_turtles[index] (save_fragment_turtles).
+    std::span<const Turtle> fragment_turtles;
 };
 
 Scene interpret(const lsys::ModuleString& string, const lsys::SymbolTable& symbols,
                 const ViewFile& view, const InterpretOptions& options);
+
+/// Fragmentation's turtle pass (manual 5.1.9 `%(par)`; lsys::LoadOptions::fragment_pass):
+/// walks `string` as `interpret` does (geometry aside), the turtle set to saved[index] at
+/// each `%(par, index)`. At each one-parameter `%` it reaches, the turtle is saved as
+/// saved[first + k] (saved is cut to `first` turtles before: a new run starts at 0).
+/// Returns the indices of those modules in `string`, in the order reached. Throws
+/// cambium::Error when `saved` would hold more than `limit` turtles.
+std::vector<std::uint32_t> save_fragment_turtles(const lsys::ModuleString& string,
+                                                 const lsys::SymbolTable& symbols,
+                                                 const ViewFile& view, std::vector<Turtle>& saved,
+                                                 std::uint32_t first, std::uint32_t limit);
 
 /// The lights render should use: the view file's `light:` commands, or cpfg's
 /// default light when there are none.

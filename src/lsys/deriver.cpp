@@ -91,7 +91,8 @@ Deriver::Deriver(const Program& program, DeriveLimits limits)
     };
     m_runtime.warning = &m_warning;
     m_query_symbol.assign(symbols.size(), 0);
-    for (const char* name : {"?P", "?H", "?L", "?U"})
+    // (and `%`, whose one-parameter modules the fragment pass maps back the same way)
+    for (const char* name : {"?P", "?H", "?L", "?U", "%"})
         if (int id = symbols.find(name); id >= 0)
             m_query_symbol[static_cast<std::size_t>(id)] = 1;
     try {
@@ -325,23 +326,60 @@ std::size_t Deriver::rewrite(const Indexed& src, ModuleString& dst, bool decompo
     const ModuleString& s = *src.string;
     m_source = &s;
     m_pass_lineage.clear();
+    m_lsystem_stack.assign(1, 0);
+    if (decomposition || m_fragment_starts.empty())
+        return rewrite_range(src, dst, decomposition, 0, s.size(), 0, nullptr);
+    // Fragmentation (manual 5.1.9): the marked `%(par)` and their fragments are left out
+    // in place; after the end of the string, each fragment is derived behind
+    // `%(par, turtle)`, in string order, as cpfg's Derive goes on past the end.
+    std::vector<Fragment> fragments;
+    m_next_mark = 0;
+    std::size_t applied = rewrite_range(src, dst, false, 0, s.size(), 0, &fragments);
+    m_fragment_starts.clear();
+    for (const Fragment& f : fragments) {
+        float head[2] = {f.parameter, static_cast<float>(f.turtle)};
+        dst.append(static_cast<SymbolId>(m_cut), std::span<const float>(head, 2));
+        if (m_track_lineage)
+            m_pass_lineage.push_back(static_cast<std::uint32_t>(f.begin - 1));
+        applied += rewrite_range(src, dst, false, f.begin, f.end, f.offset, nullptr);
+    }
+    return applied;
+}
+
+void Deriver::record_lineage(const ModuleString& s, const ModuleString& dst, std::size_t i,
+                             std::size_t first_new, bool copied)
+{
     // Lineage: modules i .. i + n copied are their own continuations; of a successor, the
     // first module with the predecessor's symbol continues it and the others are new.
+    if (!m_track_lineage)
+        return;
+    bool continued = false;
+    for (std::size_t k = first_new; k < dst.size(); ++k) {
+        bool same = copied || (!continued && dst.symbol(k) == s.symbol(i));
+        continued = continued || same;
+        m_pass_lineage.push_back(same ? static_cast<std::uint32_t>(copied ? i + (k - first_new) : i)
+                                      : no_parent);
+    }
+}
+
+std::size_t Deriver::rewrite_range(const Indexed& src, ModuleString& dst, bool decomposition,
+                                   std::size_t begin, std::size_t end, std::size_t offset,
+                                   std::vector<Fragment>* fragments)
+{
+    const ModuleString& s = *src.string;
     auto record = [&](std::size_t i, std::size_t first_new, bool copied) {
-        if (!m_track_lineage)
-            return;
-        bool continued = false;
-        for (std::size_t k = first_new; k < dst.size(); ++k) {
-            bool same = copied || (!continued && dst.symbol(k) == s.symbol(i));
-            continued = continued || same;
-            m_pass_lineage.push_back(same ? static_cast<std::uint32_t>(copied ? i + (k - first_new) : i)
-                                          : no_parent);
-        }
+        record_lineage(s, dst, i, first_new, copied);
     };
-    m_lsystem_stack.assign(1, 0);
+    // whether module i is the next marked fragment start (marks of modules a production
+    // or a cut took are passed over)
+    auto marked = [&](std::size_t i) {
+        while (m_next_mark < m_fragment_starts.size() && m_fragment_starts[m_next_mark].module < i)
+            ++m_next_mark;
+        return m_next_mark < m_fragment_starts.size() && m_fragment_starts[m_next_mark].module == i;
+    };
     std::size_t applied = 0;
-    std::size_t offset = 0;  // first parameter of module i
-    for (std::size_t i = 0; i < s.size();) {
+    // offset: the first parameter of module i
+    for (std::size_t i = begin; i < end;) {
         const LSystemDefinition& ls =
             m_program.lsystems[static_cast<std::size_t>(m_lsystem_stack.back())];
         const ProductionSet& set = decomposition ? ls.decomposition : ls.productions;
@@ -349,7 +387,7 @@ std::size_t Deriver::rewrite(const Indexed& src, ModuleString& dst, bool decompo
         // Copy a run of modules that nothing can rewrite in one go
         const std::vector<char>& copied =
             m_copied[2 * static_cast<std::size_t>(m_lsystem_stack.back()) + (decomposition ? 1 : 0)];
-        std::size_t run = run_end(s, i, copied);
+        std::size_t run = std::min(run_end(s, i, copied), end);
         if (run > i) {
             if (stochastic)
                 for (std::size_t k = i; k < run; ++k)
@@ -373,7 +411,13 @@ std::size_t Deriver::rewrite(const Indexed& src, ModuleString& dst, bool decompo
             ++applied;
             record(i, first_new, false);
         } else if (!decomposition && cuts(s, i, offset)) {
-            consumed = cut_end(s, i) - i;
+            consumed = fragment_end(s, i, end) - i;
+        } else if (fragments && is_fragment_start(s, i) && marked(i)) {
+            // a marked fragment start: left out here, its fragment derived at the end
+            std::size_t stop = fragment_end(s, i, end);
+            fragments->push_back(Fragment{i + 1, stop, offset + 1, s.param_data()[offset],
+                                          m_fragment_starts[m_next_mark++].turtle});
+            consumed = stop - i;
         } else {
             dst.append(s.symbol(i),
                        std::span<const float>(s.param_data() + offset, s.param_count(i)));
@@ -417,25 +461,32 @@ bool Deriver::never_rewritten(const ProductionSet& set, int sym, bool decomposit
 bool Deriver::cuts(const ModuleString& s, std::size_t i, std::size_t offset) const
 {
     int sym = s.symbol(i);
-    // %(par) marks a fragment (moved, not cut: docs/deviations.md); @mc(flag) cuts
+    // %(par) marks a fragment (moved by rewrite, not cut); @mc(flag) cuts
     // only when its flag is 1
     if (sym == m_cut)
         return s.param_count(i) == 0;
     return sym == m_conditional_cut && s.param_count(i) > 0 && s.param_data()[offset] == 1.0f;
 }
 
-std::size_t Deriver::cut_end(const ModuleString& s, std::size_t i) const
+std::size_t Deriver::fragment_end(const ModuleString& s, std::size_t i, std::size_t end) const
 {
-    // the end of the current branch: the ']' that closes it, or the end of the string
-    int depth = 0;
-    for (std::size_t k = i + 1; k < s.size(); ++k) {
+    // cpfg's SkipCutPart: to the ']' that closes the current branch, the '$' that closes
+    // the current sub-L-system, the next '%' with parameters (at any depth), or the end
+    int depth = 0, sub_depth = 0;
+    for (std::size_t k = i + 1; k < end; ++k) {
         int sym = s.symbol(k);
         if (sym == m_bracket_open)
             ++depth;
         else if (sym == m_bracket_close && depth-- == 0)
             return k;
+        else if (sym == m_sub_start && s.param_count(k) > 0)
+            ++sub_depth;
+        else if (sym == m_sub_end && sub_depth-- == 0)
+            return k;
+        else if (sym == m_cut && s.param_count(k) > 0)
+            return k;
     }
-    return s.size();
+    return end;
 }
 
 void Deriver::check_size(const ModuleString& s) const
@@ -591,12 +642,14 @@ bool Deriver::match_left(const Production& p, const std::vector<char>& ignored,
             int sym = s.symbol(k);
             if (sym == m_bracket_close)
                 k = src.partner[k];  // skip a whole branch to the left
-            else if (sym == m_bracket_open || (sym < static_cast<int>(ignored.size()) && ignored[static_cast<std::size_t>(sym)]))
+            else if (sym == m_bracket_open ||
+                     (sym < static_cast<int>(ignored.size()) && ignored[static_cast<std::size_t>(sym)] &&
+                      !fragment_mark(s, k)))
                 continue;            // into the parent branch, or ignored
             else
                 break;
         }
-        if (!bind(*f, s, k, src.offsets[k]))
+        if (context_barrier(s, k, *f) || !bind(*f, s, k, src.offsets[k]))
             return false;
     }
     return true;
@@ -625,14 +678,15 @@ bool Deriver::match_right(const Production& p, const std::vector<char>& ignored,
                 k = 0;
             }
             int sym = s.symbol(k);
-            if (sym < static_cast<int>(ignored.size()) && ignored[static_cast<std::size_t>(sym)])
+            if (sym < static_cast<int>(ignored.size()) && ignored[static_cast<std::size_t>(sym)] &&
+                !fragment_mark(s, k))
                 ++k;
             else if (sym == m_bracket_open && f.symbol != m_bracket_open)
                 k = src.partner[k] > k ? src.partner[k] + 1 : s.size();
             else
                 break;
         }
-        if (!bind(f, s, k, src.offsets[k]))
+        if (context_barrier(s, k, f) || !bind(f, s, k, src.offsets[k]))
             return false;
         ++k;
     }

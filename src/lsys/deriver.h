@@ -31,6 +31,14 @@ struct DeriveLimits {
     std::optional<long> seed;
 };
 
+/// A fragment start that the turtle pass reached before a step (manual 5.1.9 `%(par)`):
+/// the one-parameter `%` module's index in the string and the index its turtle was
+/// saved under (counted from 0 over the whole derivation run).
+struct FragmentStart {
+    std::uint32_t module = 0;
+    std::uint32_t turtle = 0;
+};
+
 /// Where the parameters of one module of a string went in its homomorphism expansion:
 /// the query pass answers ?P ?H ?L ?U there and copies the values back.
 struct ParamLink {
@@ -60,6 +68,19 @@ public:
     bool stop_runs_end() const { return m_runtime.stop_runs_end; }
     void step();
     void finish();
+    /// The fragment starts of the current string, in string order, for the next step()
+    /// (manual 5.1.9): that step derives each one's fragment (from after the `%(par)` to
+    /// its branch's `]`, the next `%` with parameters or a sub-L-system's `$`) at the end
+    /// of the new string behind `%(par, turtle)`, in this order, instead of in place.
+    /// A one-parameter `%` not listed here stays in place.
+    void mark_fragments(std::vector<FragmentStart> starts) { m_fragment_starts = std::move(starts); }
+    /// Whether the `%` symbol exists (only then can a string hold fragment starts).
+    bool has_cut_symbol() const { return m_cut >= 0; }
+    /// Whether module i of `s` is a fragment start: `%` with exactly one parameter.
+    bool is_fragment_start(const ModuleString& s, std::size_t i) const
+    {
+        return m_cut >= 0 && s.symbol(i) == static_cast<SymbolId>(m_cut) && s.param_count(i) == 1;
+    }
     /// Records, from the next step on, which module of the previous string each module
     /// of the new one continues (lineage()). Off by default: it costs 4 bytes a module.
     void track_lineage(bool on) { m_track_lineage = on; }
@@ -112,6 +133,36 @@ private:
     };
     void index(const ModuleString& s, Indexed& out, bool force = false) const;
     std::size_t rewrite(const Indexed& src, ModuleString& dst, bool decomposition);
+    /// Rewrites modules [begin, end) of src (parameters from `offset`) onto dst; with
+    /// `fragments`, the marked fragment starts met are skipped with their fragment and
+    /// recorded there. Returns the productions applied.
+    struct Fragment {
+        std::size_t begin, end, offset;  ///< its modules (after the `%`) and first parameter
+        float parameter;
+        std::uint32_t turtle;
+    };
+    std::size_t rewrite_range(const Indexed& src, ModuleString& dst, bool decomposition,
+                              std::size_t begin, std::size_t end, std::size_t offset,
+                              std::vector<Fragment>* fragments);
+    void record_lineage(const ModuleString& s, const ModuleString& dst, std::size_t i,
+                        std::size_t first_new, bool copied);
+    /// Where a cut or a fragment that starts at module i ends (cpfg's SkipCutPart): the
+    /// ']' that closes its branch, the '$' that closes its sub-L-system, the next '%' with
+    /// parameters, or `end`.
+    std::size_t fragment_end(const ModuleString& s, std::size_t i, std::size_t end) const;
+    /// A context search may not step onto a `%` with parameters (manual 5.1.9) unless the
+    /// context names `%` itself.
+    /// (even when `%` is ignored).
+    bool context_barrier(const ModuleString& s, std::size_t k, const FormalModule& f) const
+    {
+        return fragment_mark(s, k) && f.symbol != static_cast<SymbolId>(m_cut);
+    }
+    bool fragment_mark(const ModuleString& s, std::size_t k) const
+    {
+        return m_cut >= 0 && s.symbol(k) == static_cast<SymbolId>(m_cut) && s.param_count(k) > 0;
+    }
+    std::vector<FragmentStart> m_fragment_starts;  ///< for the next step (mark_fragments)
+    std::size_t m_next_mark = 0;                   ///< the next one rewrite_range may meet
     bool apply_first_match(const ProductionSet& set, const LSystemDefinition& ls,
                            const Indexed& src, std::size_t i, std::size_t offset,
                            ModuleString& dst, std::size_t& consumed);
@@ -150,7 +201,6 @@ private:
     bool condition_holds(const Production& p);
     void produce(const Production& p, ModuleString& dst);
     void append_evaluated(const ModuleTemplate& m, ModuleString& dst);
-    std::size_t cut_end(const ModuleString& s, std::size_t i) const;
     void decompose();
     void check_size(const ModuleString& s) const;
     [[noreturn]] void out_of_memory(std::size_t bytes, const ModuleString& building) const;

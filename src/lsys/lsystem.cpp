@@ -199,6 +199,8 @@ void Derivation::advance(int steps)
         // interpreting the string before each step, not after the last one
         if (m_lsystem->m_has_queries && options.query)
             m_lsystem->run_query(*m_deriver);
+        if (m_deriver->has_cut_symbol())
+            m_saved_turtles += m_lsystem->run_fragment_pass(*m_deriver, m_saved_turtles);
         m_deriver->step();
         if (m_track_lineage) {
             std::vector<std::uint32_t> step = m_deriver->lineage();
@@ -261,6 +263,83 @@ void LSystem::run_query(Deriver& deriver) const
     float* params = s.mutable_params().data();
     for (const ParamLink& link : links)
         std::copy_n(joined.param_data() + link.to, link.count, params + link.from);
+}
+
+std::uint32_t LSystem::run_fragment_pass(Deriver& deriver, std::uint32_t first_turtle) const
+{
+    const ModuleString& s = deriver.string();
+    // the first parameter of each fragment start, in string order
+    std::vector<std::uint32_t> starts, start_offsets;
+    for (std::size_t i = 0, offset = 0; i < s.size(); offset += s.param_count(i), ++i)
+        if (deriver.is_fragment_start(s, i)) {
+            starts.push_back(static_cast<std::uint32_t>(i));
+            start_offsets.push_back(static_cast<std::uint32_t>(offset));
+        }
+    if (starts.empty())
+        return 0;
+    auto too_many = [&] {
+        return Error(FileLoc{m_program->file_name, 0, 0},
+                     "more than " + std::to_string(m_options.max_saved_turtles) +
+                         " fragment starts %(par) in one derivation (each saves a turtle, "
+                         "manual 5.1.9)");
+    };
+    std::vector<FragmentStart> marks;
+    if (!m_options.fragment_pass) {
+        if (starts.size() > m_options.max_saved_turtles - first_turtle)
+            throw too_many();
+        for (std::size_t k = 0; k < starts.size(); ++k)
+            marks.push_back(FragmentStart{starts[k], first_turtle + static_cast<std::uint32_t>(k)});
+        deriver.mark_fragments(std::move(marks));
+        return static_cast<std::uint32_t>(starts.size());
+    }
+    // The turtle reads the string with the homomorphism applied and @-commands joined;
+    // a fragment start it reaches is found again in the derived string by its parameter
+    std::vector<std::uint32_t> reached;
+    std::vector<std::uint32_t> reached_offsets;  // in the derived string
+    auto offsets_of = [](const ModuleString& t, const std::vector<std::uint32_t>& modules) {
+        std::vector<std::uint32_t> out;
+        std::size_t m = 0, offset = 0;
+        for (std::size_t i = 0; i < t.size() && m < modules.size(); offset += t.param_count(i), ++i)
+            if (i == modules[m]) {
+                out.push_back(static_cast<std::uint32_t>(offset));
+                ++m;
+            }
+        return out;
+    };
+    if (!m_has_homomorphism && m_program->split_commands.empty()) {
+        reached = m_options.fragment_pass(s, first_turtle);
+        reached_offsets = offsets_of(s, reached);
+    } else if (!m_has_homomorphism) {
+        ModuleString joined = join_at_commands(s);
+        reached = m_options.fragment_pass(joined, first_turtle);
+        reached_offsets = offsets_of(joined, reached);  // joining keeps parameters in order
+    } else {
+        ModuleString expanded;
+        std::vector<ParamLink> links;
+        deriver.apply_homomorphism(s, expanded, &links);
+        ModuleString joined = join_at_commands(expanded);
+        reached = m_options.fragment_pass(joined, first_turtle);
+        // a `%(par)` the homomorphism wrote saves a turtle, but has no fragment to move
+        for (std::uint32_t to : offsets_of(joined, reached)) {
+            std::uint32_t from = UINT32_MAX;
+            for (const ParamLink& link : links)
+                if (link.to == to && link.count == 1)
+                    from = link.from;
+            reached_offsets.push_back(from);
+        }
+    }
+    if (reached.size() > m_options.max_saved_turtles - first_turtle)
+        throw too_many();
+    for (std::size_t k = 0; k < reached_offsets.size(); ++k) {
+        auto at = std::lower_bound(start_offsets.begin(), start_offsets.end(), reached_offsets[k]);
+        if (at != start_offsets.end() && *at == reached_offsets[k])
+            marks.push_back(FragmentStart{starts[static_cast<std::size_t>(at - start_offsets.begin())],
+                                          first_turtle + static_cast<std::uint32_t>(k)});
+    }
+    std::sort(marks.begin(), marks.end(),
+              [](const FragmentStart& a, const FragmentStart& b) { return a.module < b.module; });
+    deriver.mark_fragments(std::move(marks));
+    return static_cast<std::uint32_t>(reached.size());
 }
 
 ModuleString LSystem::join_at_commands(const ModuleString& s) const

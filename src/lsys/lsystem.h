@@ -44,6 +44,21 @@ struct LoadOptions {
     /// interpretation_string() would join them), and may change parameter values only,
     /// not modules or parameter counts.
     std::function<void(ModuleString&)> query;
+    /// Fragmentation's turtle pass (manual 5.1.9 `%(par)`), from geom. Called before every
+    /// step whose string holds a one-parameter `%` (after `query`), with the string as the
+    /// turtle reads it (as `query` gets it) and the index of the first turtle this pass
+    /// saves (0 at the start of each derivation run, so a new run starts afresh). It
+    /// interprets the string, restoring the saved turtle at each `%(par, index)`; at each
+    /// one-parameter `%` it reaches it saves the turtle under the next index and returns
+    /// those modules' indices in the string it got, in the order reached. It must not
+    /// save more than `max_saved_turtles` in a run (a cambium::Error). Unset: every
+    /// one-parameter `%` starts a fragment, numbered in string order.
+    std::function<std::vector<std::uint32_t>(const ModuleString&, std::uint32_t first_turtle)>
+        fragment_pass;
+    /// The most turtles fragment starts may save in one derivation run (each is drawn
+    /// with one; geom's turtle takes 824 bytes, so 82 MB at most): past it, derivation
+    /// fails naming the .l file.
+    std::uint32_t max_saved_turtles = 100'000;
     /// A scene's seed override (docs/scenes.md): every random stream of the derivation
     /// (stochastic productions, ran() and its kin, the homomorphism's) starts from it,
     /// and srand(x) seeds with x mixed with it.
@@ -98,6 +113,7 @@ private:
     std::unique_ptr<Deriver> m_deriver;
     bool m_finished = false;
     bool m_track_lineage = false;
+    std::uint32_t m_saved_turtles = 0;  ///< by fragment starts in this run (manual 5.1.9)
     std::vector<std::uint32_t> m_lineage;
 };
 
@@ -163,6 +179,9 @@ private:
     friend class Derivation;
     explicit LSystem(std::unique_ptr<Program> program, LoadOptions options);
     void run_query(Deriver& deriver) const;
+    /// Marks the fragment starts of the deriver's string for its next step; returns the
+    /// turtles saved (numbered from `first_turtle`).
+    std::uint32_t run_fragment_pass(Deriver& deriver, std::uint32_t first_turtle) const;
     ModuleString join_at_commands(const ModuleString& s) const;
 
     std::unique_ptr<Program> m_program;

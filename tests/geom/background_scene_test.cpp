@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <fstream>
 
@@ -322,4 +323,29 @@ TEST(BackgroundScene, UnreadableFileIsAnErrorNamingIt)
     message = error_of("bad.dat", dir);
     EXPECT_NE(message.find("bad.dat:1:10: fatal error: nowhere.h: No such file"), std::string::npos)
         << message;
+}
+
+// In a `line style: pixel` scene every line of the Scene is read in pixels; background
+// cylinders become triangles that keep their world radius (and their end discs).
+TEST(BackgroundScene, CylindersAsMeshKeepTheirWorldRadius)
+{
+    BackgroundScene s = build("translate 1 0 0\ncone 2 1 5\n");
+    ASSERT_EQ(s.geometry.lines.segment_count(), 1u);
+    const std::size_t discs = s.geometry.discs.size();
+    cylinders_as_mesh(s.geometry, 32);
+    EXPECT_EQ(s.geometry.lines.segment_count(), 0u);
+    EXPECT_EQ(s.geometry.discs.size(), discs);
+    const TriangleMesh& m = s.geometry.mesh;
+    ASSERT_EQ(m.triangles.size(), 64u);
+    for (std::size_t i = 0; i < m.positions.size(); ++i) {
+        const Float3& p = m.positions[i];
+        const double radius = std::hypot(p[0] - 1.0, p[2]);
+        const double expected = p[1] < 2.5 ? 2.0 : 1.0;  // the base at y 0, the top at y 5
+        EXPECT_NEAR(radius, expected, 1e-5) << i;
+        EXPECT_TRUE(std::abs(p[1]) < 1e-5 || std::abs(p[1] - 5) < 1e-5) << i;
+        // outward, leaning up toward the narrower top: (5, 1) / |(5, 1)| in (radial, y)
+        const Float3& n = m.normals[i];
+        EXPECT_NEAR(n[1], 1 / std::sqrt(26.0), 1e-5) << i;
+        EXPECT_GT(n[0] * (p[0] - 1.0) + n[2] * p[2], 0) << i;
+    }
 }

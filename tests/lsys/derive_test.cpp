@@ -240,12 +240,99 @@ TEST(DeriveCut, ConditionalCutFlagComesFromTheProduction)
     EXPECT_EQ(derive_text(src, 2), "B@mc(0)C[B]");
 }
 
-// Manual 5.1.9: %(par) supports fragmentation (the substring is moved, not cut): it is
-// not the cut of a plain %.
-TEST(DeriveCut, PercentWithParameterDoesNotCut)
+// Manual 5.1.9: %(par) supports fragmentation: after the step, the substring after it
+// "up to the closing ']' at the same level or up to the next %(par)" is "moved to the end
+// of the L-system string and it is preceded by a symbol %(par, turtle_index)". The
+// fragment is derived in that step (cpfg's Derive goes on past the string's end). Without
+// a turtle pass (no view), every %(par) is a fragment start, numbered in string order.
+TEST(DeriveFragment, FragmentMovesToTheEndBehindItsTurtleIndex)
 {
     const char* src = "lsystem: 1\nderivation length: 1\naxiom: A[B%(1)CD]G\nendlsystem\n";
-    EXPECT_EQ(derive_text(src), "A[B%(1)CD]G");
+    EXPECT_EQ(derive_text(src), "A[B]G%(1,0)CD");
+}
+
+// Worked by hand from the manual's rule:
+//   axiom  F [ + %(7) B [ C ] D ] E %(8) G
+//   step 1: %(7)'s fragment is "B [ C ] D" (to its branch's ']'), %(8)'s is "G" (to the
+//     end); both derived at the end, turtles 0 and 1:
+//     F [ + ] E  %(7,0) BB [ CC ] D%(9)K  %(8,1) H
+//   step 2: the new %(9) is reached first (turtle 2, counted over the run); its fragment
+//     "K" ends at the next % with parameters. "E < B" does not apply although % is
+//     ignored: "the context searches are not passing over this module".
+TEST(DeriveFragment, HandDerivedTwoSteps)
+{
+    const char* src = "lsystem: 1\nderivation length: 2\nignore: %\n"
+                      "axiom: F[+%(7)B[C]D]E%(8)G\n"
+                      "E < B --> Y\nB --> BB\nC --> CC\nG --> H\nD --> D%(9)K\nendlsystem\n";
+    EXPECT_EQ(derive_text(src, 1), "F[+]E%(7,0)BB[CC]D%(9)K%(8,1)H");
+    EXPECT_EQ(derive_text(src, 2), "F[+]E%(7,0)BBBB[CCCC]D%(9)K%(8,1)H%(9,2)K");
+}
+
+TEST(DeriveFragment, SavedTurtlesAreBounded)
+{
+    // each step doubles the fragment starts: 2 + 4 turtles by step 3 pass a limit of 5
+    LoadOptions options;
+    options.max_saved_turtles = 5;
+    LSystem ls = LSystem::from_source("lsystem: 1\nderivation length: 3\naxiom: A\n"
+                                      "A --> [%(1)A][%(1)A]\nendlsystem\n",
+                                      "test.l", options);
+    EXPECT_NO_THROW(ls.derive(2));
+    try {
+        ls.derive(3);
+        FAIL() << "expected an error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("test.l"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("more than 5 fragment starts"), std::string::npos)
+            << e.what();
+    }
+}
+
+// The turtle pass reads the string through the homomorphism; the fragment starts it
+// reaches are found again in the derived string. A %(par) that the homomorphism writes
+// takes a turtle index in the pass but has no fragment to move (docs/deviations.md).
+TEST(DeriveFragment, TurtlePassThroughTheHomomorphism)
+{
+    std::vector<std::uint32_t> firsts;
+    LoadOptions options;
+    options.fragment_pass = [&](const ModuleString& s, std::uint32_t first) {
+        firsts.push_back(first);
+        std::vector<std::uint32_t> reached;
+        // every one-parameter module the turtle meets is a `%` here
+        for (std::size_t i = 0; i < s.size(); ++i)
+            if (s.param_count(i) == 1)
+                reached.push_back(static_cast<std::uint32_t>(i));
+        return reached;
+    };
+    LSystem ls = LSystem::from_source("lsystem: 1\nderivation length: 1\naxiom: B[A%(3)C]D\n"
+                                      "homomorphism\nB --> FFF\nA --> %(9)G\nendlsystem\n",
+                                      "test.l", options);
+    // interpreted: F F F [ %(9) G %(3) C ] D: %(9) takes turtle 0, %(3) turtle 1
+    EXPECT_EQ(to_text(ls.derive(), ls.symbols()), "B[A]D%(3,1)C");
+    EXPECT_EQ(firsts, std::vector<std::uint32_t>{0});
+}
+
+TEST(DeriveFragment, ContextStopsAtPercentWithParameters)
+{
+    // right context too; a context that names % itself still matches it
+    const char* src = "lsystem: 1\nderivation length: 1\nignore: %\n"
+                      "axiom: A%(1,0)B C%(2,0)D\n"
+                      "A > B --> X\nC > %(p,q) --> Z\nendlsystem\n";
+    EXPECT_EQ(derive_text(src), "A%(1,0)BZ%(2,0)D");
+}
+
+TEST(DeriveFragment, PlainCutStopsAtTheNextFragmentStart)
+{
+    // cpfg's SkipCutPart ends a cut at any % with parameters
+    const char* src = "lsystem: 1\nderivation length: 1\naxiom: A[B%C%(5,0)D]E\nendlsystem\n";
+    EXPECT_EQ(derive_text(src), "A[B%(5,0)D]E");
+}
+
+TEST(DeriveFragment, ProductionOnPercentPreventsTheMove)
+{
+    // "A production with %(par) as a predecessor will prevent the moving of the substring."
+    const char* src = "lsystem: 1\nderivation length: 1\naxiom: A[%(1)B]C\n"
+                      "%(x) --> %(x+1)\nendlsystem\n";
+    EXPECT_EQ(derive_text(src), "A[%(2)B]C");
 }
 
 TEST(DeriveStochastic, SameSeedSameString)
