@@ -1258,8 +1258,8 @@ void EmbreeScene::intersect_coherent(std::span<const CameraRayF> rays,
     std::array<std::uint32_t, max_coherent_rays> index;  // rh[k] is rays[index[k]]
     std::size_t n = std::min({rays.size(), hits.size(), rh.size()});
     std::size_t traced = 0;
+    m.rays.add(n);
     for (std::size_t i = 0; i < n; ++i) {
-        m.rays.add();
         hits[i].reset();
         const CameraRayF& r = rays[i];
         if (!traceable(r.org, r.dir, 0, r.tfar)) {

@@ -200,20 +200,20 @@ std::uint64_t replica_seed(std::uint64_t seed, std::uint32_t i)
     return (i & 1u) ? mix64(seed ^ 0x6a09e667f3bcc909ULL) : seed;
 }
 
-/// A camera sample: its sampler and its camera ray, as traced (single precision, front
-/// clipping applied: starting at the near plane, `tnear` along the camera's ray).
+/// A camera sample: its sampler, and where its camera ray (CameraRayF, beside it: traced
+/// in single precision from the near clipping plane) starts along the camera's ray.
 struct CameraSample {
     std::optional<Sampler> sampler;
-    CameraRayF ray;
     double tnear = 0;
 };
 
-/// The camera ray of sample i of pixel (x, y).
-CameraSample camera_sample(const RenderState& f, int x, int y, std::uint32_t i)
+/// The sampler and camera ray of sample i of pixel (x, y), written in place (c, out):
+/// a batch's samples are made where they are used, not copied there.
+void camera_sample(const RenderState& f, int x, int y, std::uint32_t i, CameraSample& c,
+                   CameraRayF& out)
 {
     const RenderSettings& s = f.settings;
     const bool adaptive = s.noise_target > 0;
-    CameraSample c;
     const Sampler& sampler = c.sampler.emplace(
         static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
         adaptive ? replica_index(i) : i, adaptive ? replica_seed(s.seed, i) : s.seed, s.sampler);
@@ -232,24 +232,24 @@ CameraSample camera_sample(const RenderState& f, int x, int y, std::uint32_t i)
         auto [lens_u, lens_v] = sampler.get2d(sample_dimension::lens);
         return f.camera.generate_ray(px, py, lens_u, lens_v);
     }();
-    c.ray.org = Vec3f(ray.org);
-    c.ray.dir = Vec3f(ray.dir);
+    out.org = Vec3f(ray.org);
+    out.dir = Vec3f(ray.dir);
     if (ray.tnear > 0)
-        c.ray.org = Vec3f(ray.org + ray.dir * ray.tnear);  // front clipping: start at the plane
+        out.org = Vec3f(ray.org + ray.dir * ray.tnear);  // front clipping: start at the plane
     // Far clipping: geometry beyond the back plane must not show.
-    c.ray.tfar = std::isfinite(ray.tfar) ? static_cast<float>(ray.tfar - ray.tnear) : infinity;
+    out.tfar = std::isfinite(ray.tfar) ? static_cast<float>(ray.tfar - ray.tnear) : infinity;
     c.tnear = ray.tnear;
-    return c;
 }
 
-/// Sample i (camera sample c) added to its pixel's sums; `camera_hit`: its camera ray's
-/// first hit when already traced (null: trace_path traces it).
-void take_sample(const RenderState& f, const CameraSample& c, std::uint32_t i, PixelState& st,
+/// Sample i (camera sample c, camera ray `ray`) added to its pixel's sums; `camera_hit`:
+/// its camera ray's first hit when already traced (null: trace_path traces it).
+void take_sample(const RenderState& f, const CameraSample& c, const CameraRayF& ray,
+                 std::uint32_t i, PixelState& st,
                  const std::optional<SurfaceHit>* camera_hit = nullptr)
 {
     const RenderSettings& s = f.settings;
     VisibleSurface first;
-    PathResult r = trace_path(f.ctx, c.ray.org, c.ray.dir, *c.sampler, c.ray.tfar,
+    PathResult r = trace_path(f.ctx, ray.org, ray.dir, *c.sampler, ray.tfar,
                               s.aovs ? &first : nullptr, camera_hit);
     if (first.hit) {
         st.albedo += first.albedo;
@@ -285,8 +285,12 @@ void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uin
                   PixelState& st)
 {
     if (f.ctx.ground) {
-        for (std::uint32_t i = i0; i < i1; ++i)
-            take_sample(f, camera_sample(f, x, y, i), i, st);
+        CameraSample c;
+        CameraRayF ray;
+        for (std::uint32_t i = i0; i < i1; ++i) {
+            camera_sample(f, x, y, i, c, ray);
+            take_sample(f, c, ray, i, st);
+        }
         return;
     }
     constexpr std::uint32_t batch = EmbreeScene::max_coherent_rays;
@@ -295,13 +299,11 @@ void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uin
     std::array<std::optional<SurfaceHit>, batch> hits;
     for (std::uint32_t start = i0; start < i1; start += batch) {
         std::uint32_t n = std::min(batch, i1 - start);
-        for (std::uint32_t k = 0; k < n; ++k) {
-            samples[k] = camera_sample(f, x, y, start + k);
-            rays[k] = samples[k].ray;
-        }
+        for (std::uint32_t k = 0; k < n; ++k)
+            camera_sample(f, x, y, start + k, samples[k], rays[k]);
         f.accel.intersect_coherent(std::span(rays.data(), n), std::span(hits.data(), n));
         for (std::uint32_t k = 0; k < n; ++k)
-            take_sample(f, samples[k], start + k, st, &hits[k]);
+            take_sample(f, samples[k], rays[k], start + k, st, &hits[k]);
     }
 }
 
