@@ -21,8 +21,10 @@
 // plant pixels being those the reference's camera rays hit at least half the time.
 //
 // Times: wall (`seconds`), the process's CPU time (user + sys, `cpu_seconds`: the robust
-// figure on a loaded machine) and the set-up inside it (`setup_seconds`: textures, the
-// Embree build, lights), each per render; the time to the target in all three.
+// figure on a loaded machine) and the set-up inside them (`setup_seconds`,
+// `setup_cpu_seconds`: textures, the Embree build, lights), each per render; the time to
+// the target with the set-up (wall, CPU) and without it (`time_to_target_render_s`,
+// `time_to_target_render_cpu_s`).
 //
 // --adaptive NOISE instead renders once with adaptive sampling to that noise target (up
 // to --max-spp) and prints its mean spp, wall and CPU seconds and the error reached:
@@ -54,15 +56,18 @@
 
 #include "app/command_line.h"
 #include "app/pipeline.h"
+#include "render/ray_counter.h"
 #include "render/render.h"
 #include "scene_export.h"
 
 namespace fs = std::filesystem;
 
-// ---- Ray counting: this executable's rtcIntersect1 / rtcOccluded1 count each call and
-// forward to Embree's (cambium_render is static and links to these definitions).
+// ---- Ray counting: this executable's rtcIntersect1 / rtcIntersect1M / rtcOccluded1 count
+// each ray and forward to Embree's (cambium_render is static and links to these
+// definitions). Each thread counts in its own slot: a shared atomic would make the
+// rendering threads contend on every ray, a cost of the benchmark, not of the renderer.
 namespace {
-std::atomic<std::uint64_t> rays_traced{0};
+cambium::render::RayCounter rays_traced;
 
 template <typename F>
 F embree_function(const char* name)
@@ -75,15 +80,24 @@ extern "C" void rtcIntersect1(RTCScene scene, RTCIntersectContext* context, RTCR
 {
     using F = void (*)(RTCScene, RTCIntersectContext*, RTCRayHit*);
     static F real = embree_function<F>("rtcIntersect1");
-    rays_traced.fetch_add(1, std::memory_order_relaxed);
+    rays_traced.add();
     real(scene, context, rayhit);
+}
+
+extern "C" void rtcIntersect1M(RTCScene scene, RTCIntersectContext* context, RTCRayHit* rayhit,
+                               unsigned int m, size_t byte_stride)
+{
+    using F = void (*)(RTCScene, RTCIntersectContext*, RTCRayHit*, unsigned int, size_t);
+    static F real = embree_function<F>("rtcIntersect1M");
+    rays_traced.add(m);
+    real(scene, context, rayhit, m, byte_stride);
 }
 
 extern "C" void rtcOccluded1(RTCScene scene, RTCIntersectContext* context, RTCRay* ray)
 {
     using F = void (*)(RTCScene, RTCIntersectContext*, RTCRay*);
     static F real = embree_function<F>("rtcOccluded1");
-    rays_traced.fetch_add(1, std::memory_order_relaxed);
+    rays_traced.add();
     real(scene, context, ray);
 }
 
@@ -153,7 +167,7 @@ cambium::geom::Scene load_plant(const fs::path& folder)
 
 struct Run {
     render::Image image;
-    double seconds = 0, cpu_seconds = 0, setup_seconds = 0;
+    double seconds = 0, cpu_seconds = 0, setup_seconds = 0, setup_cpu_seconds = 0;
     std::uint64_t rays = 0, samples = 0;
 };
 
@@ -169,7 +183,7 @@ Run render_at(const cambium::geom::Scene& scene, const Settings& s, int spp,
     rs.seed = seed;
     rs.aovs = false;
     rs.noise_target = static_cast<float>(noise_target);
-    std::uint64_t rays_before = rays_traced.load();
+    std::uint64_t rays_before = rays_traced.total();
     auto start = Clock::now();
     double cpu_start = cpu_seconds();
     render::RenderReport report;
@@ -177,7 +191,8 @@ Run render_at(const cambium::geom::Scene& scene, const Settings& s, int spp,
     run.seconds = std::chrono::duration<double>(Clock::now() - start).count();
     run.cpu_seconds = cpu_seconds() - cpu_start;
     run.setup_seconds = report.setup_seconds;
-    run.rays = rays_traced.load() - rays_before;
+    run.setup_cpu_seconds = report.setup_cpu_seconds;
+    run.rays = rays_traced.total() - rays_before;
     run.samples = report.samples;
     return run;
 }
@@ -233,7 +248,7 @@ std::pair<double, double> fit_line(const std::vector<double>& x, const std::vect
 }
 
 struct Curve {
-    std::vector<double> spp, rmse, seconds, cpu_seconds, setup_seconds;
+    std::vector<double> spp, rmse, seconds, cpu_seconds, setup_seconds, setup_cpu_seconds;
     std::uint64_t rays = 0, samples = 0;
     double render_seconds = 0;
 };
@@ -278,23 +293,28 @@ void report(const std::string& plant, const Settings& s, render::SampleSequence 
     double total_spp = 0;
     for (double spp : c.spp)
         total_spp += spp;
-    std::vector<double> render_only;  // wall time less the set-up
-    for (std::size_t i = 0; i < c.spp.size(); ++i)
+    std::vector<double> render_only, render_only_cpu;  // wall and CPU time less the set-up
+    for (std::size_t i = 0; i < c.spp.size(); ++i) {
         render_only.push_back(c.seconds[i] - c.setup_seconds[i]);
+        render_only_cpu.push_back(c.cpu_seconds[i] - c.setup_cpu_seconds[i]);
+    }
     std::printf("{\"plant\":\"%s\",\"sampler\":\"%s\",\"image\":\"%dx%d\",\"threads\":%d,"
                 "\"reference_spp\":%d,\"spp\":%s,\"relative_rmse\":%s,\"seconds\":%s,"
-                "\"cpu_seconds\":%s,\"setup_seconds\":%s,"
+                "\"cpu_seconds\":%s,\"setup_seconds\":%s,\"setup_cpu_seconds\":%s,"
                 "\"slope\":%.3f,\"target_noise\":%.5f,\"spp_to_target\":%.1f,"
                 "\"time_to_target_s\":%.3f,\"time_to_target_cpu_s\":%.3f,"
-                "\"time_to_target_render_s\":%.3f,\"samples_per_s\":%.0f,"
+                "\"time_to_target_render_s\":%.3f,\"time_to_target_render_cpu_s\":%.3f,"
+                "\"samples_per_s\":%.0f,"
                 "\"rays_per_s\":%.0f,\"peak_rss_mb\":%.0f}\n",
                 plant.c_str(), name(sampler), s.width, s.height, s.threads, s.reference_spp,
                 json_array(c.spp, "%.0f").c_str(), json_array(c.rmse, "%.5f").c_str(),
                 json_array(c.seconds, "%.3f").c_str(), json_array(c.cpu_seconds, "%.3f").c_str(),
-                json_array(c.setup_seconds, "%.3f").c_str(), slope, target, spp_to_target,
+                json_array(c.setup_seconds, "%.3f").c_str(),
+                json_array(c.setup_cpu_seconds, "%.3f").c_str(), slope, target, spp_to_target,
                 seconds_at(c, c.seconds, spp_to_target),
                 seconds_at(c, c.cpu_seconds, spp_to_target),
                 seconds_at(c, render_only, spp_to_target),
+                seconds_at(c, render_only_cpu, spp_to_target),
                 double(s.width) * s.height * total_spp / c.render_seconds,
                 double(c.rays) / c.render_seconds, peak_rss_mb());
     std::fflush(stdout);
@@ -357,6 +377,7 @@ void run_plant(const std::string& plant, const fs::path& folder, const Settings&
             c.seconds.push_back(run.seconds);
             c.cpu_seconds.push_back(run.cpu_seconds);
             c.setup_seconds.push_back(run.setup_seconds);
+            c.setup_cpu_seconds.push_back(run.setup_cpu_seconds);
             c.rays += run.rays;
             c.render_seconds += run.seconds;
         }

@@ -167,6 +167,25 @@ extern "C" void rtcIntersect1(RTCScene scene, RTCIntersectContext* context, RTCR
     real_intersect()(scene, context, rayhit);
 }
 
+// Camera rays are traced as coherent streams (EmbreeScene::intersect_coherent): counted
+// and recorded ray by ray like the others (the raw replay traces them one at a time).
+extern "C" void rtcIntersect1M(RTCScene scene, RTCIntersectContext* context, RTCRayHit* rayhit,
+                               unsigned int m, size_t byte_stride)
+{
+    using Intersect1M = void (*)(RTCScene, RTCIntersectContext*, RTCRayHit*, unsigned int, size_t);
+    static auto real = reinterpret_cast<Intersect1M>(dlsym(RTLD_NEXT, "rtcIntersect1M"));
+    if (recorder.recording.load(std::memory_order_relaxed)) {
+        note_call(scene);
+        recorder.intersections.add(m);
+        thread_local std::size_t next = 0, end = 0;
+        for (unsigned int i = 0; i < m; ++i)
+            recorder.rays.record(reinterpret_cast<const RTCRayHit*>(
+                                     reinterpret_cast<const char*>(rayhit) + i * byte_stride)->ray,
+                                 next, end);
+    }
+    real(scene, context, rayhit, m, byte_stride);
+}
+
 extern "C" void rtcOccluded1(RTCScene scene, RTCIntersectContext* context, RTCRay* ray)
 {
     if (recorder.recording.load(std::memory_order_relaxed)) {

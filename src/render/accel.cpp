@@ -716,6 +716,8 @@ struct EmbreeScene::Impl : HitResolver {
     bool tilt_rays = false;  ///< some Hermite curves are built: rays are traced off_axis()
 
     Vec3f traced(const Vec3f& dir) const { return tilt_rays ? off_axis(dir) : dir; }
+    /// The hit Embree reported for the ray org + t dir, ready for shading.
+    SurfaceHit surface_hit(const RTCRayHit& rh, const Vec3f& org, const Vec3f& dir) const;
     mutable std::atomic<std::uint64_t> skipped_rays{0};
     RayCounter rays;
     double build_seconds = 0;
@@ -1245,7 +1247,45 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     rtcIntersect1(m.scene, &context.context, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return std::nullopt;
+    return m.surface_hit(rh, org, dir);
+}
 
+void EmbreeScene::intersect_coherent(std::span<const CameraRayF> rays,
+                                     std::span<std::optional<SurfaceHit>> hits) const
+{
+    const Impl& m = *m_impl;
+    std::array<RTCRayHit, max_coherent_rays> rh;
+    std::array<std::uint32_t, max_coherent_rays> index;  // rh[k] is rays[index[k]]
+    std::size_t n = std::min({rays.size(), hits.size(), rh.size()});
+    std::size_t traced = 0;
+    m.rays.add(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        hits[i].reset();
+        const CameraRayF& r = rays[i];
+        if (!traceable(r.org, r.dir, 0, r.tfar)) {
+            ++m.skipped_rays;
+            continue;
+        }
+        rh[traced].ray = make_ray(r.org, m.traced(r.dir), 0, r.tfar);
+        rh[traced].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh[traced].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        index[traced++] = static_cast<std::uint32_t>(i);
+    }
+    if (traced == 0)
+        return;
+    SkipContext context = make_context({}, true);
+    // A stream of coherent rays: Embree gathers it into SIMD packets.
+    rtcIntersect1M(m.scene, &context.context, rh.data(), static_cast<unsigned>(traced),
+                   sizeof(RTCRayHit));
+    for (std::size_t k = 0; k < traced; ++k)
+        if (rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID)
+            hits[index[k]] = m.surface_hit(rh[k], rays[index[k]].org, rays[index[k]].dir);
+}
+
+SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
+                                          const Vec3f& dir) const
+{
+    const Impl& m = *this;
     SurfaceHit h;
     h.t = rh.ray.tfar;
     // Where Embree found it: along the direction it traced (make_ray).

@@ -75,6 +75,13 @@ struct SurfaceHit {
     }
 };
 
+/// A camera ray in single precision, as intersect_coherent() traces it: from org along
+/// dir for t < tfar.
+struct CameraRayF {
+    Vec3f org, dir;
+    float tfar = 0;
+};
+
 /// The acceleration structure of one frame: every Geometry part natively in Embree
 /// (round linear and Hermite curves, sphere points, oriented discs, triangles), each
 /// prototype in its own Embree scene placed by one instance per Scene::Instance.
@@ -99,6 +106,14 @@ public:
     std::optional<SurfaceHit> intersect(const Vec3f& org, const Vec3f& dir, float tnear,
                                         float tfar, PrimId skip = {},
                                         bool coherent = false) const;
+    /// At most this many rays per intersect_coherent() call.
+    static constexpr std::size_t max_coherent_rays = 16;
+    /// intersect(r.org, r.dir, 0, r.tfar, {}, true) for each of `rays` (at most
+    /// max_coherent_rays) into `hits`, the rays traced together as one stream, which
+    /// Embree gathers into SIMD packets: cheaper per ray for camera rays close together
+    /// (a pixel's samples). The same hits as intersect() gives.
+    void intersect_coherent(std::span<const CameraRayF> rays,
+                            std::span<std::optional<SurfaceHit>> hits) const;
     /// Whether anything but `skip` blocks org + t dir for t in [tnear, tfar].
     bool occluded(const Vec3f& org, const Vec3f& dir, float tnear, float tfar,
                   PrimId skip = {}) const;

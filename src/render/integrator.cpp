@@ -356,7 +356,8 @@ VisibleSurface visible_surface(const SurfaceHit& hit, const SurfaceMaterial& mat
 }  // namespace
 
 PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec3f& camera_dir,
-                      const Sampler& sampler, float camera_tfar, VisibleSurface* first)
+                      const Sampler& sampler, float camera_tfar, VisibleSurface* first,
+                      const std::optional<SurfaceHit>* camera_hit)
 {
     if (!ctx.prepared)
         throw std::logic_error("trace_path: prepare_path_context() was not called");
@@ -376,7 +377,9 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
     PassThroughDraws pass_through(sampler, sample_dimension::vertex(0) + sample_dimension::opacity);
     for (int depth = 0; depth < ctx.max_depth;) {
         const std::uint32_t block = sample_dimension::vertex(depth);
-        std::optional<SurfaceHit> hit = first_hit(ctx, org, dir, tfar, leaving, depth == 0);
+        std::optional<SurfaceHit> hit = depth == 0 && passes == 0 && camera_hit
+                                            ? *camera_hit
+                                            : first_hit(ctx, org, dir, tfar, leaving, depth == 0);
         if (!hit) {
             if (depth == 0 && ctx.environment_visible) {
                 result.radiance += beta * env_radiance(dir);

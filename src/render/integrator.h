@@ -114,10 +114,13 @@ struct VisibleSurface {
 };
 
 /// Traces the camera ray (org, dir), which ends at tfar (far clipping), with the sampler's
-/// dimensions; fills `first` when given. Allocates nothing.
+/// dimensions; fills `first` when given. `camera_hit`, when given: the camera ray's first
+/// hit in ctx.accel, already traced (EmbreeScene::intersect_coherent; only without a
+/// ground plane). Allocates nothing.
 PathResult trace_path(const PathContext& ctx, const Vec3f& org, const Vec3f& dir,
                       const Sampler& sampler,
                       float tfar = std::numeric_limits<float>::infinity(),
-                      VisibleSurface* first = nullptr);
+                      VisibleSurface* first = nullptr,
+                      const std::optional<SurfaceHit>* camera_hit = nullptr);
 
 }  // namespace cambium::render

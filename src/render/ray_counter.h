@@ -13,9 +13,9 @@ namespace cambium::render {
 /// slots share lines and stay exact, only slower.
 class RayCounter {
 public:
-    void add() const noexcept
+    void add(std::uint64_t n = 1) const noexcept
     {
-        m_slots[thread_slot()].count.fetch_add(1, std::memory_order_relaxed);
+        m_slots[thread_slot()].count.fetch_add(n, std::memory_order_relaxed);
     }
 
     std::uint64_t total() const noexcept

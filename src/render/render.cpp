@@ -18,9 +18,11 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <ctime>
 #include <limits>
 #include <mutex>
 #include <numbers>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -198,14 +200,23 @@ std::uint64_t replica_seed(std::uint64_t seed, std::uint32_t i)
     return (i & 1u) ? mix64(seed ^ 0x6a09e667f3bcc909ULL) : seed;
 }
 
-/// Sample i of pixel (x, y), added to its sums.
-void take_sample(const RenderState& f, int x, int y, std::uint32_t i, PixelState& st)
+/// A camera sample: its sampler, and where its camera ray (CameraRayF, beside it: traced
+/// in single precision from the near clipping plane) starts along the camera's ray.
+struct CameraSample {
+    std::optional<Sampler> sampler;
+    double tnear = 0;
+};
+
+/// The sampler and camera ray of sample i of pixel (x, y), written in place (c, out):
+/// a batch's samples are made where they are used, not copied there.
+void camera_sample(const RenderState& f, int x, int y, std::uint32_t i, CameraSample& c,
+                   CameraRayF& out)
 {
     const RenderSettings& s = f.settings;
     const bool adaptive = s.noise_target > 0;
-    const Sampler sampler(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
-                          adaptive ? replica_index(i) : i,
-                          adaptive ? replica_seed(s.seed, i) : s.seed, s.sampler);
+    const Sampler& sampler = c.sampler.emplace(
+        static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+        adaptive ? replica_index(i) : i, adaptive ? replica_seed(s.seed, i) : s.seed, s.sampler);
     auto [jx, jy] = sampler.get2d(sample_dimension::film);
     double px, py;
     if (f.filter.box()) {
@@ -221,18 +232,29 @@ void take_sample(const RenderState& f, int x, int y, std::uint32_t i, PixelState
         auto [lens_u, lens_v] = sampler.get2d(sample_dimension::lens);
         return f.camera.generate_ray(px, py, lens_u, lens_v);
     }();
-    Vec3f org(ray.org), dir(ray.dir);
+    out.org = Vec3f(ray.org);
+    out.dir = Vec3f(ray.dir);
     if (ray.tnear > 0)
-        org = Vec3f(ray.org + ray.dir * ray.tnear);  // front clipping: start at the plane
+        out.org = Vec3f(ray.org + ray.dir * ray.tnear);  // front clipping: start at the plane
     // Far clipping: geometry beyond the back plane must not show.
-    float tfar = std::isfinite(ray.tfar) ? static_cast<float>(ray.tfar - ray.tnear) : infinity;
+    out.tfar = std::isfinite(ray.tfar) ? static_cast<float>(ray.tfar - ray.tnear) : infinity;
+    c.tnear = ray.tnear;
+}
 
+/// Sample i (camera sample c, camera ray `ray`) added to its pixel's sums; `camera_hit`:
+/// its camera ray's first hit when already traced (null: trace_path traces it).
+void take_sample(const RenderState& f, const CameraSample& c, const CameraRayF& ray,
+                 std::uint32_t i, PixelState& st,
+                 const std::optional<SurfaceHit>* camera_hit = nullptr)
+{
+    const RenderSettings& s = f.settings;
     VisibleSurface first;
-    PathResult r = trace_path(f.ctx, org, dir, sampler, tfar, s.aovs ? &first : nullptr);
+    PathResult r = trace_path(f.ctx, ray.org, ray.dir, *c.sampler, ray.tfar,
+                              s.aovs ? &first : nullptr, camera_hit);
     if (first.hit) {
         st.albedo += first.albedo;
         st.normal += first.normal;
-        st.depth = std::min(st.depth, static_cast<float>(first.t + ray.tnear));
+        st.depth = std::min(st.depth, static_cast<float>(first.t + c.tnear));
     }
     if ((s.transparent_background || s.ground.shadow_catcher) && !r.hit)
         r.radiance = Vec3f();
@@ -252,6 +274,37 @@ void take_sample(const RenderState& f, int x, int y, std::uint32_t i, PixelState
     double l = r.catcher ? r.lit_with : luminance(r.radiance);
     st.replica_luminance[i & 1u] += l;
     st.luminance_sq += l * l;
+}
+
+/// Samples i0 .. i1 - 1 of pixel (x, y), added to its sums in order. Their camera rays
+/// are traced together, up to EmbreeScene::max_coherent_rays at a time: a pixel's rays
+/// are close and parallel (a coherent stream, which Embree traces as SIMD packets),
+/// cheaper than one by one. With a ground plane (which camera rays meet beside the
+/// Embree scene) each path traces its own.
+void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uint32_t i1,
+                  PixelState& st)
+{
+    if (f.ctx.ground) {
+        CameraSample c;
+        CameraRayF ray;
+        for (std::uint32_t i = i0; i < i1; ++i) {
+            camera_sample(f, x, y, i, c, ray);
+            take_sample(f, c, ray, i, st);
+        }
+        return;
+    }
+    constexpr std::uint32_t batch = EmbreeScene::max_coherent_rays;
+    std::array<CameraSample, batch> samples;
+    std::array<CameraRayF, batch> rays;
+    std::array<std::optional<SurfaceHit>, batch> hits;
+    for (std::uint32_t start = i0; start < i1; start += batch) {
+        std::uint32_t n = std::min(batch, i1 - start);
+        for (std::uint32_t k = 0; k < n; ++k)
+            camera_sample(f, x, y, start + k, samples[k], rays[k]);
+        f.accel.intersect_coherent(std::span(rays.data(), n), std::span(hits.data(), n));
+        for (std::uint32_t k = 0; k < n; ++k)
+            take_sample(f, samples[k], rays[k], start + k, st, &hits[k]);
+    }
 }
 
 /// The pass schedule: cumulative samples per pixel at the end of each pass.
@@ -527,6 +580,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
     if (cameras.empty())
         return;
     auto start = Clock::now();
+    const std::clock_t cpu_start = std::clock();
     auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
     tbb::task_arena arena(settings.threads > 0 ? settings.threads
                                                : tbb::task_arena::automatic);
@@ -602,6 +656,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
 
         if (view == 0) {
             rep.setup_seconds = elapsed();
+            rep.setup_cpu_seconds = double(std::clock() - cpu_start) / CLOCKS_PER_SEC;
             rep.build_seconds = accel->build_seconds();
         }
         const int tiles_x = (w + tile_size - 1) / tile_size;
@@ -658,8 +713,10 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                             PixelState& st = pixels[std::size_t(y) * w + x];
                             if (st.done)
                                 continue;
-                            for (std::uint32_t i = st.samples; i < target; ++i, ++taken)
-                                take_sample(state, region.x + x, region.y + y, i, st);
+                            if (st.samples >= target)
+                                continue;
+                            taken += target - st.samples;
+                            take_samples(state, region.x + x, region.y + y, st.samples, target, st);
                         }
                     progress.add(taken);
                 }

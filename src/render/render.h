@@ -172,6 +172,8 @@ struct RenderReport {
     /// and of it the Embree build alone (the first view's; 0 for later views).
     double setup_seconds = 0;
     double build_seconds = 0;
+    /// The process's CPU time (all its threads: std::clock) over setup_seconds.
+    double setup_cpu_seconds = 0;
     std::uint64_t rays = 0;     ///< rays traced in this view: camera, bounce and shadow rays
     /// Bytes Embree allocated itself (BVHs, internal copies; not the shared buffers):
     /// after the build and at most so far.
