@@ -18,9 +18,12 @@ namespace {
 /// to max_homomorphism_depth).
 constexpr long long max_depth_setting = 1'000'000;
 
-std::size_t predicted(std::size_t size, double growth)
+/// The size a string of `size` reaches after a step that grows it by `growth`: a double,
+/// compared with the memory budget before it becomes a size (converting a double past
+/// SIZE_MAX is undefined)
+double predicted(std::size_t size, double growth)
 {
-    return static_cast<std::size_t>(static_cast<double>(size) * growth * 1.01) + 64;
+    return static_cast<double>(size) * growth * 1.01 + 64;
 }
 
 double growth(std::size_t before, std::size_t after)
@@ -99,7 +102,7 @@ Deriver::Deriver(const Program& program, DeriveLimits limits)
     } catch (const EvaluationError& e) {
         fail(e);
     } catch (const std::bad_alloc&) {
-        out_of_memory(m_string.memory_bytes(), m_string);
+        system_out_of_memory(m_string.memory_bytes(), m_string);
     }
 }
 
@@ -224,7 +227,7 @@ void Deriver::step()
         fail(e);
     } catch (const std::bad_alloc&) {
         // the budget is checked as the string grows; this is the system running out first
-        out_of_memory(m_string.memory_bytes() + m_next.memory_bytes(), m_next);
+        system_out_of_memory(m_string.memory_bytes() + m_next.memory_bytes(), m_next);
     }
 }
 
@@ -237,12 +240,12 @@ void Deriver::step_located()
     // Reserve what the last step's growth predicts, so the new string is not
     // reallocated (and briefly held twice) while it is built
     // (not past the memory budget: the prediction may be wrong, the budget is not)
-    std::size_t modules_ahead = predicted(m_string.size(), m_module_growth);
-    std::size_t params_ahead = predicted(m_string.param_total(), m_param_growth);
-    if (static_cast<double>(modules_ahead) * 3 + static_cast<double>(params_ahead) * 4 +
-            static_cast<double>(m_string.memory_bytes()) <
+    double modules_ahead = predicted(m_string.size(), m_module_growth);
+    double params_ahead = predicted(m_string.param_total(), m_param_growth);
+    if (modules_ahead * 3 + params_ahead * 4 + static_cast<double>(m_string.memory_bytes()) <
         static_cast<double>(m_limits.max_memory_bytes))
-        m_next.reserve(modules_ahead, params_ahead);
+        m_next.reserve(static_cast<std::size_t>(modules_ahead),
+                       static_cast<std::size_t>(params_ahead));
     std::size_t modules = m_string.size(), params = m_string.param_total();
     rewrite(m_indexed, m_next, false);
     compose_lineage(true);
@@ -471,6 +474,18 @@ void Deriver::out_of_memory(std::size_t bytes, const ModuleString& s) const
                     "has " + std::to_string(s.size()) + " modules with " +
                     std::to_string(s.param_total()) +
                     " parameters so far; reduce the derivation length or raise --max-memory");
+}
+
+void Deriver::system_out_of_memory(std::size_t bytes, const ModuleString& s) const
+{
+    // Within the budget (or it would have been reported as such): the system refused.
+    throw Error(FileLoc{m_program.file_name, 0, 0},
+                "the system refused memory in " + phase() + " with " + byte_size_text(bytes) +
+                    " held by the strings, within the memory budget of " +
+                    byte_size_text(m_limits.max_memory_bytes) + " (--max-memory); the string " +
+                    "has " + std::to_string(s.size()) + " modules with " +
+                    std::to_string(s.param_total()) +
+                    " parameters so far; reduce the derivation length or --max-memory");
 }
 
 long long Deriver::setting(const Code& code, const FileLoc& loc, const std::string& what,
@@ -722,7 +737,7 @@ void Deriver::apply_homomorphism(const ModuleString& in, ModuleString& out,
         m_keep_objects = m_in_homomorphism = false;
         fail(e);
     } catch (const std::bad_alloc&) {
-        out_of_memory(in.memory_bytes() + out.memory_bytes(), out);
+        system_out_of_memory(in.memory_bytes() + out.memory_bytes(), out);
     }
     m_keep_objects = m_in_homomorphism = false;
     m_source = nullptr;

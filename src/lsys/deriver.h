@@ -154,6 +154,8 @@ private:
     void decompose();
     void check_size(const ModuleString& s) const;
     [[noreturn]] void out_of_memory(std::size_t bytes, const ModuleString& building) const;
+    /// std::bad_alloc within the budget: the system refused the memory
+    [[noreturn]] void system_out_of_memory(std::size_t bytes, const ModuleString& building) const;
     std::string phase() const;
     long long setting(const Code& code, const FileLoc& loc, const std::string& what,
                       long long lo, long long hi);

@@ -2,10 +2,13 @@
 // Hostile L-system files (issue 11, docs/security.md): printf formats, file access
 // outside the model's folder, deep nesting, out-of-range numbers, the memory budget.
 // Each asserts the exact diagnostic: file, line, column and message.
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <climits>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -465,6 +468,48 @@ TEST(MemoryBudget, ModelsWithinTheBudgetDeriveAsBefore)
     options.max_memory_bytes = 1 << 20;
     LSystem ls = LSystem::from_source(doubling_model(6), "test.l", options);
     EXPECT_EQ(ls.derive().size(), 64u);
+}
+
+// The system refusing memory within the budget (here an address-space limit makes
+// mmap and mremap fail) is an error naming the file and the step, and it does not claim
+// that the budget was exceeded.
+TEST(MemoryBudget, MemoryTheSystemRefusesIsReportedAsSuch)
+{
+#if defined(__SANITIZE_ADDRESS__)
+    GTEST_SKIP() << "AddressSanitizer reserves its shadow memory past any address-space limit";
+#else
+    std::fflush(nullptr);
+    pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+        // the child: 48 MiB more address space than it has now, a budget far above that
+        long pages = 0;
+        if (std::FILE* statm = std::fopen("/proc/self/statm", "r")) {
+            if (std::fscanf(statm, "%ld", &pages) != 1)
+                pages = 0;
+            std::fclose(statm);
+        }
+        rlimit limit{};
+        limit.rlim_cur = limit.rlim_max =
+            static_cast<rlim_t>(pages) * static_cast<rlim_t>(sysconf(_SC_PAGESIZE)) + (48u << 20);
+        if (pages == 0 || setrlimit(RLIMIT_AS, &limit) != 0)
+            _exit(3);
+        LoadOptions options;
+        options.max_memory_bytes = std::uint64_t{1} << 40;
+        std::string e = derive_error(doubling_model(40), "test.l", options);
+        bool named = e.rfind("test.l: error: the system refused memory in step ", 0) == 0;
+        bool honest = e.find("within the memory budget of 1.0 TiB (--max-memory)") !=
+                          std::string::npos &&
+                      e.find("more than the memory budget") == std::string::npos;
+        if (!named || !honest)
+            std::fprintf(stderr, "message: %s\n", e.c_str());
+        _exit(named && honest ? 0 : 1);
+    }
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFEXITED(status)) << "the child died of signal " << WTERMSIG(status);
+    EXPECT_EQ(WEXITSTATUS(status), 0) << "3: no address-space limit could be set";
+#endif
 }
 
 TEST(MemoryBudget, ByteSizesParseWithBinarySuffixes)
