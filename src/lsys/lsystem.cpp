@@ -249,7 +249,7 @@ void LSystem::run_query(Deriver& deriver) const
     ModuleString expanded;
     std::vector<ParamLink> links;
     deriver.apply_homomorphism(s, expanded, &links);
-    ModuleString joined = join_at_commands(expanded);
+    ModuleString joined = joined_at_commands(std::move(expanded));
     std::size_t total = joined.param_total();
     m_options.query(joined);
     if (joined.param_total() != total)
@@ -257,6 +257,13 @@ void LSystem::run_query(Deriver& deriver) const
     float* params = s.mutable_params().data();
     for (const ParamLink& link : links)
         std::copy_n(joined.param_data() + link.to, link.count, params + link.from);
+}
+
+ModuleString LSystem::joined_at_commands(ModuleString s) const
+{
+    if (m_program->split_commands.empty())
+        return s;  // moved out, not copied
+    return join_at_commands(s);
 }
 
 ModuleString LSystem::join_at_commands(const ModuleString& s) const
@@ -307,7 +314,7 @@ ModuleString LSystem::interpretation_string(const ModuleString& derived,
         deriver.set_runtime(*m_last_runtime);
     ModuleString out;
     deriver.apply_homomorphism(derived, out, nullptr, objects == ObjectHandling::keep);
-    return join_at_commands(out);
+    return joined_at_commands(std::move(out));
 }
 
 bool LSystem::is_object_symbol(int symbol) const

@@ -164,6 +164,9 @@ private:
     explicit LSystem(std::unique_ptr<Program> program, LoadOptions options);
     void run_query(Deriver& deriver) const;
     ModuleString join_at_commands(const ModuleString& s) const;
+    /// join_at_commands of a string the caller gives up: the string itself when there is
+    /// no split command (no copy)
+    ModuleString joined_at_commands(ModuleString s) const;
 
     std::unique_ptr<Program> m_program;
     LoadOptions m_options;
