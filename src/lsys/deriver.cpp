@@ -41,6 +41,9 @@ int symbol_or_none(const SymbolTable& symbols, std::string_view name)
 Deriver::Deriver(const Program& program, DeriveLimits limits)
     : m_program(program), m_limits(limits)
 {
+    // module indices and parameter offsets are kept in 32 bits (no_parent is the largest)
+    m_limits.max_modules = std::min<std::size_t>(m_limits.max_modules, 0xfffffffeu);
+    m_limits.max_params = std::min<std::size_t>(m_limits.max_params, 0xffffffffu);
     const SymbolTable& symbols = program.symbols;
     m_bracket_open = symbol_or_none(symbols, "[");
     m_bracket_close = symbol_or_none(symbols, "]");
@@ -448,6 +451,10 @@ void Deriver::check_size(const ModuleString& s) const
                     "the string grew past " + std::to_string(m_limits.max_modules) +
                         " modules in " + phase() +
                         "; reduce the derivation length or raise the limit");
+    if (s.param_total() > m_limits.max_params)
+        throw Error(FileLoc{m_program.file_name, 0, 0},
+                    "the string grew past " + std::to_string(m_limits.max_params) +
+                        " parameter values in " + phase() + "; reduce the derivation length");
     // What a step holds at once: the string it builds from, its context index and the
     // string being built, at its next peak (when a full array grows, its old block and
     // the new one, a quarter larger, are held at once)

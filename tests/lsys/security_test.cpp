@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "base/limits.h"
+#include "lsys/deriver.h"
 #include "lsys/expression.h"
 #include "test_util.h"
 
@@ -468,6 +469,31 @@ TEST(MemoryBudget, ModelsWithinTheBudgetDeriveAsBefore)
     options.max_memory_bytes = 1 << 20;
     LSystem ls = LSystem::from_source(doubling_model(6), "test.l", options);
     EXPECT_EQ(ls.derive().size(), 64u);
+}
+
+// Positions in a string are 32-bit: a limit on its parameter values (2^32 - 1 at most)
+// stops the derivation with a message, checked here with a small limit.
+TEST(MemoryBudget, ParameterValuesPastTheLimitStopTheDerivation)
+{
+    LSystem ls = LSystem::from_source(doubling_model(40), "test.l");
+    DeriveLimits limits;
+    limits.max_params = 10000;  // step 5 holds 32 x 200 values, step 6 64 x 200
+    Deriver deriver(ls.program(), limits);
+    std::string e;
+    try {
+        for (int step = 0; step < 40; ++step)
+            deriver.step();
+    } catch (const Error& error) {
+        e = error.what();
+    }
+    EXPECT_EQ(e, "test.l: error: the string grew past 10000 parameter values in step 6; "
+                 "reduce the derivation length");
+    DeriveLimits past;
+    past.max_params = std::size_t{1} << 40;  // lowered to what 32-bit positions hold
+    Deriver within(ls.program(), past);
+    for (int step = 0; step < 8; ++step)
+        within.step();
+    EXPECT_EQ(within.string().param_total(), std::size_t{200} << 8);
 }
 
 // The system refusing memory within the budget (here an address-space limit makes
