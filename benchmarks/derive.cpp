@@ -19,6 +19,7 @@
 #include <ostream>
 #include <streambuf>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "lsys/lsystem.h"
@@ -35,10 +36,14 @@ fs::path bench_dir()
     return fs::path(CAMBIUM_CORPUS_DEFAULT) / "bench";
 }
 
-/// The model's .l file: the only *.l in its folder (bench models have no model.json).
+/// The model's .l file: the only *.l in its folder (bench models have no model.json);
+/// empty when there is no such folder or file.
 fs::path lsystem_file(const fs::path& folder)
 {
-    for (const auto& e : fs::directory_iterator(folder))
+    std::error_code error;
+    if (!fs::is_directory(folder, error))
+        return {};
+    for (const auto& e : fs::directory_iterator(folder, error))
         if (e.path().extension() == ".l")
             return e.path();
     return {};
@@ -46,7 +51,8 @@ fs::path lsystem_file(const fs::path& folder)
 
 double seconds(const timeval& t) { return double(t.tv_sec) + double(t.tv_usec) * 1e-6; }
 
-/// CPU time (user + system) of this process so far, in seconds, and its minor page faults.
+/// CPU time (user + system) of this process so far, in seconds, with that of the child
+/// processes it waited for (cpp while loading), and its own minor page faults.
 struct CpuMark {
     double cpu_s = 0;
     long faults = 0;
@@ -54,9 +60,12 @@ struct CpuMark {
 
 CpuMark cpu_mark()
 {
-    rusage usage{};
+    rusage usage{}, children{};
     getrusage(RUSAGE_SELF, &usage);
-    return {seconds(usage.ru_utime) + seconds(usage.ru_stime), usage.ru_minflt};
+    getrusage(RUSAGE_CHILDREN, &children);
+    return {seconds(usage.ru_utime) + seconds(usage.ru_stime) + seconds(children.ru_utime) +
+                seconds(children.ru_stime),
+            usage.ru_minflt};
 }
 
 double peak_rss_mb()
@@ -174,18 +183,40 @@ int run_command(const std::string& cambium, const std::string& model,
     return ok ? 0 : 1;
 }
 
+constexpr const char* usage =
+    "usage: derive [--cambium PATH] [model...]\n"
+    "Derives each corpus bench/ model (default: koch-L6 koch-L7 birch-225k birch-2250k) in\n"
+    "a child process and prints one JSON line per model: load, derive and -str text output\n"
+    "times (wall and CPU), page faults while deriving and peak RSS. With --cambium, the\n"
+    "command at PATH also runs on each model with -str alone and with -vv alone.\n"
+    "The corpus is $CAMBIUM_CORPUS, else " CAMBIUM_CORPUS_DEFAULT ".\n";
+
 }  // namespace
 
 int main(int argc, char** argv)
 {
     if (argc == 3 && std::string(argv[1]) == "--one")
         return run_one(argv[2]);
+    if (argc >= 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
+        std::fputs(usage, stdout);
+        return 0;
+    }
     std::string cambium;
-    if (argc >= 3 && std::string(argv[1]) == "--cambium") {
+    if (argc >= 2 && std::string(argv[1]) == "--cambium") {
+        if (argc < 3) {
+            std::fprintf(stderr, "derive: --cambium needs the path of the cambium command\n%s",
+                         usage);
+            return 2;
+        }
         cambium = fs::absolute(argv[2]).string();
         argv += 2;
         argc -= 2;
     }
+    for (int i = 1; i < argc; ++i)
+        if (argv[i][0] == '-') {
+            std::fprintf(stderr, "derive: unknown option %s\n%s", argv[i], usage);
+            return 2;
+        }
     if (!fs::is_directory(bench_dir())) {
         std::printf("{\"note\":\"corpus bench folder not found at %s; nothing measured\"}\n",
                     bench_dir().string().c_str());
@@ -196,6 +227,12 @@ int main(int argc, char** argv)
         models.assign(argv + 1, argv + argc);
     int failures = 0;
     for (const auto& m : models) {
+        if (lsystem_file(bench_dir() / m).empty()) {
+            std::printf("{\"model\":\"%s\",\"error\":\"no such model: no .l file in %s\"}\n",
+                        m.c_str(), (bench_dir() / m).string().c_str());
+            ++failures;
+            continue;
+        }
         failures += run_child("/proc/self/exe", m) != 0 ? 1 : 0;
         if (!cambium.empty())
             for (const char* option : {"-str", "-vv"})

@@ -362,8 +362,12 @@ geom::Bounds3 view_volume(const Model& model, const lsys::ModuleString& derived,
 {
     geom::InterpretOptions bounds_only = interpret_options(model, options);
     bounds_only.bounds_only = true;
-    geom::Scene scene = geom::interpret(turtle_string(model, derived, options),
-                                        model.lsystem.symbols(), *model.view, bounds_only);
+    // the derived string itself where the turtle reads it unchanged (no copy of it)
+    geom::Scene scene =
+        turtle_reads_derived_string(model, options)
+            ? geom::interpret(derived, model.lsystem.symbols(), *model.view, bounds_only)
+            : geom::interpret(turtle_string(model, derived, options), model.lsystem.symbols(),
+                              *model.view, bounds_only);
     geom::drop_unrenderable(scene);  // its check of the view volume's range
     return box_wins ? scene.view.box.value_or(scene.bounds) : scene.bounds;
 }

@@ -18,9 +18,12 @@ namespace {
 /// to max_homomorphism_depth).
 constexpr long long max_depth_setting = 1'000'000;
 
-std::size_t predicted(std::size_t size, double growth)
+/// The size a string of `size` reaches after a step that grows it by `growth`: a double,
+/// compared with the memory budget before it becomes a size (converting a double past
+/// SIZE_MAX is undefined)
+double predicted(std::size_t size, double growth)
 {
-    return static_cast<std::size_t>(static_cast<double>(size) * growth * 1.01) + 64;
+    return static_cast<double>(size) * growth * 1.01 + 64;
 }
 
 double growth(std::size_t before, std::size_t after)
@@ -38,6 +41,9 @@ int symbol_or_none(const SymbolTable& symbols, std::string_view name)
 Deriver::Deriver(const Program& program, DeriveLimits limits)
     : m_program(program), m_limits(limits)
 {
+    // module indices and parameter offsets are kept in 32 bits (no_parent is the largest)
+    m_limits.max_modules = std::min<std::size_t>(m_limits.max_modules, 0xfffffffeu);
+    m_limits.max_params = std::min<std::size_t>(m_limits.max_params, 0xffffffffu);
     const SymbolTable& symbols = program.symbols;
     m_bracket_open = symbol_or_none(symbols, "[");
     m_bracket_close = symbol_or_none(symbols, "]");
@@ -100,7 +106,7 @@ Deriver::Deriver(const Program& program, DeriveLimits limits)
     } catch (const EvaluationError& e) {
         fail(e);
     } catch (const std::bad_alloc&) {
-        out_of_memory(m_string.memory_bytes(), m_string);
+        system_out_of_memory(m_string.memory_bytes(), m_string);
     }
 }
 
@@ -225,7 +231,7 @@ void Deriver::step()
         fail(e);
     } catch (const std::bad_alloc&) {
         // the budget is checked as the string grows; this is the system running out first
-        out_of_memory(m_string.memory_bytes() + m_next.memory_bytes(), m_next);
+        system_out_of_memory(m_string.memory_bytes() + m_next.memory_bytes(), m_next);
     }
 }
 
@@ -238,12 +244,12 @@ void Deriver::step_located()
     // Reserve what the last step's growth predicts, so the new string is not
     // reallocated (and briefly held twice) while it is built
     // (not past the memory budget: the prediction may be wrong, the budget is not)
-    std::size_t modules_ahead = predicted(m_string.size(), m_module_growth);
-    std::size_t params_ahead = predicted(m_string.param_total(), m_param_growth);
-    if (static_cast<double>(modules_ahead) * 3 + static_cast<double>(params_ahead) * 4 +
-            static_cast<double>(m_string.memory_bytes()) <
+    double modules_ahead = predicted(m_string.size(), m_module_growth);
+    double params_ahead = predicted(m_string.param_total(), m_param_growth);
+    if (modules_ahead * 3 + params_ahead * 4 + static_cast<double>(m_string.memory_bytes()) <
         static_cast<double>(m_limits.max_memory_bytes))
-        m_next.reserve(modules_ahead, params_ahead);
+        m_next.reserve(static_cast<std::size_t>(modules_ahead),
+                       static_cast<std::size_t>(params_ahead));
     std::size_t modules = m_string.size(), params = m_string.param_total();
     rewrite(m_indexed, m_next, false);
     compose_lineage(true);
@@ -496,6 +502,10 @@ void Deriver::check_size(const ModuleString& s) const
                     "the string grew past " + std::to_string(m_limits.max_modules) +
                         " modules in " + phase() +
                         "; reduce the derivation length or raise the limit");
+    if (s.param_total() > m_limits.max_params)
+        throw Error(FileLoc{m_program.file_name, 0, 0},
+                    "the string grew past " + std::to_string(m_limits.max_params) +
+                        " parameter values in " + phase() + "; reduce the derivation length");
     // What a step holds at once: the string it builds from, its context index and the
     // string being built, at its next peak (when a full array grows, its old block and
     // the new one, a quarter larger, are held at once)
@@ -522,6 +532,18 @@ void Deriver::out_of_memory(std::size_t bytes, const ModuleString& s) const
                     "has " + std::to_string(s.size()) + " modules with " +
                     std::to_string(s.param_total()) +
                     " parameters so far; reduce the derivation length or raise --max-memory");
+}
+
+void Deriver::system_out_of_memory(std::size_t bytes, const ModuleString& s) const
+{
+    // Within the budget (or it would have been reported as such): the system refused.
+    throw Error(FileLoc{m_program.file_name, 0, 0},
+                "the system refused memory in " + phase() + " with " + byte_size_text(bytes) +
+                    " held by the strings, within the memory budget of " +
+                    byte_size_text(m_limits.max_memory_bytes) + " (--max-memory); the string " +
+                    "has " + std::to_string(s.size()) + " modules with " +
+                    std::to_string(s.param_total()) +
+                    " parameters so far; reduce the derivation length or --max-memory");
 }
 
 long long Deriver::setting(const Code& code, const FileLoc& loc, const std::string& what,
@@ -776,7 +798,7 @@ void Deriver::apply_homomorphism(const ModuleString& in, ModuleString& out,
         m_keep_objects = m_in_homomorphism = false;
         fail(e);
     } catch (const std::bad_alloc&) {
-        out_of_memory(in.memory_bytes() + out.memory_bytes(), out);
+        system_out_of_memory(in.memory_bytes() + out.memory_bytes(), out);
     }
     m_keep_objects = m_in_homomorphism = false;
     m_source = nullptr;

@@ -16,6 +16,9 @@ namespace cambium::lsys {
 
 struct DeriveLimits {
     std::size_t max_modules = 100'000'000;  ///< string growth limit
+    /// Parameter values the string may hold: positions in it (the context index, the
+    /// query pass's links) are 32-bit, so larger values are lowered to 2^32 - 1
+    std::size_t max_params = 0xffffffffu;
     /// What the string being built and the one it is built from may take together
     /// (their modules and parameters, as allocated)
     std::uint64_t max_memory_bytes = default_max_memory_bytes();
@@ -204,6 +207,8 @@ private:
     void decompose();
     void check_size(const ModuleString& s) const;
     [[noreturn]] void out_of_memory(std::size_t bytes, const ModuleString& building) const;
+    /// std::bad_alloc within the budget: the system refused the memory
+    [[noreturn]] void system_out_of_memory(std::size_t bytes, const ModuleString& building) const;
     std::string phase() const;
     long long setting(const Code& code, const FileLoc& loc, const std::string& what,
                       long long lo, long long hi);

@@ -255,7 +255,7 @@ void LSystem::run_query(Deriver& deriver) const
     ModuleString expanded;
     std::vector<ParamLink> links;
     deriver.apply_homomorphism(s, expanded, &links);
-    ModuleString joined = join_at_commands(expanded);
+    ModuleString joined = joined_at_commands(std::move(expanded));
     std::size_t total = joined.param_total();
     m_options.query(joined);
     if (joined.param_total() != total)
@@ -342,6 +342,13 @@ std::uint32_t LSystem::run_fragment_pass(Deriver& deriver, std::uint32_t first_t
     return static_cast<std::uint32_t>(reached.size());
 }
 
+ModuleString LSystem::joined_at_commands(ModuleString s) const
+{
+    if (m_program->split_commands.empty())
+        return s;  // moved out, not copied
+    return join_at_commands(s);
+}
+
 ModuleString LSystem::join_at_commands(const ModuleString& s) const
 {
     const auto& commands = m_program->split_commands;
@@ -390,7 +397,7 @@ ModuleString LSystem::interpretation_string(const ModuleString& derived,
         deriver.set_runtime(*m_last_runtime);
     ModuleString out;
     deriver.apply_homomorphism(derived, out, nullptr, objects == ObjectHandling::keep);
-    return join_at_commands(out);
+    return joined_at_commands(std::move(out));
 }
 
 bool LSystem::is_object_symbol(int symbol) const

@@ -183,6 +183,9 @@ private:
     /// turtles saved (numbered from `first_turtle`).
     std::uint32_t run_fragment_pass(Deriver& deriver, std::uint32_t first_turtle) const;
     ModuleString join_at_commands(const ModuleString& s) const;
+    /// join_at_commands of a string the caller gives up: the string itself when there is
+    /// no split command (no copy)
+    ModuleString joined_at_commands(ModuleString s) const;
 
     std::unique_ptr<Program> m_program;
     LoadOptions m_options;

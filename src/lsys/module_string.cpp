@@ -41,12 +41,16 @@ namespace detail {
 namespace {
 
 #ifdef __linux__
-/// Blocks from this size on are mapped directly, in whole huge pages.
-constexpr std::size_t huge_page_bytes = std::size_t{2} << 20;
+/// Blocks from this size on are mapped directly: growing them remaps their pages. (Not
+/// asked for transparent huge pages: on a virtual machine that hands freed memory back
+/// to its host, a fresh 2 MiB page cost up to 2 ms to fault in, several times the 4 KiB
+/// pages it replaces, and its zeroed tail added to the peak; docs/benchmarks.md.)
+constexpr std::size_t mapped_block_bytes = std::size_t{256} << 10;
+constexpr std::size_t page_bytes = 4096;  // mmap rounds up to the real page size
 
 std::size_t mapped_size(std::size_t bytes)
 {
-    return (bytes + huge_page_bytes - 1) & ~(huge_page_bytes - 1);
+    return (bytes + page_bytes - 1) & ~(page_bytes - 1);
 }
 #endif
 
@@ -55,11 +59,13 @@ std::size_t mapped_size(std::size_t bytes)
 std::size_t grow_block(void*& block, std::size_t old_bytes, std::size_t used,
                        std::size_t new_bytes)
 {
+    if (new_bytes > max_block_bytes)
+        throw std::bad_alloc();
 #ifdef __linux__
-    if (new_bytes >= huge_page_bytes) {
+    if (new_bytes >= mapped_block_bytes) {
         std::size_t size = mapped_size(new_bytes);
         void* grown = nullptr;
-        if (block && old_bytes >= huge_page_bytes) {
+        if (block && old_bytes >= mapped_block_bytes) {
             // The pages move with the mapping: nothing is copied or faulted in again.
             grown = ::mremap(block, old_bytes, size, MREMAP_MAYMOVE);
             if (grown == MAP_FAILED)
@@ -74,7 +80,6 @@ std::size_t grow_block(void*& block, std::size_t old_bytes, std::size_t used,
                 std::free(block);
             }
         }
-        ::madvise(grown, size, MADV_HUGEPAGE);  // a hint: failure changes nothing
         block = grown;
         return size;
     }
@@ -91,7 +96,7 @@ std::size_t grow_block(void*& block, std::size_t old_bytes, std::size_t used,
 void free_block(void* block, std::size_t bytes)
 {
 #ifdef __linux__
-    if (bytes >= huge_page_bytes) {
+    if (bytes >= mapped_block_bytes) {
         ::munmap(block, bytes);
         return;
     }

@@ -3,8 +3,10 @@
 #pragma once
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <new>
 #include <span>
 #include <string>
 #include <string_view>
@@ -35,14 +37,17 @@ private:
 
 namespace detail {
 
-/// Blocks for PodArray: small ones from malloc; large ones (Linux) mapped directly in
-/// whole huge pages, so that growing one remaps its pages instead of copying them, and
-/// asked for transparent huge pages (a derivation touches hundreds of megabytes; 4 KiB
-/// page faults were a third of its time). Replaces `block` (of `old_bytes`, `used` of
-/// them kept) by one of at least `new_bytes` and returns its size.
+/// Blocks for PodArray: small ones from malloc; from mapped_block_bytes on (Linux)
+/// mapped directly, so that growing one moves its pages with mremap instead of copying
+/// them into fresh pages that fault in again. Replaces `block` (`old_bytes` long, as the
+/// last call returned; `used` of them kept) by one of at least `new_bytes` and returns
+/// its size. Throws std::bad_alloc, leaving `block` as it was, when the system refuses
+/// or `new_bytes` is more than max_block_bytes.
 std::size_t grow_block(void*& block, std::size_t old_bytes, std::size_t used,
                        std::size_t new_bytes);
 void free_block(void* block, std::size_t bytes);
+/// The largest block grow_block gives (so that no size computation on one overflows).
+inline constexpr std::size_t max_block_bytes = std::size_t{1} << (sizeof(std::size_t) * 8 - 2);
 
 /// A growable array of trivially copyable values. Unlike std::vector, growing keeps the
 /// block's pages (realloc or mremap, no fresh copy to fault in) and clear() keeps them
@@ -50,6 +55,8 @@ void free_block(void* block, std::size_t bytes);
 template <class T>
 class PodArray {
     static_assert(std::is_trivially_copyable_v<T>);
+    // malloc's blocks are aligned for any standard type (mapped ones for a page)
+    static_assert(alignof(T) <= alignof(std::max_align_t));
 
 public:
     PodArray() = default;
@@ -57,7 +64,8 @@ public:
     PodArray(PodArray&& other) noexcept
         : m_data(std::exchange(other.m_data, nullptr)),
           m_size(std::exchange(other.m_size, 0)),
-          m_capacity(std::exchange(other.m_capacity, 0))
+          m_capacity(std::exchange(other.m_capacity, 0)),
+          m_bytes(std::exchange(other.m_bytes, 0))
     {
     }
     PodArray& operator=(const PodArray& other)
@@ -73,6 +81,7 @@ public:
             m_data = std::exchange(other.m_data, nullptr);
             m_size = std::exchange(other.m_size, 0);
             m_capacity = std::exchange(other.m_capacity, 0);
+            m_bytes = std::exchange(other.m_bytes, 0);
         }
         return *this;
     }
@@ -80,6 +89,8 @@ public:
 
     std::size_t size() const { return m_size; }
     std::size_t capacity() const { return m_capacity; }
+    /// The most values an array can hold (more throws std::bad_alloc).
+    static constexpr std::size_t max_size() { return max_block_bytes / sizeof(T); }
     bool empty() const { return m_size == 0; }
     T* data() { return m_data; }
     const T* data() const { return m_data; }
@@ -100,11 +111,13 @@ public:
     /// near the memory budget does not briefly need twice its size.
     void make_room(std::size_t extra)
     {
-        if (m_size + extra > m_capacity)
+        if (extra > m_capacity - m_size)
             regrow(grown_capacity(extra));
     }
     std::size_t grown_capacity(std::size_t extra) const
     {
+        if (extra > max_size() - m_size)
+            return max_size() + 1;  // regrow refuses it
         return std::max(m_size + extra, m_capacity + m_capacity / 4 + 64);
     }
     /// Appends without checking the room (after make_room).
@@ -144,23 +157,26 @@ public:
 private:
     void regrow(std::size_t capacity)
     {
+        if (capacity > max_size())  // capacity * sizeof(T) would not fit
+            throw std::bad_alloc();
         void* block = m_data;
-        std::size_t bytes =
-            grow_block(block, m_capacity * sizeof(T), m_size * sizeof(T), capacity * sizeof(T));
+        std::size_t bytes = grow_block(block, m_bytes, m_size * sizeof(T), capacity * sizeof(T));
         m_data = static_cast<T*>(block);
+        m_bytes = bytes;
         m_capacity = bytes / sizeof(T);
     }
     void release()
     {
         if (m_data)
-            free_block(m_data, m_capacity * sizeof(T));
+            free_block(m_data, m_bytes);
         m_data = nullptr;
-        m_size = m_capacity = 0;
+        m_size = m_capacity = m_bytes = 0;
     }
 
     T* m_data = nullptr;
     std::size_t m_size = 0;
     std::size_t m_capacity = 0;
+    std::size_t m_bytes = 0;  ///< the block's size as grow_block gave it
 };
 
 }  // namespace detail

@@ -784,17 +784,8 @@ TEST(Staging, GroundAndInbetweenOptionsAreChecked)
 TEST(Sequence, InbetweenFramesAreNumberedBetweenTheSteps)
 {
     fs::path dir = growing_plant(scratch("inbetween"));
-    // Under `make sanitize`, LeakSanitizer's own tracer crashes at this command's exit
-    // (signal 11 inside LSan, with ASan and UBSan silent): memory errors are still
-    // checked, leaks not. To be looked into (docs: issue note).
-    const char* asan = std::getenv("ASAN_OPTIONS");
-    const std::string asan_before = asan ? asan : "";
-    if (asan)
-        setenv("ASAN_OPTIONS", (asan_before + ":detect_leaks=0").c_str(), 1);
     Result r = run("-a -q -w 24 18 --spp 1 --inbetween 2 -o " + (dir / "f%02d.png").string() +
                    " -str " + (dir / "s%d.str").string() + " " + plant_files(dir));
-    if (asan)
-        setenv("ASAN_OPTIONS", asan_before.c_str(), 1);
     ASSERT_EQ(r.status, 0) << r.output;
     // steps 1, 2, 3 are frames 1, 4, 7; two in-betweens lead to each of the last two
     for (int n = 1; n <= 7; ++n)

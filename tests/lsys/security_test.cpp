@@ -2,10 +2,13 @@
 // Hostile L-system files (issue 11, docs/security.md): printf formats, file access
 // outside the model's folder, deep nesting, out-of-range numbers, the memory budget.
 // Each asserts the exact diagnostic: file, line, column and message.
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <climits>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -13,6 +16,7 @@
 #include <vector>
 
 #include "base/limits.h"
+#include "lsys/deriver.h"
 #include "lsys/expression.h"
 #include "test_util.h"
 
@@ -465,6 +469,73 @@ TEST(MemoryBudget, ModelsWithinTheBudgetDeriveAsBefore)
     options.max_memory_bytes = 1 << 20;
     LSystem ls = LSystem::from_source(doubling_model(6), "test.l", options);
     EXPECT_EQ(ls.derive().size(), 64u);
+}
+
+// Positions in a string are 32-bit: a limit on its parameter values (2^32 - 1 at most)
+// stops the derivation with a message, checked here with a small limit.
+TEST(MemoryBudget, ParameterValuesPastTheLimitStopTheDerivation)
+{
+    LSystem ls = LSystem::from_source(doubling_model(40), "test.l");
+    DeriveLimits limits;
+    limits.max_params = 10000;  // step 5 holds 32 x 200 values, step 6 64 x 200
+    Deriver deriver(ls.program(), limits);
+    std::string e;
+    try {
+        for (int step = 0; step < 40; ++step)
+            deriver.step();
+    } catch (const Error& error) {
+        e = error.what();
+    }
+    EXPECT_EQ(e, "test.l: error: the string grew past 10000 parameter values in step 6; "
+                 "reduce the derivation length");
+    DeriveLimits past;
+    past.max_params = std::size_t{1} << 40;  // lowered to what 32-bit positions hold
+    Deriver within(ls.program(), past);
+    for (int step = 0; step < 8; ++step)
+        within.step();
+    EXPECT_EQ(within.string().param_total(), std::size_t{200} << 8);
+}
+
+// The system refusing memory within the budget (here an address-space limit makes
+// mmap and mremap fail) is an error naming the file and the step, and it does not claim
+// that the budget was exceeded.
+TEST(MemoryBudget, MemoryTheSystemRefusesIsReportedAsSuch)
+{
+#if defined(__SANITIZE_ADDRESS__)
+    GTEST_SKIP() << "AddressSanitizer reserves its shadow memory past any address-space limit";
+#else
+    std::fflush(nullptr);
+    pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+        // the child: 48 MiB more address space than it has now, a budget far above that
+        long pages = 0;
+        if (std::FILE* statm = std::fopen("/proc/self/statm", "r")) {
+            if (std::fscanf(statm, "%ld", &pages) != 1)
+                pages = 0;
+            std::fclose(statm);
+        }
+        rlimit limit{};
+        limit.rlim_cur = limit.rlim_max =
+            static_cast<rlim_t>(pages) * static_cast<rlim_t>(sysconf(_SC_PAGESIZE)) + (48u << 20);
+        if (pages == 0 || setrlimit(RLIMIT_AS, &limit) != 0)
+            _exit(3);
+        LoadOptions options;
+        options.max_memory_bytes = std::uint64_t{1} << 40;
+        std::string e = derive_error(doubling_model(40), "test.l", options);
+        bool named = e.rfind("test.l: error: the system refused memory in step ", 0) == 0;
+        bool honest = e.find("within the memory budget of 1.0 TiB (--max-memory)") !=
+                          std::string::npos &&
+                      e.find("more than the memory budget") == std::string::npos;
+        if (!named || !honest)
+            std::fprintf(stderr, "message: %s\n", e.c_str());
+        _exit(named && honest ? 0 : 1);
+    }
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFEXITED(status)) << "the child died of signal " << WTERMSIG(status);
+    EXPECT_EQ(WEXITSTATUS(status), 0) << "3: no address-space limit could be set";
+#endif
 }
 
 TEST(MemoryBudget, ByteSizesParseWithBinarySuffixes)
