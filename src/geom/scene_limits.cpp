@@ -2,6 +2,7 @@
 // The numbers a Scene may hold: what Embree's float BVH and rays can take.
 #include "geom/scene_limits.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -292,6 +293,62 @@ std::size_t geometry_bytes(const Geometry& g)
                         g.discs.back_material) +
            vector_bytes(m.positions, m.normals, m.uvs, m.triangles, m.material,
                         m.back_material, m.texture);
+}
+
+namespace {
+
+/// Shrinks `v` to its size plus room for `pad_bytes` more, value-initialised.
+template <class T>
+void fit(std::vector<T>& v, std::size_t pad_bytes = 0)
+{
+    std::size_t pad = (pad_bytes + sizeof(T) - 1) / sizeof(T);
+    if (v.empty()) {
+        std::vector<T>().swap(v);  // `v = {}` keeps the capacity
+        return;
+    }
+    if (v.capacity() == v.size() + pad)
+        return;
+    std::vector<T> fitted;
+    fitted.reserve(v.size() + pad);
+    fitted.assign(v.begin(), v.end());
+    fitted.resize(v.size() + pad);  // within the capacity: initialises the padding
+    fitted.resize(v.size());
+    v.swap(fitted);
+}
+
+}  // namespace
+
+void fit_mesh_buffers(TriangleMesh& mesh, bool textured_by_instances)
+{
+    bool untextured = std::all_of(mesh.texture.begin(), mesh.texture.end(),
+                                  [](std::int16_t t) { return t == no_texture; });
+    if (untextured)
+        mesh.texture = {};
+    bool zeros = std::all_of(mesh.uvs.begin(), mesh.uvs.end(),
+                             [](const Float2& uv) { return uv[0] == 0 && uv[1] == 0; });
+    if (zeros || (untextured && !textured_by_instances))
+        mesh.uvs = {};
+    fit(mesh.positions, embree_padding_bytes);
+    fit(mesh.triangles, embree_padding_bytes);
+    fit(mesh.normals);
+    fit(mesh.uvs);
+    fit(mesh.material);
+    fit(mesh.back_material);
+    fit(mesh.texture);
+    fit(mesh.hidden_edges);
+}
+
+void fit_scene_buffers(Scene& scene)
+{
+    fit_mesh_buffers(scene.geometry.mesh, false);
+    // An instance's texture falls on its prototype's untextured primitives.
+    std::vector<bool> textured(scene.prototypes.size(), false);
+    for (const Instance& i : scene.instances)
+        if (i.texture != no_texture && i.prototype < textured.size())
+            textured[i.prototype] = true;
+    for (std::size_t p = 0; p < scene.prototypes.size(); ++p)
+        fit_mesh_buffers(scene.prototypes[p].geometry.mesh, textured[p]);
+    fit(scene.instances);
 }
 
 std::size_t scene_buffer_bytes(const Scene& scene)

@@ -11,11 +11,13 @@
 #include <cmath>
 #include <cstring>
 #include <deque>
+#include <map>
 #include <limits>
 #include <mutex>
 #include <numbers>
 #include <span>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "base/diagnostics.h"
@@ -109,21 +111,35 @@ struct Mat3 {
     Vec3f operator*(const Vec3f& v) const { return c0 * v.x + c1 * v.y + c2 * v.z; }
 };
 
-/// An Instance's placement: its linear part, the inverse transpose for normals and the
-/// factor radii scale by (the cube root of the volume scale).
+/// What a hit on an instance reads of its Instance besides the transform: the prototype and
+/// the materials and texture that replace inherit_material and no_texture. Instances that
+/// agree share one (Embree user data of their instance geometry), so an instance costs
+/// Cambium nothing beside what Embree keeps of it (issue 15.3).
+struct InstanceStyle {
+    std::uint32_t prototype = 0;
+    std::uint16_t material = 0;
+    std::uint16_t back_material = 0;
+    std::int16_t texture = geom::no_texture;
+
+    auto key() const { return std::tuple(prototype, material, back_material, texture); }
+};
+
+/// An instance's placement, made at hit time from the transform Embree holds: its linear
+/// part, the inverse transpose for normals and the factor radii scale by (the cube root
+/// of the volume scale).
 struct Placement {
-    const geom::Instance* instance = nullptr;
+    const InstanceStyle* style = nullptr;
     std::uint32_t index = PrimId::none;  ///< in Scene::instances
     Mat3 linear, normals;
     float radius_scale = 1;
     float largest_scale = 1;  ///< the most the linear part stretches a coordinate (inf-norm)
 };
 
-Placement make_placement(const geom::Instance& inst, std::uint32_t index)
+/// `m`: the 3x4 column-major transform (as geom::Instance::transform).
+Placement make_placement(const float* m, const InstanceStyle* style, std::uint32_t index)
 {
-    const auto& m = inst.transform;
     Placement p;
-    p.instance = &inst;
+    p.style = style;
     p.index = index;
     p.linear = {{m[0], m[1], m[2]}, {m[3], m[4], m[5]}, {m[6], m[7], m[8]}};
     const Vec3f &a = p.linear.c0, &b = p.linear.c1, &c = p.linear.c2;
@@ -539,8 +555,18 @@ RTCGeometry build_triangles(RTCDevice device, const GeometrySource& part)
                 throw Error("scene: triangle vertex " + std::to_string(i) + " of " +
                             std::to_string(m.positions.size()));
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    copy_buffer(g, RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3, m.positions);
-    copy_buffer(g, RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT3, m.triangles);
+    // Read in place where the Scene left room for Embree's 16-byte loads past the last
+    // element (geom::fit_mesh_buffers), else copied.
+    if (geom::padded_for_embree(m.positions))
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                   m.positions.data(), 0, sizeof(geom::Float3), m.positions.size());
+    else
+        copy_buffer(g, RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3, m.positions);
+    if (geom::padded_for_embree(m.triangles))
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m.triangles.data(),
+                                   0, sizeof(m.triangles[0]), m.triangles.size());
+    else
+        copy_buffer(g, RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT3, m.triangles);
     return g;
 }
 
@@ -666,7 +692,13 @@ struct HitResolver {
     std::unique_ptr<const Camera> camera;  ///< pixel-width lines are drawn for its pixels
     std::vector<const GeometrySource*> top_parts;  ///< by top-level geometry id
     std::vector<std::vector<const GeometrySource*>> proto_parts;  ///< by prototype, geometry id
-    std::vector<Placement> placements;  ///< by top-level geometry id
+    RTCScene top = nullptr;  ///< the top-level scene: instances' transforms and styles
+    /// Instances are attached under consecutive geometry ids from first_instance_id, in
+    /// Scene::instances order (instance i at first_instance_id + i - first_instance_index;
+    /// unplaced ones leave their id unused). Line-end scenes' instances come before.
+    std::uint32_t first_instance_id = PrimId::none;
+    std::uint32_t first_instance_index = 0;
+    std::deque<InstanceStyle> styles;  ///< one per distinct style (stable addresses)
     /// The caps and the joints of the scene's own shaded lines live in two scenes of their
     /// own, each placed once, untransformed, by a top-level instance (none: no such scene).
     /// Embree's leaves hold primitives of one geometry only: caps and joints beside every
@@ -678,11 +710,31 @@ struct HitResolver {
     };
     std::array<PlacedEnds, 2> line_end_scenes;  ///< caps, joints
 
-    const Placement* placement(std::uint32_t inst_id) const
+    bool placed_instance(std::uint32_t inst_id) const
     {
-        return inst_id < placements.size() && placements[inst_id].instance
-                   ? &placements[inst_id]
-                   : nullptr;
+        return inst_id != PrimId::none && first_instance_id != PrimId::none &&
+               inst_id >= first_instance_id;
+    }
+    /// The style of the instance with this top-level geometry id (nullptr: not an instance
+    /// of a prototype). Read during traversal by the filters, so no transform is made.
+    const InstanceStyle* style(std::uint32_t inst_id) const
+    {
+        if (!placed_instance(inst_id))
+            return nullptr;
+        return static_cast<const InstanceStyle*>(
+            rtcGetGeometryUserData(rtcGetGeometry(top, inst_id)));
+    }
+    /// The placement of that instance, from the transform Embree keeps of it.
+    std::optional<Placement> placement(std::uint32_t inst_id) const
+    {
+        if (!placed_instance(inst_id))
+            return std::nullopt;
+        RTCGeometry g = rtcGetGeometry(top, inst_id);
+        std::array<float, 12> transform;
+        rtcGetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, transform.data());
+        return make_placement(transform.data(),
+                              static_cast<const InstanceStyle*>(rtcGetGeometryUserData(g)),
+                              inst_id - first_instance_id + first_instance_index);
     }
     const GeometrySource* part(std::uint32_t inst_id, std::uint32_t geom_id) const
     {
@@ -690,11 +742,11 @@ struct HitResolver {
             for (const PlacedEnds& e : line_end_scenes)
                 if (inst_id == e.instance)
                     return e.parts[geom_id];
-        if (const Placement* p = placement(inst_id))
-            return proto_parts[p->instance->prototype][geom_id];
+        if (const InstanceStyle* st = style(inst_id))
+            return proto_parts[st->prototype][geom_id];
         return top_parts[geom_id];
     }
-    int texture_of(const GeometrySource& part, std::uint32_t prim, const Placement* p) const;
+    int texture_of(const GeometrySource& part, std::uint32_t prim, const InstanceStyle* p) const;
 };
 
 }  // namespace
@@ -792,7 +844,7 @@ void alpha_filter(const RTCFilterFunctionNArguments* args)
         if (args->valid[i] == 0)
             continue;
         std::uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
-        const Placement* p = owner.placement(RTCHitN_instID(args->hit, args->N, i, 0));
+        const InstanceStyle* p = owner.style(RTCHitN_instID(args->hit, args->N, i, 0));
         int texture = owner.texture_of(*part, prim, p);
         if (!owner.textures->has_alpha(texture))
             continue;
@@ -824,7 +876,7 @@ struct HitMaterials {
 };
 
 HitMaterials materials_at(const GeometrySource& part, std::uint32_t prim, bool back,
-                          const Placement* placement, float u)
+                          const InstanceStyle* style, float u)
 {
     std::uint32_t index = part.attribute_index(prim);
     std::uint16_t material = at_or(*part.material, index, std::uint16_t{0});
@@ -833,9 +885,7 @@ HitMaterials materials_at(const GeometrySource& part, std::uint32_t prim, bool b
     auto resolve = [&](std::uint16_t mat) -> std::uint16_t {
         if (mat != geom::inherit_material)
             return mat;
-        return placement ? (back ? placement->instance->back_material
-                                 : placement->instance->material)
-                         : 0;
+        return style ? (back ? style->back_material : style->material) : 0;
     };
     HitMaterials m;
     m.material = resolve(material);
@@ -898,7 +948,7 @@ void opacity_filter(const RTCFilterFunctionNArguments* args)
             args->valid[i] = 0;
             continue;
         }
-        const Placement* p = ctx->resolver->placement(c.inst);
+        const InstanceStyle* p = ctx->resolver->style(c.inst);
         const GeometrySource& part = *ctx->resolver->part(c.inst, c.geom);
         float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
         // The ray and Ng are both in the hit primitive's own space here.
@@ -921,14 +971,14 @@ void opacity_filter(const RTCFilterFunctionNArguments* args)
 }
 
 int HitResolver::texture_of(const GeometrySource& part, std::uint32_t prim,
-                            const Placement* p) const
+                            const InstanceStyle* p) const
 {
     if (!part.texture)
         return geom::no_texture;
     std::int16_t t = at_or(*part.texture, part.attribute_index(prim), geom::no_texture);
     // A prototype's untextured primitives take their instance's texture.
     if (t == geom::no_texture && p)
-        t = p->instance->texture;
+        t = p->texture;
     return t;
 }
 
@@ -982,7 +1032,9 @@ std::size_t bytes_shared_with_embree(const GeometrySource& part)
                flags(g.curves.flags, g.curves.segments.size());
     case Shape::sphere: return g.spheres.centres.size() * sizeof(Key);
     case Shape::disc: return g.discs.centres.size() * sizeof(Key);  // normals: copied
-    case Shape::triangle: return 0;                                 // copied
+    case Shape::triangle:  // read in place when padded (build_triangles), else copied
+        return (geom::padded_for_embree(g.mesh.positions) ? g.mesh.positions.size() * sizeof(geom::Float3) : 0) +
+               (geom::padded_for_embree(g.mesh.triangles) ? g.mesh.triangles.size() * sizeof(g.mesh.triangles[0]) : 0);
     case Shape::cap: return part.ends->caps.size() * sizeof(Key);
     case Shape::joint: return part.ends->joints.size() * sizeof(Key);
     }
@@ -1126,23 +1178,32 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
                        !scene.line_radius_in_pixels);
         rtcCommitScene(m.prototype_scenes[i]);
     }
+    // Each instance keeps nothing here: Embree holds its transform, and its user data
+    // points at the style it shares with the instances that agree with it.
+    std::map<decltype(InstanceStyle{}.key()), const InstanceStyle*> style_of;
+    m.top = m.scene;
     for (std::uint32_t index = 0; index < scene.instances.size(); ++index) {
         const geom::Instance& inst = scene.instances[index];
         RTCScene proto = m.prototype_scenes[inst.prototype];
         if (!proto)
             continue;
+        InstanceStyle style{inst.prototype, inst.material, inst.back_material, inst.texture};
+        auto [found, added] = style_of.emplace(style.key(), nullptr);
+        if (added)
+            found->second = &m.styles.emplace_back(style);
         RTCGeometry g = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_INSTANCE);
         rtcSetGeometryInstancedScene(g, proto);
         rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, inst.transform.data());
+        rtcSetGeometryUserData(g, const_cast<InstanceStyle*>(found->second));
         rtcCommitGeometry(g);
-        unsigned id = rtcAttachGeometry(m.scene, g);
+        if (m.first_instance_id == PrimId::none) {
+            m.first_instance_id = rtcAttachGeometry(m.scene, g);
+            m.first_instance_index = index;
+        } else {
+            rtcAttachGeometryByID(m.scene, g, m.first_instance_id + (index - m.first_instance_index));
+        }
         rtcReleaseGeometry(g);
-        if (m.placements.size() <= id)
-            m.placements.resize(id + 1);
-        m.placements[id] = make_placement(inst, index);
     }
-    if (m.top_parts.size() < m.placements.size())
-        m.top_parts.resize(m.placements.size(), nullptr);
     rtcCommitScene(m.scene);
     m.check("building the Embree scene");
     m.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -1183,7 +1244,7 @@ std::size_t capacity_bytes(const std::vector<T>& v)
 std::uint64_t EmbreeScene::own_bytes() const
 {
     const Impl& m = *m_impl;
-    std::size_t bytes = capacity_bytes(m.world_keys) + capacity_bytes(m.placements) +
+    std::size_t bytes = capacity_bytes(m.world_keys) + m.styles.size() * sizeof(InstanceStyle) +
                         m.parts.size() * sizeof(GeometrySource);
     for (const LineEnds& e : m.line_ends)
         bytes += capacity_bytes(e.caps) + capacity_bytes(e.cap_normals) +
@@ -1253,9 +1314,10 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     h.geom_id = rh.hit.geomID;
     h.prim_id = rh.hit.primID;
     h.inst_id = rh.hit.instID[0];
-    const Placement* placement = m.placement(h.inst_id);
+    const std::optional<Placement> placement = m.placement(h.inst_id);
     if (placement)
         h.instance = placement->index;
+    const InstanceStyle* style = placement ? placement->style : nullptr;
     const GeometrySource& part = *m.part(h.inst_id, h.geom_id);
     h.shape = part.shape;
     h.unlit = part.unlit;
@@ -1282,11 +1344,11 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     // A shading normal turned away from the ray (or absent) gives way to the true one.
     h.normal = dot(shading, dir) < 0 ? shading : geometric;
 
-    HitMaterials materials = materials_at(part, h.prim_id, h.back, placement, rh.hit.u);
+    HitMaterials materials = materials_at(part, h.prim_id, h.back, style, rh.hit.u);
     h.material = materials.material;
     h.end_material = materials.end_material;
     h.material_blend = materials.blend;
-    int texture = m.texture_of(part, h.prim_id, placement);
+    int texture = m.texture_of(part, h.prim_id, style);
     h.texture = static_cast<std::int16_t>(texture);
     if (texture != geom::no_texture) {
         auto st = shape.texture_coords(part, h.prim_id, rh.hit.u, rh.hit.v, ng);
