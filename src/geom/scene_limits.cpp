@@ -295,29 +295,6 @@ std::size_t geometry_bytes(const Geometry& g)
                         m.back_material, m.texture);
 }
 
-namespace {
-
-/// Shrinks `v` to its size plus room for `pad_bytes` more, value-initialised.
-template <class T>
-void fit(std::vector<T>& v, std::size_t pad_bytes = 0)
-{
-    std::size_t pad = (pad_bytes + sizeof(T) - 1) / sizeof(T);
-    if (v.empty()) {
-        std::vector<T>().swap(v);  // `v = {}` keeps the capacity
-        return;
-    }
-    if (v.capacity() == v.size() + pad)
-        return;
-    std::vector<T> fitted;
-    fitted.reserve(v.size() + pad);
-    fitted.assign(v.begin(), v.end());
-    fitted.resize(v.size() + pad);  // within the capacity: initialises the padding
-    fitted.resize(v.size());
-    v.swap(fitted);
-}
-
-}  // namespace
-
 void fit_mesh_buffers(TriangleMesh& mesh, bool textured_by_instances)
 {
     bool untextured = std::all_of(mesh.texture.begin(), mesh.texture.end(),
@@ -328,14 +305,14 @@ void fit_mesh_buffers(TriangleMesh& mesh, bool textured_by_instances)
                              [](const Float2& uv) { return uv[0] == 0 && uv[1] == 0; });
     if (zeros || (untextured && !textured_by_instances))
         mesh.uvs = {};
-    fit(mesh.positions, embree_padding_bytes);
-    fit(mesh.triangles, embree_padding_bytes);
-    fit(mesh.normals);
-    fit(mesh.uvs);
-    fit(mesh.material);
-    fit(mesh.back_material);
-    fit(mesh.texture);
-    fit(mesh.hidden_edges);
+    fit_buffer(mesh.positions, embree_padding_bytes);
+    fit_buffer(mesh.triangles, embree_padding_bytes);
+    fit_buffer(mesh.normals);
+    fit_buffer(mesh.uvs);
+    fit_buffer(mesh.material);
+    fit_buffer(mesh.back_material);
+    fit_buffer(mesh.texture);
+    fit_buffer(mesh.hidden_edges);
 }
 
 void fit_scene_buffers(Scene& scene)
@@ -348,7 +325,7 @@ void fit_scene_buffers(Scene& scene)
             textured[i.prototype] = true;
     for (std::size_t p = 0; p < scene.prototypes.size(); ++p)
         fit_mesh_buffers(scene.prototypes[p].geometry.mesh, textured[p]);
-    fit(scene.instances);
+    fit_buffer(scene.instances);
 }
 
 std::size_t scene_buffer_bytes(const Scene& scene)

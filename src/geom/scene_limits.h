@@ -75,6 +75,26 @@ bool padded_for_embree(const std::vector<T>& v)
     return !v.empty() && (v.capacity() - v.size()) * sizeof(T) >= embree_padding_bytes;
 }
 
+/// Shrinks `v` to its size, leaving room for `pad_bytes` more (value-initialised), such as
+/// embree_padding_bytes for a buffer Embree reads in place.
+template <class T>
+void fit_buffer(std::vector<T>& v, std::size_t pad_bytes = 0)
+{
+    std::size_t pad = (pad_bytes + sizeof(T) - 1) / sizeof(T);
+    if (v.empty()) {
+        std::vector<T>().swap(v);  // `v = {}` keeps the capacity
+        return;
+    }
+    if (v.capacity() == v.size() + pad)
+        return;
+    std::vector<T> fitted;
+    fitted.reserve(v.size() + pad);
+    fitted.assign(v.begin(), v.end());
+    fitted.resize(v.size() + pad);  // within the capacity: initialises the padding
+    fitted.resize(v.size());
+    v.swap(fitted);
+}
+
 /// Gives a mesh's buffers back their growth slack, leaving positions and triangles padded
 /// for Embree to read in place (issue 15.3: a leaf's vertex no longer lives both in the
 /// Scene and in Embree), and drops what no hit reads: texture indices when none is set,

@@ -392,7 +392,12 @@ RTCGeometry build_caps(RTCDevice device, const GeometrySource& part)
 {
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
     share_keys(g, RTC_BUFFER_TYPE_VERTEX, part.ends->caps.data(), part.ends->caps.size());
-    copy_buffer(g, RTC_BUFFER_TYPE_NORMAL, RTC_FORMAT_FLOAT3, part.ends->cap_normals);
+    const std::vector<geom::Float3>& normals = part.ends->cap_normals;
+    if (geom::padded_for_embree(normals))  // line_ends() leaves the room
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_NORMAL, 0, RTC_FORMAT_FLOAT3, normals.data(), 0,
+                                   sizeof(geom::Float3), normals.size());
+    else
+        copy_buffer(g, RTC_BUFFER_TYPE_NORMAL, RTC_FORMAT_FLOAT3, normals);
     return g;
 }
 
@@ -1035,7 +1040,9 @@ std::size_t bytes_shared_with_embree(const GeometrySource& part)
     case Shape::triangle:  // read in place when padded (build_triangles), else copied
         return (geom::padded_for_embree(g.mesh.positions) ? g.mesh.positions.size() * sizeof(geom::Float3) : 0) +
                (geom::padded_for_embree(g.mesh.triangles) ? g.mesh.triangles.size() * sizeof(g.mesh.triangles[0]) : 0);
-    case Shape::cap: return part.ends->caps.size() * sizeof(Key);
+    case Shape::cap:
+        return part.ends->caps.size() * sizeof(Key) +
+               (geom::padded_for_embree(part.ends->cap_normals) ? part.ends->cap_normals.size() * sizeof(geom::Float3) : 0);
     case Shape::joint: return part.ends->joints.size() * sizeof(Key);
     }
     return 0;

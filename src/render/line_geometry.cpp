@@ -8,6 +8,7 @@
 #include <string>
 
 #include "base/diagnostics.h"
+#include "geom/scene_limits.h"
 #include "render/pixel_lines.h"
 #include "render/vecf.h"
 
@@ -118,7 +119,7 @@ LineEnds line_ends(const geom::LinearCurves& l, const geom::Float4* keys)
     }
     // Kept while the scene is drawn: without their growth slack (a third of tree10m's).
     e.caps.shrink_to_fit();
-    e.cap_normals.shrink_to_fit();
+    geom::fit_buffer(e.cap_normals, geom::embree_padding_bytes);  // Embree reads it in place
     e.cap_segment.shrink_to_fit();
     e.cap_at_end.shrink_to_fit();
     e.joints.shrink_to_fit();
