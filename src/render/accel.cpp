@@ -3,6 +3,9 @@
 #include "render/accel.h"
 
 #include <embree3/rtcore.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include <algorithm>
 #include <array>
@@ -153,6 +156,17 @@ Placement make_placement(const float* m, const InstanceStyle* style, std::uint32
         largest = std::fmax(largest, std::fabs(m[row]) + std::fabs(m[3 + row]) + std::fabs(m[6 + row]));
     p.largest_scale = largest;
     return p;
+}
+
+/// The bytes the C heap has handed out and not taken back, in every arena (0 without glibc).
+std::size_t heap_in_use()
+{
+#if defined(__GLIBC__)
+    struct mallinfo2 info = mallinfo2();
+    return info.uordblks + info.hblkhd;
+#else
+    return 0;
+#endif
 }
 
 /// The Hermite basis at u: weights of p0, t0, p1, t1.
@@ -777,6 +791,7 @@ struct EmbreeScene::Impl : HitResolver {
     RayCounter rays;
     double build_seconds = 0;
     std::size_t embree_shared_bytes = 0;  ///< shared_bytes() of every part built
+    std::size_t embree_unmonitored_bytes = 0;  ///< embree_unmonitored_bytes()
     /// Embree's own allocations, from its memory monitor (called from any thread).
     std::atomic<std::int64_t> embree_bytes{0}, embree_peak_bytes{0};
 
@@ -1189,6 +1204,7 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
     // points at the style it shares with the instances that agree with it.
     std::map<decltype(InstanceStyle{}.key()), const InstanceStyle*> style_of;
     m.top = m.scene;
+    const std::size_t heap_before = heap_in_use();
     for (std::uint32_t index = 0; index < scene.instances.size(); ++index) {
         const geom::Instance& inst = scene.instances[index];
         RTCScene proto = m.prototype_scenes[inst.prototype];
@@ -1211,6 +1227,9 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
         }
         rtcReleaseGeometry(g);
     }
+    // Embree's memory monitor sees its buffers and BVHs, not its instance objects: they are
+    // most of the heap this loop takes (the styles it adds are a few).
+    m.embree_unmonitored_bytes = std::max(heap_in_use(), heap_before) - heap_before;
     rtcCommitScene(m.scene);
     m.check("building the Embree scene");
     m.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -1237,6 +1256,11 @@ std::uint64_t EmbreeScene::embree_peak_bytes() const
 }
 
 std::uint64_t EmbreeScene::shared_bytes() const { return m_impl->embree_shared_bytes; }
+
+std::uint64_t EmbreeScene::embree_unmonitored_bytes() const
+{
+    return m_impl->embree_unmonitored_bytes;
+}
 
 namespace {
 
