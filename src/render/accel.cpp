@@ -1036,6 +1036,13 @@ void geometry_filter(const RTCFilterFunctionNArguments* args)
 
 namespace {
 
+/// The bytes of `v` if Embree reads it in place (padded for its loads), else 0.
+template <class T>
+std::size_t padded_bytes(const std::vector<T>& v)
+{
+    return geom::padded_for_embree(v) ? v.size() * sizeof(T) : 0;
+}
+
 /// The bytes of the part's buffers that Embree reads in place (rtcSetSharedGeometryBuffer):
 /// part of what Embree needs for it, though Cambium holds them.
 std::size_t bytes_shared_with_embree(const GeometrySource& part)
@@ -1053,11 +1060,9 @@ std::size_t bytes_shared_with_embree(const GeometrySource& part)
     case Shape::sphere: return g.spheres.centres.size() * sizeof(Key);
     case Shape::disc: return g.discs.centres.size() * sizeof(Key);  // normals: copied
     case Shape::triangle:  // read in place when padded (build_triangles), else copied
-        return (geom::padded_for_embree(g.mesh.positions) ? g.mesh.positions.size() * sizeof(geom::Float3) : 0) +
-               (geom::padded_for_embree(g.mesh.triangles) ? g.mesh.triangles.size() * sizeof(g.mesh.triangles[0]) : 0);
+        return padded_bytes(g.mesh.positions) + padded_bytes(g.mesh.triangles);
     case Shape::cap:
-        return part.ends->caps.size() * sizeof(Key) +
-               (geom::padded_for_embree(part.ends->cap_normals) ? part.ends->cap_normals.size() * sizeof(geom::Float3) : 0);
+        return part.ends->caps.size() * sizeof(Key) + padded_bytes(part.ends->cap_normals);
     case Shape::joint: return part.ends->joints.size() * sizeof(Key);
     }
     return 0;
@@ -1068,10 +1073,11 @@ std::size_t bytes_shared_with_embree(const GeometrySource& part)
 void EmbreeScene::Impl::attach(RTCScene s, GeometrySource part,
                                std::vector<const GeometrySource*>& ids, bool alpha)
 {
-    RTCGeometry g = kind(part.shape).build(device, part);
+    const ShapeKind& shape = kind(part.shape);
+    RTCGeometry g = shape.build(device, part);
     embree_shared_bytes += bytes_shared_with_embree(part);
     part.owner = this;
-    part.skips_self = kind(part.shape).self_hits;
+    part.skips_self = shape.self_hits;
     part.pixel_line = part.shape == Shape::line && part.unlit;
     part.cut_out = textures && (alpha || part.pixel_line);
     parts.push_back(part);
