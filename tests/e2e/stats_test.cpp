@@ -197,8 +197,6 @@ TEST(Stats, SceneFileCountsPrototypesOnceAndPlacedCopiesPerInstance)
     expect_documented_keys(j);
     EXPECT_EQ(j["instances"], 3);
     EXPECT_EQ(j["prototypes"], 1);
-    // Embree's three instance objects (about 300 B each) are seen on the heap.
-    EXPECT_GT(j["memory_bytes"]["embree_unmonitored"].get<std::uint64_t>(), 3 * 100u);
     // The known plant once, and three placed copies of it.
     EXPECT_EQ(j["primitives"]["total"], 7);
     EXPECT_EQ(j["placed_primitives"]["total"], 21);
