@@ -131,7 +131,8 @@ public:
     std::uint64_t embree_peak_bytes() const;
     /// Embree's heap that its memory monitor does not report: its instance geometries (each
     /// an object, its transform and a slot in its scene's table, about 300 B), measured as
-    /// the heap's growth while they are made (glibc's mallinfo2; 0 where it is missing).
+    /// the heap's growth while they are made (glibc's mallinfo2; 0 where it is missing or,
+    /// under AddressSanitizer, empty).
     std::uint64_t embree_unmonitored_bytes() const;
     /// The bytes of the buffers Embree reads in place instead of copying (keys, segment
     /// indices, centres: the Scene's, or this object's own): part of what Embree needs.
