@@ -68,6 +68,8 @@ def table(stats, wall, cpu, target_first_pixel=None, target_peak=None):
         ("instances (prototypes)", f"{stats['instances']:,} ({stats['prototypes']:,})", None),
         ("primitives placed", f"{placed['total']:,}", None),
         ("Embree memory (peak)", f"{mib(m['embree'])} ({mib(m['embree_peak'])})", None),
+        ("&nbsp;&nbsp;and its instance geometries, unseen by its memory monitor",
+         mib(m.get('embree_unmonitored', 0)), None),
         ("Cambium memory: Scene buffers + renderer's (of it read by Embree in place)",
          f"{mib(m.get('scene_buffers', m['cambium']))} + {mib(m.get('render_buffers', 0))} "
          f"({mib(m.get('embree_shared', 0))})", None),
@@ -76,6 +78,8 @@ def table(stats, wall, cpu, target_first_pixel=None, target_peak=None):
          f"{per['embree']:.1f} / {per['cambium']:.1f} / {per['peak_process']:.1f}", None),
         ("memory per primitive ÷ what Embree needs, (Embree + Cambium) / (Embree + read in place)",
          f"{per['ratio_to_embree']:.2f}×", "< 1.2×"),
+        ("(the same, Embree's memory as its monitor reports it alone)",
+         f"{per.get('ratio_to_embree_monitor', per['ratio_to_embree']):.2f}×", None),
         ("(the earlier measure, (Embree + Cambium) / Embree's allocations)",
          f"{per.get('ratio_to_embree_allocations', 0):.2f}×", None),
         ("image, samples", f"{r['width']}×{r['height']}, {r['samples']:,} samples", None),

@@ -411,6 +411,7 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
     // Non-finite or huge numbers would abort inside Embree: dropped here with a warning.
     geom::drop_unrenderable(scene);
     release_unused_line_buffers(scene.geometry.lines);
+    geom::fit_scene_buffers(scene);
     return scene;
 }
 

@@ -26,6 +26,7 @@
 #include "base/subprocess.h"
 #include "geom/background_scene.h"
 #include "geom/placed_geometry.h"
+#include "geom/scene_limits.h"
 #include "render/framing.h"
 #include "render/render.h"
 
@@ -499,6 +500,7 @@ geom::Scene assemble_scene(const SceneFile& file, const Options& options,
         add_ground(out, *file.ground, SceneLimits{});
     out.view = scene_view(file, out.bounds);
     out.lights = scene_lights(file);
+    geom::fit_scene_buffers(out);  // Embree reads the meshes in place; no growth slack
 
     r.models_loaded = timing.models;
     r.derivations = timing.derivations;

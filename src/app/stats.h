@@ -71,6 +71,8 @@ struct RunStats {
     /// The renderer's buffers beside the Scene's (caps, joints, placements), and of all
     /// Cambium's buffers those Embree reads in place instead of copying.
     std::uint64_t render_buffer_bytes = 0, embree_shared_bytes = 0;
+    /// Embree's instance geometries, which its memory monitor does not report.
+    std::uint64_t embree_unmonitored_bytes = 0;
     std::uint64_t peak_process_bytes = 0;
 
     int width = 0, height = 0;

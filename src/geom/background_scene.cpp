@@ -673,7 +673,11 @@ void append_geometry(Geometry& into, const Geometry& from)
         auto base = static_cast<std::uint32_t>(a.positions.size());
         append(a.positions, b.positions);
         append(a.normals, b.normals);
-        append(a.uvs, b.uvs);
+        if (!a.uvs.empty() || !b.uvs.empty()) {  // either may have dropped all-zero uvs
+            fill_to(a.uvs, base, Float2{0, 0});
+            append(a.uvs, b.uvs);
+            fill_to(a.uvs, a.positions.size(), Float2{0, 0});
+        }
         for (const auto& t : b.triangles)
             a.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
         append(a.material, b.material);

@@ -92,9 +92,10 @@ struct Discs {
 };
 
 /// Triangles: polygons, patches, surfaces, non-circular contours, tsurfaces, background.
-/// normals and uvs are per vertex and always as long as positions (flat faces carry their
-/// face normal; untextured ones carry zeros as uv). The front of a triangle is the side
-/// its vertex normals point to (or, for a flat face, the side its winding a,b,c makes
+/// normals and uvs are per vertex and as long as positions (flat faces carry their face
+/// normal; untextured ones carry zeros as uv), except that uvs may be left empty, read as
+/// zeros, where no hit reads them (geom::fit_mesh_buffers). The front of a triangle is the
+/// side its vertex normals point to (or, for a flat face, the side its winding a,b,c makes
 /// counter-clockwise).
 struct TriangleMesh {
     std::vector<Float3> positions;

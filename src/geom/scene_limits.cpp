@@ -2,6 +2,7 @@
 // The numbers a Scene may hold: what Embree's float BVH and rays can take.
 #include "geom/scene_limits.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -292,6 +293,39 @@ std::size_t geometry_bytes(const Geometry& g)
                         g.discs.back_material) +
            vector_bytes(m.positions, m.normals, m.uvs, m.triangles, m.material,
                         m.back_material, m.texture);
+}
+
+void fit_mesh_buffers(TriangleMesh& mesh, bool textured_by_instances)
+{
+    bool untextured = std::all_of(mesh.texture.begin(), mesh.texture.end(),
+                                  [](std::int16_t t) { return t == no_texture; });
+    if (untextured)
+        mesh.texture = {};
+    bool zeros = std::all_of(mesh.uvs.begin(), mesh.uvs.end(),
+                             [](const Float2& uv) { return uv[0] == 0 && uv[1] == 0; });
+    if (zeros || (untextured && !textured_by_instances))
+        mesh.uvs = {};
+    fit_buffer(mesh.positions, embree_padding_bytes);
+    fit_buffer(mesh.triangles, embree_padding_bytes);
+    fit_buffer(mesh.normals);
+    fit_buffer(mesh.uvs);
+    fit_buffer(mesh.material);
+    fit_buffer(mesh.back_material);
+    fit_buffer(mesh.texture);
+    fit_buffer(mesh.hidden_edges);
+}
+
+void fit_scene_buffers(Scene& scene)
+{
+    fit_mesh_buffers(scene.geometry.mesh, false);
+    // An instance's texture falls on its prototype's untextured primitives.
+    std::vector<bool> textured(scene.prototypes.size(), false);
+    for (const Instance& i : scene.instances)
+        if (i.texture != no_texture && i.prototype < textured.size())
+            textured[i.prototype] = true;
+    for (std::size_t p = 0; p < scene.prototypes.size(); ++p)
+        fit_mesh_buffers(scene.prototypes[p].geometry.mesh, textured[p]);
+    fit_buffer(scene.instances);
 }
 
 std::size_t scene_buffer_bytes(const Scene& scene)

@@ -13,6 +13,7 @@
 
 #include <cstddef>
 #include <optional>
+#include <vector>
 
 #include "geom/scene.h"
 
@@ -61,6 +62,48 @@ struct DroppedGeometry {
 /// when the view volume (Scene::bounds: turtle positions, surfaces) reaches beyond
 /// max_coordinate, since no camera could frame it.
 DroppedGeometry drop_unrenderable(Scene& scene);
+
+/// Elements a buffer Embree reads in place keeps allocated (and initialised) past its
+/// end: Embree loads the last vertex with a 16-byte load (rtcSetSharedGeometryBuffer).
+inline constexpr std::size_t embree_padding_bytes = 16;
+
+/// Whether `v` has room for Embree's loads past its last element, so that render may let
+/// Embree read it in place instead of copying it (fit_mesh_buffers makes that room).
+template <class T>
+bool padded_for_embree(const std::vector<T>& v)
+{
+    return !v.empty() && (v.capacity() - v.size()) * sizeof(T) >= embree_padding_bytes;
+}
+
+/// Shrinks `v` to its size, leaving room for `pad_bytes` more (value-initialised), such as
+/// embree_padding_bytes for a buffer Embree reads in place.
+template <class T>
+void fit_buffer(std::vector<T>& v, std::size_t pad_bytes = 0)
+{
+    std::size_t pad = (pad_bytes + sizeof(T) - 1) / sizeof(T);
+    if (v.empty()) {
+        std::vector<T>().swap(v);  // `v = {}` keeps the capacity
+        return;
+    }
+    if (v.capacity() == v.size() + pad)
+        return;
+    std::vector<T> fitted;
+    fitted.reserve(v.size() + pad);
+    fitted.assign(v.begin(), v.end());
+    fitted.resize(v.size() + pad);  // within the capacity: initialises the padding
+    fitted.resize(v.size());
+    v.swap(fitted);
+}
+
+/// Gives a mesh's buffers back their growth slack, leaving positions and triangles padded
+/// for Embree to read in place (issue 15.3: a leaf's vertex no longer lives both in the
+/// Scene and in Embree), and drops what no hit reads: texture indices when none is set,
+/// texture coordinates when all are zero (render reads a missing uv as 0) or when nothing
+/// textures the mesh (`textured_by_instances`: a prototype whose instances bring a texture).
+void fit_mesh_buffers(TriangleMesh& mesh, bool textured_by_instances);
+/// fit_mesh_buffers for the scene's mesh and every prototype's; instances give back their
+/// growth slack too.
+void fit_scene_buffers(Scene& scene);
 
 /// The bytes a geometry's primitive arrays have allocated (their capacities): what the
 /// memory budget checks during interpretation.

@@ -3,6 +3,9 @@
 #include "render/accel.h"
 
 #include <embree3/rtcore.h>
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 #include <algorithm>
 #include <array>
@@ -11,11 +14,13 @@
 #include <cmath>
 #include <cstring>
 #include <deque>
+#include <map>
 #include <limits>
 #include <mutex>
 #include <numbers>
 #include <span>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "base/diagnostics.h"
@@ -109,21 +114,35 @@ struct Mat3 {
     Vec3f operator*(const Vec3f& v) const { return c0 * v.x + c1 * v.y + c2 * v.z; }
 };
 
-/// An Instance's placement: its linear part, the inverse transpose for normals and the
-/// factor radii scale by (the cube root of the volume scale).
+/// What a hit on an instance reads of its Instance besides the transform: the prototype and
+/// the materials and texture that replace inherit_material and no_texture. Instances that
+/// agree share one (Embree user data of their instance geometry), so an instance costs
+/// Cambium nothing beside what Embree keeps of it (issue 15.3).
+struct InstanceStyle {
+    std::uint32_t prototype = 0;
+    std::uint16_t material = 0;
+    std::uint16_t back_material = 0;
+    std::int16_t texture = geom::no_texture;
+
+    auto key() const { return std::tuple(prototype, material, back_material, texture); }
+};
+
+/// An instance's placement, made at hit time from the transform Embree holds: its linear
+/// part, the inverse transpose for normals and the factor radii scale by (the cube root
+/// of the volume scale).
 struct Placement {
-    const geom::Instance* instance = nullptr;
+    const InstanceStyle* style = nullptr;
     std::uint32_t index = PrimId::none;  ///< in Scene::instances
     Mat3 linear, normals;
     float radius_scale = 1;
     float largest_scale = 1;  ///< the most the linear part stretches a coordinate (inf-norm)
 };
 
-Placement make_placement(const geom::Instance& inst, std::uint32_t index)
+/// `m`: the 3x4 column-major transform (as geom::Instance::transform).
+Placement make_placement(const float* m, const InstanceStyle* style, std::uint32_t index)
 {
-    const auto& m = inst.transform;
     Placement p;
-    p.instance = &inst;
+    p.style = style;
     p.index = index;
     p.linear = {{m[0], m[1], m[2]}, {m[3], m[4], m[5]}, {m[6], m[7], m[8]}};
     const Vec3f &a = p.linear.c0, &b = p.linear.c1, &c = p.linear.c2;
@@ -137,6 +156,17 @@ Placement make_placement(const geom::Instance& inst, std::uint32_t index)
         largest = std::fmax(largest, std::fabs(m[row]) + std::fabs(m[3 + row]) + std::fabs(m[6 + row]));
     p.largest_scale = largest;
     return p;
+}
+
+/// The bytes the C heap has handed out and not taken back, in every arena (0 without glibc).
+std::size_t heap_in_use()
+{
+#if defined(__GLIBC__)
+    struct mallinfo2 info = mallinfo2();
+    return info.uordblks + info.hblkhd;
+#else
+    return 0;
+#endif
 }
 
 /// The Hermite basis at u: weights of p0, t0, p1, t1.
@@ -376,7 +406,12 @@ RTCGeometry build_caps(RTCDevice device, const GeometrySource& part)
 {
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
     share_keys(g, RTC_BUFFER_TYPE_VERTEX, part.ends->caps.data(), part.ends->caps.size());
-    copy_buffer(g, RTC_BUFFER_TYPE_NORMAL, RTC_FORMAT_FLOAT3, part.ends->cap_normals);
+    const std::vector<geom::Float3>& normals = part.ends->cap_normals;
+    if (geom::padded_for_embree(normals))  // line_ends() leaves the room
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_NORMAL, 0, RTC_FORMAT_FLOAT3, normals.data(), 0,
+                                   sizeof(geom::Float3), normals.size());
+    else
+        copy_buffer(g, RTC_BUFFER_TYPE_NORMAL, RTC_FORMAT_FLOAT3, normals);
     return g;
 }
 
@@ -539,8 +574,18 @@ RTCGeometry build_triangles(RTCDevice device, const GeometrySource& part)
                 throw Error("scene: triangle vertex " + std::to_string(i) + " of " +
                             std::to_string(m.positions.size()));
     RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    copy_buffer(g, RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3, m.positions);
-    copy_buffer(g, RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT3, m.triangles);
+    // Read in place where the Scene left room for Embree's 16-byte loads past the last
+    // element (geom::fit_mesh_buffers), else copied.
+    if (geom::padded_for_embree(m.positions))
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                   m.positions.data(), 0, sizeof(geom::Float3), m.positions.size());
+    else
+        copy_buffer(g, RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3, m.positions);
+    if (geom::padded_for_embree(m.triangles))
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m.triangles.data(),
+                                   0, sizeof(m.triangles[0]), m.triangles.size());
+    else
+        copy_buffer(g, RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT3, m.triangles);
     return g;
 }
 
@@ -666,7 +711,13 @@ struct HitResolver {
     std::unique_ptr<const Camera> camera;  ///< pixel-width lines are drawn for its pixels
     std::vector<const GeometrySource*> top_parts;  ///< by top-level geometry id
     std::vector<std::vector<const GeometrySource*>> proto_parts;  ///< by prototype, geometry id
-    std::vector<Placement> placements;  ///< by top-level geometry id
+    RTCScene top = nullptr;  ///< the top-level scene: instances' transforms and styles
+    /// Instances are attached under consecutive geometry ids from first_instance_id, in
+    /// Scene::instances order (instance i at first_instance_id + i - first_instance_index;
+    /// unplaced ones leave their id unused). Line-end scenes' instances come before.
+    std::uint32_t first_instance_id = PrimId::none;
+    std::uint32_t first_instance_index = 0;
+    std::deque<InstanceStyle> styles;  ///< one per distinct style (stable addresses)
     /// The caps and the joints of the scene's own shaded lines live in two scenes of their
     /// own, each placed once, untransformed, by a top-level instance (none: no such scene).
     /// Embree's leaves hold primitives of one geometry only: caps and joints beside every
@@ -678,11 +729,31 @@ struct HitResolver {
     };
     std::array<PlacedEnds, 2> line_end_scenes;  ///< caps, joints
 
-    const Placement* placement(std::uint32_t inst_id) const
+    bool placed_instance(std::uint32_t inst_id) const
     {
-        return inst_id < placements.size() && placements[inst_id].instance
-                   ? &placements[inst_id]
-                   : nullptr;
+        return inst_id != PrimId::none && first_instance_id != PrimId::none &&
+               inst_id >= first_instance_id;
+    }
+    /// The style of the instance with this top-level geometry id (nullptr: not an instance
+    /// of a prototype). Read during traversal by the filters, so no transform is made.
+    const InstanceStyle* style(std::uint32_t inst_id) const
+    {
+        if (!placed_instance(inst_id))
+            return nullptr;
+        return static_cast<const InstanceStyle*>(
+            rtcGetGeometryUserData(rtcGetGeometry(top, inst_id)));
+    }
+    /// The placement of that instance, from the transform Embree keeps of it.
+    std::optional<Placement> placement(std::uint32_t inst_id) const
+    {
+        if (!placed_instance(inst_id))
+            return std::nullopt;
+        RTCGeometry g = rtcGetGeometry(top, inst_id);
+        std::array<float, 12> transform;
+        rtcGetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, transform.data());
+        return make_placement(transform.data(),
+                              static_cast<const InstanceStyle*>(rtcGetGeometryUserData(g)),
+                              inst_id - first_instance_id + first_instance_index);
     }
     const GeometrySource* part(std::uint32_t inst_id, std::uint32_t geom_id) const
     {
@@ -690,11 +761,11 @@ struct HitResolver {
             for (const PlacedEnds& e : line_end_scenes)
                 if (inst_id == e.instance)
                     return e.parts[geom_id];
-        if (const Placement* p = placement(inst_id))
-            return proto_parts[p->instance->prototype][geom_id];
+        if (const InstanceStyle* st = style(inst_id))
+            return proto_parts[st->prototype][geom_id];
         return top_parts[geom_id];
     }
-    int texture_of(const GeometrySource& part, std::uint32_t prim, const Placement* p) const;
+    int texture_of(const GeometrySource& part, std::uint32_t prim, const InstanceStyle* p) const;
 };
 
 }  // namespace
@@ -722,6 +793,7 @@ struct EmbreeScene::Impl : HitResolver {
     RayCounter rays;
     double build_seconds = 0;
     std::size_t embree_shared_bytes = 0;  ///< shared_bytes() of every part built
+    std::size_t embree_unmonitored_bytes = 0;  ///< embree_unmonitored_bytes()
     /// Embree's own allocations, from its memory monitor (called from any thread).
     std::atomic<std::int64_t> embree_bytes{0}, embree_peak_bytes{0};
 
@@ -794,7 +866,7 @@ void alpha_filter(const RTCFilterFunctionNArguments* args)
         if (args->valid[i] == 0)
             continue;
         std::uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
-        const Placement* p = owner.placement(RTCHitN_instID(args->hit, args->N, i, 0));
+        const InstanceStyle* p = owner.style(RTCHitN_instID(args->hit, args->N, i, 0));
         int texture = owner.texture_of(*part, prim, p);
         if (!owner.textures->has_alpha(texture))
             continue;
@@ -826,7 +898,7 @@ struct HitMaterials {
 };
 
 HitMaterials materials_at(const GeometrySource& part, std::uint32_t prim, bool back,
-                          const Placement* placement, float u)
+                          const InstanceStyle* style, float u)
 {
     std::uint32_t index = part.attribute_index(prim);
     std::uint16_t material = at_or(*part.material, index, std::uint16_t{0});
@@ -835,9 +907,7 @@ HitMaterials materials_at(const GeometrySource& part, std::uint32_t prim, bool b
     auto resolve = [&](std::uint16_t mat) -> std::uint16_t {
         if (mat != geom::inherit_material)
             return mat;
-        return placement ? (back ? placement->instance->back_material
-                                 : placement->instance->material)
-                         : 0;
+        return style ? (back ? style->back_material : style->material) : 0;
     };
     HitMaterials m;
     m.material = resolve(material);
@@ -900,7 +970,7 @@ void opacity_filter(const RTCFilterFunctionNArguments* args)
             args->valid[i] = 0;
             continue;
         }
-        const Placement* p = ctx->resolver->placement(c.inst);
+        const InstanceStyle* p = ctx->resolver->style(c.inst);
         const GeometrySource& part = *ctx->resolver->part(c.inst, c.geom);
         float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
         // The ray and Ng are both in the hit primitive's own space here.
@@ -923,14 +993,14 @@ void opacity_filter(const RTCFilterFunctionNArguments* args)
 }
 
 int HitResolver::texture_of(const GeometrySource& part, std::uint32_t prim,
-                            const Placement* p) const
+                            const InstanceStyle* p) const
 {
     if (!part.texture)
         return geom::no_texture;
     std::int16_t t = at_or(*part.texture, part.attribute_index(prim), geom::no_texture);
     // A prototype's untextured primitives take their instance's texture.
     if (t == geom::no_texture && p)
-        t = p->instance->texture;
+        t = p->texture;
     return t;
 }
 
@@ -968,6 +1038,13 @@ void geometry_filter(const RTCFilterFunctionNArguments* args)
 
 namespace {
 
+/// The bytes of `v` if Embree reads it in place (padded for its loads), else 0.
+template <class T>
+std::size_t padded_bytes(const std::vector<T>& v)
+{
+    return geom::padded_for_embree(v) ? v.size() * sizeof(T) : 0;
+}
+
 /// The bytes of the part's buffers that Embree reads in place (rtcSetSharedGeometryBuffer):
 /// part of what Embree needs for it, though Cambium holds them.
 std::size_t bytes_shared_with_embree(const GeometrySource& part)
@@ -984,8 +1061,10 @@ std::size_t bytes_shared_with_embree(const GeometrySource& part)
                flags(g.curves.flags, g.curves.segments.size());
     case Shape::sphere: return g.spheres.centres.size() * sizeof(Key);
     case Shape::disc: return g.discs.centres.size() * sizeof(Key);  // normals: copied
-    case Shape::triangle: return 0;                                 // copied
-    case Shape::cap: return part.ends->caps.size() * sizeof(Key);
+    case Shape::triangle:  // read in place when padded (build_triangles), else copied
+        return padded_bytes(g.mesh.positions) + padded_bytes(g.mesh.triangles);
+    case Shape::cap:
+        return part.ends->caps.size() * sizeof(Key) + padded_bytes(part.ends->cap_normals);
     case Shape::joint: return part.ends->joints.size() * sizeof(Key);
     }
     return 0;
@@ -996,10 +1075,11 @@ std::size_t bytes_shared_with_embree(const GeometrySource& part)
 void EmbreeScene::Impl::attach(RTCScene s, GeometrySource part,
                                std::vector<const GeometrySource*>& ids, bool alpha)
 {
-    RTCGeometry g = kind(part.shape).build(device, part);
+    const ShapeKind& shape = kind(part.shape);
+    RTCGeometry g = shape.build(device, part);
     embree_shared_bytes += bytes_shared_with_embree(part);
     part.owner = this;
-    part.skips_self = kind(part.shape).self_hits;
+    part.skips_self = shape.self_hits;
     part.pixel_line = part.shape == Shape::line && part.unlit;
     part.cut_out = textures && (alpha || part.pixel_line);
     parts.push_back(part);
@@ -1128,23 +1208,36 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
                        !scene.line_radius_in_pixels);
         rtcCommitScene(m.prototype_scenes[i]);
     }
+    // Each instance keeps nothing here: Embree holds its transform, and its user data
+    // points at the style it shares with the instances that agree with it.
+    std::map<decltype(InstanceStyle{}.key()), const InstanceStyle*> style_of;
+    m.top = m.scene;
+    const std::size_t heap_before = heap_in_use();
     for (std::uint32_t index = 0; index < scene.instances.size(); ++index) {
         const geom::Instance& inst = scene.instances[index];
         RTCScene proto = m.prototype_scenes[inst.prototype];
         if (!proto)
             continue;
+        InstanceStyle style{inst.prototype, inst.material, inst.back_material, inst.texture};
+        auto [found, added] = style_of.emplace(style.key(), nullptr);
+        if (added)
+            found->second = &m.styles.emplace_back(style);
         RTCGeometry g = rtcNewGeometry(m.device, RTC_GEOMETRY_TYPE_INSTANCE);
         rtcSetGeometryInstancedScene(g, proto);
         rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, inst.transform.data());
+        rtcSetGeometryUserData(g, const_cast<InstanceStyle*>(found->second));
         rtcCommitGeometry(g);
-        unsigned id = rtcAttachGeometry(m.scene, g);
+        if (m.first_instance_id == PrimId::none) {
+            m.first_instance_id = rtcAttachGeometry(m.scene, g);
+            m.first_instance_index = index;
+        } else {
+            rtcAttachGeometryByID(m.scene, g, m.first_instance_id + (index - m.first_instance_index));
+        }
         rtcReleaseGeometry(g);
-        if (m.placements.size() <= id)
-            m.placements.resize(id + 1);
-        m.placements[id] = make_placement(inst, index);
     }
-    if (m.top_parts.size() < m.placements.size())
-        m.top_parts.resize(m.placements.size(), nullptr);
+    // Embree's memory monitor sees its buffers and BVHs, not its instance objects: they are
+    // most of the heap this loop takes (the styles it adds are a few).
+    m.embree_unmonitored_bytes = std::max(heap_in_use(), heap_before) - heap_before;
     rtcCommitScene(m.scene);
     m.check("building the Embree scene");
     m.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -1172,6 +1265,11 @@ std::uint64_t EmbreeScene::embree_peak_bytes() const
 
 std::uint64_t EmbreeScene::shared_bytes() const { return m_impl->embree_shared_bytes; }
 
+std::uint64_t EmbreeScene::embree_unmonitored_bytes() const
+{
+    return m_impl->embree_unmonitored_bytes;
+}
+
 namespace {
 
 template <class T>
@@ -1185,7 +1283,7 @@ std::size_t capacity_bytes(const std::vector<T>& v)
 std::uint64_t EmbreeScene::own_bytes() const
 {
     const Impl& m = *m_impl;
-    std::size_t bytes = capacity_bytes(m.world_keys) + capacity_bytes(m.placements) +
+    std::size_t bytes = capacity_bytes(m.world_keys) + m.styles.size() * sizeof(InstanceStyle) +
                         m.parts.size() * sizeof(GeometrySource);
     for (const LineEnds& e : m.line_ends)
         bytes += capacity_bytes(e.caps) + capacity_bytes(e.cap_normals) +
@@ -1293,9 +1391,10 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
     h.geom_id = rh.hit.geomID;
     h.prim_id = rh.hit.primID;
     h.inst_id = rh.hit.instID[0];
-    const Placement* placement = m.placement(h.inst_id);
+    const std::optional<Placement> placement = m.placement(h.inst_id);
     if (placement)
         h.instance = placement->index;
+    const InstanceStyle* style = placement ? placement->style : nullptr;
     const GeometrySource& part = *m.part(h.inst_id, h.geom_id);
     h.shape = part.shape;
     h.unlit = part.unlit;
@@ -1322,11 +1421,11 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
     // A shading normal turned away from the ray (or absent) gives way to the true one.
     h.normal = dot(shading, dir) < 0 ? shading : geometric;
 
-    HitMaterials materials = materials_at(part, h.prim_id, h.back, placement, rh.hit.u);
+    HitMaterials materials = materials_at(part, h.prim_id, h.back, style, rh.hit.u);
     h.material = materials.material;
     h.end_material = materials.end_material;
     h.material_blend = materials.blend;
-    int texture = m.texture_of(part, h.prim_id, placement);
+    int texture = m.texture_of(part, h.prim_id, style);
     h.texture = static_cast<std::int16_t>(texture);
     if (texture != geom::no_texture) {
         auto st = shape.texture_coords(part, h.prim_id, rh.hit.u, rh.hit.v, ng);

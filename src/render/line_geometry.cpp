@@ -11,6 +11,7 @@
 #include <tbb/parallel_for.h>
 
 #include "base/diagnostics.h"
+#include "geom/scene_limits.h"
 #include "render/pixel_lines.h"
 #include "render/vecf.h"
 
@@ -136,6 +137,11 @@ LineEnds line_ends(const geom::LinearCurves& l, const geom::Float4* keys)
     }
     LineEnds e;
     e.caps.resize(cap_start[blocks]);
+    // Embree reads the cap normals in place: room for its padding, initialised, so the
+    // fit below copies nothing
+    const std::size_t pad = (geom::embree_padding_bytes + sizeof(e.cap_normals[0]) - 1) /
+                            sizeof(e.cap_normals[0]);
+    e.cap_normals.resize(cap_start[blocks] + pad);
     e.cap_normals.resize(cap_start[blocks]);
     e.cap_segment.resize(cap_start[blocks]);
     e.cap_at_end.resize(cap_start[blocks]);
@@ -159,6 +165,7 @@ LineEnds line_ends(const geom::LinearCurves& l, const geom::Float4* keys)
                 });
         }
     });
+    geom::fit_buffer(e.cap_normals, geom::embree_padding_bytes);
     return e;
 }
 

@@ -741,6 +741,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         rep.embree_peak_bytes = accel->embree_peak_bytes();
         rep.embree_shared_bytes = accel->shared_bytes();
         rep.render_buffer_bytes = accel->own_bytes();
+        rep.embree_unmonitored_bytes = accel->embree_unmonitored_bytes();
         rep.nonfinite_samples = nonfinite.exchange(0);
         if (rep.nonfinite_samples > 0)
             warn("render: " + std::to_string(rep.nonfinite_samples) +

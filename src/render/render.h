@@ -181,6 +181,8 @@ struct RenderReport {
     /// Of the buffers Embree reads in place, their bytes (EmbreeScene::shared_bytes), and
     /// the renderer's own buffers beside the Scene's (EmbreeScene::own_bytes).
     std::uint64_t embree_shared_bytes = 0, render_buffer_bytes = 0;
+    /// Embree's heap its memory monitor does not see (EmbreeScene::embree_unmonitored_bytes).
+    std::uint64_t embree_unmonitored_bytes = 0;
 };
 
 /// Renders the scene as cpfg frames it (make_camera, plus the settings' thin lens) with

@@ -5,8 +5,10 @@
 
 #include <cmath>
 #include <limits>
+#include <map>
 
 #include "base/diagnostics.h"
+#include "geom/scene_limits.h"
 #include "render/accel.h"
 #include "geom_scenes.h"
 #include "test_scenes.h"
@@ -177,6 +179,152 @@ TEST(Primitives, InstancesPlaceInheritAndTransformNormals)
     auto other_sphere = accel.intersect({-10, 0, 30}, {0, 0, -1}, 0, inf, sphere->prim());
     ASSERT_TRUE(other_sphere);
     EXPECT_EQ(other_sphere->shape, Shape::sphere);
+}
+
+// Issue 15.3's savings must not change what a hit reads: meshes fitted for Embree
+// (positions and triangles read in place, all-zero uvs dropped) and instances that keep no
+// placement beside the transform Embree holds shade exactly as the unfitted scene does,
+// and each hit still names its instance in Scene::instances.
+TEST(Primitives, FittedMeshesAndInstancesShadeAsBefore)
+{
+    geom::Scene s;
+    s.prototypes.push_back(geom::Prototype{});  // empty: its instances are not built
+    geom::Prototype leaf;  // untextured (uvs all zero), tilted vertex normals, inheriting
+    float a = 0.5f;
+    add_triangle(leaf.geometry, {{{0, 0, 0}, {4, 0, 0}, {0, 4, 0}}},
+                 {{{-a, 0, 1}, {a, 0, 1}, {0, 0, 1}}}, {{{0, 0}, {0, 0}, {0, 0}}},
+                 geom::inherit_material, 6);
+    s.prototypes.push_back(leaf);
+    geom::Prototype mapped;  // its own texture and real uvs
+    add_triangle(mapped.geometry, {{{0, 0, 0}, {4, 0, 0}, {0, 4, 0}}},
+                 {{{0, 0, 1}, {0, 0, 1}, {0, 0, 1}}}, {{{0, 0}, {1, 0}, {0, 1}}}, 9, 9, 2);
+    s.prototypes.push_back(mapped);
+    geom::Prototype plain;  // uvs set, but nothing textures it: no hit reads them
+    add_triangle(plain.geometry, {{{0, 0, 0}, {4, 0, 0}, {0, 4, 0}}},
+                 {{{0, 0, 1}, {0, 0, 1}, {0, 0, 1}}}, {{{0, 0}, {1, 0}, {0, 1}}}, 10, 11);
+    s.prototypes.push_back(plain);
+    add_triangle(s.geometry, {{{0, 20, 0}, {4, 20, 0}, {0, 24, 0}}},
+                 {{{0, a, 1}, {0, -a, 1}, {0, 0, 1}}}, {{{0, 0}, {0, 0}, {0, 0}}}, 4, 5);
+    auto place = [&](std::uint32_t prototype, std::array<float, 12> t, std::uint16_t material,
+                     std::int16_t texture) {
+        geom::Instance i;
+        i.prototype = prototype;
+        i.transform = t;
+        i.material = material;
+        i.back_material = static_cast<std::uint16_t>(material + 1);
+        i.texture = texture;
+        s.instances.push_back(i);
+    };
+    place(0, transform({1, 0, 0, 0, 1, 0, 0, 0, 1}), 1, geom::no_texture);
+    place(1, transform({0, -1, 0, 1, 0, 0, 0, 0, 1}, {0, 0, 0}), 7, 3);  // turned 90 deg
+    place(0, transform({1, 0, 0, 0, 1, 0, 0, 0, 1}), 1, geom::no_texture);
+    place(2, transform({1, 0, 0, 0, 1, 0, 0, 0, 1}, {20, 0, 0}), 1, geom::no_texture);
+    place(1, transform({2, 0, 0, 0, 1, 0, 0, 0.5f, 1}, {40, 0, 0}), 8, geom::no_texture);
+    place(3, transform({1, 0, 0, 0, 1, 0, 0, 0, 1}, {28, 10, 0}), 1, geom::no_texture);
+    for (geom::Prototype& p : s.prototypes) {  // copied to Embree, as an unfitted Scene is
+        p.geometry.mesh.positions.shrink_to_fit();
+        p.geometry.mesh.triangles.shrink_to_fit();
+    }
+    s.geometry.mesh.positions.shrink_to_fit();
+    s.geometry.mesh.triangles.shrink_to_fit();
+
+    geom::Scene fitted = s;
+    geom::fit_scene_buffers(fitted);
+    EXPECT_TRUE(fitted.prototypes[1].geometry.mesh.uvs.empty());
+    EXPECT_TRUE(fitted.geometry.mesh.uvs.empty());
+    EXPECT_EQ(fitted.prototypes[2].geometry.mesh.uvs.size(), 3u);
+    EXPECT_TRUE(fitted.prototypes[3].geometry.mesh.uvs.empty());
+    EXPECT_TRUE(fitted.prototypes[3].geometry.mesh.texture.empty());
+    EXPECT_EQ(fitted.prototypes[1].geometry.mesh.texture.size(), 0u);
+    EXPECT_EQ(fitted.prototypes[2].geometry.mesh.texture.size(), 1u);
+    EXPECT_TRUE(geom::padded_for_embree(fitted.prototypes[1].geometry.mesh.positions));
+    EXPECT_TRUE(geom::padded_for_embree(fitted.geometry.mesh.triangles));
+    EXPECT_FALSE(geom::padded_for_embree(s.prototypes[1].geometry.mesh.positions));
+
+    EmbreeScene before(s, any_camera()), after(fitted, any_camera());
+    EXPECT_EQ(after.shared_bytes() - before.shared_bytes(), 4 * (3 * 12 + 12u));
+    EXPECT_LT(after.embree_bytes(), before.embree_bytes());
+    std::map<std::uint32_t, int> hits_of_instance;
+    for (float dz : {-1.0f, 1.0f})
+        for (float x = -5.25f; x < 50; x += 0.5f)
+            for (float y = -5.25f; y < 25; y += 0.5f) {
+                Vec3f org(x, y, -5 * dz), dir(0.1f, 0.05f, dz);
+                auto hb = before.intersect(org, dir, 0, inf);
+                auto ha = after.intersect(org, dir, 0, inf);
+                ASSERT_EQ(bool(hb), bool(ha)) << x << " " << y;
+                if (!hb)
+                    continue;
+                ++hits_of_instance[ha->instance];
+                EXPECT_EQ(ha->t, hb->t);
+                auto same = [](const Vec3f& p, const Vec3f& q) {
+                    return p.x == q.x && p.y == q.y && p.z == q.z;
+                };
+                EXPECT_TRUE(same(ha->normal, hb->normal));
+                EXPECT_TRUE(same(ha->geometric_normal, hb->geometric_normal));
+                EXPECT_TRUE(same(ha->dpds, hb->dpds));
+                EXPECT_TRUE(same(ha->dpdt, hb->dpdt));
+                EXPECT_EQ(ha->material, hb->material);
+                EXPECT_EQ(ha->texture, hb->texture);
+                EXPECT_EQ(ha->u, hb->u);
+                EXPECT_EQ(ha->v, hb->v);
+                EXPECT_EQ(ha->back, hb->back);
+                EXPECT_EQ(ha->instance, hb->instance);
+                EXPECT_EQ(ha->spawn_offset, hb->spawn_offset);
+            }
+    // The own triangle and instances 1, 3, 4 and 5 of Scene::instances are all hit.
+    EXPECT_GT(hits_of_instance[PrimId::none], 0);
+    EXPECT_GT(hits_of_instance[1], 0);
+    EXPECT_GT(hits_of_instance[3], 0);
+    EXPECT_GT(hits_of_instance[4], 0);
+    EXPECT_GT(hits_of_instance[5], 0);
+    EXPECT_EQ(hits_of_instance.size(), 5u);
+
+    // What each instance's hit reads: its materials, its texture on the untextured
+    // prototype (at the dropped uvs' zeros), the turned and sheared normals.
+    auto turned = after.intersect({-1, 1, 5}, {0, 0, -1}, 0, inf);
+    ASSERT_TRUE(turned);
+    EXPECT_EQ(turned->instance, 1u);
+    EXPECT_EQ(turned->material, 7);
+    EXPECT_EQ(turned->texture, 3);
+    EXPECT_EQ(turned->u, 0);
+    EXPECT_EQ(turned->v, 0);
+    auto under = after.intersect({-1, 1, -5}, {0, 0, 1}, 0, inf);
+    ASSERT_TRUE(under);
+    EXPECT_EQ(under->material, 6);  // the prototype's own back material
+    auto own = after.intersect({40.5f, 0.5f, 5}, {0, 0, -1}, 0, inf);
+    ASSERT_TRUE(own);
+    EXPECT_EQ(own->instance, 4u);
+    EXPECT_EQ(own->material, 8);
+    EXPECT_LT(own->geometric_normal.y, -0.4f);  // z' = z + y / 2: the normal ~ (0, -0.5, 1)
+}
+
+// An instance costs Cambium nothing beside what Embree keeps: 200 instances of a
+// prototype leave the renderer's own bytes where one instance does. Embree's instance
+// objects, which its memory monitor does not report (about 300 B each), are seen on the heap.
+TEST(Primitives, InstancesKeepNoPlacementBesideEmbree)
+{
+    auto own_bytes = [](int instances, std::uint64_t* unmonitored = nullptr) {
+        geom::Scene s;
+        geom::Prototype p;
+        add_sphere(p.geometry, {0, 0, 0}, 1, 3);
+        s.prototypes.push_back(p);
+        for (int i = 0; i < instances; ++i) {
+            geom::Instance inst;
+            inst.transform = transform({1, 0, 0, 0, 1, 0, 0, 0, 1}, {3.0 * i, 0, 0});
+            inst.material = static_cast<std::uint16_t>(i % 2);
+            s.instances.push_back(inst);
+        }
+        EmbreeScene accel(s, any_camera());
+        if (unmonitored)
+            *unmonitored = accel.embree_unmonitored_bytes();
+        return accel.own_bytes();
+    };
+    std::uint64_t unmonitored = 0;
+    EXPECT_EQ(own_bytes(2000, &unmonitored), own_bytes(2));
+#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)  // ASan's malloc reports no mallinfo
+    EXPECT_GT(unmonitored, 2000u * 150);
+    EXPECT_LT(unmonitored, 2000u * 1000);
+#endif
 }
 
 // Texture coordinates: t along a line from its keys' v, (s, t) = longitude and latitude on
