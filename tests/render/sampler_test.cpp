@@ -72,6 +72,23 @@ TEST(Sobol, SecondDimensionTableMatchesItsDefinition)
         EXPECT_EQ(sobol::to_unit(sobol::sobol_second(i)), expect[i]);
 }
 
+TEST(Sobol, BitReversalsAndTheReversedTableAgreeWithTheirDefinitions)
+{
+    auto reverse_slowly = [](std::uint64_t v, int bits) {
+        std::uint64_t r = 0;
+        for (int b = 0; b < bits; ++b)
+            r |= ((v >> b) & 1u) << (bits - 1 - b);
+        return r;
+    };
+    for (std::uint32_t i : {0u, 1u, 2u, 3u, 255u, 256u, 65535u, 0x12345678u, 0xffffffffu}) {
+        EXPECT_EQ(sobol::reverse_bits(i), reverse_slowly(i, 32)) << i;
+        std::uint64_t wide = std::uint64_t{i} * 0x9e3779b97f4a7c15ULL;
+        EXPECT_EQ(sobol::reverse_bits64(wide), reverse_slowly(wide, 64)) << i;
+        EXPECT_EQ(sobol::sobol_second_reversed(i), sobol::reverse_bits(sobol::sobol_second(i)))
+            << i;
+    }
+}
+
 TEST(Sobol, OwenScrambleKeepsAlignedIntervals)
 {
     // Values sharing their top k bits (one binary interval) still share them scrambled,
