@@ -35,6 +35,7 @@
 #include <cstring>
 #include <ctime>
 #include <exception>
+#include <limits>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -78,6 +79,9 @@ double peak_rss_mb()
 /// the sentinel tnear = -1 and are dropped before the replay.
 struct RayLog {
     static constexpr std::size_t chunk = 4096;
+    /// A thread's next and end once the log is full (before, each later ray took a chunk
+    /// number from the shared counter: contention charged to the path tracer).
+    static constexpr std::size_t full = std::numeric_limits<std::size_t>::max();
     std::vector<RTCRay> rays;
     std::atomic<std::size_t> chunks_taken{0};
 
@@ -92,10 +96,12 @@ struct RayLog {
     void record(const RTCRay& r, std::size_t& next, std::size_t& end)
     {
         if (next == end) {
+            if (next == full)  // no chunks left: not even the shared counter is touched
+                return;
             next = chunks_taken.fetch_add(1, std::memory_order_relaxed) * chunk;
             end = std::min(next + chunk, rays.size());
             if (next >= end) {  // full: record no more
-                next = end = 0;
+                next = end = full;
                 return;
             }
         }
