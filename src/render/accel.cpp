@@ -1233,11 +1233,9 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
 {
     const Impl& m = *m_impl;
     m.rays.add();
-    // One named result on every path, so the hit is built in place (no copy).
-    std::optional<SurfaceHit> result;
     if (!traceable(org, dir, tnear, tfar)) {
         ++m.skipped_rays;
-        return result;
+        return std::nullopt;
     }
     SkipContext context = make_context(skip, coherent);
     RTCRayHit rh;
@@ -1246,9 +1244,9 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(m.scene, &context.context, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
-        return result;
+        return std::nullopt;
 
-    SurfaceHit& h = result.emplace();
+    SurfaceHit h;
     h.t = rh.ray.tfar;
     // Where Embree found it: along the direction it traced (make_ray).
     h.position = org + m.traced(dir) * h.t;
@@ -1310,7 +1308,7 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     }
     h.spawn_offset = shape.offset_per_radius * h.radius + shape.offset_per_scale * scale +
                      shape.offset_absolute;
-    return result;
+    return h;
 }
 
 float EmbreeScene::transmittance(const Vec3f& org, const Vec3f& dir, float tnear, float tfar,

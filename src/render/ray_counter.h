@@ -16,14 +16,14 @@ namespace cambium::render {
 /// owned slots share one line with atomic adds and stay exact, only slower.
 class RayCounter {
 public:
-    void add() const noexcept
+    void add(std::uint64_t n = 1) const noexcept
     {
         std::size_t slot = thread_slot();
         std::atomic<std::uint64_t>& count = m_slots[slot].count;
         if (slot < owned_slots)
-            count.store(count.load(std::memory_order_relaxed) + 1, std::memory_order_relaxed);
+            count.store(count.load(std::memory_order_relaxed) + n, std::memory_order_relaxed);
         else
-            count.fetch_add(1, std::memory_order_relaxed);
+            count.fetch_add(n, std::memory_order_relaxed);
     }
 
     std::uint64_t total() const noexcept
