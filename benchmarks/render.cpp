@@ -42,6 +42,7 @@
 
 #include "geom/scene.h"
 #include "render/accel.h"
+#include "render/float_mode.h"
 #include "render/render.h"
 #include "render/ray_counter.h"
 #include "render/sampler.h"
@@ -350,6 +351,8 @@ double replay(RTCScene scene, const std::vector<RTCRay>& rays, bool occlusion,
     auto t0 = Clock::now();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 1024),
                       [&](const tbb::blocked_range<std::size_t>& r) {
+        // The modes the render's threads trace with (render/float_mode.h).
+        cambium::render::DenormalsFlushed flushed;
         ReplayContext c;
         std::uint64_t local = 0;
         for (std::size_t i = r.begin(); i != r.end(); ++i) {

@@ -27,6 +27,7 @@
 #include "base/diagnostics.h"
 #include "render/accel.h"
 #include "render/color.h"
+#include "render/float_mode.h"
 #include "render/integrator.h"
 #include "render/labels.h"
 #include "render/texture.h"
@@ -528,6 +529,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
     auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
     tbb::task_arena arena(settings.threads > 0 ? settings.threads
                                                : tbb::task_arena::automatic);
+    ArenaDenormalsFlushed flush_workers(arena);  // as Embree asks (render/float_mode.h)
     std::vector<int> targets = pass_targets(settings);
     // The sampled pixels, in image coordinates; `pixels` below holds them row by row.
     const PixelRect region = sampled_rect(settings, targets.size());
@@ -535,6 +537,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
     const int w = region.width, h = region.height;
     std::atomic<std::uint64_t> nonfinite{0};
     arena.execute([&] {
+        DenormalsFlushed flush_here;
         std::shared_ptr<const TextureSet> textures = settings.textures;
         if (!textures && (!scene.textures.empty() || !settings.ground.texture.empty()))
             textures = load_textures(scene, settings);
