@@ -199,14 +199,26 @@ std::uint64_t replica_seed(std::uint64_t seed, std::uint32_t i)
     return (i & 1u) ? mix64(seed ^ 0x6a09e667f3bcc909ULL) : seed;
 }
 
+/// The hashes pixel (x, y) draws its samples from: [0] for the seed, [1] for the odd
+/// replica's (adaptive sampling only); made once per pixel and pass.
+struct PixelReplicas {
+    PixelSeeds seeds[2];
+    PixelReplicas(int x, int y, std::uint64_t seed)
+        : seeds{{static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), seed},
+                {static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                 replica_seed(seed, 1)}}
+    {
+    }
+};
+
 /// Sample i of pixel (x, y), added to its sums.
-void take_sample(const RenderState& f, int x, int y, std::uint32_t i, PixelState& st)
+void take_sample(const RenderState& f, int x, int y, std::uint32_t i, PixelState& st,
+                 const PixelReplicas& replicas)
 {
     const RenderSettings& s = f.settings;
     const bool adaptive = s.noise_target > 0;
-    const Sampler sampler(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
-                          adaptive ? replica_index(i) : i,
-                          adaptive ? replica_seed(s.seed, i) : s.seed, s.sampler);
+    const Sampler sampler(replicas.seeds[adaptive ? (i & 1u) : 0],
+                          adaptive ? replica_index(i) : i, s.sampler);
     auto [jx, jy] = sampler.get2d(sample_dimension::film);
     double px, py;
     if (f.filter.box()) {
@@ -659,8 +671,10 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                             PixelState& st = pixels[std::size_t(y) * w + x];
                             if (st.done)
                                 continue;
+                            const PixelReplicas replicas(region.x + x, region.y + y,
+                                                         settings.seed);
                             for (std::uint32_t i = st.samples; i < target; ++i, ++taken)
-                                take_sample(state, region.x + x, region.y + y, i, st);
+                                take_sample(state, region.x + x, region.y + y, i, st, replicas);
                         }
                     progress.add(taken);
                 }

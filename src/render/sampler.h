@@ -149,6 +149,49 @@ constexpr float to_unit(std::uint32_t v) { return static_cast<float>(v >> 8) * 0
 
 }  // namespace sobol
 
+/// The hash of (pixel, seed) every draw of the pixel starts from.
+constexpr std::uint64_t pixel_hash(std::uint32_t x, std::uint32_t y, std::uint64_t seed)
+{
+    return mix64(mix64(seed ^ 0x9e3779b97f4a7c15ULL) ^ ((std::uint64_t{y} << 32) | x));
+}
+
+/// The hash of one dimension pair of a pixel, which seeds the pair's scrambles.
+constexpr std::uint64_t pair_hash(std::uint64_t pixel, std::uint32_t pair)
+{
+    return mix64(pixel + (std::uint64_t{pair} + 1) * 0x9e3779b97f4a7c15ULL);
+}
+
+/// What the samples of one pixel (and seed) share: the pixel's hash and its first pairs'
+/// hashes, each computed once on first use rather than once per sample. Local to the
+/// thread that samples the pixel (it fills itself in as samplers read it).
+class PixelSeeds {
+public:
+    static constexpr std::uint32_t cached_pairs = 32;
+
+    PixelSeeds(std::uint32_t x, std::uint32_t y, std::uint64_t seed)
+        : m_pixel(pixel_hash(x, y, seed))
+    {
+    }
+
+    std::uint64_t pixel() const { return m_pixel; }
+
+    std::uint64_t pair(std::uint32_t pair) const
+    {
+        if (pair >= cached_pairs)
+            return pair_hash(m_pixel, pair);
+        if (!(m_known >> pair & 1u)) {
+            m_pairs[pair] = pair_hash(m_pixel, pair);
+            m_known |= std::uint32_t{1} << pair;
+        }
+        return m_pairs[pair];
+    }
+
+private:
+    std::uint64_t m_pixel;
+    mutable std::uint32_t m_known = 0;
+    mutable std::array<std::uint64_t, cached_pairs> m_pairs;
+};
+
 /// The sample values of one (pixel, sample index). With SampleSequence::sobol each pair
 /// of dimensions (2k, 2k+1) is its own 2D Sobol sequence ("padded"), Owen-scrambled with a
 /// hash of (seed, pixel, pair) (one hash per pair seeds all three of its scrambles), and
@@ -161,9 +204,17 @@ class Sampler {
 public:
     Sampler(std::uint32_t x, std::uint32_t y, std::uint32_t sample, std::uint64_t seed,
             SampleSequence sequence = SampleSequence::sobol)
-        : m_pixel(mix64(mix64(seed ^ 0x9e3779b97f4a7c15ULL) ^
-                        ((std::uint64_t{y} << 32) | x))),
-          m_sample(sample), m_sample_reversed(sobol::reverse_bits(sample)), m_sequence(sequence)
+        : m_pixel(pixel_hash(x, y, seed)), m_sample(sample),
+          m_sample_reversed(sobol::reverse_bits(sample)), m_sequence(sequence)
+    {
+    }
+
+    /// The same values, with the pixel's hashes from `seeds` (made with the same x, y and
+    /// seed), which must outlive the sampler.
+    Sampler(const PixelSeeds& seeds, std::uint32_t sample,
+            SampleSequence sequence = SampleSequence::sobol)
+        : m_pixel(seeds.pixel()), m_seeds(&seeds), m_sample(sample),
+          m_sample_reversed(sobol::reverse_bits(sample)), m_sequence(sequence)
     {
     }
 
@@ -222,7 +273,7 @@ private:
     /// it as it is, x and y cheap bijective remixes of it (a xorshift and an odd multiply).
     Pair pair(std::uint32_t pair) const
     {
-        std::uint64_t h = mix64(m_pixel + (std::uint64_t{pair} + 1) * 0x9e3779b97f4a7c15ULL);
+        std::uint64_t h = m_seeds ? m_seeds->pair(pair) : pair_hash(m_pixel, pair);
         // The shuffle: an Owen scramble of the index's bits (held reversed from the start).
         std::uint32_t index = sobol::reverse_bits(sobol::scramble_reversed(m_sample_reversed, h));
         return {index, (h ^ (h >> 31)) * 0xd1b54a32d192ed03ULL,
@@ -230,6 +281,7 @@ private:
     }
 
     std::uint64_t m_pixel;
+    const PixelSeeds* m_seeds = nullptr;
     std::uint32_t m_sample;
     std::uint32_t m_sample_reversed;
     SampleSequence m_sequence;

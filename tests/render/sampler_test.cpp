@@ -30,6 +30,22 @@ TEST(Sampler, SameKeySameStream)
     }
 }
 
+TEST(Sampler, PixelSeedsGiveTheSameValuesAsPerSampleHashes)
+{
+    // The per-pixel cache is only a cache: every dimension (cached pairs and beyond), every
+    // sample, both sequences.
+    for (SampleSequence seq : {SampleSequence::sobol, SampleSequence::white}) {
+        const PixelSeeds seeds(17, 5, 42);
+        for (std::uint32_t i = 0; i < 20; ++i) {
+            Sampler cached(seeds, i, seq), plain(17, 5, i, 42, seq);
+            for (std::uint32_t d = 0; d < 2 * PixelSeeds::cached_pairs + 10; d += 2) {
+                ASSERT_EQ(cached.get2d(d), plain.get2d(d)) << i << " " << d;
+                ASSERT_EQ(cached.get1d(d + 1), plain.get1d(d + 1)) << i << " " << d;
+            }
+        }
+    }
+}
+
 TEST(Sampler, PairsAgreeWithSingleDimensions)
 {
     Sampler s(5, 9, 77, 3);
