@@ -35,12 +35,14 @@
 #include <cstring>
 #include <ctime>
 #include <exception>
+#include <limits>
 #include <mutex>
 #include <string>
 #include <vector>
 
 #include "geom/scene.h"
 #include "render/accel.h"
+#include "render/float_mode.h"
 #include "render/render.h"
 #include "render/ray_counter.h"
 #include "render/sampler.h"
@@ -78,6 +80,9 @@ double peak_rss_mb()
 /// the sentinel tnear = -1 and are dropped before the replay.
 struct RayLog {
     static constexpr std::size_t chunk = 4096;
+    /// A thread's next and end once the log is full (before, each later ray took a chunk
+    /// number from the shared counter: contention charged to the path tracer).
+    static constexpr std::size_t full = std::numeric_limits<std::size_t>::max();
     std::vector<RTCRay> rays;
     std::atomic<std::size_t> chunks_taken{0};
 
@@ -92,10 +97,12 @@ struct RayLog {
     void record(const RTCRay& r, std::size_t& next, std::size_t& end)
     {
         if (next == end) {
+            if (next == full)  // no chunks left: not even the shared counter is touched
+                return;
             next = chunks_taken.fetch_add(1, std::memory_order_relaxed) * chunk;
             end = std::min(next + chunk, rays.size());
             if (next >= end) {  // full: record no more
-                next = end = 0;
+                next = end = full;
                 return;
             }
         }
@@ -363,6 +370,8 @@ double replay(RTCScene scene, const std::vector<RTCRay>& rays, bool occlusion,
     auto t0 = Clock::now();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 1024),
                       [&](const tbb::blocked_range<std::size_t>& r) {
+        // The modes the render's threads trace with (render/float_mode.h).
+        cambium::render::DenormalsFlushed flushed;
         ReplayContext c;
         std::uint64_t local = 0;
         for (std::size_t i = r.begin(); i != r.end(); ++i) {

@@ -29,6 +29,7 @@
 #include "base/diagnostics.h"
 #include "render/accel.h"
 #include "render/color.h"
+#include "render/float_mode.h"
 #include "render/integrator.h"
 #include "render/labels.h"
 #include "render/texture.h"
@@ -200,6 +201,18 @@ std::uint64_t replica_seed(std::uint64_t seed, std::uint32_t i)
     return (i & 1u) ? mix64(seed ^ 0x6a09e667f3bcc909ULL) : seed;
 }
 
+/// The hashes pixel (x, y) draws its samples from: [0] for the seed, [1] for the odd
+/// replica's (adaptive sampling only); made once per pixel and pass.
+struct PixelReplicas {
+    PixelSeeds seeds[2];
+    PixelReplicas(int x, int y, std::uint64_t seed)
+        : seeds{{static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), seed},
+                {static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                 replica_seed(seed, 1)}}
+    {
+    }
+};
+
 /// A camera sample: its sampler, and where its camera ray (CameraRayF, beside it: traced
 /// in single precision from the near clipping plane) starts along the camera's ray.
 struct CameraSample {
@@ -209,14 +222,13 @@ struct CameraSample {
 
 /// The sampler and camera ray of sample i of pixel (x, y), written in place (c, out):
 /// a batch's samples are made where they are used, not copied there.
-void camera_sample(const RenderState& f, int x, int y, std::uint32_t i, CameraSample& c,
-                   CameraRayF& out)
+void camera_sample(const RenderState& f, int x, int y, std::uint32_t i,
+                   const PixelReplicas& replicas, CameraSample& c, CameraRayF& out)
 {
     const RenderSettings& s = f.settings;
     const bool adaptive = s.noise_target > 0;
-    const Sampler& sampler = c.sampler.emplace(
-        static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
-        adaptive ? replica_index(i) : i, adaptive ? replica_seed(s.seed, i) : s.seed, s.sampler);
+    const Sampler& sampler = c.sampler.emplace(replicas.seeds[adaptive ? (i & 1u) : 0],
+                                               adaptive ? replica_index(i) : i, s.sampler);
     auto [jx, jy] = sampler.get2d(sample_dimension::film);
     double px, py;
     if (f.filter.box()) {
@@ -284,11 +296,12 @@ void take_sample(const RenderState& f, const CameraSample& c, const CameraRayF& 
 void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uint32_t i1,
                   PixelState& st)
 {
+    const PixelReplicas replicas(x, y, f.settings.seed);
     if (f.ctx.ground) {
         CameraSample c;
         CameraRayF ray;
         for (std::uint32_t i = i0; i < i1; ++i) {
-            camera_sample(f, x, y, i, c, ray);
+            camera_sample(f, x, y, i, replicas, c, ray);
             take_sample(f, c, ray, i, st);
         }
         return;
@@ -300,7 +313,7 @@ void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uin
     for (std::uint32_t start = i0; start < i1; start += batch) {
         std::uint32_t n = std::min(batch, i1 - start);
         for (std::uint32_t k = 0; k < n; ++k)
-            camera_sample(f, x, y, start + k, samples[k], rays[k]);
+            camera_sample(f, x, y, start + k, replicas, samples[k], rays[k]);
         f.accel.intersect_coherent(std::span(rays.data(), n), std::span(hits.data(), n));
         for (std::uint32_t k = 0; k < n; ++k)
             take_sample(f, samples[k], rays[k], start + k, st, &hits[k]);
@@ -584,6 +597,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
     auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
     tbb::task_arena arena(settings.threads > 0 ? settings.threads
                                                : tbb::task_arena::automatic);
+    ArenaDenormalsFlushed flush_workers(arena);  // as Embree asks (render/float_mode.h)
     std::vector<int> targets = pass_targets(settings);
     // The sampled pixels, in image coordinates; `pixels` below holds them row by row.
     const PixelRect region = sampled_rect(settings, targets.size());
@@ -591,6 +605,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
     const int w = region.width, h = region.height;
     std::atomic<std::uint64_t> nonfinite{0};
     arena.execute([&] {
+        DenormalsFlushed flush_here;
         std::shared_ptr<const TextureSet> textures = settings.textures;
         if (!textures && (!scene.textures.empty() || !settings.ground.texture.empty()))
             textures = load_textures(scene, settings);

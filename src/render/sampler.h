@@ -49,31 +49,49 @@ constexpr std::uint32_t vertex(int depth)
 
 namespace sobol {
 
+/// The bits of v in reverse order (a byte swap, then the bits within each byte).
 constexpr std::uint32_t reverse_bits(std::uint32_t v)
 {
-    v = ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
-    v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
+    v = __builtin_bswap32(v);
     v = ((v >> 4) & 0x0f0f0f0fu) | ((v & 0x0f0f0f0fu) << 4);
-    v = ((v >> 8) & 0x00ff00ffu) | ((v & 0x00ff00ffu) << 8);
-    return (v >> 16) | (v << 16);
+    v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
+    return ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
 }
 
-/// A hash-based Owen scramble (Burley 2020) of the 32-bit binary fraction v: bit b is
-/// flipped by a pseudo-random function of `seed` and of the bits above it only, so every
-/// aligned binary interval maps onto another of the same size and a net stays a net.
-/// Bit-reversed, "the bits above" become the bits below, and each step below changes a
-/// bit by a function of lower bits only (carries and multiplication by an even number
-/// propagate upward); the two seed-dependent steps make the flips differ per seed.
-constexpr std::uint32_t owen_scramble(std::uint32_t v, std::uint64_t seed)
+/// The bits of a 64-bit v in reverse order: two 32-bit words reversed at the cost of one
+/// (the halves change places).
+constexpr std::uint64_t reverse_bits64(std::uint64_t v)
 {
-    std::uint32_t r = reverse_bits(v);
+    v = __builtin_bswap64(v);
+    v = ((v >> 4) & 0x0f0f0f0f0f0f0f0fULL) | ((v & 0x0f0f0f0f0f0f0f0fULL) << 4);
+    v = ((v >> 2) & 0x3333333333333333ULL) | ((v & 0x3333333333333333ULL) << 2);
+    return ((v >> 1) & 0x5555555555555555ULL) | ((v & 0x5555555555555555ULL) << 1);
+}
+
+/// A hash-based nested uniform (Owen) scramble of a binary fraction held bit-reversed
+/// (its most significant bit in bit 0): each step changes a bit by a function of the bits
+/// below it only (carries and multiplication by an even number propagate upward), which
+/// in the fraction's own order are the bits above it; the seed-dependent steps make the
+/// flips differ per seed. So every aligned binary interval maps onto another of the same
+/// size and a net stays a net. Working on reversed fractions saves reversing before and
+/// after each scramble (Sampler keeps its values reversed until they become floats).
+constexpr std::uint32_t scramble_reversed(std::uint32_t r, std::uint64_t seed)
+{
     r += static_cast<std::uint32_t>(seed);
     r ^= r * 0x3d4e9a2cu;
     r *= static_cast<std::uint32_t>(seed >> 32) | 1u;
     r ^= r * 0xa6f1c3d8u;
     r += static_cast<std::uint32_t>(seed >> 17);
     r ^= r * 0x5b0e7f64u;
-    return reverse_bits(r);
+    return r;
+}
+
+/// The same scramble of the 32-bit binary fraction v in its own bit order (Burley 2020's
+/// "nested uniform scramble"): bit b is flipped by a pseudo-random function of `seed` and
+/// of the bits above it only.
+constexpr std::uint32_t owen_scramble(std::uint32_t v, std::uint64_t seed)
+{
+    return reverse_bits(scramble_reversed(reverse_bits(v), seed));
 }
 
 /// The second dimension of the Sobol sequence, bit by bit: the (0,2)-sequence partner of
@@ -101,6 +119,25 @@ struct SobolSecondTable {
 };
 inline constexpr SobolSecondTable sobol_second_table;
 
+/// The second dimension bit-reversed, as the sampler scrambles it (also linear).
+struct SobolSecondReversedTable {
+    std::array<std::array<std::uint32_t, 256>, 4> byte{};
+    constexpr SobolSecondReversedTable()
+    {
+        for (std::uint32_t b = 0; b < 4; ++b)
+            for (std::uint32_t v = 0; v < 256; ++v)
+                byte[b][v] = reverse_bits(sobol_second_bitwise(v << (8 * b)));
+    }
+};
+inline constexpr SobolSecondReversedTable sobol_second_reversed_table;
+
+constexpr std::uint32_t sobol_second_reversed(std::uint32_t index)
+{
+    const auto& t = sobol_second_reversed_table.byte;
+    return t[0][index & 0xffu] ^ t[1][(index >> 8) & 0xffu] ^ t[2][(index >> 16) & 0xffu] ^
+           t[3][index >> 24];
+}
+
 constexpr std::uint32_t sobol_second(std::uint32_t index)
 {
     const auto& t = sobol_second_table.byte;
@@ -112,10 +149,53 @@ constexpr float to_unit(std::uint32_t v) { return static_cast<float>(v >> 8) * 0
 
 }  // namespace sobol
 
+/// The hash of (pixel, seed) every draw of the pixel starts from.
+constexpr std::uint64_t pixel_hash(std::uint32_t x, std::uint32_t y, std::uint64_t seed)
+{
+    return mix64(mix64(seed ^ 0x9e3779b97f4a7c15ULL) ^ ((std::uint64_t{y} << 32) | x));
+}
+
+/// The hash of one dimension pair of a pixel, which seeds the pair's scrambles.
+constexpr std::uint64_t pair_hash(std::uint64_t pixel, std::uint32_t pair)
+{
+    return mix64(pixel + (std::uint64_t{pair} + 1) * 0x9e3779b97f4a7c15ULL);
+}
+
+/// What the samples of one pixel (and seed) share: the pixel's hash and its first pairs'
+/// hashes, each computed once on first use rather than once per sample. Local to the
+/// thread that samples the pixel (it fills itself in as samplers read it).
+class PixelSeeds {
+public:
+    static constexpr std::uint32_t cached_pairs = 32;
+
+    PixelSeeds(std::uint32_t x, std::uint32_t y, std::uint64_t seed)
+        : m_pixel(pixel_hash(x, y, seed))
+    {
+    }
+
+    std::uint64_t pixel() const { return m_pixel; }
+
+    std::uint64_t pair(std::uint32_t pair) const
+    {
+        if (pair >= cached_pairs)
+            return pair_hash(m_pixel, pair);
+        if (!(m_known >> pair & 1u)) {
+            m_pairs[pair] = pair_hash(m_pixel, pair);
+            m_known |= std::uint32_t{1} << pair;
+        }
+        return m_pairs[pair];
+    }
+
+private:
+    std::uint64_t m_pixel;
+    mutable std::uint32_t m_known = 0;
+    mutable std::array<std::uint64_t, cached_pairs> m_pairs;
+};
+
 /// The sample values of one (pixel, sample index). With SampleSequence::sobol each pair
 /// of dimensions (2k, 2k+1) is its own 2D Sobol sequence ("padded"), Owen-scrambled with a
-/// hash of (seed, pixel, pair), and read at a per-pixel, per-pair shuffle of the sample
-/// index: an Owen scramble of the index's bits, which maps every aligned block of 2^k
+/// hash of (seed, pixel, pair) (one hash per pair seeds all three of its scrambles), and
+/// read at a per-pixel, per-pair shuffle of the sample index: an Owen scramble of the index's bits, which maps every aligned block of 2^k
 /// indices onto another, so each pixel's first 2^k samples are a (0,k,2)-net in every
 /// pair, while different pairs (and pixels) are decorrelated. Nothing depends on which
 /// thread, tile or pass asks, or on the frame of a turntable: images are bit-identical for
@@ -124,9 +204,17 @@ class Sampler {
 public:
     Sampler(std::uint32_t x, std::uint32_t y, std::uint32_t sample, std::uint64_t seed,
             SampleSequence sequence = SampleSequence::sobol)
-        : m_pixel(mix64(mix64(seed ^ 0x9e3779b97f4a7c15ULL) ^
-                        ((std::uint64_t{y} << 32) | x))),
-          m_sample(sample), m_sequence(sequence)
+        : m_pixel(pixel_hash(x, y, seed)), m_sample(sample),
+          m_sample_reversed(sobol::reverse_bits(sample)), m_sequence(sequence)
+    {
+    }
+
+    /// The same values, with the pixel's hashes from `seeds` (made with the same x, y and
+    /// seed), which must outlive the sampler.
+    Sampler(const PixelSeeds& seeds, std::uint32_t sample,
+            SampleSequence sequence = SampleSequence::sobol)
+        : m_pixel(seeds.pixel()), m_seeds(&seeds), m_sample(sample),
+          m_sample_reversed(sobol::reverse_bits(sample)), m_sequence(sequence)
     {
     }
 
@@ -135,11 +223,12 @@ public:
     {
         if (m_sequence == SampleSequence::white)
             return white(dimension, 0);
-        std::uint32_t pair = dimension >> 1;
-        std::uint32_t index = shuffled_index(pair);
-        std::uint32_t v = (dimension & 1u) ? sobol::sobol_second(index)
-                                           : sobol::reverse_bits(index);
-        return sobol::to_unit(sobol::owen_scramble(v, pair_seed(pair, 1 + (dimension & 1u))));
+        Pair p = pair(dimension >> 1);
+        std::uint32_t r = (dimension & 1u)
+                              ? sobol::scramble_reversed(sobol::sobol_second_reversed(p.index),
+                                                         p.y_seed)
+                              : sobol::scramble_reversed(p.index, p.x_seed);
+        return sobol::to_unit(sobol::reverse_bits(r));
     }
 
     /// The values of the pair (dimension, dimension + 1); `dimension` is even.
@@ -147,12 +236,14 @@ public:
     {
         if (m_sequence == SampleSequence::white)
             return {white(dimension, 0), white(dimension + 1, 0)};
-        std::uint32_t pair = dimension >> 1;
-        std::uint32_t index = shuffled_index(pair);
-        return {sobol::to_unit(sobol::owen_scramble(sobol::reverse_bits(index),
-                                                    pair_seed(pair, 1))),
-                sobol::to_unit(sobol::owen_scramble(sobol::sobol_second(index),
-                                                    pair_seed(pair, 2)))};
+        Pair p = pair(dimension >> 1);
+        // x = van der Corput of the index: bit-reversed, the index itself.
+        std::uint64_t rx = sobol::scramble_reversed(p.index, p.x_seed);
+        std::uint64_t ry =
+            sobol::scramble_reversed(sobol::sobol_second_reversed(p.index), p.y_seed);
+        std::uint64_t xy = sobol::reverse_bits64(ry << 32 | rx);  // x above, y below
+        return {sobol::to_unit(static_cast<std::uint32_t>(xy >> 32)),
+                sobol::to_unit(static_cast<std::uint32_t>(xy))};
     }
 
     /// An independent value for the `k`-th extra draw of `dimension` (k > 0): white noise,
@@ -172,19 +263,27 @@ private:
         return static_cast<float>(h >> 40) * 0x1.0p-24f;
     }
 
-    /// Seeds of one pair: role 0 shuffles the index, 1 and 2 scramble x and y.
-    std::uint64_t pair_seed(std::uint32_t pair, std::uint32_t role) const
-    {
-        return mix64(m_pixel + (std::uint64_t{pair} * 3 + role + 1) * 0x9e3779b97f4a7c15ULL);
-    }
+    /// What one pair needs: the pixel's shuffled sample index and the scrambles' seeds.
+    struct Pair {
+        std::uint32_t index;
+        std::uint64_t x_seed, y_seed;
+    };
 
-    std::uint32_t shuffled_index(std::uint32_t pair) const
+    /// One hash of (pixel, pair) seeds the pair's three scrambles: the index shuffle takes
+    /// it as it is, x and y cheap bijective remixes of it (a xorshift and an odd multiply).
+    Pair pair(std::uint32_t pair) const
     {
-        return sobol::owen_scramble(m_sample, pair_seed(pair, 0));
+        std::uint64_t h = m_seeds ? m_seeds->pair(pair) : pair_hash(m_pixel, pair);
+        // The shuffle: an Owen scramble of the index's bits (held reversed from the start).
+        std::uint32_t index = sobol::reverse_bits(sobol::scramble_reversed(m_sample_reversed, h));
+        return {index, (h ^ (h >> 31)) * 0xd1b54a32d192ed03ULL,
+                (h ^ (h >> 29)) * 0xaef17502108ef2d9ULL};
     }
 
     std::uint64_t m_pixel;
+    const PixelSeeds* m_seeds = nullptr;
     std::uint32_t m_sample;
+    std::uint32_t m_sample_reversed;
     SampleSequence m_sequence;
     std::uint32_t m_dimension = 0;
 };

@@ -30,6 +30,22 @@ TEST(Sampler, SameKeySameStream)
     }
 }
 
+TEST(Sampler, PixelSeedsGiveTheSameValuesAsPerSampleHashes)
+{
+    // The per-pixel cache is only a cache: every dimension (cached pairs and beyond), every
+    // sample, both sequences.
+    for (SampleSequence seq : {SampleSequence::sobol, SampleSequence::white}) {
+        const PixelSeeds seeds(17, 5, 42);
+        for (std::uint32_t i = 0; i < 20; ++i) {
+            Sampler cached(seeds, i, seq), plain(17, 5, i, 42, seq);
+            for (std::uint32_t d = 0; d < 2 * PixelSeeds::cached_pairs + 10; d += 2) {
+                ASSERT_EQ(cached.get2d(d), plain.get2d(d)) << i << " " << d;
+                ASSERT_EQ(cached.get1d(d + 1), plain.get1d(d + 1)) << i << " " << d;
+            }
+        }
+    }
+}
+
 TEST(Sampler, PairsAgreeWithSingleDimensions)
 {
     Sampler s(5, 9, 77, 3);
@@ -70,6 +86,23 @@ TEST(Sobol, SecondDimensionTableMatchesItsDefinition)
     const float expect[] = {0, 0.5f, 0.75f, 0.25f, 0.625f};
     for (std::uint32_t i = 0; i < 5; ++i)
         EXPECT_EQ(sobol::to_unit(sobol::sobol_second(i)), expect[i]);
+}
+
+TEST(Sobol, BitReversalsAndTheReversedTableAgreeWithTheirDefinitions)
+{
+    auto reverse_slowly = [](std::uint64_t v, int bits) {
+        std::uint64_t r = 0;
+        for (int b = 0; b < bits; ++b)
+            r |= ((v >> b) & 1u) << (bits - 1 - b);
+        return r;
+    };
+    for (std::uint32_t i : {0u, 1u, 2u, 3u, 255u, 256u, 65535u, 0x12345678u, 0xffffffffu}) {
+        EXPECT_EQ(sobol::reverse_bits(i), reverse_slowly(i, 32)) << i;
+        std::uint64_t wide = std::uint64_t{i} * 0x9e3779b97f4a7c15ULL;
+        EXPECT_EQ(sobol::reverse_bits64(wide), reverse_slowly(wide, 64)) << i;
+        EXPECT_EQ(sobol::sobol_second_reversed(i), sobol::reverse_bits(sobol::sobol_second(i)))
+            << i;
+    }
 }
 
 TEST(Sobol, OwenScrambleKeepsAlignedIntervals)
