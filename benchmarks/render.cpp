@@ -27,6 +27,7 @@
 #include <sys/resource.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -108,6 +109,25 @@ struct RayLog {
         }
         rays[next++] = r;
     }
+    /// Records the m rays of one stream call together in the calling thread's chunk (a
+    /// new chunk when they do not fit; the old one's rest stays empty), the first with
+    /// its batch's size in `id` (Embree does not read it; the replay restores it).
+    void record_batch(const RTCRayHit* rayhit, unsigned m, std::size_t stride, std::size_t& next,
+                      std::size_t& end)
+    {
+        if (m == 0 || m > chunk)
+            return;
+        if (next != full && end - next < m)
+            next = end;  // take a new chunk below
+        for (unsigned i = 0; i < m; ++i) {
+            RTCRay r = reinterpret_cast<const RTCRayHit*>(reinterpret_cast<const char*>(rayhit) +
+                                                          i * stride)->ray;
+            r.id = i == 0 ? m : 0;
+            record(r, next, end);
+            if (next == full)
+                return;
+        }
+    }
     /// Drops the slots never filled.
     void compact()
     {
@@ -117,14 +137,16 @@ struct RayLog {
 
 struct Recorder {
     cambium::render::RayCounter intersections, occlusions;  // per thread, uncontended
+    cambium::render::RayCounter stream_intersections;  // of `intersections`: in streams
     std::atomic<bool> started{false};
     Clock::time_point first_call;
     double first_call_cpu = 0;
     double rss_at_first_call = 0;
     std::mutex mutex;
     RTCScene scene = nullptr;          // the render's: alive until render() returns
-    /// The first rays traced, as given.
-    RayLog rays, occlusion_rays;
+    /// The first rays traced, as given; stream_rays: those traced in streams
+    /// (rtcIntersect1M: camera rays), each stream kept together.
+    RayLog rays, occlusion_rays, stream_rays;
     std::atomic<bool> recording{false};
 };
 Recorder recorder;
@@ -153,7 +175,8 @@ void note_call(RTCScene scene)
             recorder.first_call_cpu = cpu_seconds();
             // Less the recorder's own buffers (allocated and touched before the render).
             recorder.rss_at_first_call =
-                peak_rss_mb() - double((recorder.rays.rays.size() + recorder.occlusion_rays.rays.size()) *
+                peak_rss_mb() - double((recorder.rays.rays.size() + recorder.occlusion_rays.rays.size() +
+                                        recorder.stream_rays.rays.size()) *
                                        sizeof(RTCRay)) / (1024.0 * 1024.0);
             recorder.scene = scene;
             recorder.started = true;
@@ -175,7 +198,7 @@ extern "C" void rtcIntersect1(RTCScene scene, RTCIntersectContext* context, RTCR
 }
 
 // Camera rays are traced as coherent streams (EmbreeScene::intersect_coherent): counted
-// and recorded ray by ray like the others (the raw replay traces them one at a time).
+// apart and recorded stream by stream, so that the raw replay traces the same streams.
 extern "C" void rtcIntersect1M(RTCScene scene, RTCIntersectContext* context, RTCRayHit* rayhit,
                                unsigned int m, size_t byte_stride)
 {
@@ -184,11 +207,9 @@ extern "C" void rtcIntersect1M(RTCScene scene, RTCIntersectContext* context, RTC
     if (recorder.recording.load(std::memory_order_relaxed)) {
         note_call(scene);
         recorder.intersections.add(m);
+        recorder.stream_intersections.add(m);
         thread_local std::size_t next = 0, end = 0;
-        for (unsigned int i = 0; i < m; ++i)
-            recorder.rays.record(reinterpret_cast<const RTCRayHit*>(
-                                     reinterpret_cast<const char*>(rayhit) + i * byte_stride)->ray,
-                                 next, end);
+        recorder.stream_rays.record_batch(rayhit, m, byte_stride, next, end);
     }
     real(scene, context, rayhit, m, byte_stride);
 }
@@ -394,11 +415,49 @@ double replay(RTCScene scene, const std::vector<RTCRay>& rays, bool occlusion,
     return seconds_since(t0);
 }
 
+/// Raw rtcIntersect1M over the recorded streams (each as the path tracer traced it, with
+/// a coherent context), in parallel; returns seconds.
+double replay_streams(RTCScene scene, const std::vector<RTCRay>& rays, std::uint64_t& hits)
+{
+    using Intersect1M = void (*)(RTCScene, RTCIntersectContext*, RTCRayHit*, unsigned int, size_t);
+    static auto real = reinterpret_cast<Intersect1M>(dlsym(RTLD_NEXT, "rtcIntersect1M"));
+    std::vector<std::size_t> starts;  // each stream's first ray (its size in `id`)
+    for (std::size_t i = 0; i < rays.size(); i += std::max<unsigned>(rays[i].id, 1))
+        if (rays[i].id > 0 && i + rays[i].id <= rays.size())
+            starts.push_back(i);
+    std::atomic<std::uint64_t> hit_count{0};
+    auto t0 = Clock::now();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, starts.size(), 64),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+        cambium::render::DenormalsFlushed flushed;
+        ReplayContext c;
+        c.context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        std::array<RTCRayHit, RayLog::chunk> batch;
+        std::uint64_t local = 0;
+        for (std::size_t b = r.begin(); b != r.end(); ++b) {
+            const std::size_t first = starts[b];
+            const unsigned m = rays[first].id;
+            for (unsigned k = 0; k < m; ++k) {
+                batch[k].ray = rays[first + k];
+                batch[k].ray.id = 0;
+                batch[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                batch[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            }
+            real(scene, &c.context, batch.data(), m, sizeof(RTCRayHit));
+            for (unsigned k = 0; k < m; ++k)
+                local += batch[k].hit.geomID != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
+        }
+        hit_count += local;
+    });
+    hits = hit_count;
+    return seconds_since(t0);
+}
+
 /// Raw Embree on the recorded rays of both kinds.
 struct RawFigures {
-    std::uint64_t hits = 0, occluded = 0;
-    double intersect_s = 0, occluded_s = 0;
-    double intersect_cpu_s = 0, occluded_cpu_s = 0;
+    std::uint64_t hits = 0, occluded = 0, stream_hits = 0;
+    double intersect_s = 0, occluded_s = 0, stream_s = 0;
+    double intersect_cpu_s = 0, occluded_cpu_s = 0, stream_cpu_s = 0;
 };
 
 int run(int argc, char** argv)
@@ -460,10 +519,11 @@ int run(int argc, char** argv)
     // while its Embree scene is alive.
     recorder.rays.prepare(2'000'000);  // touched here, before the clock starts
     recorder.occlusion_rays.prepare(2'000'000);
+    recorder.stream_rays.prepare(2'000'000);
     recorder.recording = true;
     Clock::time_point trace_end;
     double trace_end_cpu = 0;
-    std::uint64_t intersections = 0, occlusions = 0;
+    std::uint64_t intersections = 0, occlusions = 0, stream_intersections = 0;
     RawFigures raw;
     settings.on_pass = [&](const cambium::render::Image&) {
         trace_end = Clock::now();
@@ -471,16 +531,21 @@ int run(int argc, char** argv)
         recorder.recording = false;
         intersections = recorder.intersections.total();
         occlusions = recorder.occlusions.total();
+        stream_intersections = recorder.stream_intersections.total();
         recorder.rays.compact();
         recorder.occlusion_rays.compact();
+        recorder.stream_rays.compact();
         arena.execute([&] {
             double cpu0 = cpu_seconds();
             raw.intersect_s = replay(recorder.scene, recorder.rays.rays, false, raw.hits);
             double cpu1 = cpu_seconds();
             raw.occluded_s =
                 replay(recorder.scene, recorder.occlusion_rays.rays, true, raw.occluded);
+            double cpu2 = cpu_seconds();
+            raw.stream_s = replay_streams(recorder.scene, recorder.stream_rays.rays, raw.stream_hits);
             raw.intersect_cpu_s = cpu1 - cpu0;
-            raw.occluded_cpu_s = cpu_seconds() - cpu1;
+            raw.occluded_cpu_s = cpu2 - cpu1;
+            raw.stream_cpu_s = cpu_seconds() - cpu2;
         });
     };
     auto r0 = Clock::now();
@@ -496,17 +561,25 @@ int run(int argc, char** argv)
     double rays = double(intersections + occlusions);
     // Raw Embree's time for the path tracer's mix of rays, at the replayed rates.
     auto rate = [](std::size_t n, double s) { return s > 0 ? double(n) / s : 0.0; };
+    // Rays traced one by one and in streams (camera rays) are replayed as they were traced.
+    const std::uint64_t single_intersections = intersections - stream_intersections;
     double raw_intersect_rate = rate(recorder.rays.rays.size(), raw.intersect_s);
+    double raw_stream_rate = rate(recorder.stream_rays.rays.size(), raw.stream_s);
     double raw_occluded_rate = rate(recorder.occlusion_rays.rays.size(), raw.occluded_s);
-    double raw_mix_s = (raw_intersect_rate > 0 ? double(intersections) / raw_intersect_rate : 0) +
-                       (raw_occluded_rate > 0 ? double(occlusions) / raw_occluded_rate : 0);
+    double raw_mix_s =
+        (raw_intersect_rate > 0 ? double(single_intersections) / raw_intersect_rate : 0) +
+        (raw_stream_rate > 0 ? double(stream_intersections) / raw_stream_rate : 0) +
+        (raw_occluded_rate > 0 ? double(occlusions) / raw_occluded_rate : 0);
     double raw_rays_per_s = raw_mix_s > 0 ? rays / raw_mix_s : 0;
     // The same in CPU seconds (the measure that holds on a loaded machine).
     double trace_cpu_s = trace_end_cpu - recorder.first_call_cpu;
     double raw_mix_cpu_s =
-        (raw.intersect_cpu_s > 0
-             ? double(intersections) * raw.intersect_cpu_s / double(recorder.rays.rays.size())
-             : 0) +
+        (raw.intersect_cpu_s > 0 ? double(single_intersections) * raw.intersect_cpu_s /
+                                       double(recorder.rays.rays.size())
+                                 : 0) +
+        (raw.stream_cpu_s > 0 ? double(stream_intersections) * raw.stream_cpu_s /
+                                    double(recorder.stream_rays.rays.size())
+                              : 0) +
         (raw.occluded_cpu_s > 0 ? double(occlusions) * raw.occluded_cpu_s /
                                       double(recorder.occlusion_rays.rays.size())
                                 : 0);
@@ -518,7 +591,9 @@ int run(int argc, char** argv)
         "\"intersect_rays\":%llu,\"occlusion_rays\":%llu,\"rays_per_s\":%.0f,"
         "\"paths_per_s\":%.0f,\"raw_embree\":{\"intersect_rays\":%zu,\"intersect_s\":%.3f,"
         "\"intersect_rays_per_s\":%.0f,\"hit_fraction\":%.3f,\"occlusion_rays\":%zu,"
-        "\"occlusion_s\":%.3f,\"occlusion_rays_per_s\":%.0f,\"rays_per_s\":%.0f},"
+        "\"occlusion_s\":%.3f,\"occlusion_rays_per_s\":%.0f,\"stream_rays\":%zu,"
+        "\"stream_s\":%.3f,\"stream_rays_per_s\":%.0f,\"rays_per_s\":%.0f},"
+        "\"stream_intersect_rays\":%llu,"
         "\"path_tracer_intersect_rays_per_s\":%.0f,\"path_tracer_fraction_of_raw\":%.3f,"
         "\"trace_cpu_s\":%.3f,\"raw_embree_cpu_s\":%.3f,"
         "\"path_tracer_fraction_of_raw_cpu\":%.3f,\"peak_rss_mb\":%.1f}\n",
@@ -531,7 +606,9 @@ int run(int argc, char** argv)
         double(report.samples) / trace_s, recorder.rays.rays.size(), raw.intersect_s,
         raw_intersect_rate,
         recorder.rays.rays.empty() ? 0.0 : double(raw.hits) / double(recorder.rays.rays.size()),
-        recorder.occlusion_rays.rays.size(), raw.occluded_s, raw_occluded_rate, raw_rays_per_s,
+        recorder.occlusion_rays.rays.size(), raw.occluded_s, raw_occluded_rate,
+        recorder.stream_rays.rays.size(), raw.stream_s, raw_stream_rate, raw_rays_per_s,
+        static_cast<unsigned long long>(stream_intersections),
         double(intersections) / trace_s,
         raw_rays_per_s > 0 ? rays / trace_s / raw_rays_per_s : 0.0, trace_cpu_s, raw_mix_cpu_s,
         trace_cpu_s > 0 ? raw_mix_cpu_s / trace_cpu_s : 0.0, peak_rss_mb());
