@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "app/pipeline.h"
+#include "e2e/model_folder.h"
 
 using namespace cambium;
 namespace fs = std::filesystem;
@@ -21,14 +22,7 @@ namespace {
 
 app::Options write_model(const std::string& name, const std::string& lsystem)
 {
-    fs::path dir = fs::temp_directory_path() / ("cambium_fragment_" + name);
-    fs::create_directories(dir);
-    std::ofstream(dir / "plant.l") << lsystem;
-    std::ofstream(dir / "plant.v") << "line style: cylinder\ninitial line width: 0.2\n";
-    app::Options options;
-    options.lsystem = dir / "plant.l";
-    options.view = dir / "plant.v";
-    return options;
+    return cambium::testing::write_model("fragment_" + name, lsystem);
 }
 
 using Segment = std::array<long, 6>;

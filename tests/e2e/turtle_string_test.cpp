@@ -9,6 +9,7 @@
 #include <string>
 
 #include "app/pipeline.h"
+#include "e2e/model_folder.h"
 
 using namespace cambium;
 namespace fs = std::filesystem;
@@ -17,14 +18,7 @@ namespace {
 
 app::Options write_model(const std::string& name, const std::string& lsystem)
 {
-    fs::path dir = fs::temp_directory_path() / ("cambium_turtle_string_" + name);
-    fs::create_directories(dir);
-    std::ofstream(dir / "plant.l") << lsystem;
-    std::ofstream(dir / "plant.v") << "line style: cylinder\ninitial line width: 0.2\n";
-    app::Options options;
-    options.lsystem = dir / "plant.l";
-    options.view = dir / "plant.v";
-    return options;
+    return cambium::testing::write_model("turtle_string_" + name, lsystem);
 }
 
 const std::string plain = "lsystem: 1\nderivation length: 3\naxiom: A\n"
