@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "app/pipeline.h"
-#include "e2e/model_folder.h"
+#include "model_folder.h"
 
 using namespace cambium;
 namespace fs = std::filesystem;

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "app/pipeline.h"
-#include "e2e/model_folder.h"
+#include "model_folder.h"
 
 using namespace cambium;
 namespace fs = std::filesystem;
