@@ -106,13 +106,23 @@ namespace {
 using Clock = std::chrono::steady_clock;
 namespace render = cambium::render;
 
-/// The benchmark plants: thin twigs, leaves, transparent organs and instancing, and
-/// textured generalized cylinders.
-const std::map<std::string, std::string> plants = {
-    {"FernLeaf", "cpfg/10-manuals/15-VlabTools/FernLeaf"},
-    {"WeepingBirch", "cpfg/10-manuals/11-CPFG/WeepingBirch"},
-    {"Lilac", "cpfg/10-manuals/11-CPFG/Lilac"},
-    {"GeneralizedCylinder", "cpfg/10-manuals/11-CPFG/GeneralizedCylinder"},
+/// Where a benchmark plant comes from: a corpus model (its model.json gives the command
+/// line) or one of the project's own scenes (with its command line here).
+struct PlantSource {
+    std::string folder;   ///< under the corpus, or under the project's source folder
+    std::string command;  ///< empty: the corpus model's model.json; else the project's
+};
+
+/// The benchmark plants: leaves (FernLeaf), thin twigs (WeepingBirch), instancing and a
+/// faint glow (Lilac), textured generalized cylinders, and translucent leaves lit by two
+/// lights (the project's default tree: `translucency:` passes a third of the leaves'
+/// diffuse light through).
+const std::map<std::string, PlantSource> plants = {
+    {"FernLeaf", {"cpfg/10-manuals/15-VlabTools/FernLeaf", ""}},
+    {"WeepingBirch", {"cpfg/10-manuals/11-CPFG/WeepingBirch", ""}},
+    {"Lilac", {"cpfg/10-manuals/11-CPFG/Lilac", ""}},
+    {"GeneralizedCylinder", {"cpfg/10-manuals/11-CPFG/GeneralizedCylinder", ""}},
+    {"TranslucentTree", {"scenes/default", "cpfg -M plant.mat plant.l plant.v"}},
 };
 
 struct Settings {
@@ -148,11 +158,13 @@ const char* name(render::SampleSequence s)
 
 /// The plant's scene, through the same path as `cambium <model.json's command>`; the
 /// current folder becomes the model's (its files are named relative to it).
-cambium::geom::Scene load_plant(const fs::path& folder)
+cambium::geom::Scene load_plant(const fs::path& folder, std::string command)
 {
-    std::ifstream in(folder / "model.json");
-    nlohmann::json json = nlohmann::json::parse(in);
-    std::istringstream words(json.at("command").get<std::string>());
+    if (command.empty()) {
+        std::ifstream in(folder / "model.json");
+        command = nlohmann::json::parse(in).at("command").get<std::string>();
+    }
+    std::istringstream words(command);
     std::vector<std::string> args;
     std::string word;
     words >> word;  // "cpfg"
@@ -355,10 +367,11 @@ void run_adaptive(const std::string& plant, const cambium::geom::Scene& scene,
     std::fflush(stdout);
 }
 
-void run_plant(const std::string& plant, const fs::path& folder, const Settings& s,
+void run_plant(const std::string& plant, const fs::path& folder, const std::string& command,
+               const Settings& s,
                const fs::path& cache)
 {
-    cambium::geom::Scene scene = load_plant(folder);
+    cambium::geom::Scene scene = load_plant(folder, command);
     std::vector<float> ref = reference(
         scene, s,
         cache / (plant + "-" + std::to_string(s.width) + "x" + std::to_string(s.height) + "-" +
@@ -451,19 +464,22 @@ int main(int argc, char** argv)
         fs::path corpus = fs::absolute(env ? env : CAMBIUM_CORPUS_DEFAULT);
         fs::path cache = fs::absolute(CAMBIUM_BUILD_DIR) / "convergence-cache";
         for (const std::string& plant : s.plants) {
-            fs::path folder = corpus / plants.at(plant);
-            if (!fs::exists(folder / "model.json")) {
+            const PlantSource& source = plants.at(plant);
+            const fs::path folder = source.command.empty()
+                                        ? corpus / source.folder
+                                        : fs::path(CAMBIUM_SOURCE_DIR) / source.folder;
+            if (source.command.empty() && !fs::exists(folder / "model.json")) {
                 std::printf("{\"plant\":\"%s\",\"skipped\":\"no corpus model at %s\"}\n",
                             plant.c_str(), folder.string().c_str());
                 continue;
             }
             if (s.export_folder.empty()) {
-                run_plant(plant, folder, s, cache);
+                run_plant(plant, folder, source.command, s, cache);
                 continue;
             }
             fs::create_directories(s.export_folder);
             std::ofstream out(s.export_folder / (plant + ".json"));
-            cambium::bench::write_scene_json(load_plant(folder), s.width, s.height, folder, out);
+            cambium::bench::write_scene_json(load_plant(folder, source.command), s.width, s.height, folder, out);
             if (!out)
                 throw std::runtime_error("cannot write " + (s.export_folder / plant).string());
         }

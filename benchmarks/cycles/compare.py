@@ -30,7 +30,7 @@ import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-PLANTS = ["FernLeaf", "WeepingBirch", "Lilac", "GeneralizedCylinder"]
+PLANTS = ["FernLeaf", "WeepingBirch", "Lilac", "GeneralizedCylinder", "TranslucentTree"]
 
 
 def system_python_env():
