@@ -435,10 +435,13 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         kept.push_back({frame, std::move(turtle),
                         own_camera ? std::optional<geom::View>(scene.view) : std::nullopt});
     };
-    // -homo: strings after the homomorphism, which the turtle then reads as they are
-    auto written_string = [&](const lsys::ModuleString& derived) {
-        return options.homomorphism_in_string ? model.lsystem.interpretation_string(derived)
-                                              : derived;
+    // -homo: the strings written are the homomorphism's output, which the turtle then
+    // reads as it is; otherwise the derived string is written as it stands (not copied)
+    // and the turtle reads turtle_string()'s.
+    auto after_homomorphism = [&](const lsys::ModuleString& derived) {
+        return options.homomorphism_in_string
+                   ? std::optional(model.lsystem.interpretation_string(derived))
+                   : std::nullopt;
     };
     const std::vector<lsys::Growth> grows = grown_symbols(model.lsystem);
     lsys::ModuleString before;  // the previous frame's string (--inbetween)
@@ -471,7 +474,8 @@ int run_animation(const Options& options, const SequenceOutputs& out)
                 lsys::ModuleString grown = lsys::inbetween(
                     before, string, lineage, float(k) / float(numbering.inbetween + 1), grows);
                 ledger.derived(g.number, seconds_since(blend_start));
-                take(turtle_string(model, written_string(grown), options), g);
+                std::optional<lsys::ModuleString> homo = after_homomorphism(grown);
+                take(homo ? std::move(*homo) : turtle_string(model, grown, options), g);
             }
         if (numbering.inbetween > 0) {
             before = string;
@@ -479,7 +483,8 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         }
         if (!filter.selected(number))
             return;
-        lsys::ModuleString written = written_string(string);
+        std::optional<lsys::ModuleString> homo = after_homomorphism(string);
+        const lsys::ModuleString& written = homo ? *homo : string;
         if (writes)
             out.write_strings(model, written, f.number);
         if (!options.view_volume && !filter.to_render(number))
@@ -499,7 +504,7 @@ int run_animation(const Options& options, const SequenceOutputs& out)
             return;
         geom::AnimationFrame anchor = f;
         anchor.number = number;
-        take(turtle_string(model, written, options), anchor);
+        take(homo ? std::move(*homo) : turtle_string(model, string, options), anchor);
     });
     out.say(fmt::format("derived {} steps once for {} frames", derived, images_total));
     if (keep_all && !kept.empty()) {
