@@ -37,12 +37,11 @@ public:
     {
         write_with_oiio(image, temporary, format, file, options);
     }
-    std::unique_ptr<TextureSource> open_textures(const std::vector<geom::TextureDef>& defs,
-                                                 const std::filesystem::path& base,
-                                                 std::uint64_t max_memory_bytes,
-                                                 const WarnFn& warn) const override
+    std::optional<TexturePixels> read_texture(const std::filesystem::path& file,
+                                              std::uint64_t max_memory_bytes,
+                                              std::string& why) const override
     {
-        return open_oiio_textures(defs, base, max_memory_bytes, warn);
+        return read_oiio_texture(file, max_memory_bytes, why);
     }
     MapTexels read_map(const std::filesystem::path& file, float scale,
                        std::size_t max_texels) const override

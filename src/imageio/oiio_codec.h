@@ -11,10 +11,8 @@ void write_with_oiio(const Image& image, const std::filesystem::path& temporary,
                      ImageFormat format, const std::filesystem::path& file,
                      const WriteOptions& options);
 
-std::unique_ptr<TextureSource> open_oiio_textures(const std::vector<geom::TextureDef>& defs,
-                                                  const std::filesystem::path& base,
-                                                  std::uint64_t max_memory_bytes,
-                                                  const WarnFn& warn);
+std::optional<TexturePixels> read_oiio_texture(const std::filesystem::path& file,
+                                               std::uint64_t max_memory_bytes, std::string& why);
 
 MapTexels read_oiio_map(const std::filesystem::path& file, float scale, std::size_t max_texels);
 

@@ -9,36 +9,22 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "geom/scene.h"
 #include "render/image_io.h"
-#include "render/texture.h"
+#include "render/mip_map.h"
 
 namespace cambium::render {
-
-/// One TextureSet's opened textures (see TextureSet for the meaning of each call).
-class TextureSource {
-public:
-    virtual ~TextureSource() = default;
-    virtual std::size_t size() const = 0;
-    virtual bool valid(int index) const = 0;
-    virtual bool decal(int index) const = 0;
-    virtual bool has_alpha(int index) const = 0;
-    virtual Texel lookup(int index, float s, float t, const TextureFootprint& footprint) const = 0;
-};
 
 /// An environment map's texels: linear RGB, rows top to bottom, scaled.
 struct MapTexels {
     int width = 0, height = 0;
     std::vector<float> rgb;
 };
-
-/// Warnings go back through this (the module's copy of base has its own sinks).
-using WarnFn = std::function<void(const std::string& file, const std::string& message)>;
 
 /// The image file formats write_image knows, from the file's extension.
 enum class ImageFormat { png, jpeg, tiff, exr };
@@ -50,9 +36,13 @@ public:
     virtual void write(const Image& image, const std::filesystem::path& temporary,
                        ImageFormat format, const std::filesystem::path& file,
                        const WriteOptions& options) const = 0;
-    virtual std::unique_ptr<TextureSource> open_textures(
-        const std::vector<geom::TextureDef>& defs, const std::filesystem::path& base,
-        std::uint64_t max_memory_bytes, const WarnFn& warn) const = 0;
+    /// A texture file's pixels. Throws cambium::Error naming the file when its header
+    /// declares more than max_texture_side pixels on a side, or pixels (with MIP levels)
+    /// past `max_memory_bytes`, found before any pixel is read; nullopt with `why` set
+    /// when the file cannot be read (cpfg draws without such a texture).
+    virtual std::optional<TexturePixels> read_texture(const std::filesystem::path& file,
+                                                      std::uint64_t max_memory_bytes,
+                                                      std::string& why) const = 0;
     /// Throws cambium::Error naming the file when it cannot be read or is too large.
     virtual MapTexels read_map(const std::filesystem::path& file, float scale,
                                std::size_t max_texels) const = 0;
@@ -62,7 +52,7 @@ public:
 const ImageCodec& image_codec();
 
 /// The interface's version: the loader refuses a module of another version.
-inline constexpr int image_codec_version = 1;
+inline constexpr int image_codec_version = 2;
 
 }  // namespace cambium::render
 

@@ -1,22 +1,31 @@
 // SPDX-License-Identifier: Apache-2.0
-// The view file's textures: opened and looked up by the image I/O module
-// (render/image_codec.h), loaded only when a model has textures.
+// The view file's textures: decoded by the image I/O module (render/image_codec.h),
+// loaded only when a model has textures, and filtered here (render/mip_map.h).
 #include "render/texture.h"
 
 #include <atomic>
+#include <optional>
 
 #include "base/diagnostics.h"
 #include "render/image_codec.h"
+#include "render/mip_map.h"
 
 namespace cambium::render {
 
-struct TextureSet::Impl {
-    std::unique_ptr<TextureSource> source;  // null: no textures
+namespace {
+
+struct Entry {
+    std::optional<MipMap> map;  // none: the file was missing or unreadable
+    bool decal = false;
 };
 
-namespace {
 std::atomic<std::uint64_t> texture_sets_constructed{0};
+
 }  // namespace
+
+struct TextureSet::Impl {
+    std::vector<Entry> entries;
+};
 
 std::uint64_t TextureSet::constructed_count() { return texture_sets_constructed.load(); }
 
@@ -25,24 +34,50 @@ TextureSet::TextureSet(const std::vector<geom::TextureDef>& defs,
     : m_impl(std::make_unique<Impl>())
 {
     texture_sets_constructed.fetch_add(1);
-    if (defs.empty())
-        return;
-    m_impl->source = image_codec().open_textures(
-        defs, base, max_memory_bytes,
-        [](const std::string& file, const std::string& message) { warn(FileLoc{file}, message); });
+    for (const geom::TextureDef& def : defs) {
+        std::filesystem::path file = def.file;
+        if (file.is_relative() && !base.empty())
+            file = base / file;
+        // As cpfg, a texture that cannot be read is a warning and the surfaces it names
+        // are drawn untextured (the corpus names maple.rgb beside a maple.png); the
+        // index keeps its place for @Tx.
+        Entry& entry = m_impl->entries.emplace_back();
+        if (!std::filesystem::is_regular_file(file)) {
+            warn(FileLoc{file.string()}, "texture not found; drawing without it");
+            continue;
+        }
+        std::string why;
+        std::optional<TexturePixels> pixels =
+            image_codec().read_texture(file, max_memory_bytes, why);
+        if (!pixels) {
+            warn(FileLoc{file.string()}, "texture cannot be read" +
+                                             (why.empty() ? std::string() : ": " + why) +
+                                             "; drawing without it");
+            continue;
+        }
+        entry.map.emplace(std::move(*pixels), TextureFilter{def.linear_filter, def.mipmap});
+        entry.decal = def.decal;
+    }
 }
 
 TextureSet::~TextureSet() = default;
 
-std::size_t TextureSet::size() const { return m_impl->source ? m_impl->source->size() : 0; }
+std::size_t TextureSet::size() const { return m_impl->entries.size(); }
 
-bool TextureSet::valid(int index) const { return m_impl->source && m_impl->source->valid(index); }
+bool TextureSet::valid(int index) const
+{
+    return index >= 0 && static_cast<std::size_t>(index) < m_impl->entries.size() &&
+           m_impl->entries[static_cast<std::size_t>(index)].map.has_value();
+}
 
-bool TextureSet::decal(int index) const { return valid(index) && m_impl->source->decal(index); }
+bool TextureSet::decal(int index) const
+{
+    return valid(index) && m_impl->entries[static_cast<std::size_t>(index)].decal;
+}
 
 bool TextureSet::has_alpha(int index) const
 {
-    return valid(index) && m_impl->source->has_alpha(index);
+    return valid(index) && m_impl->entries[static_cast<std::size_t>(index)].map->has_alpha();
 }
 
 Texel TextureSet::lookup(int index, float s, float t, float width) const
@@ -52,7 +87,8 @@ Texel TextureSet::lookup(int index, float s, float t, float width) const
 
 Texel TextureSet::lookup(int index, float s, float t, const TextureFootprint& fp) const
 {
-    return valid(index) ? m_impl->source->lookup(index, s, t, fp) : Texel{};
+    return valid(index) ? m_impl->entries[static_cast<std::size_t>(index)].map->lookup(s, t, fp)
+                        : Texel{};
 }
 
 Vec3f TextureSet::apply(int index, const Vec3f& diffuse, float s, float t,
@@ -60,8 +96,9 @@ Vec3f TextureSet::apply(int index, const Vec3f& diffuse, float s, float t,
 {
     if (!valid(index))
         return diffuse;
-    Texel texel = lookup(index, s, t, footprint);
-    return decal(index) ? texel.colour : diffuse * texel.colour;
+    const Entry& entry = m_impl->entries[static_cast<std::size_t>(index)];
+    Texel texel = entry.map->lookup(s, t, footprint);
+    return entry.decal ? texel.colour : diffuse * texel.colour;
 }
 
 }  // namespace cambium::render

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// The view file's textures, looked up through one OpenImageIO TextureSystem per render.
+// The view file's textures: decoded by OpenImageIO, MIP-mapped and filtered in memory.
 #pragma once
 
 #include <filesystem>
@@ -24,7 +24,7 @@ struct TextureFootprint {
     float dsdx = 0, dtdx = 0, dsdy = 0, dtdy = 0;
 };
 
-/// The Scene's TextureDefs, opened once (mipmapped on demand by OIIO, any format OIIO reads,
+/// The Scene's TextureDefs, opened once (MIP-mapped when opened, any format OIIO reads,
 /// SGI .rgb included). Thread-safe lookups after construction.
 ///
 /// Coordinates are OpenGL's: (s, t) in [0, 1]^2 with t = 0 the image's bottom row; both
