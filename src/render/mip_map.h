@@ -3,9 +3,9 @@
 // GL_REPEAT texture (nearest or linear within a level, linear between levels).
 //
 // Why not OpenImageIO's TextureSystem, which the textures used to go through: its tile
-// cache and general filters cost some 150 ns a lookup, a fifth of the render time of a
-// textured plant (docs/benchmarks.md), while a view file's textures are small images
-// that fit in memory whole. OpenImageIO still decodes the files (render/image_codec.h).
+// cache and general filters cost 3 to 4 times as much a lookup, a fifth of the render
+// time of a textured plant (docs/benchmarks.md), while a view file's textures are small
+// images that fit in memory whole. OpenImageIO still decodes the files (render/image_codec.h).
 #pragma once
 
 #include <cstdint>
