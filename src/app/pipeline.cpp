@@ -222,7 +222,8 @@ double deferred_number(const geom::ViewCommand& c)
 
 /// cpfg's colormap-mode lighting: materials 0..255 move their index by the cosine,
 /// their copies 256..511 (predefined surfaces and patches) by the surface rule.
-void light_by_colour_index(geom::Scene& scene, const geom::ViewFile& view)
+void light_by_colour_index(geom::Scene& scene, const geom::ViewFile& view,
+                           const geom::Palette& palette, int colour_block)
 {
     geom::ColourIndexLight light;
     // cpfg's light direction is the first light's position or direction, normalised.
@@ -242,13 +243,25 @@ void light_by_colour_index(geom::Scene& scene, const geom::ViewFile& view)
             light.surface_diffuse = static_cast<float>(deferred_number(c));
     }
     scene.colour_index_light = light;
-    scene.materials.resize(2 * geom::colour_indices);
+    // 0..255: the selected colormap, cosine rule; 256..511: the same, surface rule;
+    // 512..767: the next colormap, surface rule, for patch colours past 255 (cpfg's
+    // colour table runs on into it; an unloaded one is grey, a last one repeats).
+    const int next_block = std::min(colour_block + 1, geom::Palette::blocks - 1);
+    std::vector<geom::Material> next =
+        next_block > colour_block ? palette.entries(next_block) : scene.materials;
+    scene.materials.resize(3 * geom::colour_indices);
     for (std::size_t i = 0; i < geom::colour_indices; ++i) {
         geom::Material& m = scene.materials[i];
         m.index_lighting = geom::IndexLighting::cosine;
         m.colour_index = static_cast<std::uint8_t>(i);
         scene.materials[i + geom::colour_indices] = m;
         scene.materials[i + geom::colour_indices].index_lighting = geom::IndexLighting::surface;
+        geom::Material& n = scene.materials[i + 2 * geom::colour_indices];
+        n = next.at(i);
+        n.transparency = 0;
+        n.index_lighting = geom::IndexLighting::surface;
+        n.colour_index = static_cast<std::uint8_t>(i);
+        n.colour_table = 2 * geom::colour_indices;
     }
 }
 /// The scene's own lines: with no texture on any of them, the per-key texture v and the
@@ -334,7 +347,10 @@ geom::InterpretOptions interpret_options(const Model& model, const Options& opti
     geom::InterpretOptions turtle;
     turtle.strings = model.lsystem.program().strings;
     if (lit_by_colour_index(model))
+    {
         turtle.surface_material_offset = geom::colour_indices;
+        turtle.next_colormap_material_offset = 2 * geom::colour_indices;
+    }
     turtle.max_memory_bytes = options.max_memory_bytes;
     if (model.fragment_turtles)
         turtle.fragment_turtles = *model.fragment_turtles;
@@ -390,7 +406,7 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
         for (int i = t.first; i <= t.last; ++i)
             scene.materials.at(static_cast<std::size_t>(i)).translucency = t.amount;
     if (index_lit)
-        light_by_colour_index(scene, *model.view);
+        light_by_colour_index(scene, *model.view, model.palette, options.colour_block);
 
     geom::BackgroundScene background = geom::load_view_background(
         *model.view, scene.materials[0],

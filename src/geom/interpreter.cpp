@@ -336,10 +336,36 @@ private:
     {
         m_surfaces = load_view_surfaces(m_view);
         for (SurfaceDef& def : m_surfaces) {
+            if (m_options.surface_material_offset != 0)
+                apply_patch_colours(def);
             m_surface_prototypes.push_back({static_cast<std::uint32_t>(m_scene.prototypes.size()), -1});
             m_scene.prototypes.push_back(std::move(def.prototype));
             def.prototype = Prototype{};
         }
+    }
+
+    /// Colormap-mode lighting: a patch with its own colours takes their materials
+    /// instead of the instance's (cpfg's determine_vertex_shading).
+    void apply_patch_colours(SurfaceDef& def) const
+    {
+        TriangleMesh& mesh = def.prototype.geometry.mesh;
+        for (std::size_t t = 0; t < def.patch_colours.size() && t < mesh.material.size(); ++t) {
+            const PatchColours& c = def.patch_colours[t];
+            if (c.top != 0)
+                mesh.material[t] = patch_material(c.top);
+            if (c.bottom != 0)
+                mesh.back_material[t] = patch_material(c.bottom);
+        }
+    }
+
+    /// The material of patch colour `colour` (not 0): past 255 it lies in the next
+    /// colormap; past 511 it is clamped there (docs/deviations.md).
+    std::uint16_t patch_material(int colour) const
+    {
+        if (colour < 256 || m_options.next_colormap_material_offset == 0)
+            return surface_material(colour);
+        return static_cast<std::uint16_t>(m_options.next_colormap_material_offset +
+                                          std::min(colour - 256, 255));
     }
 
     /// The prototype of surface `slot` for a texture: textures with `S:` use a copy

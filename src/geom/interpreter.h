@@ -55,6 +55,12 @@ struct InterpretOptions {
     /// lighting differs from other primitives' (pipeline: 256 in colormap mode with
     /// lighting, where the materials 256..511 are the surface-lit copies).
     std::uint16_t surface_material_offset = 0;
+    /// Where a predefined surface's patch colours (PatchColours) past 255 take their
+    /// materials: colour c is material next_colormap_material_offset + c - 256 (pipeline:
+    /// 512, the next colormap's entries, surface-lit). Patch colours 1..255 are
+    /// surface_material_offset + c; with surface_material_offset 0 (no colormap-mode
+    /// lighting) patch colours are not used, as in cpfg.
+    std::uint16_t next_colormap_material_offset = 0;
     /// The turtles saved at fragment starts over the derivation (manual 5.1.9), by index:
     /// `%(par, index)` sets the turtle to fragment_turtles[index] (save_fragment_turtles).
     std::span<const Turtle> fragment_turtles;

@@ -23,6 +23,7 @@ std::vector<Material> read_material_file(const std::filesystem::path& file);
 class Palette {
 public:
     enum class Mode { none, colormap, materials };
+    static constexpr int blocks = 16;
 
     void load_colormap(int block, const std::filesystem::path& file);
     void load_materials(int block, const std::filesystem::path& file);
@@ -40,7 +41,7 @@ private:
     void check_block(int block) const;
 
     Mode m_mode = Mode::none;
-    std::array<std::optional<std::vector<Material>>, 16> m_blocks;
+    std::array<std::optional<std::vector<Material>>, blocks> m_blocks;
 };
 
 }  // namespace cambium::geom

@@ -169,9 +169,12 @@ struct Material {
     /// Cambium extension (view file `translucency:`, docs/materials.md): the fraction of
     /// the diffuse albedo transmitted through the surface instead of reflected.
     float translucency = 0;
-    /// Colormap-mode lighting: the rule and the colour index (0..255) it starts from.
+    /// Colormap-mode lighting: the rule and the colour index (0..255) it starts from,
+    /// in the 256 materials from `colour_table` on (the colormap whose entries the
+    /// index moves over: the selected one, or the next for patch colours past 255).
     IndexLighting index_lighting = IndexLighting::none;
     std::uint8_t colour_index = 0;
+    std::uint16_t colour_table = 0;
 };
 
 /// The settings of cpfg's colormap-mode lighting (manual 5.2.5): the direction toward

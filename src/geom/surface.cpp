@@ -228,6 +228,7 @@ constexpr std::array<const char*, neighbour_count> neighbour_labels = {"AL:", "A
 struct FilePatch {
     std::string name;
     FileLoc loc;
+    PatchColours colours;
     PatchControl control{};
     std::array<std::string, neighbour_count> neighbours;
 };
@@ -276,15 +277,16 @@ FilePatch read_patch(TextCursor& in, std::string name, FileLoc loc)
     FilePatch p;
     p.name = std::move(name);
     p.loc = std::move(loc);
-    // Patch colours and diffuse coefficients are read and not used (see report).
+    // The colours (used by colormap-mode lighting); the diffuse coefficients are read
+    // and not used (docs/deviations.md).
     in.expect("TOP", "(patch colours)");
     in.expect("COLOR:", "(patch colours)");
-    in.integer("top colour");
+    p.colours.top = in.integer("top colour");
     in.expect("DIFFUSE:", "(patch colours)");
     in.number("top diffuse");
     in.expect("BOTTOM", "(patch colours)");
     in.expect("COLOR:", "(patch colours)");
-    in.integer("bottom colour");
+    p.colours.bottom = in.integer("bottom colour");
     in.expect("DIFFUSE:", "(patch colours)");
     in.number("bottom diffuse");
     for (int n = 0; n < neighbour_count; ++n) {
@@ -498,8 +500,15 @@ SurfaceDef parse_surface_text(std::string_view text, const std::string& file_nam
 
     std::int16_t texture = def.texture.value_or(no_texture);
     TriangleMesh& mesh = def.prototype.geometry.mesh;
-    for (const PatchGrid& g : grids)
-        append_patch_grid(g, inherit_material, inherit_material, texture, mesh);
+    bool coloured = false;
+    for (std::size_t i = 0; i < grids.size(); ++i) {
+        append_patch_grid(grids[i], inherit_material, inherit_material, texture, mesh);
+        const PatchColours& c = patches[i].colours;
+        def.patch_colours.resize(mesh.triangles.size(), c);
+        coloured = coloured || c.top != 0 || c.bottom != 0;
+    }
+    if (!coloured)
+        def.patch_colours.clear();
     def.uvs_per_surface = per_surface_uvs(mesh);
     return def;
 }

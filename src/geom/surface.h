@@ -46,6 +46,15 @@ struct SurfaceCommand {
 /// warning here).
 SurfaceCommand parse_surface_command(const ViewCommand& command);
 
+/// A patch's own colour indices (manual 5.4.3 `TOP COLOR:`, `BOTTOM COLOR:`): 0 means
+/// the turtle's. cpfg's colormap-mode lighting uses them instead of the turtle's index,
+/// relative to the selected colormap (so 256..511 lie in the next one); lighting by
+/// materials ignores them.
+struct PatchColours {
+    int top = 0;     ///< the side the normal points to
+    int bottom = 0;  ///< the other side
+};
+
 /// A predefined surface, ready to be instanced.
 ///
 /// The prototype is in the *turtle frame* of the surface: its x, y, z axes are the
@@ -62,6 +71,9 @@ struct SurfaceDef {
     /// Per vertex of prototype.geometry.mesh: cpfg's "texture per surface" uvs (x, y of
     /// the prototype mapped to [0,1] over its bounds), for textures with the `S:` flag.
     std::vector<Float2> uvs_per_surface;
+    /// Per triangle of prototype.geometry.mesh: its patch's colours; empty when every
+    /// patch takes the turtle's (bicubic surfaces only).
+    std::vector<PatchColours> patch_colours;
 
     // As read from the file (bicubic only; a tsurface has zeros and heading +y, up +z).
     Vec3 contact_point, end_point;

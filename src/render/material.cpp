@@ -195,13 +195,18 @@ Vec3f hue_at_luminance(const geom::Rgb& entry, const geom::Rgb& own)
 std::vector<IndexRamp> make_index_ramps(const std::vector<geom::Material>& materials,
                                         const geom::ColourIndexLight& light)
 {
-    const int last = static_cast<int>(std::min(materials.size(), geom::colour_indices)) - 1;
-    auto entry = [&](int index) {
-        return materials[static_cast<std::size_t>(std::clamp(index, 0, last))].diffuse;
-    };
     std::vector<IndexRamp> ramps(materials.size());
     for (std::size_t m = 0; m < materials.size(); ++m) {
         const geom::Material& material = materials[m];
+        // The entries the index moves over: 256 from the material's colour table on.
+        const std::size_t table = material.colour_table;
+        const int last =
+            table < materials.size()
+                ? static_cast<int>(std::min(materials.size() - table, geom::colour_indices)) - 1
+                : -1;
+        auto entry = [&](int index) {
+            return materials[table + static_cast<std::size_t>(std::clamp(index, 0, last))].diffuse;
+        };
         IndexRamp& ramp = ramps[m];
         ramp.rule = last < 0 ? geom::IndexLighting::none : material.index_lighting;
         const int own = material.colour_index;

@@ -55,8 +55,12 @@ TEST(ColourIndexLighting, ShadedColormapModelsReadTheViewsSettings)
     EXPECT_EQ(light.diffuse_reflection, 25);
     EXPECT_FLOAT_EQ(light.surface_ambient, 0.3f);
     EXPECT_FLOAT_EQ(light.surface_diffuse, 0.6f);
-    // Entries 0..255 move by the cosine; their copies 256..511 (surfaces) by the surface rule.
-    ASSERT_EQ(scene.materials.size(), 2 * geom::colour_indices);
+    // Entries 0..255 move by the cosine; their copies 256..511 (surfaces) by the surface
+    // rule; 512..767 are the next colormap's (unloaded here: cpfg's grey), for patches.
+    ASSERT_EQ(scene.materials.size(), 3 * geom::colour_indices);
+    EXPECT_EQ(scene.materials[512 + 7].index_lighting, geom::IndexLighting::surface);
+    EXPECT_EQ(scene.materials[512 + 7].colour_table, 512);
+    EXPECT_EQ(scene.materials[512 + 7].diffuse, (geom::Rgb{200 / 255.0f, 200 / 255.0f, 200 / 255.0f}));
     EXPECT_EQ(scene.materials[7].index_lighting, geom::IndexLighting::cosine);
     EXPECT_EQ(scene.materials[7].colour_index, 7);
     EXPECT_EQ(scene.materials[256 + 7].index_lighting, geom::IndexLighting::surface);
@@ -118,3 +122,92 @@ TEST(ColourIndexLighting, HugeOrNonFiniteCoefficientsAreBounded)
     }
 }
 }  // namespace
+
+namespace {
+
+/// A surface file of two unit-square patches: the first takes the turtle's colour, the
+/// second has TOP COLOR 300 (past the first colormap) and BOTTOM COLOR 40.
+std::string two_patch_surface()
+{
+    std::string s = "0 1 0 1 0 0\nCONTACT POINT X: 0 Y: 0 Z: 0\nEND POINT X: 0 Y: 1 Z: 0\n"
+                    "HEADING X: 0 Y: 1 Z: 0\nUP X: 0 Y: 0 Z: 1\nSIZE: 1\n";
+    for (const char* colours : {"TOP COLOR: 0 DIFFUSE: 0.00 BOTTOM COLOR: 0 DIFFUSE: 0.00",
+                                "TOP COLOR: 300 DIFFUSE: 0.00 BOTTOM COLOR: 40 DIFFUSE: 0.00"}) {
+        s += std::string("patch\n") + colours + "\nAL: ~ A: ~ AR: ~\nL: ~ R: ~\nBL: ~ B: ~ BR: ~\n";
+        for (int i = 0; i < 4; ++i) {
+            for (int j = 0; j < 4; ++j)
+                s += std::to_string(j / 3.0) + " " + std::to_string(i / 3.0) + " 0  ";
+            s += "\n";
+        }
+    }
+    return s;
+}
+
+/// `;(7)~s` with that surface, lit by colour index with two colormaps (-m1: entry i is
+/// (i, i, i); -m2: entry i is (255 - i, i, 0)), or by a material file.
+geom::Scene interpret_patch_colour_model(const std::string& name, bool material_file)
+{
+    fs::path dir = fs::temp_directory_path() / ("cambium_patch_colours_" + name);
+    fs::create_directories(dir);
+    std::ofstream(dir / "plant.l") << "lsystem: 1\nderivation length: 1\naxiom: ;(7)~s\nendlsystem\n";
+    std::ofstream(dir / "plant.v") << "render mode: shaded\nsurface: s patches.s 1\n";
+    std::ofstream(dir / "patches.s") << two_patch_surface();
+    for (int block : {1, 2}) {
+        std::ofstream map(dir / ("plant" + std::to_string(block) + ".map"), std::ios::binary);
+        for (int i = 0; i < 256; ++i) {
+            map.put(static_cast<char>(block == 1 ? i : 255 - i));
+            map.put(static_cast<char>(i));
+            map.put(static_cast<char>(block == 1 ? i : 0));
+        }
+    }
+    std::ofstream(dir / "plant.mat", std::ios::binary) << std::string(15, '\0');
+    app::Options options;
+    options.lsystem = dir / "plant.l";
+    options.view = dir / "plant.v";
+    if (material_file) {
+        options.colour_files.push_back(app::ColourFile{1, true, dir / "plant.mat"});
+    } else {
+        options.colour_files.push_back(app::ColourFile{1, false, dir / "plant1.map"});
+        options.colour_files.push_back(app::ColourFile{2, false, dir / "plant2.map"});
+    }
+    app::Model model = app::load_model(options);
+    geom::Scene scene = app::interpret(model, app::derive(model, options), options);
+    fs::remove_all(dir);
+    return scene;
+}
+
+}  // namespace
+
+TEST(ColourIndexLighting, PatchColoursReplaceTheTurtlesAndReachTheNextColormap)
+{
+    geom::Scene scene = interpret_patch_colour_model("colormap", false);
+    ASSERT_EQ(scene.prototypes.size(), 1u);
+    const geom::TriangleMesh& mesh = scene.prototypes[0].geometry.mesh;
+    ASSERT_FALSE(mesh.triangles.empty());
+    const std::size_t half = mesh.triangles.size() / 2;  // the two patches' triangles
+    // The first patch takes the instance's (the turtle's colour 7, surface-lit: 256 + 7).
+    EXPECT_EQ(mesh.material.front(), geom::inherit_material);
+    EXPECT_EQ(mesh.back_material.front(), geom::inherit_material);
+    ASSERT_EQ(scene.instances.size(), 1u);
+    EXPECT_EQ(scene.instances[0].material, 256 + 7);
+    // The second: TOP 300 is entry 44 of the next colormap, BOTTOM 40 entry 40 of this one.
+    EXPECT_EQ(mesh.material[half], 512 + 44);
+    EXPECT_EQ(mesh.back_material[half], 256 + 40);
+    EXPECT_EQ(mesh.material.back(), 512 + 44);
+    const geom::Material& top = scene.materials.at(512 + 44);
+    EXPECT_EQ(top.diffuse, (geom::Rgb{(255 - 44) / 255.0f, 44 / 255.0f, 0}));
+    EXPECT_EQ(top.index_lighting, geom::IndexLighting::surface);
+    EXPECT_EQ(top.colour_index, 44);
+    EXPECT_EQ(top.colour_table, 512);
+    EXPECT_EQ(scene.materials.at(256 + 40).diffuse, (geom::Rgb{40 / 255.0f, 40 / 255.0f, 40 / 255.0f}));
+}
+
+TEST(ColourIndexLighting, MaterialFilesIgnorePatchColours)
+{
+    geom::Scene scene = interpret_patch_colour_model("materials", true);
+    ASSERT_EQ(scene.prototypes.size(), 1u);
+    for (std::uint16_t m : scene.prototypes[0].geometry.mesh.material)
+        EXPECT_EQ(m, geom::inherit_material);
+    for (std::uint16_t m : scene.prototypes[0].geometry.mesh.back_material)
+        EXPECT_EQ(m, geom::inherit_material);
+}
