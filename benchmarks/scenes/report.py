@@ -62,7 +62,8 @@ def table(stats, wall, cpu, target_first_pixel=None, target_peak=None):
          f"{t['build']:.2f} s", None),
         ("rendering (after the first pixel)", f"{t['render']:.2f} s", None),
         ("whole command: wall, CPU (user + system)", f"{wall:.2f} s, {cpu:.2f} s", None),
-        ("primitives built", f"{p['total']:,} ({p['cylinders']:,} cylinders, {p['curve_segments']:,} "
+        ("primitives built", f"{p['total']:,} ({p['cylinders']:,} cylinders, "
+                             f"{p.get('lines', 0):,} pixel-width lines, {p['curve_segments']:,} "
                              f"curve segments, {p['spheres']:,} spheres, {p['discs']:,} discs, "
                              f"{p['triangles']:,} triangles)", None),
         ("instances (prototypes)", f"{stats['instances']:,} ({stats['prototypes']:,})", None),
