@@ -302,13 +302,15 @@ void Deriver::decompose()
     // `warnings` after the section keyword: say when the depth cut decomposition short
     if (applied > 0 && set.warnings && depth > 0) {
         index(m_string, m_indexed);
+        // The probe is written into m_next, whose capacity the budget check counts (a
+        // string of its own would be held beside m_next's capacity, unseen by it).
         m_next.clear();
-        ModuleString probe;
         Runtime saved = m_runtime;  // probing must not run blocks for real
         Rand48 saved_random = m_stochastic;
-        if (rewrite(m_indexed, probe, true) > 0)
+        if (rewrite(m_indexed, m_next, true) > 0)
             warn(set.productions.front().loc,
                  "maximum depth (" + std::to_string(depth) + ") of the decomposition reached");
+        m_next.clear();
         m_runtime = saved;
         m_stochastic = saved_random;
     }
