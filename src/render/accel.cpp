@@ -722,7 +722,8 @@ struct HitResolver {
     /// own, each placed once, untransformed, by a top-level instance (none: no such scene).
     /// Embree's leaves hold primitives of one geometry only: caps and joints beside every
     /// segment in one BVH left most leaves with one primitive, and cost 187 B per segment
-    /// instead of about 70 (issue 15.3).
+    /// instead of about 70 (issue 15.3). Scenes of few lines keep them beside the lines,
+    /// which saves every ray two traversals (EmbreeScene's constructor).
     struct PlacedEnds {
         std::uint32_t instance = PrimId::none;
         std::vector<const GeometrySource*> parts;  ///< by geometry id in its scene
@@ -1168,10 +1169,18 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
         m.world_keys = keys_in_world_units(own.lines, camera);
     RTCScene caps = m.new_scene(), joints = m.new_scene();
     auto& [cap_scene, joint_scene] = m.line_end_scenes;
+    // Few lines keep their caps and joints beside them in the top-level BVH: each scene of
+    // their own is a second and third traversal for every ray that crosses the plant
+    // (Lilac, 2 k segments: 14% of the render's CPU time), and the leaves they crowd cost
+    // little memory at this size (about 120 B a segment more: 2 MB at most).
+    constexpr std::size_t ends_beside_lines_up_to = 16384;
+    const bool ends_beside = own.lines.segment_count() <= ends_beside_lines_up_to;
     m.add_geometry(m.scene, own, m.top_parts,
                    m.world_keys.empty() ? nullptr : m.world_keys.data(),
                    scene.line_radius_in_pixels, false, true,
-                   {caps, joints, &cap_scene.parts, &joint_scene.parts});
+                   ends_beside ? Impl::LineEndsTarget{nullptr, nullptr, nullptr, nullptr}
+                               : Impl::LineEndsTarget{caps, joints, &cap_scene.parts,
+                                                      &joint_scene.parts});
     m.place_line_ends(caps, cap_scene);
     m.place_line_ends(joints, joint_scene);
     m.segments = own.lines.segment_count() + own.curves.segment_count();
