@@ -1169,12 +1169,12 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
         m.world_keys = keys_in_world_units(own.lines, camera);
     RTCScene caps = m.new_scene(), joints = m.new_scene();
     auto& [cap_scene, joint_scene] = m.line_end_scenes;
-    // Few lines keep their caps and joints beside them in the top-level BVH: each scene of
-    // their own is a second and third traversal for every ray that crosses the plant
-    // (Lilac, 2 k segments: 14% of the render's CPU time), and the leaves they crowd cost
-    // little memory at this size (about 120 B a segment more: 2 MB at most).
-    constexpr std::size_t ends_beside_lines_up_to = 16384;
-    const bool ends_beside = own.lines.segment_count() <= ends_beside_lines_up_to;
+    // Up to a quarter million lines keep their caps and joints beside them in the
+    // top-level BVH: each scene of their own is a second and third traversal for every ray
+    // that crosses the plant (Lilac, 2 k segments: 14% of the render's CPU time;
+    // WeepingBirch, 29 k: 15%), and the leaves they crowd cost about 130 B a segment more
+    // (WeepingBirch: Embree 2.6 -> 6.4 MiB; 34 MB at the limit).
+    const bool ends_beside = own.lines.segment_count() <= line_ends_beside_up_to;
     m.add_geometry(m.scene, own, m.top_parts,
                    m.world_keys.empty() ? nullptr : m.world_keys.data(),
                    scene.line_radius_in_pixels, false, true,
