@@ -722,8 +722,8 @@ struct HitResolver {
     /// own, each placed once, untransformed, by a top-level instance (none: no such scene).
     /// Embree's leaves hold primitives of one geometry only: caps and joints beside every
     /// segment in one BVH left most leaves with one primitive, and cost 187 B per segment
-    /// instead of about 70 (issue 15.3). Scenes of few lines keep them beside the lines,
-    /// which saves every ray two traversals (EmbreeScene's constructor).
+    /// instead of about 70 (issue 15.3). Up to EmbreeScene::line_ends_beside_up_to
+    /// segments they stay beside the lines, which saves every ray two traversals.
     struct PlacedEnds {
         std::uint32_t instance = PrimId::none;
         std::vector<const GeometrySource*> parts;  ///< by geometry id in its scene
