@@ -133,6 +133,8 @@ struct Settings {
     double target = 0;
     double adaptive = 0;  ///< --adaptive: one adaptive render to this noise target instead
     fs::path export_folder;  ///< --export-scene: write the scenes instead of rendering
+    int max_depth = 0;       ///< --max-depth: path segments (0: the renderer's default)
+    fs::path save_folder;    ///< --save-images: each render as raw RGBA floats there
 };
 
 /// The process's CPU time so far, user + sys, in seconds.
@@ -194,6 +196,8 @@ Run render_at(const cambium::geom::Scene& scene, const Settings& s, int spp,
     rs.sampler = sampler;
     rs.seed = seed;
     rs.aovs = false;
+    if (s.max_depth > 0)
+        rs.max_depth = s.max_depth;
     rs.noise_target = static_cast<float>(noise_target);
     std::uint64_t rays_before = rays_traced.total();
     auto start = Clock::now();
@@ -332,6 +336,18 @@ void report(const std::string& plant, const Settings& s, render::SampleSequence 
     std::fflush(stdout);
 }
 
+/// --save-images: `rgba` as raw floats (width x height x 4, rows from the top) in
+/// FOLDER/NAME.f32, for looking at where the error lies.
+void save_image(const Settings& s, const std::string& name, const std::vector<float>& rgba)
+{
+    if (s.save_folder.empty())
+        return;
+    fs::create_directories(s.save_folder);
+    std::ofstream out(s.save_folder / (name + ".f32"), std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(rgba.data()),
+              std::streamsize(rgba.size() * sizeof(float)));
+}
+
 /// RMS over the plant's pixels of the relative error of each pixel's luminance, the
 /// quantity adaptive sampling's noise target bounds (render.cpp: relative_error).
 double pixel_relative_error(const std::vector<float>& image, const std::vector<float>& ref)
@@ -375,7 +391,9 @@ void run_plant(const std::string& plant, const fs::path& folder, const std::stri
     std::vector<float> ref = reference(
         scene, s,
         cache / (plant + "-" + std::to_string(s.width) + "x" + std::to_string(s.height) + "-" +
-                 std::to_string(s.reference_spp) + ".f32"));
+                 std::to_string(s.reference_spp) +
+                 (s.max_depth > 0 ? "-depth" + std::to_string(s.max_depth) : "") + ".f32"));
+    save_image(s, plant + "-reference", ref);
     if (s.adaptive > 0) {
         run_adaptive(plant, scene, ref, s);
         return;
@@ -385,6 +403,8 @@ void run_plant(const std::string& plant, const fs::path& folder, const std::stri
         Curve& c = curves[sampler];
         for (int spp = 1; spp <= s.max_spp; spp *= 2) {
             Run run = render_at(scene, s, spp, sampler, 0);
+            save_image(s, plant + "-" + name(sampler) + "-" + std::to_string(spp),
+                       run.image.rgba);
             c.spp.push_back(spp);
             c.rmse.push_back(relative_rmse(run.image.rgba, ref));
             c.seconds.push_back(run.seconds);
@@ -442,6 +462,10 @@ Settings parse(int argc, char** argv)
             s.target = std::stod(value());
         } else if (arg == "--adaptive") {
             s.adaptive = std::stod(value());
+        } else if (arg == "--max-depth") {
+            s.max_depth = std::stoi(value());
+        } else if (arg == "--save-images") {
+            s.save_folder = fs::absolute(value());
         } else if (arg == "--export-scene") {
             s.export_folder = fs::absolute(value());
         } else {

@@ -722,7 +722,8 @@ struct HitResolver {
     /// own, each placed once, untransformed, by a top-level instance (none: no such scene).
     /// Embree's leaves hold primitives of one geometry only: caps and joints beside every
     /// segment in one BVH left most leaves with one primitive, and cost 187 B per segment
-    /// instead of about 70 (issue 15.3).
+    /// instead of about 70 (issue 15.3). Up to EmbreeScene::line_ends_beside_up_to
+    /// segments they stay beside the lines, which saves every ray two traversals.
     struct PlacedEnds {
         std::uint32_t instance = PrimId::none;
         std::vector<const GeometrySource*> parts;  ///< by geometry id in its scene
@@ -1168,10 +1169,18 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
         m.world_keys = keys_in_world_units(own.lines, camera);
     RTCScene caps = m.new_scene(), joints = m.new_scene();
     auto& [cap_scene, joint_scene] = m.line_end_scenes;
+    // Up to a quarter million lines keep their caps and joints beside them in the
+    // top-level BVH: each scene of their own is a second and third traversal for every ray
+    // that crosses the plant (Lilac, 2 k segments: 14% of the render's CPU time;
+    // WeepingBirch, 29 k: 15%), and the leaves they crowd cost about 130 B a segment more
+    // (WeepingBirch: Embree 2.6 -> 6.4 MiB; 34 MB at the limit).
+    const bool ends_beside = own.lines.segment_count() <= line_ends_beside_up_to;
     m.add_geometry(m.scene, own, m.top_parts,
                    m.world_keys.empty() ? nullptr : m.world_keys.data(),
                    scene.line_radius_in_pixels, false, true,
-                   {caps, joints, &cap_scene.parts, &joint_scene.parts});
+                   ends_beside ? Impl::LineEndsTarget{nullptr, nullptr, nullptr, nullptr}
+                               : Impl::LineEndsTarget{caps, joints, &cap_scene.parts,
+                                                      &joint_scene.parts});
     m.place_line_ends(caps, cap_scene);
     m.place_line_ends(joints, joint_scene);
     m.segments = own.lines.segment_count() + own.curves.segment_count();

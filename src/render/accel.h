@@ -2,6 +2,7 @@
 // EmbreeScene: the Scene's primitives in Embree (the only user of <embree3/rtcore.h>).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -89,6 +90,11 @@ struct CameraRayF {
 /// Thread-safe for concurrent intersect()/occluded() after construction.
 class EmbreeScene {
 public:
+    /// A scene whose own shaded lines have at most this many segments builds their caps
+    /// and joints beside them in one BVH (faster: one traversal, not three); more keep
+    /// them in two scenes of their own (less memory: docs/architecture.md).
+    static constexpr std::size_t line_ends_beside_up_to = 262144;
+
     /// Builds the scene; `camera` converts pixel-width line radii to world units. With
     /// `textures`, hits on textured meshes and curves where the texture's alpha < 0.5 are
     /// ignored (cut-outs). Throws cambium::Error if Embree fails or an index is out of range.

@@ -120,6 +120,8 @@ void AreaLights::add(Group& group, const Light& light, std::uint64_t k)
         m_full = true;
         return;
     }
+    m_max_luminance =
+        std::max({m_max_luminance, luminance(light.front), luminance(light.back)});
     group.index.emplace(k, static_cast<std::uint32_t>(group.lights.size()));
     group.lights.push_back(light);
     ++m_stored;

@@ -55,6 +55,8 @@ public:
     std::size_t placed_size() const { return m_placed; }
     /// The summed area times luminance of the lights' sides: their emitted power over pi.
     double power() const { return m_power; }
+    /// The largest luminance any listed light emits from either side.
+    float max_luminance() const { return m_max_luminance; }
 
     /// A point on a light for the shading point p, from three uniforms; nullopt if the
     /// point sends nothing toward p.
@@ -119,6 +121,7 @@ private:
     std::unordered_map<std::uint32_t, std::uint32_t> m_placement_of;  ///< instance -> placement
     std::size_t m_max = 0, m_stored = 0, m_placed = 0;
     double m_power = 0;
+    float m_max_luminance = 0;
     bool m_full = false;
 };
 

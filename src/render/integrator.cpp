@@ -167,14 +167,48 @@ struct LightUniforms {
     float choose, u0, u1, u2;
 };
 
+/// The vertex's next-event uniforms, drawn from its block only where they matter: the
+/// choice when there is a choice, the point on the light for lights with extent (a delta
+/// light has one). The dimensions are fixed (sampler.h), so a value left undrawn changes
+/// no other; the hashing it would cost is a few percent of a plant's render.
+LightUniforms light_uniforms(const LightSet& lights, const Sampler& sampler,
+                             std::uint32_t block, std::optional<ChosenLight>& chosen)
+{
+    LightUniforms u{};
+    bool drawn_choice = lights.size() > 1;
+    if (drawn_choice) {
+        auto [choose, area] = sampler.get2d(block + sample_dimension::light_choice);
+        u.choose = choose;
+        u.u0 = area;
+    }
+    chosen = lights.choose(u.choose);
+    if (!chosen)
+        return u;
+    switch (lights.kind(chosen->index)) {
+    case LightKind::point:
+    case LightKind::spot:
+    case LightKind::directional: return u;
+    case LightKind::area:
+    case LightKind::environment: break;
+    }
+    if (!drawn_choice)
+        u.u0 = sampler.get2d(block + sample_dimension::light_choice)[1];
+    auto [u1, u2] = sampler.get2d(block + sample_dimension::light_point);
+    u.u1 = u1;
+    u.u2 = u2;
+    return u;
+}
+
 /// Direct light from one light chosen by power (pbrt's SampleLd): a delta light at full
 /// weight, the others weighted against BSDF sampling of the same direction by the power
-/// heuristic (full weight at the path's last vertex, where no BSDF ray follows).
+/// heuristic (full weight at the path's last vertex, where no BSDF ray follows). Draws
+/// its uniforms from the vertex's block.
 Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, const Vertex& v,
-                bool last, const LightUniforms& u)
+                bool last, const Sampler& sampler, std::uint32_t block)
 {
     const LightSet& lights = facts.lights;
-    std::optional<ChosenLight> chosen = lights.choose(u.choose);
+    std::optional<ChosenLight> chosen;
+    const LightUniforms u = light_uniforms(lights, sampler, block, chosen);
     if (!chosen || !(chosen->probability > 0))
         return {};
     LightLiSample ls = lights.sample_li(chosen->index, v.hit.position, u.u0, u.u1, u.u2);
@@ -450,10 +484,7 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         }
         Vertex vertex{*hit, bsdf, -dir};
         const bool last = depth + 1 == ctx.max_depth;
-        auto [u_choose, u_area] = sampler.get2d(block + sample_dimension::light_choice);
-        auto [u_light0, u_light1] = sampler.get2d(block + sample_dimension::light_point);
-        LightUniforms lu{u_choose, u_area, u_light0, u_light1};
-        result.radiance += beta * sample_ld(ctx, facts, vertex, last, lu);
+        result.radiance += beta * sample_ld(ctx, facts, vertex, last, sampler, block);
         if (++depth == ctx.max_depth)
             break;
 

@@ -102,6 +102,34 @@ double environment_luminance(const Environment& env)
     return sum / (n * n);
 }
 
+/// Emissive primitives fainter than this share of the lights' irradiance are not sampled.
+constexpr float faint_emission = 0.01f;
+
+/// The luminance of the irradiance the view file's lights give every surface facing them:
+/// directional lights and point lights without fall-off light each point alike (a spot
+/// light's cone or an attenuated light's distance may leave a point unlit).
+float sure_irradiance(const std::vector<RenderLight>& lights)
+{
+    float sum = 0;
+    for (const RenderLight& l : lights) {
+        bool everywhere = l.kind == RenderLight::Kind::directional ||
+                          (l.kind == RenderLight::Kind::point && l.att_linear == 0 &&
+                           l.att_quadratic == 0);
+        if (everywhere)
+            sum += pi * luminance(l.colour) * attenuation(l, 0);
+    }
+    return sum;
+}
+
+/// Whether the emissive primitives are too faint to be worth next-event samples: a
+/// hemisphere full of the brightest of them (irradiance pi L) would give a surface less
+/// than 1% of what the lights give it. BSDF sampling then finds their light alone,
+/// without fireflies: a BSDF-sampled hit adds at most the surface's albedo times L.
+bool faint(const AreaLights& area, const std::vector<RenderLight>& lights)
+{
+    return pi * area.max_luminance() < faint_emission * sure_irradiance(lights);
+}
+
 LightKind kind_of(const RenderLight& l)
 {
     switch (l.kind) {
@@ -121,7 +149,7 @@ LightSet::LightSet(const std::vector<RenderLight>& lights, const AreaLights* are
         float falloff = attenuation(l, 0);
         add({kind_of(l), l}, pi * luminance(l.colour) * (falloff > 0 ? falloff : 1.0f));
     }
-    if (area_lights && !area_lights->empty()) {
+    if (area_lights && !area_lights->empty() && !faint(*area_lights, lights)) {
         m_area = area_lights;
         float r = scene_radius > 0 ? scene_radius : 1.0f;
         add({LightKind::area, {}}, area_lights->power() / (double(r) * r));

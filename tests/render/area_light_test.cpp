@@ -5,12 +5,15 @@
 
 #include <cmath>
 #include <cstdio>
+#include <memory>
+#include <utility>
 #include <numbers>
 #include <vector>
 
 #include "render/accel.h"
 #include "render/area_light.h"
 #include "render/color.h"
+#include "render/light.h"
 #include "render/render.h"
 #include "geom_scenes.h"
 #include "test_scenes.h"
@@ -296,6 +299,63 @@ TEST(AreaLight, RenderSamplesEmittersUnlessTurnedOff)
     EXPECT_NEAR(on.mean, expect, 0.01 * expect);
     EXPECT_NEAR(off.mean, expect, 4 * std::sqrt(off.variance / 64) + 0.01 * expect);
     EXPECT_LT(on.variance * 20, off.variance);
+}
+
+// Emitters far fainter than the view's lights are left to BSDF sampling (LightSet), and
+// all their light still arrives: a sun from below lights nothing the camera sees, so the
+// patch shows the faint disc's light alone, against the closed form. Were the disc left
+// out of the set while pdf_li() still weighed its hits against light sampling, the mean
+// would fall short.
+TEST(AreaLight, FaintEmittersAreLeftToBsdfSamplingWithAllTheirLight)
+{
+    geom::Scene s = plane_scene();
+    const float display = 0.05f;  // linear 0.0039: pi L is 1.2% of the sun's pi
+    s.materials[2].emission = grey(display);
+    const double h = 1, r = 1.5;
+    add_disc(s.geometry, {0, 0, float(h)}, float(r), {0, 0, -1}, 2, 3);
+    geom::Light sun;
+    sun.kind = geom::Light::Kind::directional;
+    sun.direction = {0, 0, -1};  // toward the light: below the plane
+    s.lights.push_back(sun);
+    const Camera camera = patch_camera(0.5);
+
+    EmbreeScene accel(s, camera);
+    const Vec3f p(0, 0, 0.5f);
+    std::optional<SurfaceHit> on_disc = accel.intersect(p, {0, 0, 1}, 0, 1e30f);
+    ASSERT_TRUE(on_disc);
+    auto light_set = [&](float emission_display) {
+        geom::Scene lit = s;
+        lit.materials[2].emission = grey(emission_display);
+        std::vector<SurfaceMaterial> materials = make_materials(lit.materials);
+        auto area = std::make_unique<AreaLights>(lit, materials);
+        LightSet set(make_lights(lit.lights), area.get(), nullptr, false, 3);
+        return std::pair(std::move(area), std::move(set));
+    };
+    auto [faint_area, faint] = light_set(display);
+    EXPECT_EQ(faint_area->size(), 1u);
+    EXPECT_EQ(faint.size(), 1u);  // the sun alone
+    EXPECT_EQ(faint.pdf_li(p, *on_disc), 0.0f);
+    auto [bright_area, bright] = light_set(0.3f);  // linear 0.073: 7% of the sun's
+    EXPECT_EQ(bright.size(), 2u);
+    EXPECT_GT(bright.pdf_li(p, *on_disc), 0.0f);
+
+    RenderSettings settings;
+    settings.width = settings.height = 8;
+    settings.samples_per_pixel = 64;
+    settings.max_depth = 2;
+    settings.threads = 2;
+    settings.ambient = {0, 0, 0};
+    settings.opengl_ambient = false;
+    settings.aovs = false;
+    Image img = render(s, camera, settings);
+    std::vector<double> g;
+    for (std::size_t i = 0; i < img.rgba.size(); i += 4)
+        g.push_back(img.rgba[i + 1]);
+    Stats got = stats(g);
+    double expect = albedo() * srgb_to_linear(display) * r * r / (h * h + r * r);
+    EXPECT_NEAR(got.mean, expect, 0.02 * expect);
+    std::printf("[area] faint disc, BSDF sampling alone: %.6f expected %.6f\n", got.mean,
+                expect);
 }
 
 // Nothing emits: the list is empty and sampling gives nothing.
