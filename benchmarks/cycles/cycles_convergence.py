@@ -86,7 +86,10 @@ def main():
             Matrix.Translation(-location) @ camera.matrix_world
     import_seconds = (time.perf_counter() - wall, cpu_seconds() - cpu)
     os.makedirs(args.cache, exist_ok=True)
-    size = f"{scene['width']}x{scene['height']}" + (f"-tilt{args.tilt:g}" if args.tilt else "")
+    # The reference is cached per setting that changes how Cycles samples (its noise
+    # adds to every measured error): the camera tilt and whether emitters are lights.
+    size = f"{scene['width']}x{scene['height']}" + (f"-tilt{args.tilt:g}" if args.tilt else "") + \
+        ("-no-mesh-lights" if args.no_mesh_lights else "")
     scratch = os.path.join(args.cache, f"{plant}-{size}-run.exr")
     sync = timed_render(scratch, 1, 0)
 
