@@ -167,43 +167,112 @@ struct LightUniforms {
     float choose, u0, u1, u2;
 };
 
-/// Direct light from one light chosen by power (pbrt's SampleLd): a delta light at full
-/// weight, the others weighted against BSDF sampling of the same direction by the power
-/// heuristic (full weight at the path's last vertex, where no BSDF ray follows).
-Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, const Vertex& v,
-                bool last, const LightUniforms& u)
+/// The fraction of light from a light sample that reaches the shading point: the spawned
+/// origin is off the surface, so the shadow ray aims from it at the point where the light
+/// sample's ray ends (just short of the light), as a ray parallel to wi could meet a curved
+/// light sooner; 0 where blocked.
+float light_visibility(const PathContext& ctx, const PathContext::SceneFlags& facts,
+                       const SurfaceHit& hit, const LightLiSample& ls)
 {
-    const LightSet& lights = facts.lights;
-    std::optional<ChosenLight> chosen = lights.choose(u.choose);
-    if (!chosen || !(chosen->probability > 0))
-        return {};
-    LightLiSample ls = lights.sample_li(chosen->index, v.hit.position, u.u0, u.u1, u.u2);
+    Spawn s = spawn(hit, ls.wi);
+    Vec3f toward = ls.wi;
+    float tfar = ls.tfar;
+    if (!std::isinf(tfar)) {
+        Vec3f to = hit.position + ls.wi * ls.tfar - s.origin;
+        tfar = length(to);
+        if (!(tfar > 0))
+            return 0;
+        toward = to / tfar;
+    }
+    return transmittance(ctx, facts, s, toward, tfar);
+}
+
+/// f |cos| of the light sample at the vertex, unshadowed; black where it cannot light the
+/// surface's side the path sees.
+Vec3f unshadowed(const Vertex& v, const LightLiSample& ls)
+{
     if (!(ls.pdf > 0) || is_black(ls.li))
         return {};
     Vec3f f = bsdf_eval(v.bsdf, v.hit.normal, v.wo, ls.wi);
     float cos = std::fabs(dot(v.hit.normal, ls.wi));
     if (is_black(f) || cos <= 0 || !same_side(v.hit, ls.wi))
         return {};
-    Spawn s = spawn(v.hit, ls.wi);
-    Vec3f toward = ls.wi;
-    float tfar = ls.tfar;
-    if (!std::isinf(tfar)) {
-        // The spawned origin is off the surface: aim from it at the point where the light
-        // sample's ray ends (just short of the light), as a ray parallel to wi could meet a
-        // curved light sooner.
-        Vec3f to = v.hit.position + ls.wi * ls.tfar - s.origin;
-        tfar = length(to);
-        if (!(tfar > 0))
-            return {};
-        toward = to / tfar;
+    return f * ls.li * cos;
+}
+
+float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+/// Direct light from a set of delta lights only (a view file's lights): each light's
+/// unshadowed contribution is known exactly for the price of a BSDF evaluation, so one
+/// light is chosen in proportion to it (its luminance) and one shadow ray traced. The
+/// estimate is then the unshadowed sum times the chosen light's visibility: a light
+/// behind an opaque surface (FernLeaf's and GeneralizedCylinder's two opposite lights)
+/// is never chosen, and noise is left only where lights are partly shadowed. Unbiased:
+/// every light that gives the point anything keeps a non-zero chance. Nullopt where a
+/// contribution is not finite (a broken light): the choice by power then shows it.
+std::optional<Vec3f> sample_delta_ld(const PathContext& ctx, const PathContext::SceneFlags& facts,
+                      const Vertex& v, const LightUniforms& u)
+{
+    const LightSet& lights = facts.lights;
+    const std::uint32_t n = static_cast<std::uint32_t>(lights.size());
+    std::array<LightLiSample, LightSet::max_delta_choice> samples;
+    std::array<Vec3f, LightSet::max_delta_choice> contribution;
+    std::array<float, LightSet::max_delta_choice> weight{};
+    float total = 0;
+    for (std::uint32_t i = 0; i < n; ++i) {
+        samples[i] = lights.sample_li(i, v.hit.position, u.u0, u.u1, u.u2);
+        contribution[i] = unshadowed(v, samples[i]);
+        weight[i] = luminance(contribution[i]);
+        if (!std::isfinite(weight[i]))
+            return std::nullopt;
+        weight[i] = std::fmax(weight[i], 0.0f);
+        total += weight[i];
     }
-    float through = transmittance(ctx, facts, s, toward, tfar);
+    if (!(total > 0) || !std::isfinite(total))
+        return Vec3f();
+    // The light whose share of the total holds u.choose; the last lit one if rounding
+    // leaves u past the sum.
+    float target = u.choose * total;
+    std::uint32_t chosen = n;
+    for (std::uint32_t i = 0; i < n; ++i) {
+        if (!(weight[i] > 0))
+            continue;
+        chosen = i;
+        if (target < weight[i])
+            break;
+        target -= weight[i];
+    }
+    float through = light_visibility(ctx, facts, v.hit, samples[chosen]);
+    if (through <= 0)
+        return Vec3f();
+    return contribution[chosen] * (through * total / weight[chosen]);
+}
+
+/// Direct light from one light (pbrt's SampleLd): among delta lights only, chosen by what
+/// each gives the point (sample_delta_ld); otherwise chosen by power, a delta light at
+/// full weight, the others weighted against BSDF sampling of the same direction by the
+/// power heuristic (full weight at the path's last vertex, where no BSDF ray follows).
+Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, const Vertex& v,
+                bool last, const LightUniforms& u)
+{
+    const LightSet& lights = facts.lights;
+    if (lights.delta_only())
+        if (std::optional<Vec3f> ld = sample_delta_ld(ctx, facts, v, u))
+            return *ld;
+    std::optional<ChosenLight> chosen = lights.choose(u.choose);
+    if (!chosen || !(chosen->probability > 0))
+        return {};
+    LightLiSample ls = lights.sample_li(chosen->index, v.hit.position, u.u0, u.u1, u.u2);
+    Vec3f c = unshadowed(v, ls);
+    if (is_black(c))
+        return {};
+    float through = light_visibility(ctx, facts, v.hit, ls);
     if (through <= 0)
         return {};
     float pdf = chosen->probability * ls.pdf;
     float w = ls.delta || last ? 1.0f
                                : power_heuristic(pdf, bsdf_pdf(v.bsdf, v.hit.normal, v.wo, ls.wi));
-    return f * ls.li * (cos * through * w / pdf);
+    return c * (through * w / pdf);
 }
 
 /// What a ray that escapes along d sees: the environment, or the uniform ambient.
@@ -211,8 +280,6 @@ Vec3f escaped_radiance(const PathContext& ctx, const Vec3f& d)
 {
     return ctx.environment ? ctx.environment->radiance(d) : ctx.ambient;
 }
-
-float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 /// A direction about the unit normal n drawn with density cos / pi (Malley's method).
 Vec3f cosine_direction(const Vec3f& n, float u1, float u2)
@@ -466,10 +533,15 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         if (is_black(beta))
             break;
         if (depth >= ctx.roulette_depth) {
-            float survive = std::fmin(max_component(beta), 0.95f);
-            if (sampler.get1d(block + sample_dimension::roulette) >= survive)
-                break;
-            beta *= 1.0f / survive;
+            // Survival in proportion to the throughput's largest channel (pbrt-v4's rule):
+            // a path as bright as it started always goes on (max_depth ends it); no
+            // cap below 1, which would kill a share of bright paths for nothing but noise.
+            float survive = max_component(beta);
+            if (survive < 1) {
+                if (sampler.get1d(block + sample_dimension::roulette) >= survive)
+                    break;
+                beta *= 1.0f / survive;
+            }
         }
         Spawn s = spawn(*hit, bs.wi);
         org = s.origin;
