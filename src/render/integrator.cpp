@@ -210,8 +210,9 @@ float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f
 /// is never chosen, and noise is left only where lights are partly shadowed. Unbiased:
 /// every light that gives the point anything keeps a non-zero chance. Nullopt where a
 /// contribution is not finite (a broken light): the choice by power then shows it.
-std::optional<Vec3f> sample_delta_ld(const PathContext& ctx, const PathContext::SceneFlags& facts,
-                      const Vertex& v, const LightUniforms& u)
+std::optional<Vec3f> sample_delta_ld(const PathContext& ctx,
+                                     const PathContext::SceneFlags& facts, const Vertex& v,
+                                     float u_choose)
 {
     const LightSet& lights = facts.lights;
     const std::uint32_t n = static_cast<std::uint32_t>(lights.size());
@@ -220,7 +221,7 @@ std::optional<Vec3f> sample_delta_ld(const PathContext& ctx, const PathContext::
     std::array<float, LightSet::max_delta_choice> weight{};
     float total = 0;
     for (std::uint32_t i = 0; i < n; ++i) {
-        samples[i] = lights.sample_li(i, v.hit.position, u.u0, u.u1, u.u2);
+        samples[i] = lights.sample_li(i, v.hit.position, 0, 0, 0);  // delta: no point to draw
         contribution[i] = unshadowed(v, samples[i]);
         weight[i] = luminance(contribution[i]);
         if (!std::isfinite(weight[i]))
@@ -232,7 +233,7 @@ std::optional<Vec3f> sample_delta_ld(const PathContext& ctx, const PathContext::
         return Vec3f();
     // The light whose share of the total holds u.choose; the last lit one if rounding
     // leaves u past the sum.
-    float target = u.choose * total;
+    float target = u_choose * total;
     std::uint32_t chosen = n;
     for (std::uint32_t i = 0; i < n; ++i) {
         if (!(weight[i] > 0))
@@ -257,7 +258,7 @@ Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, co
 {
     const LightSet& lights = facts.lights;
     if (lights.delta_only())
-        if (std::optional<Vec3f> ld = sample_delta_ld(ctx, facts, v, u))
+        if (std::optional<Vec3f> ld = sample_delta_ld(ctx, facts, v, u.choose))
             return *ld;
     std::optional<ChosenLight> chosen = lights.choose(u.choose);
     if (!chosen || !(chosen->probability > 0))
