@@ -216,22 +216,22 @@ std::optional<Vec3f> sample_delta_ld(const PathContext& ctx,
 {
     const LightSet& lights = facts.lights;
     const std::uint32_t n = static_cast<std::uint32_t>(lights.size());
-    std::array<LightLiSample, LightSet::max_delta_choice> samples;
-    std::array<Vec3f, LightSet::max_delta_choice> contribution;
-    std::array<float, LightSet::max_delta_choice> weight{};
+    std::array<float, LightSet::max_delta_choice> weight;  // luminance of each contribution
     float total = 0;
+    LightLiSample ls;  // the last light's, kept: a single light's is not made twice
+    Vec3f contribution;
     for (std::uint32_t i = 0; i < n; ++i) {
-        samples[i] = lights.sample_li(i, v.hit.position, 0, 0, 0);  // delta: no point to draw
-        contribution[i] = unshadowed(v, samples[i]);
-        weight[i] = luminance(contribution[i]);
-        if (!std::isfinite(weight[i]))
+        ls = lights.sample_li(i, v.hit.position, 0, 0, 0);  // delta: no point to draw
+        contribution = unshadowed(v, ls);
+        float w = luminance(contribution);
+        if (!std::isfinite(w))
             return std::nullopt;
-        weight[i] = std::fmax(weight[i], 0.0f);
+        weight[i] = std::fmax(w, 0.0f);
         total += weight[i];
     }
     if (!(total > 0) || !std::isfinite(total))
         return Vec3f();
-    // The light whose share of the total holds u.choose; the last lit one if rounding
+    // The light whose share of the total holds u_choose; the last lit one if rounding
     // leaves u past the sum.
     float target = u_choose * total;
     std::uint32_t chosen = n;
@@ -243,10 +243,14 @@ std::optional<Vec3f> sample_delta_ld(const PathContext& ctx,
             break;
         target -= weight[i];
     }
-    float through = light_visibility(ctx, facts, v.hit, samples[chosen]);
+    if (chosen + 1 != n) {
+        ls = lights.sample_li(chosen, v.hit.position, 0, 0, 0);
+        contribution = unshadowed(v, ls);
+    }
+    float through = light_visibility(ctx, facts, v.hit, ls);
     if (through <= 0)
         return Vec3f();
-    return contribution[chosen] * (through * total / weight[chosen]);
+    return contribution * (through * total / weight[chosen]);
 }
 
 /// Direct light from one light (pbrt's SampleLd): among delta lights only, chosen by what
@@ -534,15 +538,10 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         if (is_black(beta))
             break;
         if (depth >= ctx.roulette_depth) {
-            // Survival in proportion to the throughput's largest channel (pbrt-v4's rule):
-            // a path as bright as it started always goes on (max_depth ends it); no
-            // cap below 1, which would kill a share of bright paths for nothing but noise.
-            float survive = max_component(beta);
-            if (survive < 1) {
-                if (sampler.get1d(block + sample_dimension::roulette) >= survive)
-                    break;
-                beta *= 1.0f / survive;
-            }
+            float survive = std::fmin(max_component(beta), 0.95f);
+            if (sampler.get1d(block + sample_dimension::roulette) >= survive)
+                break;
+            beta *= 1.0f / survive;
         }
         Spawn s = spawn(*hit, bs.wi);
         org = s.origin;

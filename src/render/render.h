@@ -56,9 +56,8 @@ struct RenderSettings {
     int samples_per_pixel = 64;
     /// Path segments at most: 1 = direct light only, 2 = one bounce, ...
     int max_depth = 6;
-    /// Russian roulette starts after this many segments (1: from the first bounce, as
-    /// Cycles' defaults do; docs/benchmarks.md, "Cambium against Cycles").
-    int roulette_depth = 1;
+    /// Russian roulette starts after this many segments.
+    int roulette_depth = 3;
     std::uint64_t seed = 0;
     /// Owen-scrambled Sobol (default) or white noise (for comparisons, --sampler).
     SampleSequence sampler = SampleSequence::sobol;
