@@ -79,6 +79,31 @@ TEST(Physics, WhiteFurnaceSphere)
     }
 }
 
+// Russian roulette from the first bounce: a convex grey sphere in a uniform sky of
+// radiance 1 shows its albedo (every bounce ray escapes, with weight = albedo). A path of
+// throughput at least 0.5 always goes on (no noise at all); a dimmer one goes on with
+// probability throughput / 0.5 and is reweighted, so the mean stays the albedo (without
+// the reweighting it would be 2 albedo^2) while the noise shows the roulette ran.
+TEST(Physics, RouletteThinsOnlyDimPaths)
+{
+    for (float display : {0.5f, 0.9f}) {
+        geom::Scene s;
+        s.materials[1].diffuse = grey(display);
+        add_sphere(s.geometry, {0, 0, 0}, 3);
+        Camera c = top_camera(0, 0, 8, 16, 16);
+        const float albedo = srgb_to_linear(display);
+        double se = -1;
+        float v = furnace(s, c, 5, 5, 11, 11, 32, 1, nullptr, &se);
+        EXPECT_NEAR(v, albedo, std::fmax(4 * se, 1e-4)) << display;
+        if (albedo >= 0.5f)
+            EXPECT_LT(se, 1e-6) << "a path of throughput " << albedo << " was cut";
+        else
+            EXPECT_GT(se, 1e-3) << "no path of throughput " << albedo << " was cut";
+        std::printf("[furnace] roulette, albedo %.3f: %.5f (standard error %.5f)\n", albedo, v,
+                    se);
+    }
+}
+
 TEST(Physics, WhiteFurnaceRoundCurves)
 {
     for (float tr : {0.0f, 0.5f}) {
