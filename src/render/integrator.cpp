@@ -22,6 +22,11 @@ namespace {
 constexpr float infinity = std::numeric_limits<float>::infinity();
 /// Transparent surfaces a ray may pass through before it counts as blocked.
 constexpr int max_pass_throughs = 64;
+/// The throughput (largest channel) from which Russian roulette always keeps a path:
+/// measured on the benchmark plants (docs/benchmarks.md, "TranslucentTree"), 1 cost
+/// GeneralizedCylinder 12% in time to equal noise, 0.5 nothing, and either saves
+/// TranslucentTree's bounces off its dark leaves.
+constexpr float roulette_keep_above = 0.5f;
 
 const SurfaceMaterial& material_at(const PathContext& ctx, std::uint16_t m)
 {
@@ -167,6 +172,92 @@ struct LightUniforms {
     float choose, u0, u1, u2;
 };
 
+/// The fraction of light from a light sample that reaches the shading point: the spawned
+/// origin is off the surface, so the shadow ray aims from it at the point where the light
+/// sample's ray ends (just short of the light), as a ray parallel to wi could meet a curved
+/// light sooner; 0 where blocked.
+float light_visibility(const PathContext& ctx, const PathContext::SceneFlags& facts,
+                       const SurfaceHit& hit, const LightLiSample& ls)
+{
+    Spawn s = spawn(hit, ls.wi);
+    Vec3f toward = ls.wi;
+    float tfar = ls.tfar;
+    if (!std::isinf(tfar)) {
+        Vec3f to = hit.position + ls.wi * ls.tfar - s.origin;
+        tfar = length(to);
+        if (!(tfar > 0))
+            return 0;
+        toward = to / tfar;
+    }
+    return transmittance(ctx, facts, s, toward, tfar);
+}
+
+/// f |cos| of the light sample at the vertex, unshadowed; black where it cannot light the
+/// surface's side the path sees.
+Vec3f unshadowed(const Vertex& v, const LightLiSample& ls)
+{
+    if (!(ls.pdf > 0) || is_black(ls.li))
+        return {};
+    Vec3f f = bsdf_eval(v.bsdf, v.hit.normal, v.wo, ls.wi);
+    float cos = std::fabs(dot(v.hit.normal, ls.wi));
+    if (is_black(f) || cos <= 0 || !same_side(v.hit, ls.wi))
+        return {};
+    return f * ls.li * cos;
+}
+
+float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+/// Direct light from a set of delta lights only (a view file's lights): each light's
+/// unshadowed contribution is known exactly for the price of a BSDF evaluation, so one
+/// light is chosen in proportion to it (its luminance) and one shadow ray traced. The
+/// estimate is then the unshadowed sum times the chosen light's visibility: a light
+/// behind an opaque surface (FernLeaf's and GeneralizedCylinder's two opposite lights)
+/// is never chosen, and noise is left only where lights are partly shadowed. Unbiased:
+/// every light that gives the point anything keeps a non-zero chance. Nullopt where a
+/// contribution is not finite (a broken light): the choice by power then shows it.
+std::optional<Vec3f> sample_delta_ld(const PathContext& ctx,
+                                     const PathContext::SceneFlags& facts, const Vertex& v,
+                                     float u_choose)
+{
+    const LightSet& lights = facts.lights;
+    const std::uint32_t n = static_cast<std::uint32_t>(lights.size());
+    std::array<float, LightSet::max_delta_choice> weight;  // luminance of each contribution
+    float total = 0;
+    LightLiSample ls;  // the last light's, kept: a single light's is not made twice
+    Vec3f contribution;
+    for (std::uint32_t i = 0; i < n; ++i) {
+        ls = lights.sample_li(i, v.hit.position, 0, 0, 0);  // delta: no point to draw
+        contribution = unshadowed(v, ls);
+        float w = luminance(contribution);
+        if (!std::isfinite(w))
+            return std::nullopt;
+        weight[i] = std::fmax(w, 0.0f);
+        total += weight[i];
+    }
+    if (!(total > 0) || !std::isfinite(total))
+        return Vec3f();
+    // The light whose share of the total holds u_choose; the last lit one if rounding
+    // leaves u past the sum.
+    float target = u_choose * total;
+    std::uint32_t chosen = n;
+    for (std::uint32_t i = 0; i < n; ++i) {
+        if (!(weight[i] > 0))
+            continue;
+        chosen = i;
+        if (target < weight[i])
+            break;
+        target -= weight[i];
+    }
+    if (chosen + 1 != n) {
+        ls = lights.sample_li(chosen, v.hit.position, 0, 0, 0);
+        contribution = unshadowed(v, ls);
+    }
+    float through = light_visibility(ctx, facts, v.hit, ls);
+    if (through <= 0)
+        return Vec3f();
+    return contribution * (through * total / weight[chosen]);
+}
+
 /// The vertex's next-event uniforms, drawn from its block only where they matter: the
 /// choice when there is a choice, the point on the light for lights with extent (a delta
 /// light has one). The dimensions are fixed (sampler.h), so a value left undrawn changes
@@ -199,45 +290,37 @@ LightUniforms light_uniforms(const LightSet& lights, const Sampler& sampler,
     return u;
 }
 
-/// Direct light from one light chosen by power (pbrt's SampleLd): a delta light at full
-/// weight, the others weighted against BSDF sampling of the same direction by the power
-/// heuristic (full weight at the path's last vertex, where no BSDF ray follows). Draws
-/// its uniforms from the vertex's block.
+/// Direct light from one light (pbrt's SampleLd): among delta lights only, chosen by what
+/// each gives the point (sample_delta_ld); otherwise chosen by power, a delta light at
+/// full weight, the others weighted against BSDF sampling of the same direction by the
+/// power heuristic (full weight at the path's last vertex, where no BSDF ray follows).
 Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, const Vertex& v,
                 bool last, const Sampler& sampler, std::uint32_t block)
 {
     const LightSet& lights = facts.lights;
+    if (lights.delta_only()) {
+        // A delta light needs no point on it: only the choice is drawn, and only when
+        // there is a choice.
+        float u_choose =
+            lights.size() > 1 ? sampler.get1d(block + sample_dimension::light_choice) : 0.0f;
+        if (std::optional<Vec3f> ld = sample_delta_ld(ctx, facts, v, u_choose))
+            return *ld;
+    }
     std::optional<ChosenLight> chosen;
     const LightUniforms u = light_uniforms(lights, sampler, block, chosen);
     if (!chosen || !(chosen->probability > 0))
         return {};
     LightLiSample ls = lights.sample_li(chosen->index, v.hit.position, u.u0, u.u1, u.u2);
-    if (!(ls.pdf > 0) || is_black(ls.li))
+    Vec3f c = unshadowed(v, ls);
+    if (is_black(c))
         return {};
-    Vec3f f = bsdf_eval(v.bsdf, v.hit.normal, v.wo, ls.wi);
-    float cos = std::fabs(dot(v.hit.normal, ls.wi));
-    if (is_black(f) || cos <= 0 || !same_side(v.hit, ls.wi))
-        return {};
-    Spawn s = spawn(v.hit, ls.wi);
-    Vec3f toward = ls.wi;
-    float tfar = ls.tfar;
-    if (!std::isinf(tfar)) {
-        // The spawned origin is off the surface: aim from it at the point where the light
-        // sample's ray ends (just short of the light), as a ray parallel to wi could meet a
-        // curved light sooner.
-        Vec3f to = v.hit.position + ls.wi * ls.tfar - s.origin;
-        tfar = length(to);
-        if (!(tfar > 0))
-            return {};
-        toward = to / tfar;
-    }
-    float through = transmittance(ctx, facts, s, toward, tfar);
+    float through = light_visibility(ctx, facts, v.hit, ls);
     if (through <= 0)
         return {};
     float pdf = chosen->probability * ls.pdf;
     float w = ls.delta || last ? 1.0f
                                : power_heuristic(pdf, bsdf_pdf(v.bsdf, v.hit.normal, v.wo, ls.wi));
-    return f * ls.li * (cos * through * w / pdf);
+    return c * (through * w / pdf);
 }
 
 /// What a ray that escapes along d sees: the environment, or the uniform ambient.
@@ -245,8 +328,6 @@ Vec3f escaped_radiance(const PathContext& ctx, const Vec3f& d)
 {
     return ctx.environment ? ctx.environment->radiance(d) : ctx.ambient;
 }
-
-float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 /// A direction about the unit normal n drawn with density cos / pi (Malley's method).
 Vec3f cosine_direction(const Vec3f& n, float u1, float u2)
@@ -497,10 +578,17 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         if (is_black(beta))
             break;
         if (depth >= ctx.roulette_depth) {
-            float survive = std::fmin(max_component(beta), 0.95f);
-            if (sampler.get1d(block + sample_dimension::roulette) >= survive)
-                break;
-            beta *= 1.0f / survive;
+            // A path goes on for sure while its throughput's largest channel is at least
+            // roulette_keep_above, else with probability in proportion to it: dim paths
+            // (after a dark leaf) are thinned from the first bounce, bright ones are never
+            // cut (a fixed cap below 1 killed a share of them for nothing but noise);
+            // max_depth ends every path.
+            float survive = max_component(beta) / roulette_keep_above;
+            if (survive < 1) {
+                if (sampler.get1d(block + sample_dimension::roulette) >= survive)
+                    break;
+                beta *= 1.0f / survive;
+            }
         }
         Spawn s = spawn(*hit, bs.wi);
         org = s.origin;

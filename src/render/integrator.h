@@ -47,7 +47,7 @@ struct PathContext {
     /// instead of cpfg's background colour.
     bool environment_visible = false;
     int max_depth = 6;
-    int roulette_depth = 3;
+    int roulette_depth = 1;  ///< as RenderSettings::roulette_depth
     /// `render mode: filled` / `wireframe`: every surface shows its flat colour, unlit.
     bool unlit = false;
     /// `render mode: flat`: shading uses each facet's own normal.

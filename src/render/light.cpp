@@ -172,6 +172,10 @@ LightSet::LightSet(const std::vector<RenderLight>& lights, const AreaLights* are
     for (double& c : m_cdf)
         c /= m_cdf.back();
     m_weights.clear();
+    m_delta_only = !m_lights.empty() && m_lights.size() <= max_delta_choice &&
+                   std::none_of(m_lights.begin(), m_lights.end(), [](const Entry& e) {
+                       return e.kind == LightKind::area || e.kind == LightKind::environment;
+                   });
     for (std::size_t i = 0; i < m_lights.size(); ++i) {
         float p = static_cast<float>(m_cdf[i + 1] - m_cdf[i]);
         if (m_lights[i].kind == LightKind::area)

@@ -94,6 +94,11 @@ public:
     bool empty() const { return m_lights.empty(); }
     std::size_t size() const { return m_lights.size(); }
     LightKind kind(std::uint32_t index) const { return m_lights[index].kind; }
+    /// Whether the set holds only delta lights (point, spot, directional), at most
+    /// max_delta_choice of them: then next-event estimation can weigh each light by what
+    /// it gives the shading point, at no more than a BSDF evaluation per light.
+    bool delta_only() const { return m_delta_only; }
+    static constexpr std::size_t max_delta_choice = 8;  ///< OpenGL's (cpfg's) eight lights
 
     /// The light for the uniform u; nullopt when the set is empty.
     std::optional<ChosenLight> choose(float u) const;
@@ -120,6 +125,7 @@ private:
     const AreaLights* m_area = nullptr;
     const Environment* m_environment = nullptr;
     float m_area_probability = 0, m_environment_probability = 0;
+    bool m_delta_only = false;
 };
 
 }  // namespace cambium::render

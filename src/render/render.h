@@ -56,8 +56,9 @@ struct RenderSettings {
     int samples_per_pixel = 64;
     /// Path segments at most: 1 = direct light only, 2 = one bounce, ...
     int max_depth = 6;
-    /// Russian roulette starts after this many segments.
-    int roulette_depth = 3;
+    /// Russian roulette starts after this many segments (1: from the first bounce, as
+    /// Cycles' defaults do; integrator.cpp's roulette_keep_above keeps bright paths).
+    int roulette_depth = 1;
     std::uint64_t seed = 0;
     /// Owen-scrambled Sobol (default) or white noise (for comparisons, --sampler).
     SampleSequence sampler = SampleSequence::sobol;

@@ -79,6 +79,31 @@ TEST(Physics, WhiteFurnaceSphere)
     }
 }
 
+// Russian roulette from the first bounce: a convex grey sphere in a uniform sky of
+// radiance 1 shows its albedo (every bounce ray escapes, with weight = albedo). A path of
+// throughput at least 0.5 always goes on (no noise at all); a dimmer one goes on with
+// probability throughput / 0.5 and is reweighted, so the mean stays the albedo (without
+// the reweighting it would be 2 albedo^2) while the noise shows the roulette ran.
+TEST(Physics, RouletteThinsOnlyDimPaths)
+{
+    for (float display : {0.5f, 0.9f}) {
+        geom::Scene s;
+        s.materials[1].diffuse = grey(display);
+        add_sphere(s.geometry, {0, 0, 0}, 3);
+        Camera c = top_camera(0, 0, 8, 16, 16);
+        const float albedo = srgb_to_linear(display);
+        double se = -1;
+        float v = furnace(s, c, 5, 5, 11, 11, 32, 1, nullptr, &se);
+        EXPECT_NEAR(v, albedo, std::fmax(4 * se, 1e-4)) << display;
+        if (albedo >= 0.5f)
+            EXPECT_LT(se, 1e-6) << "a path of throughput " << albedo << " was cut";
+        else
+            EXPECT_GT(se, 1e-3) << "no path of throughput " << albedo << " was cut";
+        std::printf("[furnace] roulette, albedo %.3f: %.5f (standard error %.5f)\n", albedo, v,
+                    se);
+    }
+}
+
 TEST(Physics, WhiteFurnaceRoundCurves)
 {
     for (float tr : {0.0f, 0.5f}) {
@@ -252,6 +277,52 @@ TEST(Physics, TranslucentLeafLitFromBehind)
     EXPECT_NEAR(radiance_at(s, 0, 0), 0.4f * srgb_to_linear(0.7f), 1e-3f);
     s.materials[1].translucency = 0;
     EXPECT_EQ(radiance_at(s, 0, 0), 0.0f);
+}
+
+// Among a view file's lights, next-event estimation picks one by what it gives the point
+// (docs/architecture.md): an opaque plane lit from above by one light and from below by
+// another is never given the light below, so its direct light has no noise at all, and a
+// translucent leaf between two lights of different colours shows, channel by channel,
+// reflect x one light + transmit x the other.
+TEST(Physics, DeltaLightsChosenByWhatTheyGive)
+{
+    geom::Scene s = lit_plane(0.6f);
+    s.lights.push_back(directional({0, 0, 1}));
+    s.lights.push_back(directional({0, 0, -1}));
+    double se = -1;
+    EXPECT_NEAR(radiance_at(s, 0, 0, 1, 16, false, &se), srgb_to_linear(0.6f), 1e-5f);
+    EXPECT_EQ(se, 0.0) << "the light below the opaque plane was chosen";
+
+    geom::Scene leaf;
+    leaf.materials[1].diffuse = grey(0.7f);
+    leaf.materials[1].translucency = 0.4f;
+    add_quad(leaf.geometry, -5, -5, 5, 5, 0, 1, 1);
+    geom::Light warm = directional({0.3, 0, 1});  // above, seen: reflected
+    warm.diffuse = {1, 0.5f, 0.2f};
+    geom::Light cool = directional({0, -0.4, -1});  // below: transmitted
+    cool.diffuse = {0.1f, 0.3f, 0.9f};
+    leaf.lights = {warm, cool};
+    Camera c = top_camera(0, 0, 0.2, 20, 20);
+    EmbreeScene accel(leaf, c);
+    PathContext ctx = context(leaf, accel, 0, 1);
+    prepare_path_context(ctx);
+    BlockMean m = trace_block(ctx, c, 9, 9, 11, 11, 64);
+    const float albedo = srgb_to_linear(0.7f);
+    auto expect = [&](float w, float k) {
+        float cos_warm = 1 / std::sqrt(1.09f), cos_cool = 1 / std::sqrt(1.16f);
+        return 0.6f * albedo * srgb_to_linear(w) * cos_warm +
+               0.4f * albedo * srgb_to_linear(k) * cos_cool;
+    };
+    // Each sample is exact but for the choice (the chosen light's colour, scaled to the
+    // luminance of both): a pixel's 64 stratified choices take each light within one of
+    // its share, which moves the mean by well under 1%; a wrong weight (the choice's
+    // probability left out or taken by power) moves it by tens of percent.
+    EXPECT_NEAR(m.radiance.x, expect(1, 0.1f), 1e-2f * expect(1, 0.1f));
+    EXPECT_NEAR(m.radiance.y, expect(0.5f, 0.3f), 1e-2f * expect(0.5f, 0.3f));
+    EXPECT_NEAR(m.radiance.z, expect(0.2f, 0.9f), 1e-2f * expect(0.2f, 0.9f));
+    std::printf("[direct] leaf between two lights: %.5f %.5f %.5f expected %.5f %.5f %.5f\n",
+                m.radiance.x, m.radiance.y, m.radiance.z, expect(1, 0.1f), expect(0.5f, 0.3f),
+                expect(0.2f, 0.9f));
 }
 
 // Transparency 0.5: half the camera rays pass (black behind), and a shadow through it is half.
