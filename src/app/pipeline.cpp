@@ -12,6 +12,7 @@
 #include "base/diagnostics.h"
 #include "base/subprocess.h"
 #include "geom/background_scene.h"
+#include "geom/flatten.h"
 #include "geom/function.h"
 #include "geom/gencyl.h"
 #include "geom/interpreter.h"
@@ -424,6 +425,11 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
     }
     if (scene.shading == geom::Shading::wireframe)
         geom::draw_as_wireframe(scene, wireframe_style(model, scene, options));
+    // Small instanced surfaces (petals, leaves) drawn in place: one BVH for rays to
+    // walk instead of two (docs/architecture.md), within a share of the memory budget.
+    geom::FlattenLimits flatten;
+    flatten.max_bytes = options.max_memory_bytes / 8;
+    geom::flatten_small_instances(scene, flatten);
     // Non-finite or huge numbers would abort inside Embree: dropped here with a warning.
     geom::drop_unrenderable(scene);
     release_unused_line_buffers(scene.geometry.lines);

@@ -180,16 +180,19 @@ geom::Scene interpret_patch_colour_model(const std::string& name, bool material_
 
 TEST(ColourIndexLighting, PatchColoursReplaceTheTurtlesAndReachTheNextColormap)
 {
+    // The small surface is drawn in place (geom/flatten.h): its triangles carry the
+    // materials the instance showed.
     geom::Scene scene = interpret_patch_colour_model("colormap", false);
-    ASSERT_EQ(scene.prototypes.size(), 1u);
-    const geom::TriangleMesh& mesh = scene.prototypes[0].geometry.mesh;
+    EXPECT_TRUE(scene.instances.empty());
+    const geom::TriangleMesh& mesh = scene.geometry.mesh;
     ASSERT_FALSE(mesh.triangles.empty());
+    ASSERT_EQ(mesh.material.size(), mesh.triangles.size());
+    ASSERT_EQ(mesh.back_material.size(), mesh.triangles.size());
     const std::size_t half = mesh.triangles.size() / 2;  // the two patches' triangles
-    // The first patch takes the instance's (the turtle's colour 7, surface-lit: 256 + 7).
-    EXPECT_EQ(mesh.material.front(), geom::inherit_material);
-    EXPECT_EQ(mesh.back_material.front(), geom::inherit_material);
-    ASSERT_EQ(scene.instances.size(), 1u);
-    EXPECT_EQ(scene.instances[0].material, 256 + 7);
+    // The first patch takes the turtle's colour 7, surface-lit (256 + 7), on both sides.
+    EXPECT_EQ(mesh.material.front(), 256 + 7);
+    EXPECT_EQ(mesh.back_material.front(), 256 + 7);
+    EXPECT_EQ(mesh.material[half - 1], 256 + 7);
     // The second: TOP 300 is entry 44 of the next colormap, BOTTOM 40 entry 40 of this one.
     EXPECT_EQ(mesh.material[half], 512 + 44);
     EXPECT_EQ(mesh.back_material[half], 256 + 40);
@@ -205,9 +208,10 @@ TEST(ColourIndexLighting, PatchColoursReplaceTheTurtlesAndReachTheNextColormap)
 TEST(ColourIndexLighting, MaterialFilesIgnorePatchColours)
 {
     geom::Scene scene = interpret_patch_colour_model("materials", true);
-    ASSERT_EQ(scene.prototypes.size(), 1u);
-    for (std::uint16_t m : scene.prototypes[0].geometry.mesh.material)
-        EXPECT_EQ(m, geom::inherit_material);
-    for (std::uint16_t m : scene.prototypes[0].geometry.mesh.back_material)
-        EXPECT_EQ(m, geom::inherit_material);
+    const geom::TriangleMesh& mesh = scene.geometry.mesh;
+    ASSERT_FALSE(mesh.triangles.empty());
+    for (std::uint16_t m : mesh.material)
+        EXPECT_EQ(m, 7);  // the turtle's material, no offset
+    for (std::uint16_t m : mesh.back_material)
+        EXPECT_EQ(m, 7);
 }
