@@ -220,30 +220,25 @@ struct CameraSample {
     double tnear = 0;
 };
 
-/// The sampler and camera ray of sample i of pixel (x, y), written in place (c, out):
-/// a batch's samples are made where they are used, not copied there.
-void camera_sample(const RenderState& f, int x, int y, std::uint32_t i,
-                   const PixelReplicas& replicas, CameraSample& c, CameraRayF& out)
+/// Sample i of pixel (x, y): its sampler, written in place (c), and the image point its
+/// camera ray goes through.
+PixelPoint film_point(const RenderState& f, int x, int y, std::uint32_t i,
+                      const PixelReplicas& replicas, CameraSample& c)
 {
     const RenderSettings& s = f.settings;
     const bool adaptive = s.noise_target > 0;
     const Sampler& sampler = c.sampler.emplace(replicas.seeds[adaptive ? (i & 1u) : 0],
                                                adaptive ? replica_index(i) : i, s.sampler);
     auto [jx, jy] = sampler.get2d(sample_dimension::film);
-    double px, py;
-    if (f.filter.box()) {
-        px = x + jx;  // in float, as before filters existed: the same images
-        py = y + jy;
-    } else {
-        px = x + 0.5 + f.filter.offset(jx);
-        py = y + 0.5 + f.filter.offset(jy);
-    }
-    CameraRay ray = [&] {
-        if (!f.lens)
-            return f.camera.generate_ray(px, py);
-        auto [lens_u, lens_v] = sampler.get2d(sample_dimension::lens);
-        return f.camera.generate_ray(px, py, lens_u, lens_v);
-    }();
+    if (f.filter.box())
+        return {x + jx, y + jy};  // in float, as before filters existed: the same images
+    return {x + 0.5 + f.filter.offset(jx), y + 0.5 + f.filter.offset(jy)};
+}
+
+/// Camera sample c's ray as it is traced (out): in single precision, from the near
+/// clipping plane.
+void traced_ray(const CameraRay& ray, CameraSample& c, CameraRayF& out)
+{
     out.org = Vec3f(ray.org);
     out.dir = Vec3f(ray.dir);
     if (ray.tnear > 0)
@@ -251,6 +246,46 @@ void camera_sample(const RenderState& f, int x, int y, std::uint32_t i,
     // Far clipping: geometry beyond the back plane must not show.
     out.tfar = std::isfinite(ray.tfar) ? static_cast<float>(ray.tfar - ray.tnear) : infinity;
     c.tnear = ray.tnear;
+}
+
+/// Camera sample c's ray through image point p (thin lens: through its lens sample).
+CameraRay camera_ray(const RenderState& f, const CameraSample& c, const PixelPoint& p)
+{
+    if (!f.lens)
+        return f.camera.generate_ray(p.x, p.y);
+    auto [lens_u, lens_v] = c.sampler->get2d(sample_dimension::lens);
+    return f.camera.generate_ray(p.x, p.y, lens_u, lens_v);
+}
+
+/// The sampler and camera ray of sample i of pixel (x, y), written in place (c, out):
+/// a batch's samples are made where they are used, not copied there.
+void camera_sample(const RenderState& f, int x, int y, std::uint32_t i,
+                   const PixelReplicas& replicas, CameraSample& c, CameraRayF& out)
+{
+    PixelPoint p = film_point(f, x, y, i, replicas, c);
+    traced_ray(camera_ray(f, c, p), c, out);
+}
+
+/// camera_sample for samples i0 .. i0 + n - 1 (n at most EmbreeScene::max_coherent_rays),
+/// in passes over the batch: sampler and image points, camera rays (Camera::generate_rays
+/// without a lens), their traced form. The same rays as one camera_sample each.
+void camera_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uint32_t n,
+                    const PixelReplicas& replicas, CameraSample* c, CameraRayF* out)
+{
+    constexpr std::uint32_t batch = EmbreeScene::max_coherent_rays;
+    std::array<PixelPoint, batch> points;
+    std::array<CameraRay, batch> rays;
+    n = std::min(n, batch);
+    for (std::uint32_t k = 0; k < n; ++k)
+        points[k] = film_point(f, x, y, i0 + k, replicas, c[k]);
+    if (!f.lens) {
+        f.camera.generate_rays(std::span(points.data(), n), std::span(rays.data(), n));
+    } else {
+        for (std::uint32_t k = 0; k < n; ++k)
+            rays[k] = camera_ray(f, c[k], points[k]);
+    }
+    for (std::uint32_t k = 0; k < n; ++k)
+        traced_ray(rays[k], c[k], out[k]);
 }
 
 /// Sample i (camera sample c, camera ray `ray`) added to its pixel's sums; `camera_hit`:
@@ -261,8 +296,10 @@ void take_sample(const RenderState& f, const CameraSample& c, const CameraRayF& 
 {
     const RenderSettings& s = f.settings;
     VisibleSurface first;
-    PathResult r = trace_path(f.ctx, ray.org, ray.dir, *c.sampler, ray.tfar,
-                              s.aovs ? &first : nullptr, camera_hit);
+    PathResult r = camera_hit && !*camera_hit
+                       ? camera_miss(f.ctx, ray.dir)
+                       : trace_path(f.ctx, ray.org, ray.dir, *c.sampler, ray.tfar,
+                                    s.aovs ? &first : nullptr, camera_hit);
     if (first.hit) {
         st.albedo += first.albedo;
         st.normal += first.normal;
@@ -312,8 +349,7 @@ void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uin
     std::array<std::optional<SurfaceHit>, batch> hits;
     for (std::uint32_t start = i0; start < i1; start += batch) {
         std::uint32_t n = std::min(batch, i1 - start);
-        for (std::uint32_t k = 0; k < n; ++k)
-            camera_sample(f, x, y, start + k, replicas, samples[k], rays[k]);
+        camera_samples(f, x, y, start, n, replicas, samples.data(), rays.data());
         f.accel.intersect_coherent(std::span(rays.data(), n), std::span(hits.data(), n));
         for (std::uint32_t k = 0; k < n; ++k)
             take_sample(f, samples[k], rays[k], start + k, st, &hits[k]);
