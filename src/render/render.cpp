@@ -266,26 +266,34 @@ void camera_sample(const RenderState& f, int x, int y, std::uint32_t i,
     traced_ray(camera_ray(f, c, p), c, out);
 }
 
-/// camera_sample for samples i0 .. i0 + n - 1 (n at most EmbreeScene::max_coherent_rays),
-/// in passes over the batch: sampler and image points, camera rays (Camera::generate_rays
+/// A batch of camera samples traced together (take_samples): made once per tile, not per
+/// pixel (its members' initialisers cost a visible share of the pixel loop).
+struct CameraBatch {
+    static constexpr std::uint32_t size = EmbreeScene::max_coherent_rays;
+    std::array<PixelPoint, size> points;
+    std::array<CameraRay, size> camera_rays;
+    std::array<CameraSample, size> samples;
+    std::array<CameraRayF, size> rays;
+    std::array<std::optional<SurfaceHit>, size> hits;
+};
+
+/// camera_sample for samples i0 .. i0 + n - 1 (n at most CameraBatch::size) into b, in
+/// passes over the batch: sampler and image points, camera rays (Camera::generate_rays
 /// without a lens), their traced form. The same rays as one camera_sample each.
 void camera_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uint32_t n,
-                    const PixelReplicas& replicas, CameraSample* c, CameraRayF* out)
+                    const PixelReplicas& replicas, CameraBatch& b)
 {
-    constexpr std::uint32_t batch = EmbreeScene::max_coherent_rays;
-    std::array<PixelPoint, batch> points;
-    std::array<CameraRay, batch> rays;
-    n = std::min(n, batch);
+    n = std::min(n, CameraBatch::size);
     for (std::uint32_t k = 0; k < n; ++k)
-        points[k] = film_point(f, x, y, i0 + k, replicas, c[k]);
+        b.points[k] = film_point(f, x, y, i0 + k, replicas, b.samples[k]);
     if (!f.lens) {
-        f.camera.generate_rays(std::span(points.data(), n), std::span(rays.data(), n));
+        f.camera.generate_rays(std::span(b.points.data(), n), std::span(b.camera_rays.data(), n));
     } else {
         for (std::uint32_t k = 0; k < n; ++k)
-            rays[k] = camera_ray(f, c[k], points[k]);
+            b.camera_rays[k] = camera_ray(f, b.samples[k], b.points[k]);
     }
     for (std::uint32_t k = 0; k < n; ++k)
-        traced_ray(rays[k], c[k], out[k]);
+        traced_ray(b.camera_rays[k], b.samples[k], b.rays[k]);
 }
 
 /// Sample i (camera sample c, camera ray `ray`) added to its pixel's sums; `camera_hit`:
@@ -331,7 +339,7 @@ void take_sample(const RenderState& f, const CameraSample& c, const CameraRayF& 
 /// cheaper than one by one. With a ground plane (which camera rays meet beside the
 /// Embree scene) each path traces its own.
 void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uint32_t i1,
-                  PixelState& st)
+                  PixelState& st, CameraBatch& b)
 {
     const PixelReplicas replicas(x, y, f.settings.seed);
     if (f.ctx.ground) {
@@ -343,16 +351,12 @@ void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uin
         }
         return;
     }
-    constexpr std::uint32_t batch = EmbreeScene::max_coherent_rays;
-    std::array<CameraSample, batch> samples;
-    std::array<CameraRayF, batch> rays;
-    std::array<std::optional<SurfaceHit>, batch> hits;
-    for (std::uint32_t start = i0; start < i1; start += batch) {
-        std::uint32_t n = std::min(batch, i1 - start);
-        camera_samples(f, x, y, start, n, replicas, samples.data(), rays.data());
-        f.accel.intersect_coherent(std::span(rays.data(), n), std::span(hits.data(), n));
+    for (std::uint32_t start = i0; start < i1; start += CameraBatch::size) {
+        std::uint32_t n = std::min(CameraBatch::size, i1 - start);
+        camera_samples(f, x, y, start, n, replicas, b);
+        f.accel.intersect_coherent(std::span(b.rays.data(), n), std::span(b.hits.data(), n));
         for (std::uint32_t k = 0; k < n; ++k)
-            take_sample(f, samples[k], rays[k], start + k, st, &hits[k]);
+            take_sample(f, b.samples[k], b.rays[k], start + k, st, &b.hits[k]);
     }
 }
 
@@ -758,6 +762,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                 for (int t = r.begin(); t != r.end(); ++t) {
                     int x0 = (t % tiles_x) * tile_size, y0 = (t / tiles_x) * tile_size;
                     std::uint64_t taken = 0;
+                    CameraBatch batch;
                     // Checked every row, so even passes of thousands of samples stop soon.
                     for (int y = y0; y < std::min(y0 + tile_size, h) && !should_stop(); ++y)
                         for (int x = x0; x < std::min(x0 + tile_size, w); ++x) {
@@ -767,7 +772,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                             if (st.samples >= target)
                                 continue;
                             taken += target - st.samples;
-                            take_samples(state, region.x + x, region.y + y, st.samples, target, st);
+                            take_samples(state, region.x + x, region.y + y, st.samples, target, st, batch);
                         }
                     progress.add(taken);
                 }
