@@ -128,33 +128,39 @@ struct InstanceStyle {
 };
 
 /// An instance's placement, made at hit time from the transform Embree holds: its linear
-/// part, the inverse transpose for normals and the factor radii scale by (the cube root
-/// of the volume scale).
+/// part and the inverse transpose for normals. The factors radii and offsets scale by are
+/// made only for the hits that need them (most instanced hits are on flat prototypes):
+/// a cube root on every instanced hit was a visible share of hit processing.
 struct Placement {
-    const InstanceStyle* style = nullptr;
+    InstanceStyle style;  ///< the instance's own (equal to the shared one Embree holds)
     std::uint32_t index = PrimId::none;  ///< in Scene::instances
     Mat3 linear, normals;
-    float radius_scale = 1;
-    float largest_scale = 1;  ///< the most the linear part stretches a coordinate (inf-norm)
+    float det = 1;  ///< of the linear part
+
+    /// The factor radii scale by: the cube root of the volume scale.
+    float radius_scale() const { return std::cbrt(std::fabs(det)); }
+    /// The most the linear part stretches a coordinate (inf-norm).
+    float largest_scale() const
+    {
+        const Vec3f &a = linear.c0, &b = linear.c1, &c = linear.c2;
+        return std::fmax(std::fmax(std::fabs(a.x) + std::fabs(b.x) + std::fabs(c.x),
+                                   std::fabs(a.y) + std::fabs(b.y) + std::fabs(c.y)),
+                         std::fabs(a.z) + std::fabs(b.z) + std::fabs(c.z));
+    }
 };
 
 /// `m`: the 3x4 column-major transform (as geom::Instance::transform).
-Placement make_placement(const float* m, const InstanceStyle* style, std::uint32_t index)
+Placement make_placement(const float* m, const InstanceStyle& style, std::uint32_t index)
 {
     Placement p;
     p.style = style;
     p.index = index;
     p.linear = {{m[0], m[1], m[2]}, {m[3], m[4], m[5]}, {m[6], m[7], m[8]}};
     const Vec3f &a = p.linear.c0, &b = p.linear.c1, &c = p.linear.c2;
-    float det = dot(a, cross(b, c));
-    float inv = det != 0 ? 1 / det : 0;
+    p.det = dot(a, cross(b, c));
+    float inv = p.det != 0 ? 1 / p.det : 0;
     // (A^-1)^T has the columns (b x c, c x a, a x b) / det.
     p.normals = {cross(b, c) * inv, cross(c, a) * inv, cross(a, b) * inv};
-    p.radius_scale = std::cbrt(std::fabs(det));
-    float largest = 0;
-    for (int row = 0; row < 3; ++row)
-        largest = std::fmax(largest, std::fabs(m[row]) + std::fabs(m[3 + row]) + std::fabs(m[6 + row]));
-    p.largest_scale = largest;
     return p;
 }
 
@@ -717,6 +723,7 @@ struct HitResolver {
     /// unplaced ones leave their id unused). Line-end scenes' instances come before.
     std::uint32_t first_instance_id = PrimId::none;
     std::uint32_t first_instance_index = 0;
+    std::span<const geom::Instance> instances;  ///< the scene's (it outlives this)
     std::deque<InstanceStyle> styles;  ///< one per distinct style (stable addresses)
     /// The caps and the joints of the scene's own shaded lines live in two scenes of their
     /// own, each placed once, untransformed, by a top-level instance (none: no such scene).
@@ -744,17 +751,24 @@ struct HitResolver {
         return static_cast<const InstanceStyle*>(
             rtcGetGeometryUserData(rtcGetGeometry(top, inst_id)));
     }
-    /// The placement of that instance, from the transform Embree keeps of it.
+    /// The placement of that instance, from the scene's own instance: the transform
+    /// Embree was given and the style, in one record. (Asking Embree for its copy of them
+    /// took three API calls per instanced hit, each entering the shared device, and two
+    /// cache misses.)
     std::optional<Placement> placement(std::uint32_t inst_id) const
     {
         if (!placed_instance(inst_id))
             return std::nullopt;
-        RTCGeometry g = rtcGetGeometry(top, inst_id);
-        std::array<float, 12> transform;
-        rtcGetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, transform.data());
-        return make_placement(transform.data(),
-                              static_cast<const InstanceStyle*>(rtcGetGeometryUserData(g)),
-                              inst_id - first_instance_id + first_instance_index);
+        const std::uint32_t index = inst_id - first_instance_id + first_instance_index;
+        const geom::Instance& inst = *instance(inst_id);
+        return make_placement(inst.transform.data(),
+                              {inst.prototype, inst.material, inst.back_material, inst.texture},
+                              index);
+    }
+    /// The scene's record of a placed instance (placed_instance(inst_id)).
+    const geom::Instance* instance(std::uint32_t inst_id) const
+    {
+        return &instances[inst_id - first_instance_id + first_instance_index];
     }
     const GeometrySource* part(std::uint32_t inst_id, std::uint32_t geom_id) const
     {
@@ -764,6 +778,18 @@ struct HitResolver {
                     return e.parts[geom_id];
         if (const InstanceStyle* st = style(inst_id))
             return proto_parts[st->prototype][geom_id];
+        return top_parts[geom_id];
+    }
+    /// The same, given the hit's placement (no second look-up of the instance).
+    const GeometrySource* part(std::uint32_t inst_id, std::uint32_t geom_id,
+                               const std::optional<Placement>& placement) const
+    {
+        if (placement)
+            return proto_parts[placement->style.prototype][geom_id];
+        if (inst_id != PrimId::none)
+            for (const PlacedEnds& e : line_end_scenes)
+                if (inst_id == e.instance)
+                    return e.parts[geom_id];
         return top_parts[geom_id];
     }
     int texture_of(const GeometrySource& part, std::uint32_t prim, const InstanceStyle* p) const;
@@ -1227,6 +1253,7 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
     // points at the style it shares with the instances that agree with it.
     std::map<decltype(InstanceStyle{}.key()), const InstanceStyle*> style_of;
     m.top = m.scene;
+    m.instances = scene.instances;
     const std::size_t heap_before = heap_in_use();
     for (std::uint32_t index = 0; index < scene.instances.size(); ++index) {
         const geom::Instance& inst = scene.instances[index];
@@ -1390,6 +1417,11 @@ void EmbreeScene::intersect_coherent(std::span<const CameraRayF> rays,
     // A stream of coherent rays: Embree gathers it into SIMD packets.
     rtcIntersect1M(m.scene, &context.context, rh.data(), static_cast<unsigned>(traced),
                    sizeof(RTCRayHit));
+    // The instance records of the stream's instanced hits, asked for together: their
+    // cache misses overlap instead of stalling each hit's conversion in turn.
+    for (std::size_t k = 0; k < traced; ++k)
+        if (m.placed_instance(rh[k].hit.instID[0]) && rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID)
+            __builtin_prefetch(m.instance(rh[k].hit.instID[0]));
     for (std::size_t k = 0; k < traced; ++k)
         if (rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID)
             hits[index[k]] = m.surface_hit(rh[k], rays[index[k]].org, rays[index[k]].dir);
@@ -1409,8 +1441,8 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
     const std::optional<Placement> placement = m.placement(h.inst_id);
     if (placement)
         h.instance = placement->index;
-    const InstanceStyle* style = placement ? placement->style : nullptr;
-    const GeometrySource& part = *m.part(h.inst_id, h.geom_id);
+    const InstanceStyle* style = placement ? &placement->style : nullptr;
+    const GeometrySource& part = *m.part(h.inst_id, h.geom_id, placement);
     h.shape = part.shape;
     h.unlit = part.unlit;
 
@@ -1423,7 +1455,8 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
     if (placement) {
         geometric = placement->normals * geometric;
         shading = placement->normals * shading;
-        h.radius *= placement->radius_scale;
+        if (h.radius != 0)
+            h.radius *= placement->radius_scale();
     }
     geometric = normalize(geometric);
     h.back = local.two_sided && dot(geometric, dir) > 0;
@@ -1457,7 +1490,7 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
         // Nothing skips a flat primitive: its offset must clear the float error of the hit,
         // which grows with the primitive's coordinates and (through the hit distance's
         // error) with the ray's length.
-        float extent = local.extent * (placement ? placement->largest_scale : 1);
+        float extent = local.extent * (placement ? placement->largest_scale() : 1);
         scale = std::fmax(scale, extent) + 0.2f * h.t;
     }
     h.spawn_offset = shape.offset_per_radius * h.radius + shape.offset_per_scale * scale +

@@ -173,17 +173,30 @@ PixelPoint Camera::project(const Vec3& p) const
     return {m_width * 0.5 + x / m_pixel_size, m_height * 0.5 - y / m_pixel_size};
 }
 
-CameraRay Camera::generate_ray(double x, double y) const
+void Camera::generate_rays(std::span<const PixelPoint> points, std::span<CameraRay> rays) const
 {
-    double sx = (x - m_width * 0.5) * m_pixel_size;
-    double sy = (m_height * 0.5 - y) * m_pixel_size;
-    CameraRay ray;
-    if (m_projection == Projection::parallel)
-        ray = {m_origin + m_right * sx + m_up * sy - m_forward * m_back_off, m_forward};
-    else
-        ray = {m_origin, geom::normalize(m_forward * m_focus_distance + m_right * sx + m_up * sy)};
-    clip(ray);
-    return ray;
+    const std::size_t n = std::min(points.size(), rays.size());
+    for (std::size_t i = 0; i < n; ++i) {
+        double sx = (points[i].x - m_width * 0.5) * m_pixel_size;
+        double sy = (m_height * 0.5 - points[i].y) * m_pixel_size;
+        CameraRay& ray = rays[i];
+        ray.tnear = 0;
+        ray.tfar = std::numeric_limits<double>::infinity();
+        if (m_projection == Projection::parallel) {
+            ray.org = m_origin + m_right * sx + m_up * sy - m_forward * m_back_off;
+            ray.dir = m_forward;
+        } else {
+            ray.org = m_origin;
+            ray.dir = m_forward * m_focus_distance + m_right * sx + m_up * sy;
+        }
+    }
+    // As generate_ray: the direction times the reciprocal of its length.
+    if (m_projection == Projection::perspective)
+        for (std::size_t i = 0; i < n; ++i)
+            rays[i].dir = rays[i].dir * (1.0 / geom::length(rays[i].dir));
+    if (!std::isinf(m_clip_near) || !std::isinf(m_clip_far))
+        for (std::size_t i = 0; i < n; ++i)
+            clip(rays[i]);
 }
 
 CameraRay Camera::generate_ray(double x, double y, double lens_u, double lens_v) const

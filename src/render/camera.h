@@ -2,7 +2,9 @@
 // The camera that frames a Scene as cpfg's window does: parallel auto-fit or perspective.
 #pragma once
 
+#include <cmath>
 #include <limits>
+#include <span>
 #include <string>
 
 #include "geom/scene.h"
@@ -42,7 +44,30 @@ public:
     PixelPoint project(const geom::Vec3& p) const;
     /// The ray through the image point (x, y) (continuous pixel coordinates), from the
     /// centre of the lens.
-    CameraRay generate_ray(double x, double y) const;
+    CameraRay generate_ray(double x, double y) const
+    {
+        // Inline: one call per camera sample, and its result is used at once.
+        double sx = (x - m_width * 0.5) * m_pixel_size;
+        double sy = (m_height * 0.5 - y) * m_pixel_size;
+        CameraRay ray;
+        if (m_projection == Projection::parallel)
+            ray = {m_origin + m_right * sx + m_up * sy - m_forward * m_back_off, m_forward};
+        else
+        {
+            // One division, not three (a third of a camera sample's own time was waiting
+            // on them): within one rounding of the double quotient, far below the float
+            // the ray is traced in.
+            geom::Vec3 d = m_forward * m_focus_distance + m_right * sx + m_up * sy;
+            ray = {m_origin, d * (1.0 / geom::length(d))};
+        }
+        if (!std::isinf(m_clip_near) || !std::isinf(m_clip_far))
+            clip(ray);
+        return ray;
+    }
+    /// generate_ray(x, y) for each of `points`, into `rays` (as many): the same rays, made
+    /// in passes over the batch so that the square roots and divisions of one ray do not
+    /// wait on those of the ray before (a camera sample's own time was mostly that wait).
+    void generate_rays(std::span<const PixelPoint> points, std::span<CameraRay> rays) const;
     /// The same through the lens point given by two uniforms in [0, 1) (a thin lens:
     /// every ray through (x, y) meets the others on the plane in focus). Equals
     /// generate_ray(x, y) for a pinhole camera.

@@ -471,6 +471,22 @@ VisibleSurface visible_surface(const SurfaceHit& hit, const SurfaceMaterial& mat
 
 }  // namespace
 
+PathResult camera_miss(const PathContext& ctx, const Vec3f& dir)
+{
+    if (!ctx.prepared)
+        throw std::logic_error("camera_miss: prepare_path_context() was not called");
+    // As trace_path's first vertex without a hit, with the same arithmetic (bit-identical).
+    PathResult result;
+    const Vec3f beta(1.0f);
+    if (ctx.max_depth <= 0)
+        return result;
+    if (ctx.environment_visible)
+        result.radiance += beta * escaped_radiance(ctx, dir);
+    else
+        result.radiance += beta * ctx.background;
+    return result;
+}
+
 PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec3f& camera_dir,
                       const Sampler& sampler, float camera_tfar, VisibleSurface* first,
                       const std::optional<SurfaceHit>* camera_hit)

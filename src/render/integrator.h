@@ -113,6 +113,11 @@ struct VisibleSurface {
     float t = 0;   ///< distance along the camera ray
 };
 
+/// What trace_path returns for a camera ray already traced that met nothing (an empty
+/// `camera_hit`): the background or the environment it sees, without setting up a path.
+/// Most camera rays of a plant miss, so their cost per sample counts.
+PathResult camera_miss(const PathContext& ctx, const Vec3f& dir);
+
 /// Traces the camera ray (org, dir), which ends at tfar (far clipping), with the sampler's
 /// dimensions; fills `first` when given. `camera_hit`, when given: the camera ray's first
 /// hit in ctx.accel, already traced (EmbreeScene::intersect_coherent; only without a

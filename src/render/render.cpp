@@ -220,30 +220,25 @@ struct CameraSample {
     double tnear = 0;
 };
 
-/// The sampler and camera ray of sample i of pixel (x, y), written in place (c, out):
-/// a batch's samples are made where they are used, not copied there.
-void camera_sample(const RenderState& f, int x, int y, std::uint32_t i,
-                   const PixelReplicas& replicas, CameraSample& c, CameraRayF& out)
+/// Sample i of pixel (x, y): its sampler, written in place (c), and the image point its
+/// camera ray goes through.
+PixelPoint film_point(const RenderState& f, int x, int y, std::uint32_t i,
+                      const PixelReplicas& replicas, CameraSample& c)
 {
     const RenderSettings& s = f.settings;
     const bool adaptive = s.noise_target > 0;
     const Sampler& sampler = c.sampler.emplace(replicas.seeds[adaptive ? (i & 1u) : 0],
                                                adaptive ? replica_index(i) : i, s.sampler);
     auto [jx, jy] = sampler.get2d(sample_dimension::film);
-    double px, py;
-    if (f.filter.box()) {
-        px = x + jx;  // in float, as before filters existed: the same images
-        py = y + jy;
-    } else {
-        px = x + 0.5 + f.filter.offset(jx);
-        py = y + 0.5 + f.filter.offset(jy);
-    }
-    CameraRay ray = [&] {
-        if (!f.lens)
-            return f.camera.generate_ray(px, py);
-        auto [lens_u, lens_v] = sampler.get2d(sample_dimension::lens);
-        return f.camera.generate_ray(px, py, lens_u, lens_v);
-    }();
+    if (f.filter.box())
+        return {x + jx, y + jy};  // in float, as before filters existed: the same images
+    return {x + 0.5 + f.filter.offset(jx), y + 0.5 + f.filter.offset(jy)};
+}
+
+/// Camera sample c's ray as it is traced (out): in single precision, from the near
+/// clipping plane.
+void traced_ray(const CameraRay& ray, CameraSample& c, CameraRayF& out)
+{
     out.org = Vec3f(ray.org);
     out.dir = Vec3f(ray.dir);
     if (ray.tnear > 0)
@@ -251,6 +246,54 @@ void camera_sample(const RenderState& f, int x, int y, std::uint32_t i,
     // Far clipping: geometry beyond the back plane must not show.
     out.tfar = std::isfinite(ray.tfar) ? static_cast<float>(ray.tfar - ray.tnear) : infinity;
     c.tnear = ray.tnear;
+}
+
+/// Camera sample c's ray through image point p (thin lens: through its lens sample).
+CameraRay camera_ray(const RenderState& f, const CameraSample& c, const PixelPoint& p)
+{
+    if (!f.lens)
+        return f.camera.generate_ray(p.x, p.y);
+    auto [lens_u, lens_v] = c.sampler->get2d(sample_dimension::lens);
+    return f.camera.generate_ray(p.x, p.y, lens_u, lens_v);
+}
+
+/// The sampler and camera ray of sample i of pixel (x, y), written in place (c, out):
+/// a batch's samples are made where they are used, not copied there.
+void camera_sample(const RenderState& f, int x, int y, std::uint32_t i,
+                   const PixelReplicas& replicas, CameraSample& c, CameraRayF& out)
+{
+    PixelPoint p = film_point(f, x, y, i, replicas, c);
+    traced_ray(camera_ray(f, c, p), c, out);
+}
+
+/// A batch of camera samples traced together (take_samples): made once per tile, not per
+/// pixel (its members' initialisers cost a visible share of the pixel loop).
+struct CameraBatch {
+    static constexpr std::uint32_t size = EmbreeScene::max_coherent_rays;
+    std::array<PixelPoint, size> points;
+    std::array<CameraRay, size> camera_rays;
+    std::array<CameraSample, size> samples;
+    std::array<CameraRayF, size> rays;
+    std::array<std::optional<SurfaceHit>, size> hits;
+};
+
+/// camera_sample for samples i0 .. i0 + n - 1 (n at most CameraBatch::size) into b, in
+/// passes over the batch: sampler and image points, camera rays (Camera::generate_rays
+/// without a lens), their traced form. The same rays as one camera_sample each.
+void camera_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uint32_t n,
+                    const PixelReplicas& replicas, CameraBatch& b)
+{
+    n = std::min(n, CameraBatch::size);
+    for (std::uint32_t k = 0; k < n; ++k)
+        b.points[k] = film_point(f, x, y, i0 + k, replicas, b.samples[k]);
+    if (!f.lens) {
+        f.camera.generate_rays(std::span(b.points.data(), n), std::span(b.camera_rays.data(), n));
+    } else {
+        for (std::uint32_t k = 0; k < n; ++k)
+            b.camera_rays[k] = camera_ray(f, b.samples[k], b.points[k]);
+    }
+    for (std::uint32_t k = 0; k < n; ++k)
+        traced_ray(b.camera_rays[k], b.samples[k], b.rays[k]);
 }
 
 /// Sample i (camera sample c, camera ray `ray`) added to its pixel's sums; `camera_hit`:
@@ -261,8 +304,10 @@ void take_sample(const RenderState& f, const CameraSample& c, const CameraRayF& 
 {
     const RenderSettings& s = f.settings;
     VisibleSurface first;
-    PathResult r = trace_path(f.ctx, ray.org, ray.dir, *c.sampler, ray.tfar,
-                              s.aovs ? &first : nullptr, camera_hit);
+    PathResult r = camera_hit && !*camera_hit
+                       ? camera_miss(f.ctx, ray.dir)
+                       : trace_path(f.ctx, ray.org, ray.dir, *c.sampler, ray.tfar,
+                                    s.aovs ? &first : nullptr, camera_hit);
     if (first.hit) {
         st.albedo += first.albedo;
         st.normal += first.normal;
@@ -294,7 +339,7 @@ void take_sample(const RenderState& f, const CameraSample& c, const CameraRayF& 
 /// cheaper than one by one. With a ground plane (which camera rays meet beside the
 /// Embree scene) each path traces its own.
 void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uint32_t i1,
-                  PixelState& st)
+                  PixelState& st, CameraBatch& b)
 {
     const PixelReplicas replicas(x, y, f.settings.seed);
     if (f.ctx.ground) {
@@ -306,17 +351,12 @@ void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uin
         }
         return;
     }
-    constexpr std::uint32_t batch = EmbreeScene::max_coherent_rays;
-    std::array<CameraSample, batch> samples;
-    std::array<CameraRayF, batch> rays;
-    std::array<std::optional<SurfaceHit>, batch> hits;
-    for (std::uint32_t start = i0; start < i1; start += batch) {
-        std::uint32_t n = std::min(batch, i1 - start);
+    for (std::uint32_t start = i0; start < i1; start += CameraBatch::size) {
+        std::uint32_t n = std::min(CameraBatch::size, i1 - start);
+        camera_samples(f, x, y, start, n, replicas, b);
+        f.accel.intersect_coherent(std::span(b.rays.data(), n), std::span(b.hits.data(), n));
         for (std::uint32_t k = 0; k < n; ++k)
-            camera_sample(f, x, y, start + k, replicas, samples[k], rays[k]);
-        f.accel.intersect_coherent(std::span(rays.data(), n), std::span(hits.data(), n));
-        for (std::uint32_t k = 0; k < n; ++k)
-            take_sample(f, samples[k], rays[k], start + k, st, &hits[k]);
+            take_sample(f, b.samples[k], b.rays[k], start + k, st, &b.hits[k]);
     }
 }
 
@@ -722,6 +762,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                 for (int t = r.begin(); t != r.end(); ++t) {
                     int x0 = (t % tiles_x) * tile_size, y0 = (t / tiles_x) * tile_size;
                     std::uint64_t taken = 0;
+                    CameraBatch batch;
                     // Checked every row, so even passes of thousands of samples stop soon.
                     for (int y = y0; y < std::min(y0 + tile_size, h) && !should_stop(); ++y)
                         for (int x = x0; x < std::min(x0 + tile_size, w); ++x) {
@@ -731,7 +772,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                             if (st.samples >= target)
                                 continue;
                             taken += target - st.samples;
-                            take_samples(state, region.x + x, region.y + y, st.samples, target, st);
+                            take_samples(state, region.x + x, region.y + y, st.samples, target, st, batch);
                         }
                     progress.add(taken);
                 }
