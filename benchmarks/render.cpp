@@ -85,17 +85,25 @@ struct RayLog {
     /// number from the shared counter: contention charged to the path tracer).
     static constexpr std::size_t full = std::numeric_limits<std::size_t>::max();
     std::vector<RTCRay> rays;
+    /// Beside each single ray, the primitive it skips (the one it leaves, which the round
+    /// shapes' filters reject), so that the replay asks Embree the same question as the
+    /// path tracer did; empty for the camera streams, which skip nothing.
+    std::vector<cambium::render::PrimId> skips;
     std::atomic<std::size_t> chunks_taken{0};
 
-    /// Makes `count` sentinel slots (before the clock starts: they are touched here).
-    void prepare(std::size_t count)
+    /// Makes `count` sentinel slots (before the clock starts: they are touched here), with
+    /// room for each ray's skipped primitive when `with_skips`.
+    void prepare(std::size_t count, bool with_skips)
     {
         RTCRay sentinel{};
         sentinel.tnear = -1;
         rays.assign(count, sentinel);
+        skips.assign(with_skips ? count : 0, {});
     }
-    /// Records r in the calling thread's chunk [next, end), taking a new one when full.
-    void record(const RTCRay& r, std::size_t& next, std::size_t& end)
+    /// Records r (which skips `skip`) in the calling thread's chunk [next, end), taking a
+    /// new one when full.
+    void record(const RTCRay& r, std::size_t& next, std::size_t& end,
+                const cambium::render::PrimId& skip = {})
     {
         if (next == end) {
             if (next == full)  // no chunks left: not even the shared counter is touched
@@ -107,6 +115,8 @@ struct RayLog {
                 return;
             }
         }
+        if (!skips.empty())
+            skips[next] = skip;
         rays[next++] = r;
     }
     /// Records the m rays of one stream call together in the calling thread's chunk (a
@@ -131,7 +141,20 @@ struct RayLog {
     /// Drops the slots never filled.
     void compact()
     {
-        std::erase_if(rays, [](const RTCRay& r) { return r.tnear < 0; });
+        std::size_t kept = 0;
+        for (std::size_t i = 0; i < rays.size(); ++i)
+            if (rays[i].tnear >= 0) {
+                if (!skips.empty())
+                    skips[kept] = skips[i];
+                rays[kept++] = rays[i];
+            }
+        rays.resize(kept);
+        if (!skips.empty())
+            skips.resize(kept);
+    }
+    std::size_t bytes() const
+    {
+        return rays.size() * sizeof(RTCRay) + skips.size() * sizeof(cambium::render::PrimId);
     }
 };
 
@@ -166,6 +189,18 @@ Occluded1 real_occluded()
     return f;
 }
 
+/// The primitive a path tracer's ray skips, read from its context: render/accel.cpp's
+/// SkipContext (Embree's context, then the PrimId), with which every context the path
+/// tracer passes begins (as ReplayContext below assumes too).
+cambium::render::PrimId skip_of(const RTCIntersectContext* context)
+{
+    struct Skipping {
+        RTCIntersectContext context;
+        cambium::render::PrimId skip;
+    };
+    return reinterpret_cast<const Skipping*>(context)->skip;
+}
+
 void note_call(RTCScene scene)
 {
     if (!recorder.started.load(std::memory_order_relaxed)) {
@@ -175,9 +210,8 @@ void note_call(RTCScene scene)
             recorder.first_call_cpu = cpu_seconds();
             // Less the recorder's own buffers (allocated and touched before the render).
             recorder.rss_at_first_call =
-                peak_rss_mb() - double((recorder.rays.rays.size() + recorder.occlusion_rays.rays.size() +
-                                        recorder.stream_rays.rays.size()) *
-                                       sizeof(RTCRay)) / (1024.0 * 1024.0);
+                peak_rss_mb() - double(recorder.rays.bytes() + recorder.occlusion_rays.bytes() +
+                                       recorder.stream_rays.bytes()) / (1024.0 * 1024.0);
             recorder.scene = scene;
             recorder.started = true;
         }
@@ -192,7 +226,7 @@ extern "C" void rtcIntersect1(RTCScene scene, RTCIntersectContext* context, RTCR
         note_call(scene);
         recorder.intersections.add();
         thread_local std::size_t next = 0, end = 0;
-        recorder.rays.record(rayhit->ray, next, end);
+        recorder.rays.record(rayhit->ray, next, end, skip_of(context));
     }
     real_intersect()(scene, context, rayhit);
 }
@@ -220,7 +254,7 @@ extern "C" void rtcOccluded1(RTCScene scene, RTCIntersectContext* context, RTCRa
         note_call(scene);
         recorder.occlusions.add();
         thread_local std::size_t next = 0, end = 0;
-        recorder.occlusion_rays.record(*ray, next, end);
+        recorder.occlusion_rays.record(*ray, next, end, skip_of(context));
     }
     real_occluded()(scene, context, ray);
 }
@@ -375,18 +409,18 @@ bool accel_draws_instances()
 }
 
 /// The intersection context as render/accel.cpp extends it (SkipContext): Embree's, then
-/// the primitive a ray must skip, here none (the filters of round shapes read it).
+/// the primitive a ray must skip, the one the path tracer's ray skipped (the filters of
+/// round shapes read it; camera rays skip none).
 struct ReplayContext {
     RTCIntersectContext context;
-    std::uint32_t skip[3] = {RTC_INVALID_GEOMETRY_ID, RTC_INVALID_GEOMETRY_ID,
-                             RTC_INVALID_GEOMETRY_ID};
+    cambium::render::PrimId skip;
     ReplayContext() { rtcInitIntersectContext(&context); }
 };
 
 /// Raw rtcIntersect1 (or rtcOccluded1) over the recorded rays, in parallel; returns seconds.
-double replay(RTCScene scene, const std::vector<RTCRay>& rays, bool occlusion,
-              std::uint64_t& hits)
+double replay(RTCScene scene, const RayLog& log, bool occlusion, std::uint64_t& hits)
 {
+    const std::vector<RTCRay>& rays = log.rays;
     std::atomic<std::uint64_t> hit_count{0};
     auto t0 = Clock::now();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 1024),
@@ -396,6 +430,8 @@ double replay(RTCScene scene, const std::vector<RTCRay>& rays, bool occlusion,
         ReplayContext c;
         std::uint64_t local = 0;
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            if (!log.skips.empty())
+                c.skip = log.skips[i];
             if (occlusion) {
                 RTCRay ray = rays[i];
                 real_occluded()(scene, &c.context, &ray);
@@ -517,9 +553,9 @@ int run(int argc, char** argv)
 
     // The path tracer, counted by the interposer; the raw replay at the end of its pass,
     // while its Embree scene is alive.
-    recorder.rays.prepare(2'000'000);  // touched here, before the clock starts
-    recorder.occlusion_rays.prepare(2'000'000);
-    recorder.stream_rays.prepare(2'000'000);
+    recorder.rays.prepare(2'000'000, true);  // touched here, before the clock starts
+    recorder.occlusion_rays.prepare(2'000'000, true);
+    recorder.stream_rays.prepare(2'000'000, false);
     recorder.recording = true;
     Clock::time_point trace_end;
     double trace_end_cpu = 0;
@@ -537,10 +573,10 @@ int run(int argc, char** argv)
         recorder.stream_rays.compact();
         arena.execute([&] {
             double cpu0 = cpu_seconds();
-            raw.intersect_s = replay(recorder.scene, recorder.rays.rays, false, raw.hits);
+            raw.intersect_s = replay(recorder.scene, recorder.rays, false, raw.hits);
             double cpu1 = cpu_seconds();
             raw.occluded_s =
-                replay(recorder.scene, recorder.occlusion_rays.rays, true, raw.occluded);
+                replay(recorder.scene, recorder.occlusion_rays, true, raw.occluded);
             double cpu2 = cpu_seconds();
             raw.stream_s = replay_streams(recorder.scene, recorder.stream_rays.rays, raw.stream_hits);
             raw.intersect_cpu_s = cpu1 - cpu0;
@@ -573,16 +609,16 @@ int run(int argc, char** argv)
     double raw_rays_per_s = raw_mix_s > 0 ? rays / raw_mix_s : 0;
     // The same in CPU seconds (the measure that holds on a loaded machine).
     double trace_cpu_s = trace_end_cpu - recorder.first_call_cpu;
+    // Raw Embree's CPU seconds for `traced` rays of a kind, at its rate on the `recorded`
+    // ones replayed (none recorded, as with --depth 1's single rays: none to charge).
+    auto raw_cpu_for = [](double traced, double replay_cpu_s, std::size_t recorded) {
+        return recorded > 0 && replay_cpu_s > 0 ? traced * replay_cpu_s / double(recorded) : 0;
+    };
     double raw_mix_cpu_s =
-        (raw.intersect_cpu_s > 0 ? double(single_intersections) * raw.intersect_cpu_s /
-                                       double(recorder.rays.rays.size())
-                                 : 0) +
-        (raw.stream_cpu_s > 0 ? double(stream_intersections) * raw.stream_cpu_s /
-                                    double(recorder.stream_rays.rays.size())
-                              : 0) +
-        (raw.occluded_cpu_s > 0 ? double(occlusions) * raw.occluded_cpu_s /
-                                      double(recorder.occlusion_rays.rays.size())
-                                : 0);
+        raw_cpu_for(double(single_intersections), raw.intersect_cpu_s, recorder.rays.rays.size()) +
+        raw_cpu_for(double(stream_intersections), raw.stream_cpu_s,
+                    recorder.stream_rays.rays.size()) +
+        raw_cpu_for(double(occlusions), raw.occluded_cpu_s, recorder.occlusion_rays.rays.size());
     std::printf(
         "{\"scale\":%g,\"threads\":%d,\"segments\":%zu,\"embree_segments\":%zu,"
         "\"instances\":%zu,\"instances_in_accel\":%s,\"generate_s\":%.3f,\"build_s\":%.3f,"
