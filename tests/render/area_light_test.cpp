@@ -273,20 +273,28 @@ TEST(AreaLight, NeeLowersVarianceKeepingTheMean)
                 nee.mean, nee.variance, bsdf.mean, bsdf.variance, expect);
 }
 
+/// An 8x8 render of `spp` samples, two segments deep, lit by the scene's lights alone (no
+/// ambient, no OpenGL ambient term), without layers.
+RenderSettings lit_only_by_lights(int spp)
+{
+    RenderSettings settings;
+    settings.width = settings.height = 8;
+    settings.samples_per_pixel = spp;
+    settings.max_depth = 2;
+    settings.threads = 2;
+    settings.ambient = {0, 0, 0};
+    settings.opengl_ambient = false;
+    settings.aovs = false;
+    return settings;
+}
+
 // render() builds the list (RenderSettings::area_lights) and gets the same mean without it.
 TEST(AreaLight, RenderSamplesEmittersUnlessTurnedOff)
 {
     geom::Scene s = plane_scene();
     add_disc(s.geometry, {0, 0, 2}, 0.3f, {0, 0, -1}, 2, 3);
     double expect = albedo() * 0.09 / (4 + 0.09);
-    RenderSettings settings;
-    settings.width = settings.height = 8;
-    settings.samples_per_pixel = 16;
-    settings.max_depth = 2;
-    settings.threads = 2;
-    settings.ambient = {0, 0, 0};
-    settings.opengl_ambient = false;  // the emitter alone lights the patch
-    settings.aovs = false;
+    RenderSettings settings = lit_only_by_lights(16);  // the emitter alone lights the patch
     auto block = [&](bool area) {
         settings.area_lights = area;
         Image img = render(s, patch_camera(1), settings);
@@ -339,14 +347,7 @@ TEST(AreaLight, FaintEmittersAreLeftToBsdfSamplingWithAllTheirLight)
     EXPECT_EQ(bright.size(), 2u);
     EXPECT_GT(bright.pdf_li(p, *on_disc), 0.0f);
 
-    RenderSettings settings;
-    settings.width = settings.height = 8;
-    settings.samples_per_pixel = 64;
-    settings.max_depth = 2;
-    settings.threads = 2;
-    settings.ambient = {0, 0, 0};
-    settings.opengl_ambient = false;
-    settings.aovs = false;
+    RenderSettings settings = lit_only_by_lights(64);
     Image img = render(s, camera, settings);
     std::vector<double> g;
     for (std::size_t i = 0; i < img.rgba.size(); i += 4)
