@@ -329,6 +329,13 @@ Vec3f escaped_radiance(const PathContext& ctx, const Vec3f& d)
     return ctx.environment ? ctx.environment->radiance(d) : ctx.ambient;
 }
 
+/// What a camera ray that meets nothing along d sees: the environment where the camera
+/// sees it, else the view's background.
+Vec3f seen_by_camera(const PathContext& ctx, const Vec3f& d)
+{
+    return ctx.environment_visible ? escaped_radiance(ctx, d) : ctx.background;
+}
+
 /// A direction about the unit normal n drawn with density cos / pi (Malley's method).
 Vec3f cosine_direction(const Vec3f& n, float u1, float u2)
 {
@@ -475,15 +482,10 @@ PathResult camera_miss(const PathContext& ctx, const Vec3f& dir)
 {
     if (!ctx.prepared)
         throw std::logic_error("camera_miss: prepare_path_context() was not called");
-    // As trace_path's first vertex without a hit, with the same arithmetic (bit-identical).
+    // As trace_path's first vertex without a hit (bit-identical: its throughput is 1).
     PathResult result;
-    const Vec3f beta(1.0f);
-    if (ctx.max_depth <= 0)
-        return result;
-    if (ctx.environment_visible)
-        result.radiance += beta * escaped_radiance(ctx, dir);
-    else
-        result.radiance += beta * ctx.background;
+    if (ctx.max_depth > 0)
+        result.radiance += seen_by_camera(ctx, dir);
     return result;
 }
 
@@ -513,10 +515,8 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
                                             ? *camera_hit
                                             : first_hit(ctx, org, dir, tfar, leaving, depth == 0);
         if (!hit) {
-            if (depth == 0 && ctx.environment_visible) {
-                result.radiance += beta * env_radiance(dir);
-            } else if (depth == 0) {
-                result.radiance += beta * ctx.background;
+            if (depth == 0) {
+                result.radiance += beta * seen_by_camera(ctx, dir);
             } else if (!facts.environment_black) {
                 float w = bsdf_hit_weight(bsdf_pdf_prev, lights.pdf_li(dir));
                 result.radiance += beta * env_radiance(dir) * w;
