@@ -176,25 +176,12 @@ PixelPoint Camera::project(const Vec3& p) const
 void Camera::generate_rays(std::span<const PixelPoint> points, std::span<CameraRay> rays) const
 {
     const std::size_t n = std::min(points.size(), rays.size());
-    for (std::size_t i = 0; i < n; ++i) {
-        double sx = (points[i].x - m_width * 0.5) * m_pixel_size;
-        double sy = (m_height * 0.5 - points[i].y) * m_pixel_size;
-        CameraRay& ray = rays[i];
-        ray.tnear = 0;
-        ray.tfar = std::numeric_limits<double>::infinity();
-        if (m_projection == Projection::parallel) {
-            ray.org = m_origin + m_right * sx + m_up * sy - m_forward * m_back_off;
-            ray.dir = m_forward;
-        } else {
-            ray.org = m_origin;
-            ray.dir = m_forward * m_focus_distance + m_right * sx + m_up * sy;
-        }
-    }
-    // As generate_ray: the direction times the reciprocal of its length.
+    for (std::size_t i = 0; i < n; ++i)
+        rays[i] = unnormalised_ray(points[i].x, points[i].y);
     if (m_projection == Projection::perspective)
         for (std::size_t i = 0; i < n; ++i)
-            rays[i].dir = rays[i].dir * (1.0 / geom::length(rays[i].dir));
-    if (!std::isinf(m_clip_near) || !std::isinf(m_clip_far))
+            normalise(rays[i]);
+    if (clipped())
         for (std::size_t i = 0; i < n; ++i)
             clip(rays[i]);
 }
@@ -203,10 +190,8 @@ CameraRay Camera::generate_ray(double x, double y, double lens_u, double lens_v)
 {
     if (m_aperture_radius <= 0 || m_projection == Projection::parallel)
         return generate_ray(x, y);
-    double sx = (x - m_width * 0.5) * m_pixel_size;
-    double sy = (m_height * 0.5 - y) * m_pixel_size;
     // The pinhole ray meets the plane in focus here; every lens point aims at it.
-    Vec3 through = m_forward * m_focus_distance + m_right * sx + m_up * sy;
+    Vec3 through = unnormalised_ray(x, y).dir;
     Vec3 target = m_origin + through * (m_lens_focus / m_focus_distance);
     auto [lx, ly] = concentric_disk(lens_u, lens_v);
     Vec3 lens = m_origin + m_right * (lx * m_aperture_radius) + m_up * (ly * m_aperture_radius);

@@ -47,20 +47,10 @@ public:
     CameraRay generate_ray(double x, double y) const
     {
         // Inline: one call per camera sample, and its result is used at once.
-        double sx = (x - m_width * 0.5) * m_pixel_size;
-        double sy = (m_height * 0.5 - y) * m_pixel_size;
-        CameraRay ray;
-        if (m_projection == Projection::parallel)
-            ray = {m_origin + m_right * sx + m_up * sy - m_forward * m_back_off, m_forward};
-        else
-        {
-            // One division, not three (a third of a camera sample's own time was waiting
-            // on them): within one rounding of the double quotient, far below the float
-            // the ray is traced in.
-            geom::Vec3 d = m_forward * m_focus_distance + m_right * sx + m_up * sy;
-            ray = {m_origin, d * (1.0 / geom::length(d))};
-        }
-        if (!std::isinf(m_clip_near) || !std::isinf(m_clip_far))
+        CameraRay ray = unnormalised_ray(x, y);
+        if (m_projection == Projection::perspective)
+            normalise(ray);
+        if (clipped())
             clip(ray);
         return ray;
     }
@@ -111,6 +101,21 @@ public:
     void check_range(const std::string& what) const;
 
 private:
+    /// The ray through the image point (x, y), its direction not yet of unit length
+    /// (perspective views) and not clipped.
+    CameraRay unnormalised_ray(double x, double y) const
+    {
+        double sx = (x - m_width * 0.5) * m_pixel_size;
+        double sy = (m_height * 0.5 - y) * m_pixel_size;
+        if (m_projection == Projection::parallel)
+            return {m_origin + m_right * sx + m_up * sy - m_forward * m_back_off, m_forward};
+        return {m_origin, m_forward * m_focus_distance + m_right * sx + m_up * sy};
+    }
+    /// The direction times the reciprocal of its length: one division, not three (a third
+    /// of a camera sample's own time was waiting on them), within one rounding of the
+    /// double quotient, far below the float the ray is traced in.
+    static void normalise(CameraRay& ray) { ray.dir = ray.dir * (1.0 / geom::length(ray.dir)); }
+    bool clipped() const { return !std::isinf(m_clip_near) || !std::isinf(m_clip_far); }
     Camera() = default;
     /// Sets the ray's [tnear, tfar] from the clipping planes.
     void clip(CameraRay& ray) const;
