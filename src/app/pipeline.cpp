@@ -347,8 +347,7 @@ geom::InterpretOptions interpret_options(const Model& model, const Options& opti
 {
     geom::InterpretOptions turtle;
     turtle.strings = model.lsystem.program().strings;
-    if (lit_by_colour_index(model))
-    {
+    if (lit_by_colour_index(model)) {
         turtle.surface_material_offset = geom::colour_indices;
         turtle.next_colormap_material_offset = 2 * geom::colour_indices;
     }
