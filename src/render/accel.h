@@ -76,13 +76,6 @@ struct SurfaceHit {
     }
 };
 
-/// A camera ray in single precision, as intersect_coherent() traces it: from org along
-/// dir for t < tfar.
-struct CameraRayF {
-    Vec3f org, dir;
-    float tfar = 0;
-};
-
 /// The acceleration structure of one frame: every Geometry part natively in Embree
 /// (round linear and Hermite curves, sphere points, oriented discs, triangles), each
 /// prototype in its own Embree scene placed by one instance per Scene::Instance.

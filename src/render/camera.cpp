@@ -158,6 +158,12 @@ Camera Camera::perspective(const Vec3& eye, const Vec3& focus, const Vec3& up, d
     c.m_pixel_size = 2 * c.m_focus_distance * std::tan(fov / 2) / height;
     c.m_width = width;
     c.m_height = height;
+    c.m_origin_f = Vec3f(c.m_origin);
+    c.m_forward_f = Vec3f(c.m_forward * c.m_focus_distance);
+    c.m_right_f = Vec3f(c.m_right * c.m_pixel_size);
+    c.m_up_f = Vec3f(c.m_up * c.m_pixel_size);
+    c.m_half_width_f = static_cast<float>(width * 0.5);
+    c.m_half_height_f = static_cast<float>(height * 0.5);
     return c;
 }
 

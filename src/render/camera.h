@@ -2,6 +2,7 @@
 // The camera that frames a Scene as cpfg's window does: parallel auto-fit or perspective.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -9,6 +10,7 @@
 
 #include "geom/scene.h"
 #include "geom/vec.h"
+#include "render/vecf.h"
 
 namespace cambium::render {
 
@@ -24,6 +26,13 @@ struct CameraRay {
     geom::Vec3 org, dir;
     double tnear = 0;
     double tfar = std::numeric_limits<double>::infinity();
+};
+
+/// A camera ray in single precision, as EmbreeScene::intersect_coherent() traces it: from
+/// org along dir for t < tfar.
+struct CameraRayF {
+    Vec3f org, dir;
+    float tfar = 0;
 };
 
 /// A pinhole or orthographic camera in world units. Immutable after make_camera().
@@ -58,6 +67,31 @@ public:
     /// in passes over the batch so that the square roots and divisions of one ray do not
     /// wait on those of the ray before (a camera sample's own time was mostly that wait).
     void generate_rays(std::span<const PixelPoint> points, std::span<CameraRay> rays) const;
+    /// Whether generate_rays_f() makes this camera's rays: a pinhole perspective camera
+    /// without clipping planes. A parallel view (pixel-exact lines), a lens or clipping
+    /// (cpfg's planes, measured in double) keep generate_ray()'s double precision.
+    bool single_precision() const
+    {
+        return m_projection == Projection::perspective && m_aperture_radius <= 0 && !clipped();
+    }
+    /// For a single_precision() camera: the ray through the image point (xs[k], ys[k]) for
+    /// each k, into `rays` (as many; tfar infinite), made in float arithmetic from the
+    /// camera's frame rounded to float once. The direction is generate_ray()'s within a
+    /// few float roundings (about 1e-7 rad, a ten-thousandth of a pixel); a float square
+    /// root and reciprocal per ray instead of double ones, which held up every camera
+    /// sample.
+    void generate_rays_f(std::span<const float> xs, std::span<const float> ys,
+                         std::span<CameraRayF> rays) const
+    {
+        const std::size_t n = std::min({xs.size(), ys.size(), rays.size()});
+        for (std::size_t k = 0; k < n; ++k) {
+            Vec3f d = m_forward_f + m_right_f * (xs[k] - m_half_width_f) +
+                      m_up_f * (m_half_height_f - ys[k]);
+            rays[k].org = m_origin_f;
+            rays[k].dir = d * (1.0f / std::sqrt(dot(d, d)));
+            rays[k].tfar = std::numeric_limits<float>::infinity();
+        }
+    }
     /// The same through the lens point given by two uniforms in [0, 1) (a thin lens:
     /// every ray through (x, y) meets the others on the plane in focus). Equals
     /// generate_ray(x, y) for a pinhole camera.
@@ -131,6 +165,10 @@ private:
     double m_lens_focus = 1;            // eye to the plane in focus
     double m_clip_near = -std::numeric_limits<double>::infinity();  // depth along forward
     double m_clip_far = std::numeric_limits<double>::infinity();
+    // Perspective, for generate_rays_f(): the eye, forward to the focus plane, right and
+    // up one pixel long there, half the image size in pixels.
+    Vec3f m_origin_f, m_forward_f, m_right_f, m_up_f;
+    float m_half_width_f = 0, m_half_height_f = 0;
 };
 
 /// The camera that frames the scene as cpfg does (docs: render/camera.cpp, "cpfg framing").

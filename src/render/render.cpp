@@ -163,6 +163,27 @@ struct PixelState {
 
 float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
+/// What a camera ray that meets nothing adds to its pixel when that is the same in every
+/// direction (no visible environment) and finite: take_sample's sums for camera_miss's
+/// result, made once per view instead of once per sample (most samples of a plant miss).
+struct FlatMiss {
+    Vec3f radiance;
+    double luminance = 0;
+};
+
+std::optional<FlatMiss> flat_miss(const PathContext& ctx, const RenderSettings& s)
+{
+    if (ctx.environment_visible)
+        return std::nullopt;
+    // camera_miss's radiance, after take_sample's transparency.
+    Vec3f radiance = ctx.max_depth > 0 ? ctx.background : Vec3f();
+    if (s.transparent_background || s.ground.shadow_catcher)
+        radiance = Vec3f();
+    if (!std::isfinite(radiance.x + radiance.y + radiance.z))
+        return std::nullopt;  // take_sample counts it as not finite
+    return FlatMiss{radiance, luminance(radiance)};
+}
+
 /// Everything one sample needs, shared read-only by all threads.
 struct RenderState {
     const PathContext& ctx;
@@ -172,6 +193,11 @@ struct RenderState {
     FilterTable filter;
     bool lens = false;
     std::atomic<std::uint64_t>* nonfinite = nullptr;  // samples whose radiance was NaN or infinite
+    /// Camera rays made in float (Camera::generate_rays_f): a pinhole perspective camera
+    /// without clipping, and the box filter (whose image points are floats already).
+    bool float_rays = camera.single_precision() && filter.box();
+    bool adaptive = settings.noise_target > 0;
+    std::optional<FlatMiss> miss = flat_miss(ctx, settings);
 };
 
 /// A camera ray's cone: a parallel camera's rays are a pixel wide; a perspective one's
@@ -213,31 +239,64 @@ struct PixelReplicas {
     }
 };
 
-/// A camera sample: its sampler, and where its camera ray (CameraRayF, beside it: traced
-/// in single precision from the near clipping plane) starts along the camera's ray.
-struct CameraSample {
-    std::optional<Sampler> sampler;
-    double tnear = 0;
-};
-
-/// Sample i of pixel (x, y): its sampler, written in place (c), and the image point its
-/// camera ray goes through.
-PixelPoint film_point(const RenderState& f, int x, int y, std::uint32_t i,
-                      const PixelReplicas& replicas, CameraSample& c)
+/// The sampler of sample i of a pixel: its replica's sequence at its index there.
+Sampler sampler_of(const RenderState& f, const PixelReplicas& replicas, std::uint32_t i)
 {
-    const RenderSettings& s = f.settings;
-    const bool adaptive = s.noise_target > 0;
-    const Sampler& sampler = c.sampler.emplace(replicas.seeds[adaptive ? (i & 1u) : 0],
-                                               adaptive ? replica_index(i) : i, s.sampler);
-    auto [jx, jy] = sampler.get2d(sample_dimension::film);
-    if (f.filter.box())
-        return {x + jx, y + jy};  // in float, as before filters existed: the same images
-    return {x + 0.5 + f.filter.offset(jx), y + 0.5 + f.filter.offset(jy)};
+    return Sampler(replicas.seeds[f.adaptive ? (i & 1u) : 0], f.adaptive ? replica_index(i) : i,
+                   f.settings.sampler);
 }
 
-/// Camera sample c's ray as it is traced (out): in single precision, from the near
-/// clipping plane.
-void traced_ray(const CameraRay& ray, CameraSample& c, CameraRayF& out)
+/// A batch of camera samples traced together (take_samples): made once per tile, not per
+/// pixel (its members' initialisers cost a visible share of the pixel loop).
+struct CameraBatch {
+    static constexpr std::uint32_t size = EmbreeScene::max_coherent_rays;
+    std::array<float, size> jx, jy;  // film pairs, then (float rays) image points
+    std::array<PixelPoint, size> points;
+    std::array<CameraRay, size> camera_rays;
+    /// Where each camera ray (traced in single precision from the near clipping plane)
+    /// starts along the camera's ray.
+    std::array<double, size> tnear;
+    std::array<CameraRayF, size> rays;
+    std::array<std::optional<SurfaceHit>, size> hits;
+};
+
+/// The film pairs of samples i0 .. i0 + n - 1 of a pixel (n at most CameraBatch::size),
+/// into jx and jy: the values of sampler_of(f, replicas, i).get2d(film), made per replica
+/// in one loop (sobol_pairs).
+void film_pairs(const RenderState& f, const PixelReplicas& replicas, std::uint32_t i0,
+                std::uint32_t n, CameraBatch& b)
+{
+    if (f.settings.sampler != SampleSequence::sobol) {
+        for (std::uint32_t k = 0; k < n; ++k) {
+            auto [u, v] = sampler_of(f, replicas, i0 + k).get2d(sample_dimension::film);
+            b.jx[k] = u;
+            b.jy[k] = v;
+        }
+        return;
+    }
+    if (!f.adaptive) {
+        sobol_pairs(replicas.seeds[0], sample_dimension::film, i0, n, b.jx.data(), b.jy.data());
+        return;
+    }
+    // Even samples are the first replica's, odd ones the second's (replica_index).
+    std::array<float, CameraBatch::size> x, y;
+    for (std::uint32_t r = 0; r < 2; ++r) {
+        std::uint32_t first = i0 + ((i0 ^ r) & 1u);  // the replica's first sample in the batch
+        if (first >= i0 + n)
+            continue;
+        std::uint32_t count = (i0 + n - first + 1) / 2;
+        sobol_pairs(replicas.seeds[r], sample_dimension::film, replica_index(first), count,
+                    x.data(), y.data());
+        for (std::uint32_t j = 0; j < count; ++j) {
+            b.jx[first - i0 + 2 * j] = x[j];
+            b.jy[first - i0 + 2 * j] = y[j];
+        }
+    }
+}
+
+/// Camera ray `ray` as it is traced (out): in single precision, from the near clipping
+/// plane; `tnear`: where that is along the camera's ray.
+void traced_ray(const CameraRay& ray, double& tnear, CameraRayF& out)
 {
     out.org = Vec3f(ray.org);
     out.dir = Vec3f(ray.dir);
@@ -245,73 +304,63 @@ void traced_ray(const CameraRay& ray, CameraSample& c, CameraRayF& out)
         out.org = Vec3f(ray.org + ray.dir * ray.tnear);  // front clipping: start at the plane
     // Far clipping: geometry beyond the back plane must not show.
     out.tfar = std::isfinite(ray.tfar) ? static_cast<float>(ray.tfar - ray.tnear) : infinity;
-    c.tnear = ray.tnear;
+    tnear = ray.tnear;
 }
 
-/// Camera sample c's ray through image point p (thin lens: through its lens sample).
-CameraRay camera_ray(const RenderState& f, const CameraSample& c, const PixelPoint& p)
-{
-    if (!f.lens)
-        return f.camera.generate_ray(p.x, p.y);
-    auto [lens_u, lens_v] = c.sampler->get2d(sample_dimension::lens);
-    return f.camera.generate_ray(p.x, p.y, lens_u, lens_v);
-}
-
-/// The sampler and camera ray of sample i of pixel (x, y), written in place (c, out):
-/// a batch's samples are made where they are used, not copied there.
-void camera_sample(const RenderState& f, int x, int y, std::uint32_t i,
-                   const PixelReplicas& replicas, CameraSample& c, CameraRayF& out)
-{
-    PixelPoint p = film_point(f, x, y, i, replicas, c);
-    traced_ray(camera_ray(f, c, p), c, out);
-}
-
-/// A batch of camera samples traced together (take_samples): made once per tile, not per
-/// pixel (its members' initialisers cost a visible share of the pixel loop).
-struct CameraBatch {
-    static constexpr std::uint32_t size = EmbreeScene::max_coherent_rays;
-    std::array<PixelPoint, size> points;
-    std::array<CameraRay, size> camera_rays;
-    std::array<CameraSample, size> samples;
-    std::array<CameraRayF, size> rays;
-    std::array<std::optional<SurfaceHit>, size> hits;
-};
-
-/// camera_sample for samples i0 .. i0 + n - 1 (n at most CameraBatch::size) into b, in
-/// passes over the batch: sampler and image points, camera rays (Camera::generate_rays
-/// without a lens), their traced form. The same rays as one camera_sample each.
+/// The camera rays of samples i0 .. i0 + n - 1 of pixel (x, y) (n at most
+/// CameraBatch::size) into b, in passes over the batch: film pairs, image points, camera
+/// rays (in float where RenderState::float_rays; else in double, Camera::generate_rays
+/// without a lens), their traced form.
 void camera_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uint32_t n,
                     const PixelReplicas& replicas, CameraBatch& b)
 {
     n = std::min(n, CameraBatch::size);
-    for (std::uint32_t k = 0; k < n; ++k)
-        b.points[k] = film_point(f, x, y, i0 + k, replicas, b.samples[k]);
+    film_pairs(f, replicas, i0, n, b);
+    if (f.float_rays) {
+        for (std::uint32_t k = 0; k < n; ++k) {
+            b.jx[k] += static_cast<float>(x);  // the image point, in float as below
+            b.jy[k] += static_cast<float>(y);
+            b.tnear[k] = 0;
+        }
+        f.camera.generate_rays_f(std::span(b.jx.data(), n), std::span(b.jy.data(), n),
+                                 std::span(b.rays.data(), n));
+        return;
+    }
+    for (std::uint32_t k = 0; k < n; ++k) {
+        if (f.filter.box())  // in float, as before filters existed: the same images
+            b.points[k] = {x + b.jx[k], y + b.jy[k]};
+        else
+            b.points[k] = {x + 0.5 + f.filter.offset(b.jx[k]), y + 0.5 + f.filter.offset(b.jy[k])};
+    }
     if (!f.lens) {
         f.camera.generate_rays(std::span(b.points.data(), n), std::span(b.camera_rays.data(), n));
     } else {
-        for (std::uint32_t k = 0; k < n; ++k)
-            b.camera_rays[k] = camera_ray(f, b.samples[k], b.points[k]);
+        for (std::uint32_t k = 0; k < n; ++k) {
+            auto [lens_u, lens_v] = sampler_of(f, replicas, i0 + k).get2d(sample_dimension::lens);
+            b.camera_rays[k] = f.camera.generate_ray(b.points[k].x, b.points[k].y, lens_u, lens_v);
+        }
     }
     for (std::uint32_t k = 0; k < n; ++k)
-        traced_ray(b.camera_rays[k], b.samples[k], b.rays[k]);
+        traced_ray(b.camera_rays[k], b.tnear[k], b.rays[k]);
 }
 
-/// Sample i (camera sample c, camera ray `ray`) added to its pixel's sums; `camera_hit`:
-/// its camera ray's first hit when already traced (null: trace_path traces it).
-void take_sample(const RenderState& f, const CameraSample& c, const CameraRayF& ray,
-                 std::uint32_t i, PixelState& st,
+/// Sample i (its camera ray `ray`, starting `tnear` along the camera's) added to its
+/// pixel's sums; `camera_hit`: its camera ray's first hit when already traced (null:
+/// trace_path traces it).
+void take_sample(const RenderState& f, const PixelReplicas& replicas, double tnear,
+                 const CameraRayF& ray, std::uint32_t i, PixelState& st,
                  const std::optional<SurfaceHit>* camera_hit = nullptr)
 {
     const RenderSettings& s = f.settings;
     VisibleSurface first;
     PathResult r = camera_hit && !*camera_hit
                        ? camera_miss(f.ctx, ray.dir)
-                       : trace_path(f.ctx, ray.org, ray.dir, *c.sampler, ray.tfar,
+                       : trace_path(f.ctx, ray.org, ray.dir, sampler_of(f, replicas, i), ray.tfar,
                                     s.aovs ? &first : nullptr, camera_hit);
     if (first.hit) {
         st.albedo += first.albedo;
         st.normal += first.normal;
-        st.depth = std::min(st.depth, static_cast<float>(first.t + c.tnear));
+        st.depth = std::min(st.depth, static_cast<float>(first.t + tnear));
     }
     if ((s.transparent_background || s.ground.shadow_catcher) && !r.hit)
         r.radiance = Vec3f();
@@ -327,10 +376,23 @@ void take_sample(const RenderState& f, const CameraSample& c, const CameraRayF& 
     st.caught += r.catcher ? 1 : 0;
     st.lit_with += r.lit_with;
     st.lit_without += r.lit_without;
+    if (!f.adaptive)
+        return;  // only adaptive sampling reads the luminance sums (relative_error_squared)
     // Adaptive sampling watches a shadow catcher's light estimate (its colour is 0).
     double l = r.catcher ? r.lit_with : luminance(r.radiance);
     st.replica_luminance[i & 1u] += l;
     st.luminance_sq += l * l;
+}
+
+/// take_sample for sample i whose camera ray met nothing, with a FlatMiss: the same sums.
+void take_flat_miss(const RenderState& f, const FlatMiss& miss, std::uint32_t i, PixelState& st)
+{
+    st.radiance += miss.radiance;
+    st.samples += 1;
+    if (!f.adaptive)
+        return;
+    st.replica_luminance[i & 1u] += miss.luminance;
+    st.luminance_sq += miss.luminance * miss.luminance;
 }
 
 /// Samples i0 .. i1 - 1 of pixel (x, y), added to its sums in order. Their camera rays
@@ -342,21 +404,21 @@ void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uin
                   PixelState& st, CameraBatch& b)
 {
     const PixelReplicas replicas(x, y, f.settings.seed);
-    if (f.ctx.ground) {
-        CameraSample c;
-        CameraRayF ray;
-        for (std::uint32_t i = i0; i < i1; ++i) {
-            camera_sample(f, x, y, i, replicas, c, ray);
-            take_sample(f, c, ray, i, st);
-        }
-        return;
-    }
     for (std::uint32_t start = i0; start < i1; start += CameraBatch::size) {
         std::uint32_t n = std::min(CameraBatch::size, i1 - start);
         camera_samples(f, x, y, start, n, replicas, b);
+        if (f.ctx.ground) {
+            for (std::uint32_t k = 0; k < n; ++k)
+                take_sample(f, replicas, b.tnear[k], b.rays[k], start + k, st);
+            continue;
+        }
         f.accel.intersect_coherent(std::span(b.rays.data(), n), std::span(b.hits.data(), n));
-        for (std::uint32_t k = 0; k < n; ++k)
-            take_sample(f, b.samples[k], b.rays[k], start + k, st, &b.hits[k]);
+        for (std::uint32_t k = 0; k < n; ++k) {
+            if (f.miss && !b.hits[k])
+                take_flat_miss(f, *f.miss, start + k, st);
+            else
+                take_sample(f, replicas, b.tnear[k], b.rays[k], start + k, st, &b.hits[k]);
+        }
     }
 }
 

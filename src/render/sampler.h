@@ -3,6 +3,7 @@
 // Sobol points in padded 2D pairs (a low-discrepancy sequence), or white noise.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 
@@ -68,6 +69,17 @@ constexpr std::uint64_t reverse_bits64(std::uint64_t v)
     return ((v >> 1) & 0x5555555555555555ULL) | ((v & 0x5555555555555555ULL) << 1);
 }
 
+/// reverse_bits in shifts and masks only, without the byte swap: the same bits, in a form
+/// that vectorises.
+constexpr std::uint32_t reverse_bits_shifts(std::uint32_t v)
+{
+    v = (v >> 16) | (v << 16);
+    v = ((v >> 8) & 0x00ff00ffu) | ((v & 0x00ff00ffu) << 8);
+    v = ((v >> 4) & 0x0f0f0f0fu) | ((v & 0x0f0f0f0fu) << 4);
+    v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
+    return ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
+}
+
 /// A hash-based nested uniform (Owen) scramble of a binary fraction held bit-reversed
 /// (its most significant bit in bit 0): each step changes a bit by a function of the bits
 /// below it only (carries and multiplication by an even number propagate upward), which
@@ -75,15 +87,27 @@ constexpr std::uint64_t reverse_bits64(std::uint64_t v)
 /// flips differ per seed. So every aligned binary interval maps onto another of the same
 /// size and a net stays a net. Working on reversed fractions saves reversing before and
 /// after each scramble (Sampler keeps its values reversed until they become floats).
-constexpr std::uint32_t scramble_reversed(std::uint32_t r, std::uint64_t seed)
+struct ScrambleKey {
+    std::uint32_t add, odd, add2;  // the seed's parts the steps use
+    explicit constexpr ScrambleKey(std::uint64_t seed)
+        : add(static_cast<std::uint32_t>(seed)), odd(static_cast<std::uint32_t>(seed >> 32) | 1u),
+          add2(static_cast<std::uint32_t>(seed >> 17))
+    {
+    }
+};
+constexpr std::uint32_t scramble_reversed(std::uint32_t r, const ScrambleKey& key)
 {
-    r += static_cast<std::uint32_t>(seed);
+    r += key.add;
     r ^= r * 0x3d4e9a2cu;
-    r *= static_cast<std::uint32_t>(seed >> 32) | 1u;
+    r *= key.odd;
     r ^= r * 0xa6f1c3d8u;
-    r += static_cast<std::uint32_t>(seed >> 17);
+    r += key.add2;
     r ^= r * 0x5b0e7f64u;
     return r;
+}
+constexpr std::uint32_t scramble_reversed(std::uint32_t r, std::uint64_t seed)
+{
+    return scramble_reversed(r, ScrambleKey(seed));
 }
 
 /// The same scramble of the 32-bit binary fraction v in its own bit order (Burley 2020's
@@ -138,6 +162,20 @@ constexpr std::uint32_t sobol_second_reversed(std::uint32_t index)
            t[3][index >> 24];
 }
 
+/// The same without the table, in shifts and masks only (which vectorise; table lookups
+/// do not): bit j of the reversed value is the xor of the index bits b whose bit position
+/// holds every bit of j's (Pascal's triangle mod 2: C(b, j) is odd iff j & ~b == 0, by
+/// Lucas's theorem), a sum over supersets of the 5 bits of a position, made one position
+/// bit at a time.
+constexpr std::uint32_t sobol_second_reversed_shifts(std::uint32_t index)
+{
+    index ^= (index >> 1) & 0x55555555u;
+    index ^= (index >> 2) & 0x33333333u;
+    index ^= (index >> 4) & 0x0f0f0f0fu;
+    index ^= (index >> 8) & 0x00ff00ffu;
+    return index ^ (index >> 16);
+}
+
 constexpr std::uint32_t sobol_second(std::uint32_t index)
 {
     const auto& t = sobol_second_table.byte;
@@ -146,6 +184,36 @@ constexpr std::uint32_t sobol_second(std::uint32_t index)
 }
 
 constexpr float to_unit(std::uint32_t v) { return static_cast<float>(v >> 8) * 0x1.0p-24f; }
+
+/// The three scrambles' seeds of one dimension pair, from the pair's hash: the index
+/// shuffle takes it as it is, x and y cheap bijective remixes of it (a xorshift and an
+/// odd multiply).
+struct PairSeeds {
+    std::uint64_t shuffle, x, y;
+    explicit constexpr PairSeeds(std::uint64_t h)
+        : shuffle(h), x((h ^ (h >> 31)) * 0xd1b54a32d192ed03ULL),
+          y((h ^ (h >> 29)) * 0xaef17502108ef2d9ULL)
+    {
+    }
+};
+
+/// The pixel's shuffled sample index for a pair: an Owen scramble of the sample index's
+/// bits (`sample_reversed`: the index bit-reversed, as the scramble takes it).
+constexpr std::uint32_t shuffled_index(std::uint32_t sample_reversed, const PairSeeds& s)
+{
+    return reverse_bits(scramble_reversed(sample_reversed, s.shuffle));
+}
+
+/// The pair's two values at the shuffled index: x the van der Corput point of the index
+/// (bit-reversed, the index itself), y the second Sobol dimension, each Owen-scrambled,
+/// then reversed together in one 64-bit reversal (x above, y below).
+inline std::array<float, 2> pair_values(std::uint32_t index, const PairSeeds& s)
+{
+    std::uint64_t rx = scramble_reversed(index, s.x);
+    std::uint64_t ry = scramble_reversed(sobol_second_reversed(index), s.y);
+    std::uint64_t xy = reverse_bits64(ry << 32 | rx);
+    return {to_unit(static_cast<std::uint32_t>(xy >> 32)), to_unit(static_cast<std::uint32_t>(xy))};
+}
 
 }  // namespace sobol
 
@@ -192,6 +260,16 @@ private:
     mutable std::array<std::uint64_t, cached_pairs> m_pairs;
 };
 
+/// Sampler(seeds, first + k).get2d(dimension) for k < n (Owen-scrambled Sobol), into
+/// xs[k] and ys[k]: the pair values of consecutive samples of one pixel. The samples
+/// share the pair's seeds (hashed and remixed once, not once per sample), and blocks of
+/// them are made in integer arithmetic without byte swaps or table lookups, which the
+/// compiler turns into SIMD code where the processor has AVX2, 8 samples per instruction
+/// (the film pair of every camera sample was the path tracer's largest fixed cost per
+/// sample). sampler.cpp.
+void sobol_pairs(const PixelSeeds& seeds, std::uint32_t dimension, std::uint32_t first,
+                 std::uint32_t n, float* xs, float* ys);
+
 /// The sample values of one (pixel, sample index). With SampleSequence::sobol each pair
 /// of dimensions (2k, 2k+1) is its own 2D Sobol sequence ("padded"), Owen-scrambled with a
 /// hash of (seed, pixel, pair) (one hash per pair seeds all three of its scrambles), and
@@ -223,11 +301,12 @@ public:
     {
         if (m_sequence == SampleSequence::white)
             return white(dimension, 0);
-        Pair p = pair(dimension >> 1);
+        const sobol::PairSeeds seeds(pair_hash(dimension >> 1));
+        const std::uint32_t index = sobol::shuffled_index(m_sample_reversed, seeds);
         std::uint32_t r = (dimension & 1u)
-                              ? sobol::scramble_reversed(sobol::sobol_second_reversed(p.index),
-                                                         p.y_seed)
-                              : sobol::scramble_reversed(p.index, p.x_seed);
+                              ? sobol::scramble_reversed(sobol::sobol_second_reversed(index),
+                                                         seeds.y)
+                              : sobol::scramble_reversed(index, seeds.x);
         return sobol::to_unit(sobol::reverse_bits(r));
     }
 
@@ -236,14 +315,8 @@ public:
     {
         if (m_sequence == SampleSequence::white)
             return {white(dimension, 0), white(dimension + 1, 0)};
-        Pair p = pair(dimension >> 1);
-        // x = van der Corput of the index: bit-reversed, the index itself.
-        std::uint64_t rx = sobol::scramble_reversed(p.index, p.x_seed);
-        std::uint64_t ry =
-            sobol::scramble_reversed(sobol::sobol_second_reversed(p.index), p.y_seed);
-        std::uint64_t xy = sobol::reverse_bits64(ry << 32 | rx);  // x above, y below
-        return {sobol::to_unit(static_cast<std::uint32_t>(xy >> 32)),
-                sobol::to_unit(static_cast<std::uint32_t>(xy))};
+        const sobol::PairSeeds seeds(pair_hash(dimension >> 1));
+        return sobol::pair_values(sobol::shuffled_index(m_sample_reversed, seeds), seeds);
     }
 
     /// An independent value for the `k`-th extra draw of `dimension` (k > 0): white noise,
@@ -263,21 +336,10 @@ private:
         return static_cast<float>(h >> 40) * 0x1.0p-24f;
     }
 
-    /// What one pair needs: the pixel's shuffled sample index and the scrambles' seeds.
-    struct Pair {
-        std::uint32_t index;
-        std::uint64_t x_seed, y_seed;
-    };
-
-    /// One hash of (pixel, pair) seeds the pair's three scrambles: the index shuffle takes
-    /// it as it is, x and y cheap bijective remixes of it (a xorshift and an odd multiply).
-    Pair pair(std::uint32_t pair) const
+    /// The hash of (pixel, pair), which seeds the pair's three scrambles (PairSeeds).
+    std::uint64_t pair_hash(std::uint32_t pair) const
     {
-        std::uint64_t h = m_seeds ? m_seeds->pair(pair) : pair_hash(m_pixel, pair);
-        // The shuffle: an Owen scramble of the index's bits (held reversed from the start).
-        std::uint32_t index = sobol::reverse_bits(sobol::scramble_reversed(m_sample_reversed, h));
-        return {index, (h ^ (h >> 31)) * 0xd1b54a32d192ed03ULL,
-                (h ^ (h >> 29)) * 0xaef17502108ef2d9ULL};
+        return m_seeds ? m_seeds->pair(pair) : render::pair_hash(m_pixel, pair);
     }
 
     std::uint64_t m_pixel;

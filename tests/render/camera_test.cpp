@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "render/camera.h"
 
@@ -154,6 +155,38 @@ TEST(Camera, ThinLensRaysMeetOnTheFocusPlane)
     CameraRay same = pinhole.generate_ray(13.3, 47.9, 0.9, 0.1);
     EXPECT_EQ(same.org.x, centre.org.x);
     EXPECT_EQ(same.dir.y, centre.dir.y);
+}
+
+// A pinhole perspective camera without clipping makes its rays in float too: the same
+// rays as the double ones within float rounding; any other camera keeps double precision.
+TEST(Camera, SinglePrecisionRaysAreTheDoubleRaysRounded)
+{
+    Camera c = Camera::perspective({12, 14, 19}, {0, 10, 0}, {0, 1, 0}, 50, 320, 240);
+    ASSERT_TRUE(c.single_precision());
+    std::vector<float> xs, ys;
+    for (float x : {0.0f, 0.37f, 159.99f, 160.0f, 271.5f, 319.999f})
+        for (float y : {0.0f, 0.61f, 119.5f, 200.25f, 239.99f}) {
+            xs.push_back(x);
+            ys.push_back(y);
+        }
+    std::vector<CameraRayF> rays(xs.size());
+    c.generate_rays_f(xs, ys, rays);
+    for (std::size_t k = 0; k < xs.size(); ++k) {
+        CameraRay d = c.generate_ray(xs[k], ys[k]);
+        EXPECT_EQ(rays[k].org.x, float(d.org.x));
+        EXPECT_EQ(rays[k].org.y, float(d.org.y));
+        EXPECT_EQ(rays[k].org.z, float(d.org.z));
+        // A few float roundings of a unit vector (2^-24 each), far below a pixel's angle
+        // (50 degrees / 240 = 3.6e-3 rad).
+        EXPECT_NEAR(rays[k].dir.x, d.dir.x, 4e-7) << k;
+        EXPECT_NEAR(rays[k].dir.y, d.dir.y, 4e-7) << k;
+        EXPECT_NEAR(rays[k].dir.z, d.dir.z, 4e-7) << k;
+        EXPECT_TRUE(std::isinf(rays[k].tfar));
+    }
+    EXPECT_FALSE(c.with_lens(0.1).single_precision());
+    EXPECT_FALSE(c.with_clipping(1, 100).single_precision());
+    EXPECT_FALSE(Camera::parallel({0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 0.1, 10, 64, 48)
+                     .single_precision());
 }
 
 // Perspective clipping planes are at depths along the view direction: an oblique ray

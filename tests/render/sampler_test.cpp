@@ -46,6 +46,25 @@ TEST(Sampler, PixelSeedsGiveTheSameValuesAsPerSampleHashes)
     }
 }
 
+TEST(Sampler, BatchedPairsGiveEachSamplersValues)
+{
+    // sobol_pairs (SIMD where the processor has it) against one Sampler per sample: every
+    // start, count (within a block, whole blocks, a block and a bit), cached and uncached
+    // pairs, and indices whose high bits are set.
+    const PixelSeeds seeds(211, 37, 9);
+    for (std::uint32_t first : {0u, 5u, 16u, 1000u, 0x7ffffff0u, 0xfffffff0u})
+        for (std::uint32_t n : {1u, 7u, 16u, 17u, 40u})
+            for (std::uint32_t d : {0u, 2u, 10u, 2 * PixelSeeds::cached_pairs + 4}) {
+                std::vector<float> xs(n), ys(n);
+                sobol_pairs(seeds, d, first, n, xs.data(), ys.data());
+                for (std::uint32_t k = 0; k < n; ++k) {
+                    auto [x, y] = Sampler(seeds, first + k).get2d(d);
+                    ASSERT_EQ(xs[k], x) << first << " " << n << " " << d << " " << k;
+                    ASSERT_EQ(ys[k], y) << first << " " << n << " " << d << " " << k;
+                }
+            }
+}
+
 TEST(Sampler, PairsAgreeWithSingleDimensions)
 {
     Sampler s(5, 9, 77, 3);
@@ -98,11 +117,22 @@ TEST(Sobol, BitReversalsAndTheReversedTableAgreeWithTheirDefinitions)
     };
     for (std::uint32_t i : {0u, 1u, 2u, 3u, 255u, 256u, 65535u, 0x12345678u, 0xffffffffu}) {
         EXPECT_EQ(sobol::reverse_bits(i), reverse_slowly(i, 32)) << i;
+        EXPECT_EQ(sobol::reverse_bits_shifts(i), reverse_slowly(i, 32)) << i;
         std::uint64_t wide = std::uint64_t{i} * 0x9e3779b97f4a7c15ULL;
         EXPECT_EQ(sobol::reverse_bits64(wide), reverse_slowly(wide, 64)) << i;
         EXPECT_EQ(sobol::sobol_second_reversed(i), sobol::reverse_bits(sobol::sobol_second(i)))
             << i;
     }
+    // The table-free form, from the bit-by-bit definition (not the table), on every index
+    // below 2^16 and a spread of larger ones.
+    for (std::uint64_t i = 0; i < (1u << 16); ++i)
+        ASSERT_EQ(sobol::sobol_second_reversed_shifts(std::uint32_t(i)),
+                  reverse_slowly(sobol::sobol_second_bitwise(std::uint32_t(i)), 32))
+            << i;
+    for (std::uint64_t i = 1; i < (std::uint64_t{1} << 32); i = i * 3 + 1)
+        ASSERT_EQ(sobol::sobol_second_reversed_shifts(std::uint32_t(i)),
+                  reverse_slowly(sobol::sobol_second_bitwise(std::uint32_t(i)), 32))
+            << i;
 }
 
 TEST(Sobol, OwenScrambleKeepsAlignedIntervals)
