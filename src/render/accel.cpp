@@ -1345,8 +1345,9 @@ bool traceable(const Vec3f& org, const Vec3f& dir, float tnear, float tfar)
 {
     constexpr auto reach = static_cast<float>(geom::max_ray_start);
     auto within = [](float v, float limit) { return v >= -limit && v <= limit; };
-    return within(org.x, reach) && within(org.y, reach) && within(org.z, reach) &&
-           std::isfinite(dir.x) && std::isfinite(dir.y) && std::isfinite(dir.z) && tnear >= 0 &&
+    // & rather than &&: every test is cheap, and one branch predicts better than nine.
+    return within(org.x, reach) & within(org.y, reach) & within(org.z, reach) &
+           std::isfinite(dir.x) & std::isfinite(dir.y) & std::isfinite(dir.z) & (tnear >= 0) &
            !std::isnan(tfar);
 }
 
@@ -1391,19 +1392,25 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
 }
 
 void EmbreeScene::intersect_coherent(std::span<const CameraRayF> rays,
-                                     std::span<std::optional<SurfaceHit>> hits) const
+                                     std::span<std::optional<SurfaceHit>> hits,
+                                     bool checked) const
 {
     const Impl& m = *m_impl;
     std::array<RTCRayHit, max_coherent_rays> rh;
-    std::array<std::uint32_t, max_coherent_rays> index;  // rh[k] is rays[index[k]]
     std::size_t n = std::min({rays.size(), hits.size(), rh.size()});
-    std::size_t traced = 0;
     m.rays.add(n);
+    // Camera rays are almost always all traceable: then rh[i] is rays[i], made in one pass
+    // without an index (the check is branch-free, so it does not mispredict either).
+    bool all_traceable = true;
+    for (std::size_t i = 0; i < n && !checked; ++i)
+        all_traceable &= traceable(rays[i].org, rays[i].dir, 0, rays[i].tfar);
+    std::array<std::uint32_t, max_coherent_rays> index;  // rh[k] is rays[index[k]]
+    std::size_t traced = 0;
     for (std::size_t i = 0; i < n; ++i) {
-        hits[i].reset();
         const CameraRayF& r = rays[i];
-        if (!traceable(r.org, r.dir, 0, r.tfar)) {
+        if (!all_traceable && !traceable(r.org, r.dir, 0, r.tfar)) {
             ++m.skipped_rays;
+            hits[i].reset();
             continue;
         }
         rh[traced].ray = make_ray(r.org, m.traced(r.dir), 0, r.tfar);
@@ -1422,9 +1429,13 @@ void EmbreeScene::intersect_coherent(std::span<const CameraRayF> rays,
     for (std::size_t k = 0; k < traced; ++k)
         if (m.placed_instance(rh[k].hit.instID[0]) && rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID)
             __builtin_prefetch(m.instance(rh[k].hit.instID[0]));
-    for (std::size_t k = 0; k < traced; ++k)
+    for (std::size_t k = 0; k < traced; ++k) {
+        std::size_t i = all_traceable ? k : index[k];
         if (rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID)
-            hits[index[k]] = m.surface_hit(rh[k], rays[index[k]].org, rays[index[k]].dir);
+            hits[i] = m.surface_hit(rh[k], rays[i].org, rays[i].dir);
+        else
+            hits[i].reset();
+    }
 }
 
 SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,

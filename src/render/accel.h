@@ -110,9 +110,12 @@ public:
     /// intersect(r.org, r.dir, 0, r.tfar, {}, true) for each of `rays` (at most
     /// max_coherent_rays) into `hits`, the rays traced together as one stream, which
     /// Embree gathers into SIMD packets: cheaper per ray for camera rays close together
-    /// (a pixel's samples). The same hits as intersect() gives.
+    /// (a pixel's samples). The same hits as intersect() gives. `checked`: the caller
+    /// vouches that every ray is one intersect() would trace (finite, starting within
+    /// geom::max_ray_start), as Camera::generate_rays_f's are once Camera::check_range
+    /// passed, and the check per ray is left out.
     void intersect_coherent(std::span<const CameraRayF> rays,
-                            std::span<std::optional<SurfaceHit>> hits) const;
+                            std::span<std::optional<SurfaceHit>> hits, bool checked = false) const;
     /// Whether anything but `skip` blocks org + t dir for t in [tnear, tfar].
     bool occluded(const Vec3f& org, const Vec3f& dir, float tnear, float tfar,
                   PrimId skip = {}) const;

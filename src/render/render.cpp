@@ -227,22 +227,25 @@ std::uint64_t replica_seed(std::uint64_t seed, std::uint32_t i)
     return (i & 1u) ? mix64(seed ^ 0x6a09e667f3bcc909ULL) : seed;
 }
 
-/// The hashes pixel (x, y) draws its samples from: [0] for the seed, [1] for the odd
-/// replica's (adaptive sampling only); made once per pixel and pass.
+/// The hashes pixel (x, y) draws its samples from: the seed's, and the odd replica's
+/// (made for adaptive sampling only); made once per pixel and pass.
 struct PixelReplicas {
-    PixelSeeds seeds[2];
-    PixelReplicas(int x, int y, std::uint64_t seed)
-        : seeds{{static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), seed},
-                {static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
-                 replica_seed(seed, 1)}}
+    PixelSeeds even;
+    std::optional<PixelSeeds> odd;
+    PixelReplicas(int x, int y, std::uint64_t seed, bool adaptive)
+        : even(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y), seed)
     {
+        if (adaptive)
+            odd.emplace(static_cast<std::uint32_t>(x), static_cast<std::uint32_t>(y),
+                        replica_seed(seed, 1));
     }
+    const PixelSeeds& seeds(std::uint32_t replica) const { return replica ? *odd : even; }
 };
 
 /// The sampler of sample i of a pixel: its replica's sequence at its index there.
 Sampler sampler_of(const RenderState& f, const PixelReplicas& replicas, std::uint32_t i)
 {
-    return Sampler(replicas.seeds[f.adaptive ? (i & 1u) : 0], f.adaptive ? replica_index(i) : i,
+    return Sampler(replicas.seeds(f.adaptive ? (i & 1u) : 0), f.adaptive ? replica_index(i) : i,
                    f.settings.sampler);
 }
 
@@ -275,7 +278,7 @@ void film_pairs(const RenderState& f, const PixelReplicas& replicas, std::uint32
         return;
     }
     if (!f.adaptive) {
-        sobol_pairs(replicas.seeds[0], sample_dimension::film, i0, n, b.jx.data(), b.jy.data());
+        sobol_pairs(replicas.even, sample_dimension::film, i0, n, b.jx.data(), b.jy.data());
         return;
     }
     // Even samples are the first replica's, odd ones the second's (replica_index).
@@ -285,7 +288,7 @@ void film_pairs(const RenderState& f, const PixelReplicas& replicas, std::uint32
         if (first >= i0 + n)
             continue;
         std::uint32_t count = (i0 + n - first + 1) / 2;
-        sobol_pairs(replicas.seeds[r], sample_dimension::film, replica_index(first), count,
+        sobol_pairs(replicas.seeds(r), sample_dimension::film, replica_index(first), count,
                     x.data(), y.data());
         for (std::uint32_t j = 0; j < count; ++j) {
             b.jx[first - i0 + 2 * j] = x[j];
@@ -384,10 +387,13 @@ void take_sample(const RenderState& f, const PixelReplicas& replicas, double tne
     st.luminance_sq += l * l;
 }
 
-/// take_sample for sample i whose camera ray met nothing, with a FlatMiss: the same sums.
-void take_flat_miss(const RenderState& f, const FlatMiss& miss, std::uint32_t i, PixelState& st)
+/// take_sample for sample i whose camera ray met nothing, with a FlatMiss: the same sums,
+/// the radiance's in `radiance` (the pixel's, held where the compiler can keep it in
+/// registers across a batch's misses; the same additions in the same order).
+void take_flat_miss(const RenderState& f, const FlatMiss& miss, std::uint32_t i, PixelState& st,
+                    Vec3f& radiance)
 {
-    st.radiance += miss.radiance;
+    radiance += miss.radiance;
     st.samples += 1;
     if (!f.adaptive)
         return;
@@ -403,7 +409,7 @@ void take_flat_miss(const RenderState& f, const FlatMiss& miss, std::uint32_t i,
 void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uint32_t i1,
                   PixelState& st, CameraBatch& b)
 {
-    const PixelReplicas replicas(x, y, f.settings.seed);
+    const PixelReplicas replicas(x, y, f.settings.seed, f.adaptive);
     for (std::uint32_t start = i0; start < i1; start += CameraBatch::size) {
         std::uint32_t n = std::min(CameraBatch::size, i1 - start);
         camera_samples(f, x, y, start, n, replicas, b);
@@ -412,13 +418,20 @@ void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uin
                 take_sample(f, replicas, b.tnear[k], b.rays[k], start + k, st);
             continue;
         }
-        f.accel.intersect_coherent(std::span(b.rays.data(), n), std::span(b.hits.data(), n));
+        // Float rays start at the eye, which check_range put within reach of Embree.
+        f.accel.intersect_coherent(std::span(b.rays.data(), n), std::span(b.hits.data(), n),
+                                   f.float_rays);
+        Vec3f radiance = st.radiance;
         for (std::uint32_t k = 0; k < n; ++k) {
-            if (f.miss && !b.hits[k])
-                take_flat_miss(f, *f.miss, start + k, st);
-            else
-                take_sample(f, replicas, b.tnear[k], b.rays[k], start + k, st, &b.hits[k]);
+            if (f.miss && !b.hits[k]) {
+                take_flat_miss(f, *f.miss, start + k, st, radiance);
+                continue;
+            }
+            st.radiance = radiance;
+            take_sample(f, replicas, b.tnear[k], b.rays[k], start + k, st, &b.hits[k]);
+            radiance = st.radiance;
         }
+        st.radiance = radiance;
     }
 }
 
