@@ -192,6 +192,33 @@ void Camera::generate_rays(std::span<const PixelPoint> points, std::span<CameraR
             clip(rays[i]);
 }
 
+void Camera::generate_rays_f(std::span<const float> xs, std::span<const float> ys,
+                             std::span<CameraRayF> rays) const
+{
+    // Blocks of 16 in separate arrays per component, so that the arithmetic vectorises
+    // (several rays per square root and division, the same correctly rounded results).
+    constexpr std::size_t block = 16;
+    const std::size_t n = std::min({xs.size(), ys.size(), rays.size()});
+    for (std::size_t k0 = 0; k0 < n; k0 += block) {
+        const std::size_t m = std::min(block, n - k0);
+        std::array<float, block> dx{}, dy{}, dz{}, inv{};
+        for (std::size_t k = 0; k < m; ++k) {
+            float sx = xs[k0 + k] - m_half_width_f, sy = m_half_height_f - ys[k0 + k];
+            dx[k] = m_forward_f.x + m_right_f.x * sx + m_up_f.x * sy;
+            dy[k] = m_forward_f.y + m_right_f.y * sx + m_up_f.y * sy;
+            dz[k] = m_forward_f.z + m_right_f.z * sx + m_up_f.z * sy;
+        }
+        for (std::size_t k = 0; k < block; ++k)
+            inv[k] = 1.0f / std::sqrt(dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k]);
+        for (std::size_t k = 0; k < m; ++k) {
+            CameraRayF& r = rays[k0 + k];
+            r.org = m_origin_f;
+            r.dir = {dx[k] * inv[k], dy[k] * inv[k], dz[k] * inv[k]};
+            r.tfar = std::numeric_limits<float>::infinity();
+        }
+    }
+}
+
 CameraRay Camera::generate_ray(double x, double y, double lens_u, double lens_v) const
 {
     if (m_aperture_radius <= 0 || m_projection == Projection::parallel)

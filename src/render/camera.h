@@ -81,17 +81,7 @@ public:
     /// root and reciprocal per ray instead of double ones, which held up every camera
     /// sample.
     void generate_rays_f(std::span<const float> xs, std::span<const float> ys,
-                         std::span<CameraRayF> rays) const
-    {
-        const std::size_t n = std::min({xs.size(), ys.size(), rays.size()});
-        for (std::size_t k = 0; k < n; ++k) {
-            Vec3f d = m_forward_f + m_right_f * (xs[k] - m_half_width_f) +
-                      m_up_f * (m_half_height_f - ys[k]);
-            rays[k].org = m_origin_f;
-            rays[k].dir = d * (1.0f / std::sqrt(dot(d, d)));
-            rays[k].tfar = std::numeric_limits<float>::infinity();
-        }
-    }
+                         std::span<CameraRayF> rays) const;
     /// The same through the lens point given by two uniforms in [0, 1) (a thin lens:
     /// every ray through (x, y) meets the others on the plane in focus). Equals
     /// generate_ray(x, y) for a pinhole camera.
