@@ -9,8 +9,7 @@ namespace cambium::render {
 
 namespace {
 
-/// The pair values of samples first .. first + 15 (sobol_pairs), as 32-bit fractions in
-/// their own bit order. Plain integer arithmetic over a fixed count, which vectorises:
+/// The pair values of samples first .. first + 15 (sobol_pairs). Plain integer arithmetic over a fixed count, which vectorises:
 /// GCC builds one version for AVX2 (vpmulld does a lane's multiply in one instruction)
 /// and one for the baseline processor, and picks at load time (an ifunc). Both give the
 /// same bits.
@@ -18,15 +17,16 @@ namespace {
                                                            const sobol::ScrambleKey& kx,
                                                            const sobol::ScrambleKey& ky,
                                                            std::uint32_t first,
-                                                           std::uint32_t* __restrict x,
-                                                           std::uint32_t* __restrict y)
+                                                           float* __restrict x,
+                                                           float* __restrict y)
 {
     using namespace sobol;
     for (std::uint32_t k = 0; k < 16; ++k) {
         std::uint32_t index =
             reverse_bits_shifts(scramble_reversed(reverse_bits_shifts(first + k), shuffle));
-        x[k] = reverse_bits_shifts(scramble_reversed(index, kx));
-        y[k] = reverse_bits_shifts(scramble_reversed(sobol_second_reversed_shifts(index), ky));
+        x[k] = to_unit(reverse_bits_shifts(scramble_reversed(index, kx)));
+        y[k] = to_unit(
+            reverse_bits_shifts(scramble_reversed(sobol_second_reversed_shifts(index), ky)));
     }
 }
 
@@ -40,13 +40,15 @@ void sobol_pairs(const PixelSeeds& seeds, std::uint32_t dimension, std::uint32_t
     constexpr std::uint32_t block = 16;
     for (std::uint32_t k0 = 0; k0 < n; k0 += block) {
         // The whole block (a fixed count vectorises); values past n are not stored.
-        alignas(32) std::array<std::uint32_t, block> x, y;
-        pair_block(shuffle, kx, ky, first + k0, x.data(), y.data());
         const std::uint32_t m = std::min(block, n - k0);
-        for (std::uint32_t k = 0; k < m; ++k) {
-            xs[k0 + k] = sobol::to_unit(x[k]);
-            ys[k0 + k] = sobol::to_unit(y[k]);
+        if (m == block) {
+            pair_block(shuffle, kx, ky, first + k0, xs + k0, ys + k0);
+            continue;
         }
+        alignas(32) std::array<float, block> x, y;
+        pair_block(shuffle, kx, ky, first + k0, x.data(), y.data());
+        std::copy_n(x.data(), m, xs + k0);
+        std::copy_n(y.data(), m, ys + k0);
     }
 }
 
