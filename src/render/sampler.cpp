@@ -9,16 +9,20 @@ namespace cambium::render {
 
 namespace {
 
-/// The pair values of samples first .. first + 15 (sobol_pairs). Plain integer arithmetic over a fixed count, which vectorises:
-/// GCC builds one version for AVX2 (vpmulld does a lane's multiply in one instruction)
-/// and one for the baseline processor, and picks at load time (an ifunc). Both give the
-/// same bits.
-[[gnu::target_clones("avx2", "default")]] void pair_block(const sobol::ScrambleKey& shuffle,
-                                                           const sobol::ScrambleKey& kx,
-                                                           const sobol::ScrambleKey& ky,
-                                                           std::uint32_t first,
-                                                           float* __restrict x,
-                                                           float* __restrict y)
+// The AVX2 clone exists only on x86 (elsewhere the compiler vectorises for what it has).
+#if defined(__x86_64__) || defined(__i386__)
+#define CAMBIUM_SIMD_CLONES [[gnu::target_clones("avx2", "default")]]
+#else
+#define CAMBIUM_SIMD_CLONES
+#endif
+
+/// The pair values of samples first .. first + 15 (sobol_pairs). Plain integer arithmetic
+/// over a fixed count, which vectorises: GCC builds one version for AVX2 (vpmulld does a
+/// lane's multiply in one instruction) and one for the baseline processor, and picks at
+/// load time (an ifunc). Both give the same bits.
+CAMBIUM_SIMD_CLONES void pair_block(const sobol::ScrambleKey& shuffle, const sobol::ScrambleKey& kx,
+                                    const sobol::ScrambleKey& ky, std::uint32_t first,
+                                    float* __restrict x, float* __restrict y)
 {
     using namespace sobol;
     for (std::uint32_t k = 0; k < 16; ++k) {
