@@ -176,8 +176,10 @@ std::optional<FlatMiss> flat_miss(const PathContext& ctx, const RenderSettings& 
 {
     if (ctx.environment_visible)
         return std::nullopt;
-    // camera_miss's radiance, after take_sample's transparency.
-    Vec3f radiance = ctx.max_depth > 0 ? ctx.background : Vec3f();
+    // camera_miss's radiance (the same addition), after take_sample's transparency.
+    Vec3f radiance;
+    if (ctx.max_depth > 0)
+        radiance += ctx.background;
     if (s.transparent_background || s.ground.shadow_catcher)
         radiance = Vec3f();
     if (!std::isfinite(radiance.x + radiance.y + radiance.z))
@@ -250,8 +252,9 @@ Sampler sampler_of(const RenderState& f, const PixelReplicas& replicas, std::uin
                    f.settings.sampler);
 }
 
-/// A batch of camera samples traced together (take_samples): made once per tile, not per
-/// pixel (its members' initialisers cost a visible share of the pixel loop).
+/// A batch of camera samples traced together (trace_batch): made once per tile, in
+/// RowBatches, not per pixel (its members' initialisers cost a visible share of the
+/// pixel loop).
 struct CameraBatch {
     static constexpr std::uint32_t size = EmbreeScene::max_coherent_rays;
     std::array<float, size> jx, jy;  // film pairs, then (float rays) image points
@@ -456,7 +459,7 @@ void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uin
 /// adds any to the sums, so the row's camera streams meet Embree back to back (its nodes
 /// stay in cache) instead of between the paths of the hits (and the hits' paths follow
 /// each other too); each pixel's sums take the same samples in the same order. (Rounds
-/// over a row measured faster than over a whole tile or two or four rows.)
+/// over one row measured as fast as over two and faster than over four or a whole tile.)
 void take_row(const RenderState& f, const PixelRect& region, int y, int x0, int x1,
               std::uint32_t target, std::vector<PixelState>& pixels, int w, RowBatches& row)
 {
