@@ -33,9 +33,7 @@
 //
 // --export-scene FOLDER renders nothing: it writes each plant's interpreted scene as
 // FOLDER/NAME.json (scene_export.h), which benchmarks/cycles/ builds in Blender.
-#include <embree3/rtcore.h>
 
-#include <dlfcn.h>
 #include <sys/resource.h>
 
 #include <algorithm>
@@ -58,49 +56,14 @@
 #include "app/pipeline.h"
 #include "render/ray_counter.h"
 #include "render/render.h"
+#include "ray_replay.h"
 #include "scene_export.h"
 
 namespace fs = std::filesystem;
 
-// ---- Ray counting: this executable's rtcIntersect1 / rtcIntersect1M / rtcOccluded1 count
-// each ray and forward to Embree's (cambium_render is static and links to these
-// definitions). Each thread counts in its own slot: a shared atomic would make the
-// rendering threads contend on every ray, a cost of the benchmark, not of the renderer.
-namespace {
-cambium::render::RayCounter rays_traced;
-
-template <typename F>
-F embree_function(const char* name)
-{
-    return reinterpret_cast<F>(dlsym(RTLD_NEXT, name));
-}
-}  // namespace
-
-extern "C" void rtcIntersect1(RTCScene scene, RTCIntersectContext* context, RTCRayHit* rayhit)
-{
-    using F = void (*)(RTCScene, RTCIntersectContext*, RTCRayHit*);
-    static F real = embree_function<F>("rtcIntersect1");
-    rays_traced.add();
-    real(scene, context, rayhit);
-}
-
-extern "C" void rtcIntersect1M(RTCScene scene, RTCIntersectContext* context, RTCRayHit* rayhit,
-                               unsigned int m, size_t byte_stride)
-{
-    using F = void (*)(RTCScene, RTCIntersectContext*, RTCRayHit*, unsigned int, size_t);
-    static F real = embree_function<F>("rtcIntersect1M");
-    rays_traced.add(m);
-    real(scene, context, rayhit, m, byte_stride);
-}
-
-extern "C" void rtcOccluded1(RTCScene scene, RTCIntersectContext* context, RTCRay* ray)
-{
-    using F = void (*)(RTCScene, RTCIntersectContext*, RTCRay*);
-    static F real = embree_function<F>("rtcOccluded1");
-    rays_traced.add();
-    real(scene, context, ray);
-}
-
+// Rays are counted (and, for --raw-embree, recorded and replayed) by the interposer of
+// ray_replay.h: this executable's rtcIntersect1 / rtcIntersect1M / rtcOccluded1 count each
+// ray per thread and forward to Embree's (cambium_render is static and links to them).
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -199,7 +162,7 @@ Run render_at(const cambium::geom::Scene& scene, const Settings& s, int spp,
     if (s.max_depth > 0)
         rs.max_depth = s.max_depth;
     rs.noise_target = static_cast<float>(noise_target);
-    std::uint64_t rays_before = rays_traced.total();
+    std::uint64_t rays_before = cambium::bench::recorder.rays_traced();
     auto start = Clock::now();
     double cpu_start = cpu_seconds();
     render::RenderReport report;
@@ -208,7 +171,7 @@ Run render_at(const cambium::geom::Scene& scene, const Settings& s, int spp,
     run.cpu_seconds = cpu_seconds() - cpu_start;
     run.setup_seconds = report.setup_seconds;
     run.setup_cpu_seconds = report.setup_cpu_seconds;
-    run.rays = rays_traced.total() - rays_before;
+    run.rays = cambium::bench::recorder.rays_traced() - rays_before;
     run.samples = report.samples;
     return run;
 }
