@@ -98,6 +98,8 @@ struct Settings {
     fs::path export_folder;  ///< --export-scene: write the scenes instead of rendering
     int max_depth = 0;       ///< --max-depth: path segments (0: the renderer's default)
     fs::path save_folder;    ///< --save-images: each render as raw RGBA floats there
+    bool series = true;      ///< the convergence series (off: --raw-embree-only)
+    bool raw_embree = true;  ///< the raw-Embree measurement (off: --no-raw-embree)
 };
 
 /// The process's CPU time so far, user + sys, in seconds.
@@ -148,8 +150,9 @@ struct Run {
     std::uint64_t rays = 0, samples = 0;
 };
 
-Run render_at(const cambium::geom::Scene& scene, const Settings& s, int spp,
-              render::SampleSequence sampler, std::uint64_t seed, double noise_target = 0)
+/// The measured renders' settings.
+render::RenderSettings render_settings(const Settings& s, int spp, render::SampleSequence sampler,
+                                       std::uint64_t seed, double noise_target = 0)
 {
     render::RenderSettings rs;
     rs.width = s.width;
@@ -162,6 +165,13 @@ Run render_at(const cambium::geom::Scene& scene, const Settings& s, int spp,
     if (s.max_depth > 0)
         rs.max_depth = s.max_depth;
     rs.noise_target = static_cast<float>(noise_target);
+    return rs;
+}
+
+Run render_at(const cambium::geom::Scene& scene, const Settings& s, int spp,
+              render::SampleSequence sampler, std::uint64_t seed, double noise_target = 0)
+{
+    render::RenderSettings rs = render_settings(s, spp, sampler, seed, noise_target);
     std::uint64_t rays_before = cambium::bench::recorder.rays_traced();
     auto start = Clock::now();
     double cpu_start = cpu_seconds();
@@ -346,6 +356,58 @@ void run_adaptive(const std::string& plant, const cambium::geom::Scene& scene,
     std::fflush(stdout);
 }
 
+/// The path tracer against raw Embree on the same rays (ray_replay.h): one render at
+/// --max-spp, as the measured renders but in one pass (its on_pass is the end of tracing),
+/// whose rays are recorded, a subsample of about 300 k of each kind, and replayed with raw
+/// Embree on the render's scene and threads while it is alive. A pilot render at an
+/// eighth of the spp first counts the rays of each kind, which sets the subsample.
+void run_raw_embree(const std::string& plant, const cambium::geom::Scene& scene,
+                    const Settings& s, render::SampleSequence sampler)
+{
+    using cambium::bench::recorder;
+    const int pilot_spp = std::max(1, s.max_spp / 8);
+    const std::uint64_t i0 = recorder.intersections.total(), o0 = recorder.occlusions.total(),
+                        m0 = recorder.stream_intersections.total();
+    render_at(scene, s, pilot_spp, sampler, 0);
+    const double per_spp = double(s.max_spp) / pilot_spp;
+    const auto streams = std::uint64_t(double(recorder.stream_intersections.total() - m0) * per_spp);
+    const auto singles = std::uint64_t(double(recorder.intersections.total() - i0) * per_spp) - streams;
+    const auto occlusions = std::uint64_t(double(recorder.occlusions.total() - o0) * per_spp);
+
+    render::RenderSettings rs = render_settings(s, s.max_spp, sampler, 0);
+    rs.passes = 1;
+    cambium::bench::TraceFigures t;
+    // on_pass runs in the render's arena, so the replay runs on the render's threads.
+    rs.on_pass = [&t](const render::Image&) {
+        recorder.stop();
+        t = recorder.replay();
+    };
+    recorder.prepare(400'000, singles, occlusions, streams);  // allocated and touched here
+    recorder.start();
+    render::RenderReport report;
+    render::render(scene, rs, &report);
+    const cambium::bench::RawFigures& raw = t.raw;
+    std::printf("{\"plant\":\"%s\",\"sampler\":\"%s\",\"raw_embree_measurement\":true,"
+                "\"image\":\"%dx%d\",\"threads\":%d,\"spp\":%d,\"samples\":%llu,"
+                "\"intersect_rays\":%llu,\"stream_intersect_rays\":%llu,"
+                "\"occlusion_rays\":%llu,\"replayed\":{\"intersect_rays\":%zu,"
+                "\"stream_rays\":%zu,\"occlusion_rays\":%zu,\"one_in\":[%zu,%zu,%zu]},"
+                "\"trace_s\":%.3f,\"trace_cpu_s\":%.3f,\"raw_embree_cpu_s\":%.3f,"
+                "\"path_tracer_rays_per_s\":%.0f,\"raw_embree_rays_per_s\":%.0f,"
+                "\"path_tracer_fraction_of_raw\":%.3f,"
+                "\"path_tracer_fraction_of_raw_cpu\":%.3f}\n",
+                plant.c_str(), name(sampler), s.width, s.height, s.threads, s.max_spp,
+                static_cast<unsigned long long>(report.samples),
+                static_cast<unsigned long long>(t.intersections),
+                static_cast<unsigned long long>(t.stream_intersections),
+                static_cast<unsigned long long>(t.occlusions), raw.singles, raw.streams,
+                raw.occlusions, recorder.singles.every, recorder.streams.every,
+                recorder.occlusion_rays.every, t.trace_s, t.trace_cpu_s, t.raw_mix_cpu_s(),
+                t.trace_s > 0 ? double(t.rays()) / t.trace_s : 0.0, t.raw_rays_per_s(),
+                t.path_tracer_fraction_of_raw(), t.path_tracer_fraction_of_raw_cpu());
+    std::fflush(stdout);
+}
+
 void run_plant(const std::string& plant, const fs::path& folder, const std::string& command,
                const Settings& s,
                const fs::path& cache)
@@ -389,6 +451,13 @@ void run_plant(const std::string& plant, const fs::path& folder, const std::stri
         report(plant, s, sampler, curve, target);
 }
 
+/// The plant's folder: under the corpus, or the project's own.
+fs::path plant_folder(const PlantSource& source, const fs::path& corpus)
+{
+    return source.command.empty() ? corpus / source.folder
+                                  : fs::path(CAMBIUM_SOURCE_DIR) / source.folder;
+}
+
 Settings parse(int argc, char** argv)
 {
     Settings s;
@@ -429,6 +498,10 @@ Settings parse(int argc, char** argv)
             s.max_depth = std::stoi(value());
         } else if (arg == "--save-images") {
             s.save_folder = fs::absolute(value());
+        } else if (arg == "--raw-embree-only") {
+            s.series = false;
+        } else if (arg == "--no-raw-embree") {
+            s.raw_embree = false;
         } else if (arg == "--export-scene") {
             s.export_folder = fs::absolute(value());
         } else {
@@ -438,6 +511,8 @@ Settings parse(int argc, char** argv)
     if (s.plants.empty())
         for (const auto& [plant, folder] : plants)
             s.plants.push_back(plant);
+    if (!s.series && !s.raw_embree)
+        throw std::runtime_error("--raw-embree-only and --no-raw-embree leave nothing to do");
     return s;
 }
 
@@ -450,25 +525,40 @@ int main(int argc, char** argv)
         const char* env = std::getenv("CAMBIUM_CORPUS");
         fs::path corpus = fs::absolute(env ? env : CAMBIUM_CORPUS_DEFAULT);
         fs::path cache = fs::absolute(CAMBIUM_BUILD_DIR) / "convergence-cache";
+        std::vector<std::string> found;  // the plants whose model is there
         for (const std::string& plant : s.plants) {
             const PlantSource& source = plants.at(plant);
-            const fs::path folder = source.command.empty()
-                                        ? corpus / source.folder
-                                        : fs::path(CAMBIUM_SOURCE_DIR) / source.folder;
+            const fs::path folder = plant_folder(source, corpus);
             if (source.command.empty() && !fs::exists(folder / "model.json")) {
                 std::printf("{\"plant\":\"%s\",\"skipped\":\"no corpus model at %s\"}\n",
                             plant.c_str(), folder.string().c_str());
                 continue;
             }
-            if (s.export_folder.empty()) {
+            found.push_back(plant);
+            if (!s.export_folder.empty()) {
+                fs::create_directories(s.export_folder);
+                std::ofstream out(s.export_folder / (plant + ".json"));
+                cambium::bench::write_scene_json(load_plant(folder, source.command), s.width,
+                                                 s.height, folder, out);
+                if (!out)
+                    throw std::runtime_error("cannot write " +
+                                             (s.export_folder / plant).string());
+            } else if (s.series) {
                 run_plant(plant, folder, source.command, s, cache);
-                continue;
             }
-            fs::create_directories(s.export_folder);
-            std::ofstream out(s.export_folder / (plant + ".json"));
-            cambium::bench::write_scene_json(load_plant(folder, source.command), s.width, s.height, folder, out);
-            if (!out)
-                throw std::runtime_error("cannot write " + (s.export_folder / plant).string());
+        }
+        // After every plant's series, so that the logs' memory is not in their peak RSS.
+        if (s.raw_embree && s.export_folder.empty() && !(s.adaptive > 0)) {
+            // The renderer's default sampler unless only white noise was asked for.
+            const render::SampleSequence sampler =
+                std::count(s.samplers.begin(), s.samplers.end(), render::SampleSequence::sobol)
+                    ? render::SampleSequence::sobol
+                    : s.samplers.front();
+            for (const std::string& plant : found) {
+                const PlantSource& source = plants.at(plant);
+                run_raw_embree(plant, load_plant(plant_folder(source, corpus), source.command),
+                               s, sampler);
+            }
         }
     } catch (const std::exception& e) {
         std::fprintf(stderr, "convergence: %s\n", e.what());

@@ -63,7 +63,12 @@ void RayLog::record_stream(const RTCRayHit* rayhit, unsigned m, std::size_t stri
 {
     if (at.epoch != epoch.load(std::memory_order_relaxed))
         at = LogCursor{0, 0, 0, 0, false, epoch.load(std::memory_order_relaxed)};
-    if (at.groups++ % every != 0 || m == 0 || m > chunk)
+    if (at.left == 0) {  // a new group of streams, of about `chunk` rays
+        at.left = chunk;
+        at.keeping = at.groups++ % every == 0;
+    }
+    at.left -= std::min<std::size_t>(at.left, m);
+    if (!at.keeping || m == 0 || m > chunk)
         return;
     if (at.end - at.next < m && !take_chunk(at))  // whole streams only
         return;
@@ -281,14 +286,12 @@ double replay_streams(RTCScene scene, const std::vector<RTCRay>& rays, std::uint
     return seconds_since(t0);
 }
 
-/// One group in how many, so that about `keep` of `expected` rays (in groups of `group`
-/// rays) are recorded; 0 expected: every group.
+}  // namespace
+
 std::size_t one_in(std::size_t keep, std::uint64_t expected)
 {
     return keep > 0 && expected > keep ? std::size_t(expected / keep) : 1;
 }
-
-}  // namespace
 
 void Recorder::prepare(std::size_t keep, std::uint64_t expected_singles,
                        std::uint64_t expected_occlusions, std::uint64_t expected_streams)

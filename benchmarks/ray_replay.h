@@ -7,8 +7,8 @@
 // definitions, which count each ray per thread and forward to Embree's own (found with
 // dlsym(RTLD_NEXT)). Between start() and stop() they also record a systematic subsample of
 // the rays of each kind: single intersection rays (bounces), occlusion (shadow) rays, and
-// the camera rays the renderer traces as coherent streams (rtcIntersect1M, kept stream by
-// stream). The benchmark calls stop() and replay() from RenderSettings::on_pass at the end
+// the camera rays the renderer traces as coherent streams (rtcIntersect1M, kept as whole
+// streams). The benchmark calls stop() and replay() from RenderSettings::on_pass at the end
 // of a render's single pass, while the render's Embree scene and the buffers it shares are
 // alive: replay() traces the recorded rays again with raw Embree calls on that scene, on
 // the caller's arena, singles and shadow rays one at a time, streams as the same streams
@@ -24,8 +24,8 @@
 // What recording costs the trace (it is charged to the path tracer): a relaxed load and
 // a per-thread add per ray, and a 48-byte store (plus 12 bytes for the skipped
 // primitive) per recorded ray. To keep that small the recorder keeps only every k-th
-// group of each thread's rays (groups of RayLog::chunk rays, or one stream), k chosen per
-// kind from the expected count so that about `keep` rays are recorded; the slots are
+// group of each thread's rays (runs of RayLog::chunk consecutive rays, or of whole streams
+// of about as many), k chosen per kind from the expected count; the slots are
 // handed out a chunk at a time (one atomic add per chunk) and allocated and touched in
 // prepare(), before the trace starts.
 #pragma once
@@ -58,7 +58,7 @@ double peak_rss_mb();
 struct LogCursor {
     std::size_t next = 0, end = 0;
     std::size_t left = 0;     ///< rays still to see in the current group
-    std::uint64_t groups = 0;  ///< groups seen (a group: `chunk` rays, or one stream)
+    std::uint64_t groups = 0;  ///< groups seen (`chunk` rays, or whole streams of as many)
     bool keeping = false;      ///< whether the current group is recorded
     std::uint32_t epoch = 0;
 };
@@ -66,9 +66,10 @@ struct LogCursor {
 /// Slots for recorded rays of one kind, handed to each thread a chunk at a time: one
 /// atomic add per chunk rather than per ray (a counter shared by all threads would charge
 /// the path tracer for cache-line contention that only the benchmark causes). Each thread
-/// records one group of its rays in `every` (a group being `chunk` consecutive rays, or
-/// one stream). Slots never filled keep the sentinel tnear = -1 and are dropped before the
-/// replay.
+/// records one group of its rays in `every`, a group being `chunk` consecutive rays (or
+/// consecutive whole streams of about as many rays): runs of neighbouring rays, so that the
+/// replay keeps the locality between them that the trace had. Slots never filled keep the
+/// sentinel tnear = -1 and are dropped before the replay.
 struct RayLog {
     static constexpr std::size_t chunk = 4096;
     /// A thread's next and end once the log is full (before, each later ray took a chunk
@@ -101,7 +102,7 @@ struct RayLog {
             store(r, at, skip);
     }
     /// Records the m rays of one stream call together in the calling thread's chunk (a
-    /// new chunk when they do not fit; the old one's rest stays empty) if the stream is
+    /// new chunk when they do not fit; the old one's rest stays empty) if its group is
     /// kept, the first with its stream's size in `id` (Embree does not read it; the
     /// replay restores it).
     void record_stream(const RTCRayHit* rayhit, unsigned m, std::size_t stride, LogCursor& at);
@@ -124,6 +125,10 @@ private:
     }
     bool take_chunk(LogCursor& at);
 };
+
+/// One group in how many to record so that about `keep` of `expected` rays are kept
+/// (1 when expected is 0 or at most keep).
+std::size_t one_in(std::size_t keep, std::uint64_t expected);
 
 /// Raw Embree on the recorded rays of each kind: rays replayed, hits, wall and CPU seconds.
 struct RawFigures {

@@ -246,7 +246,15 @@ int run(int argc, char** argv)
 
     // The path tracer, counted by the interposer; the raw replay at the end of its pass,
     // while its Embree scene is alive.
-    recorder.prepare(2'000'000, 0, 0, 0);  // every ray, up to 2 M of each kind; touched here
+    // The logs are allocated and touched here, before the trace. Camera rays (streams):
+    // their count is known, so one run of streams in k is recorded, about 300 k rays.
+    // Bounces and shadow rays: every one, up to 2 M of each (their count is not known
+    // before).
+    const std::uint64_t camera_rays =
+        std::uint64_t(width) * std::uint64_t(height) * std::uint64_t(spp);
+    recorder.singles.prepare(2'000'000, true, 1);
+    recorder.occlusion_rays.prepare(2'000'000, true, 1);
+    recorder.streams.prepare(400'000, false, cambium::bench::one_in(300'000, camera_rays));
     recorder.start();
     cambium::bench::TraceFigures t;
     settings.on_pass = [&](const cambium::render::Image&) {
