@@ -390,8 +390,11 @@ void run_raw_embree(const std::string& plant, const cambium::geom::Scene& scene,
     std::printf("{\"plant\":\"%s\",\"sampler\":\"%s\",\"raw_embree_measurement\":true,"
                 "\"image\":\"%dx%d\",\"threads\":%d,\"spp\":%d,\"samples\":%llu,"
                 "\"intersect_rays\":%llu,\"stream_intersect_rays\":%llu,"
-                "\"occlusion_rays\":%llu,\"replayed\":{\"intersect_rays\":%zu,"
+                "\"occlusion_rays\":%llu,\"recorded\":{\"intersect_rays\":%zu,"
                 "\"stream_rays\":%zu,\"occlusion_rays\":%zu,\"one_in\":[%zu,%zu,%zu]},"
+                "\"raw_embree\":{\"intersect_rays\":%zu,\"intersect_cpu_s\":%.3f,"
+                "\"stream_rays\":%zu,\"stream_cpu_s\":%.3f,\"occlusion_rays\":%zu,"
+                "\"occlusion_cpu_s\":%.3f},"
                 "\"trace_s\":%.3f,\"trace_cpu_s\":%.3f,\"raw_embree_cpu_s\":%.3f,"
                 "\"path_tracer_rays_per_s\":%.0f,\"raw_embree_rays_per_s\":%.0f,"
                 "\"path_tracer_fraction_of_raw\":%.3f,"
@@ -400,9 +403,11 @@ void run_raw_embree(const std::string& plant, const cambium::geom::Scene& scene,
                 static_cast<unsigned long long>(report.samples),
                 static_cast<unsigned long long>(t.intersections),
                 static_cast<unsigned long long>(t.stream_intersections),
-                static_cast<unsigned long long>(t.occlusions), raw.singles, raw.streams,
-                raw.occlusions, recorder.singles.every, recorder.streams.every,
-                recorder.occlusion_rays.every, t.trace_s, t.trace_cpu_s, t.raw_mix_cpu_s(),
+                static_cast<unsigned long long>(t.occlusions), recorder.singles.rays.size(),
+                recorder.streams.rays.size(), recorder.occlusion_rays.rays.size(),
+                recorder.singles.every, recorder.streams.every, recorder.occlusion_rays.every,
+                raw.singles, raw.intersect_cpu_s, raw.streams, raw.stream_cpu_s, raw.occlusions,
+                raw.occluded_cpu_s, t.trace_s, t.trace_cpu_s, t.raw_mix_cpu_s(),
                 t.trace_s > 0 ? double(t.rays()) / t.trace_s : 0.0, t.raw_rays_per_s(),
                 t.path_tracer_fraction_of_raw(), t.path_tracer_fraction_of_raw_cpu());
     std::fflush(stdout);

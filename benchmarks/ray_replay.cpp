@@ -330,24 +330,45 @@ void Recorder::stop()
     streams.compact();
 }
 
+namespace {
+
+/// Replays one kind's recorded rays (`once` traces them all and returns its wall seconds)
+/// again and again until the replays have taken `min_cpu_s` CPU seconds (at most 32
+/// rounds; a replay of a few milliseconds is mostly thread wake-up and scheduling noise),
+/// adding up rays replayed, hits, wall and CPU seconds.
+template <typename Once>
+void replay_rounds(Once once, std::size_t recorded, std::size_t& replayed, std::uint64_t& hits,
+                   double& seconds, double& cpu_seconds)
+{
+    constexpr double min_cpu_s = 0.1;
+    for (int round = 0; recorded > 0 && round < 32 && cpu_seconds < min_cpu_s; ++round) {
+        const double cpu0 = process_cpu_seconds();
+        std::uint64_t round_hits = 0;
+        seconds += once(round_hits);
+        cpu_seconds += process_cpu_seconds() - cpu0;
+        hits += round_hits;
+        replayed += recorded;
+    }
+}
+
+}  // namespace
+
 TraceFigures Recorder::replay()
 {
     TraceFigures t = m_trace;
     RawFigures& raw = t.raw;
-    raw.singles = singles.rays.size();
-    raw.occlusions = occlusion_rays.rays.size();
-    raw.streams = streams.rays.size();
     if (!scene)
         return t;
-    double cpu0 = process_cpu_seconds();
-    raw.intersect_s = bench::replay(scene, singles, false, raw.hits);
-    double cpu1 = process_cpu_seconds();
-    raw.occluded_s = bench::replay(scene, occlusion_rays, true, raw.occluded);
-    double cpu2 = process_cpu_seconds();
-    raw.stream_s = replay_streams(scene, streams.rays, raw.stream_hits);
-    raw.intersect_cpu_s = cpu1 - cpu0;
-    raw.occluded_cpu_s = cpu2 - cpu1;
-    raw.stream_cpu_s = process_cpu_seconds() - cpu2;
+    replay_rounds([&](std::uint64_t& hits) { return bench::replay(scene, singles, false, hits); },
+                  singles.rays.size(), raw.singles, raw.hits, raw.intersect_s,
+                  raw.intersect_cpu_s);
+    replay_rounds(
+        [&](std::uint64_t& hits) { return bench::replay(scene, occlusion_rays, true, hits); },
+        occlusion_rays.rays.size(), raw.occlusions, raw.occluded, raw.occluded_s,
+        raw.occluded_cpu_s);
+    replay_rounds([&](std::uint64_t& hits) { return replay_streams(scene, streams.rays, hits); },
+                  streams.rays.size(), raw.streams, raw.stream_hits, raw.stream_s,
+                  raw.stream_cpu_s);
     return t;
 }
 

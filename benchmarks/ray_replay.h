@@ -130,7 +130,8 @@ private:
 /// (1 when expected is 0 or at most keep).
 std::size_t one_in(std::size_t keep, std::uint64_t expected);
 
-/// Raw Embree on the recorded rays of each kind: rays replayed, hits, wall and CPU seconds.
+/// Raw Embree on the recorded rays of each kind: rays replayed (each recorded ray as many
+/// times as its kind was replayed), hits, wall and CPU seconds.
 struct RawFigures {
     std::size_t singles = 0, occlusions = 0, streams = 0;  ///< rays replayed
     std::uint64_t hits = 0, occluded = 0, stream_hits = 0;
