@@ -10,7 +10,9 @@
 // interposer in ray_replay.h (shared with the convergence benchmark): when the render's
 // one pass ends (on_pass, while its Embree scene and the buffers it shares are alive)
 // the recorded rays are traced again with raw rtcIntersect1 / rtcIntersect1M /
-// rtcOccluded1 on that same scene and the same threads. The render builds the BVH once:
+// rtcOccluded1 on that same scene and the same threads (camera rays: a subsample of
+// about 300 k in runs of whole streams; bounce and shadow rays: every one, up to 2 M of
+// each; each kind replayed until it has taken 0.1 CPU s). The render builds the BVH once:
 // build_s is the time from render() to its first ray. path_tracer_fraction_of_raw
 // compares wall-clock rates; path_tracer_fraction_of_raw_cpu compares the CPU seconds of
 // the trace with raw Embree's CPU seconds for the same number of rays of each kind, which
