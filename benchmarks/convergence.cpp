@@ -70,16 +70,16 @@
 
 #include "app/command_line.h"
 #include "app/pipeline.h"
-#include "render/ray_counter.h"
 #include "render/render.h"
 #include "ray_replay.h"
 #include "scene_export.h"
 
 namespace fs = std::filesystem;
 
-// Rays are counted (and, for --raw-embree, recorded and replayed) by the interposer of
-// ray_replay.h: this executable's rtcIntersect1 / rtcIntersect1M / rtcOccluded1 count each
-// ray per thread and forward to Embree's (cambium_render is static and links to them).
+// Rays are counted (and, for the raw-Embree measurement, recorded and replayed) by the
+// interposer of ray_replay.h: this executable's rtcIntersect1 / rtcIntersect1M /
+// rtcOccluded1 count each ray per thread and forward to Embree's (cambium_render is static
+// and links to them).
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -372,36 +372,34 @@ void run_adaptive(const std::string& plant, const cambium::geom::Scene& scene,
     std::fflush(stdout);
 }
 
-/// The path tracer against raw Embree on the same rays (ray_replay.h): one render at
-/// --max-spp, as the measured renders but in one pass (its on_pass is the end of tracing),
-/// whose rays are recorded, a subsample of about 300 k of each kind, and replayed with raw
-/// Embree on the render's scene and threads while it is alive. A pilot render at an
-/// eighth of the spp first counts the rays of each kind, which sets the subsample.
-void run_raw_embree(const std::string& plant, const cambium::geom::Scene& scene,
-                    const Settings& s, render::SampleSequence sampler)
+/// Rays of each kind a render traces.
+struct RayCounts {
+    std::uint64_t singles = 0, occlusions = 0, streams = 0;
+};
+
+/// The rays of each kind a render at --max-spp will trace, from a pilot render at an eighth
+/// of the spp: what sets the recorder's subsample.
+RayCounts expected_rays(const cambium::geom::Scene& scene, const Settings& s,
+                        render::SampleSequence sampler)
 {
     using cambium::bench::recorder;
     const int pilot_spp = std::max(1, s.max_spp / 8);
     const std::uint64_t i0 = recorder.intersections.total(), o0 = recorder.occlusions.total(),
                         m0 = recorder.stream_intersections.total();
     render_at(scene, s, pilot_spp, sampler, 0);
-    const double per_spp = double(s.max_spp) / pilot_spp;
-    const auto streams = std::uint64_t(double(recorder.stream_intersections.total() - m0) * per_spp);
-    const auto singles = std::uint64_t(double(recorder.intersections.total() - i0) * per_spp) - streams;
-    const auto occlusions = std::uint64_t(double(recorder.occlusions.total() - o0) * per_spp);
+    const double scale = double(s.max_spp) / pilot_spp;
+    auto scaled = [scale](std::uint64_t n) { return std::uint64_t(double(n) * scale); };
+    const std::uint64_t streams = recorder.stream_intersections.total() - m0;
+    return {scaled(recorder.intersections.total() - i0 - streams),
+            scaled(recorder.occlusions.total() - o0), scaled(streams)};
+}
 
-    render::RenderSettings rs = render_settings(s, s.max_spp, sampler, 0);
-    rs.passes = 1;
-    cambium::bench::TraceFigures t;
-    // on_pass runs in the render's arena, so the replay runs on the render's threads.
-    rs.on_pass = [&t](const render::Image&) {
-        recorder.stop();
-        t = recorder.replay();
-    };
-    recorder.prepare(400'000, singles, occlusions, streams);  // allocated and touched here
-    recorder.start();
-    render::RenderReport report;
-    render::render(scene, rs, &report);
+/// One `"raw_embree_measurement":true` line (see the top of the file).
+void report_raw_embree(const std::string& plant, const Settings& s,
+                       render::SampleSequence sampler, std::uint64_t samples,
+                       const cambium::bench::TraceFigures& t)
+{
+    const cambium::bench::Recorder& r = cambium::bench::recorder;
     const cambium::bench::RawFigures& raw = t.raw;
     std::printf("{\"plant\":\"%s\",\"sampler\":\"%s\",\"raw_embree_measurement\":true,"
                 "\"image\":\"%dx%d\",\"threads\":%d,\"spp\":%d,\"samples\":%llu,"
@@ -416,17 +414,42 @@ void run_raw_embree(const std::string& plant, const cambium::geom::Scene& scene,
                 "\"path_tracer_fraction_of_raw\":%.3f,"
                 "\"path_tracer_fraction_of_raw_cpu\":%.3f}\n",
                 plant.c_str(), name(sampler), s.width, s.height, s.threads, s.max_spp,
-                static_cast<unsigned long long>(report.samples),
+                static_cast<unsigned long long>(samples),
                 static_cast<unsigned long long>(t.intersections),
                 static_cast<unsigned long long>(t.stream_intersections),
-                static_cast<unsigned long long>(t.occlusions), recorder.singles.rays.size(),
-                recorder.streams.rays.size(), recorder.occlusion_rays.rays.size(),
-                recorder.singles.every, recorder.streams.every, recorder.occlusion_rays.every,
-                raw.singles, raw.intersect_cpu_s, raw.streams, raw.stream_cpu_s, raw.occlusions,
-                raw.occluded_cpu_s, t.trace_s, t.trace_cpu_s, t.raw_mix_cpu_s(),
+                static_cast<unsigned long long>(t.occlusions), r.singles.rays.size(),
+                r.streams.rays.size(), r.occlusion_rays.rays.size(), r.singles.every,
+                r.streams.every, r.occlusion_rays.every, raw.singles, raw.intersect_cpu_s,
+                raw.streams, raw.stream_cpu_s, raw.occlusions, raw.occluded_cpu_s, t.trace_s,
+                t.trace_cpu_s, t.raw_mix_cpu_s(),
                 t.trace_s > 0 ? double(t.rays()) / t.trace_s : 0.0, t.raw_rays_per_s(),
                 t.path_tracer_fraction_of_raw(), t.path_tracer_fraction_of_raw_cpu());
     std::fflush(stdout);
+}
+
+/// The path tracer against raw Embree on the same rays (ray_replay.h): one render at
+/// --max-spp, as the measured renders but in one pass (its on_pass is the end of tracing),
+/// whose rays are recorded, a subsample of about 300 k of each kind, and replayed with raw
+/// Embree on the render's scene and threads while it is alive.
+void run_raw_embree(const std::string& plant, const cambium::geom::Scene& scene,
+                    const Settings& s, render::SampleSequence sampler)
+{
+    using cambium::bench::recorder;
+    const RayCounts expected = expected_rays(scene, s, sampler);
+    render::RenderSettings rs = render_settings(s, s.max_spp, sampler, 0);
+    rs.passes = 1;
+    cambium::bench::TraceFigures t;
+    // on_pass runs in the render's arena, so the replay runs on the render's threads.
+    rs.on_pass = [&t](const render::Image&) {
+        recorder.stop();
+        t = recorder.replay();
+    };
+    // The logs are allocated and touched here, before the trace.
+    recorder.prepare(400'000, expected.singles, expected.occlusions, expected.streams);
+    recorder.start();
+    render::RenderReport report;
+    render::render(scene, rs, &report);
+    report_raw_embree(plant, s, sampler, report.samples, t);
 }
 
 void run_plant(const std::string& plant, const fs::path& folder, const std::string& command,
