@@ -323,8 +323,10 @@ void Recorder::stop()
     m_trace.intersections = intersections.total() - m_intersections0;
     m_trace.occlusions = occlusions.total() - m_occlusions0;
     m_trace.stream_intersections = stream_intersections.total() - m_streams0;
-    m_trace.trace_s = std::chrono::duration<double>(m_end - first_call).count();
-    m_trace.trace_cpu_s = m_end_cpu - first_call_cpu;
+    if (started) {  // else the render traced no ray: no trace to time
+        m_trace.trace_s = std::chrono::duration<double>(m_end - first_call).count();
+        m_trace.trace_cpu_s = m_end_cpu - first_call_cpu;
+    }
     singles.compact();
     occlusion_rays.compact();
     streams.compact();
