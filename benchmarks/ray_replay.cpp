@@ -316,16 +316,16 @@ void Recorder::start()
 
 void Recorder::stop()
 {
-    m_end = Clock::now();
-    m_end_cpu = process_cpu_seconds();
+    const Clock::time_point end = Clock::now();
+    const double end_cpu = process_cpu_seconds();
     recording = false;
     m_trace = {};
     m_trace.intersections = intersections.total() - m_intersections0;
     m_trace.occlusions = occlusions.total() - m_occlusions0;
     m_trace.stream_intersections = stream_intersections.total() - m_streams0;
     if (started) {  // else the render traced no ray: no trace to time
-        m_trace.trace_s = std::chrono::duration<double>(m_end - first_call).count();
-        m_trace.trace_cpu_s = m_end_cpu - first_call_cpu;
+        m_trace.trace_s = std::chrono::duration<double>(end - first_call).count();
+        m_trace.trace_cpu_s = end_cpu - first_call_cpu;
     }
     singles.compact();
     occlusion_rays.compact();

@@ -187,7 +187,7 @@ struct Recorder {
     {
         return intersections.total() + occlusions.total();
     }
-    /// The logs' and the trace's record of the last recording.
+    /// The logs' memory.
     std::size_t log_bytes() const
     {
         return singles.bytes() + occlusion_rays.bytes() + streams.bytes();
@@ -196,8 +196,6 @@ struct Recorder {
 private:
     std::uint64_t m_intersections0 = 0, m_occlusions0 = 0, m_streams0 = 0;
     TraceFigures m_trace;
-    Clock::time_point m_end;
-    double m_end_cpu = 0;
 };
 
 extern Recorder recorder;
