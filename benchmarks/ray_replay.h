@@ -16,8 +16,10 @@
 //
 // The figures: the trace is the span from the first Embree call after start() (the first
 // ray of the pixel loop: the set-up traces none) to stop(), in wall and process CPU
-// seconds. Raw Embree's CPU seconds for the same rays are, per kind, the traced count
-// times the replay's CPU seconds per recorded ray; path_tracer_fraction_of_raw_cpu is
+// seconds. Each kind is replayed again and again until it has taken 0.1 CPU s (a replay of
+// a few milliseconds is mostly thread wake-up). Raw Embree's CPU seconds for the same rays
+// are, per kind, the traced count times the replay's CPU seconds per replayed ray;
+// path_tracer_fraction_of_raw_cpu is
 // their sum over the trace's CPU seconds (CPU time, unlike wall time, does not measure
 // the neighbours on a loaded machine).
 //
