@@ -1,0 +1,421 @@
+// SPDX-License-Identifier: Apache-2.0
+// The interposed Embree entry points, the ray logs and the raw replay (ray_replay.h).
+#include "ray_replay.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <dlfcn.h>
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <array>
+#include <ctime>
+
+#include "render/float_mode.h"
+
+namespace cambium::bench {
+
+Recorder recorder;
+
+double process_cpu_seconds()
+{
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+double peak_rss_mb()
+{
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return static_cast<double>(usage.ru_maxrss) / 1024.0;  // KiB
+}
+
+// ---- The logs --------------------------------------------------------------------------
+
+void RayLog::prepare(std::size_t count, bool with_skips, std::size_t every_group)
+{
+    RTCRay sentinel{};
+    sentinel.tnear = -1;
+    rays.assign(count, sentinel);
+    skips.assign(with_skips ? count : 0, {});
+    chunks_taken = 0;
+    every = std::max<std::size_t>(every_group, 1);
+    epoch.fetch_add(1);
+}
+
+bool RayLog::take_chunk(LogCursor& at)
+{
+    if (at.next == full)  // no chunks left: not even the shared counter is touched
+        return false;
+    at.next = chunks_taken.fetch_add(1, std::memory_order_relaxed) * chunk;
+    at.end = std::min(at.next + chunk, rays.size());
+    if (at.next >= at.end) {  // full: record no more
+        at.next = at.end = full;
+        return false;
+    }
+    return true;
+}
+
+void RayLog::record_stream(const RTCRayHit* rayhit, unsigned m, std::size_t stride,
+                           LogCursor& at)
+{
+    if (at.epoch != epoch.load(std::memory_order_relaxed))
+        at = LogCursor{0, 0, 0, 0, false, epoch.load(std::memory_order_relaxed)};
+    if (at.left == 0) {  // a new group of streams, of about `chunk` rays
+        at.left = chunk;
+        at.keeping = at.groups++ % every == 0;
+    }
+    at.left -= std::min<std::size_t>(at.left, m);
+    if (!at.keeping || m == 0 || m > chunk)
+        return;
+    if (at.end - at.next < m && !take_chunk(at))  // whole streams only
+        return;
+    for (unsigned i = 0; i < m; ++i) {
+        RTCRay r = reinterpret_cast<const RTCRayHit*>(reinterpret_cast<const char*>(rayhit) +
+                                                      i * stride)->ray;
+        r.id = i == 0 ? m : 0;
+        rays[at.next++] = r;
+    }
+}
+
+void RayLog::compact()
+{
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < rays.size(); ++i)
+        if (rays[i].tnear >= 0) {
+            if (!skips.empty())
+                skips[kept] = skips[i];
+            rays[kept++] = rays[i];
+        }
+    rays.resize(kept);
+    if (!skips.empty())
+        skips.resize(kept);
+}
+
+}  // namespace cambium::bench
+
+// ---- The interposer --------------------------------------------------------------------
+
+namespace {
+
+using cambium::bench::recorder;
+using Intersect1 = void (*)(RTCScene, RTCIntersectContext*, RTCRayHit*);
+using Intersect1M = void (*)(RTCScene, RTCIntersectContext*, RTCRayHit*, unsigned int, size_t);
+using Occluded1 = void (*)(RTCScene, RTCIntersectContext*, RTCRay*);
+
+template <typename F>
+F embree_function(const char* name)
+{
+    return reinterpret_cast<F>(dlsym(RTLD_NEXT, name));
+}
+
+Intersect1 real_intersect()
+{
+    static auto f = embree_function<Intersect1>("rtcIntersect1");
+    return f;
+}
+
+Intersect1M real_intersect_stream()
+{
+    static auto f = embree_function<Intersect1M>("rtcIntersect1M");
+    return f;
+}
+
+Occluded1 real_occluded()
+{
+    static auto f = embree_function<Occluded1>("rtcOccluded1");
+    return f;
+}
+
+/// The primitive a path tracer's ray skips, read from its context: render/accel.cpp's
+/// SkipContext (Embree's context, then the PrimId), with which every context the path
+/// tracer passes begins (as ReplayContext below assumes too).
+cambium::render::PrimId skip_of(const RTCIntersectContext* context)
+{
+    struct Skipping {
+        RTCIntersectContext context;
+        cambium::render::PrimId skip;
+    };
+    return reinterpret_cast<const Skipping*>(context)->skip;
+}
+
+/// The first Embree call of a trace opens it: its time, CPU time, memory and scene.
+void note_call(RTCScene scene)
+{
+    if (recorder.started.load(std::memory_order_relaxed))
+        return;
+    std::lock_guard lock(recorder.mutex);
+    if (recorder.started)
+        return;
+    recorder.first_call = cambium::bench::Clock::now();
+    recorder.first_call_cpu = cambium::bench::process_cpu_seconds();
+    // Less the recorder's own logs (allocated and touched before the render).
+    recorder.rss_at_first_call =
+        cambium::bench::peak_rss_mb() - double(recorder.log_bytes()) / (1024.0 * 1024.0);
+    recorder.scene = scene;
+    recorder.started = true;
+}
+
+}  // namespace
+
+extern "C" void rtcIntersect1(RTCScene scene, RTCIntersectContext* context, RTCRayHit* rayhit)
+{
+    recorder.intersections.add();
+    if (recorder.recording.load(std::memory_order_relaxed)) {
+        note_call(scene);
+        thread_local cambium::bench::LogCursor at;
+        recorder.singles.record(rayhit->ray, at, skip_of(context));
+    }
+    real_intersect()(scene, context, rayhit);
+}
+
+// Camera rays are traced as coherent streams (EmbreeScene::intersect_coherent): counted
+// apart and recorded stream by stream, so that the raw replay traces the same streams.
+extern "C" void rtcIntersect1M(RTCScene scene, RTCIntersectContext* context, RTCRayHit* rayhit,
+                               unsigned int m, size_t byte_stride)
+{
+    recorder.intersections.add(m);
+    recorder.stream_intersections.add(m);
+    if (recorder.recording.load(std::memory_order_relaxed)) {
+        note_call(scene);
+        thread_local cambium::bench::LogCursor at;
+        recorder.streams.record_stream(rayhit, m, byte_stride, at);
+    }
+    real_intersect_stream()(scene, context, rayhit, m, byte_stride);
+}
+
+extern "C" void rtcOccluded1(RTCScene scene, RTCIntersectContext* context, RTCRay* ray)
+{
+    recorder.occlusions.add();
+    if (recorder.recording.load(std::memory_order_relaxed)) {
+        note_call(scene);
+        thread_local cambium::bench::LogCursor at;
+        recorder.occlusion_rays.record(*ray, at, skip_of(context));
+    }
+    real_occluded()(scene, context, ray);
+}
+
+// ---- The replay --------------------------------------------------------------------------
+
+namespace cambium::bench {
+namespace {
+
+/// The intersection context as render/accel.cpp extends it (SkipContext): Embree's, then
+/// the primitive a ray must skip, the one the path tracer's ray skipped (the filters of
+/// round shapes read it; camera rays skip none).
+struct ReplayContext {
+    RTCIntersectContext context;
+    render::PrimId skip;
+    ReplayContext() { rtcInitIntersectContext(&context); }
+};
+
+double seconds_since(Clock::time_point t)
+{
+    return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+/// Raw rtcIntersect1 (or rtcOccluded1) over the recorded rays, in parallel; returns seconds.
+double replay(RTCScene scene, const RayLog& log, bool occlusion, std::uint64_t& hits)
+{
+    const std::vector<RTCRay>& rays = log.rays;
+    std::atomic<std::uint64_t> hit_count{0};
+    auto t0 = Clock::now();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 1024),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+        // The modes the render's threads trace with (render/float_mode.h).
+        render::DenormalsFlushed flushed;
+        ReplayContext c;
+        std::uint64_t local = 0;
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            if (!log.skips.empty())
+                c.skip = log.skips[i];
+            if (occlusion) {
+                RTCRay ray = rays[i];
+                real_occluded()(scene, &c.context, &ray);
+                local += ray.tfar < 0 ? 1 : 0;
+                continue;
+            }
+            RTCRayHit rh;
+            rh.ray = rays[i];
+            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            real_intersect()(scene, &c.context, &rh);
+            local += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
+        }
+        hit_count += local;
+    });
+    hits = hit_count;
+    return seconds_since(t0);
+}
+
+/// Raw rtcIntersect1M over the recorded streams (each as the path tracer traced it, with
+/// a coherent context), in parallel; returns seconds.
+double replay_streams(RTCScene scene, const std::vector<RTCRay>& rays, std::uint64_t& hits)
+{
+    std::vector<std::size_t> starts;  // each stream's first ray (its size in `id`)
+    for (std::size_t i = 0; i < rays.size(); i += std::max<unsigned>(rays[i].id, 1))
+        if (rays[i].id > 0 && i + rays[i].id <= rays.size())
+            starts.push_back(i);
+    std::atomic<std::uint64_t> hit_count{0};
+    auto t0 = Clock::now();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, starts.size(), 64),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+        render::DenormalsFlushed flushed;
+        ReplayContext c;
+        c.context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+        std::array<RTCRayHit, RayLog::chunk> batch;
+        std::uint64_t local = 0;
+        for (std::size_t b = r.begin(); b != r.end(); ++b) {
+            const std::size_t first = starts[b];
+            const unsigned m = rays[first].id;
+            for (unsigned k = 0; k < m; ++k) {
+                batch[k].ray = rays[first + k];
+                batch[k].ray.id = 0;
+                batch[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                batch[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            }
+            real_intersect_stream()(scene, &c.context, batch.data(), m, sizeof(RTCRayHit));
+            for (unsigned k = 0; k < m; ++k)
+                local += batch[k].hit.geomID != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
+        }
+        hit_count += local;
+    });
+    hits = hit_count;
+    return seconds_since(t0);
+}
+
+}  // namespace
+
+std::size_t one_in(std::size_t keep, std::uint64_t expected)
+{
+    return keep > 0 && expected > keep ? std::size_t(expected / keep) : 1;
+}
+
+void Recorder::prepare(std::size_t keep, std::uint64_t expected_singles,
+                       std::uint64_t expected_occlusions, std::uint64_t expected_streams)
+{
+    // A subsample aims at three quarters of the slots: the rest is room for part-filled
+    // chunks (one per thread) and for a trace a little longer than expected.
+    const std::size_t aim = keep / 4 * 3;
+    singles.prepare(keep, true, one_in(aim, expected_singles));
+    occlusion_rays.prepare(keep, true, one_in(aim, expected_occlusions));
+    streams.prepare(keep, false, one_in(aim, expected_streams));
+}
+
+void Recorder::start()
+{
+    started = false;
+    scene = nullptr;
+    m_intersections0 = intersections.total();
+    m_occlusions0 = occlusions.total();
+    m_streams0 = stream_intersections.total();
+    recording = true;
+}
+
+void Recorder::stop()
+{
+    const Clock::time_point end = Clock::now();
+    const double end_cpu = process_cpu_seconds();
+    recording = false;
+    m_trace = {};
+    m_trace.intersections = intersections.total() - m_intersections0;
+    m_trace.occlusions = occlusions.total() - m_occlusions0;
+    m_trace.stream_intersections = stream_intersections.total() - m_streams0;
+    if (started) {  // else the render traced no ray: no trace to time
+        m_trace.trace_s = std::chrono::duration<double>(end - first_call).count();
+        m_trace.trace_cpu_s = end_cpu - first_call_cpu;
+    }
+    singles.compact();
+    occlusion_rays.compact();
+    streams.compact();
+}
+
+namespace {
+
+/// Replays one kind's recorded rays (`once` traces them all and returns its wall seconds)
+/// again and again until the replays have taken `min_cpu_s` CPU seconds (at most 32
+/// rounds; a replay of a few milliseconds is mostly thread wake-up and scheduling noise),
+/// adding up rays replayed, hits, wall and CPU seconds.
+template <typename Once>
+void replay_rounds(Once once, std::size_t recorded, std::size_t& replayed, std::uint64_t& hits,
+                   double& seconds, double& cpu_seconds)
+{
+    constexpr double min_cpu_s = 0.1;
+    for (int round = 0; recorded > 0 && round < 32 && cpu_seconds < min_cpu_s; ++round) {
+        const double cpu0 = process_cpu_seconds();
+        std::uint64_t round_hits = 0;
+        seconds += once(round_hits);
+        cpu_seconds += process_cpu_seconds() - cpu0;
+        hits += round_hits;
+        replayed += recorded;
+    }
+}
+
+}  // namespace
+
+TraceFigures Recorder::replay()
+{
+    TraceFigures t = m_trace;
+    RawFigures& raw = t.raw;
+    if (!scene)
+        return t;
+    replay_rounds([&](std::uint64_t& hits) { return bench::replay(scene, singles, false, hits); },
+                  singles.rays.size(), raw.singles, raw.hits, raw.intersect_s,
+                  raw.intersect_cpu_s);
+    replay_rounds(
+        [&](std::uint64_t& hits) { return bench::replay(scene, occlusion_rays, true, hits); },
+        occlusion_rays.rays.size(), raw.occlusions, raw.occluded, raw.occluded_s,
+        raw.occluded_cpu_s);
+    replay_rounds([&](std::uint64_t& hits) { return replay_streams(scene, streams.rays, hits); },
+                  streams.rays.size(), raw.streams, raw.stream_hits, raw.stream_s,
+                  raw.stream_cpu_s);
+    return t;
+}
+
+// ---- The arithmetic ------------------------------------------------------------------------
+
+namespace {
+
+/// Raw Embree's seconds for `traced` rays of a kind, at its rate on the `replayed` ones
+/// (none replayed, as with --depth 1's single rays: none to charge).
+double raw_seconds_for(std::uint64_t traced, double replay_s, std::size_t replayed)
+{
+    return replayed > 0 && replay_s > 0 ? double(traced) * replay_s / double(replayed) : 0;
+}
+
+}  // namespace
+
+double TraceFigures::raw_mix_s() const
+{
+    return raw_seconds_for(single_intersections(), raw.intersect_s, raw.singles) +
+           raw_seconds_for(stream_intersections, raw.stream_s, raw.streams) +
+           raw_seconds_for(occlusions, raw.occluded_s, raw.occlusions);
+}
+
+double TraceFigures::raw_mix_cpu_s() const
+{
+    return raw_seconds_for(single_intersections(), raw.intersect_cpu_s, raw.singles) +
+           raw_seconds_for(stream_intersections, raw.stream_cpu_s, raw.streams) +
+           raw_seconds_for(occlusions, raw.occluded_cpu_s, raw.occlusions);
+}
+
+double TraceFigures::raw_rays_per_s() const
+{
+    double s = raw_mix_s();
+    return s > 0 ? double(rays()) / s : 0;
+}
+
+double TraceFigures::path_tracer_fraction_of_raw() const
+{
+    double raw_rate = raw_rays_per_s();
+    return raw_rate > 0 && trace_s > 0 ? double(rays()) / trace_s / raw_rate : 0;
+}
+
+double TraceFigures::path_tracer_fraction_of_raw_cpu() const
+{
+    return trace_cpu_s > 0 ? raw_mix_cpu_s() / trace_cpu_s : 0;
+}
+
+}  // namespace cambium::bench

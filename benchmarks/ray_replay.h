@@ -1,0 +1,205 @@
+// SPDX-License-Identifier: Apache-2.0
+// The path tracer's rays against raw Embree on the same rays, shared by the render and
+// convergence benchmarks.
+//
+// How it works: ray_replay.cpp defines rtcIntersect1, rtcIntersect1M and rtcOccluded1.
+// cambium_render is a static library, so the executable's calls resolve to these
+// definitions, which count each ray per thread and forward to Embree's own (found with
+// dlsym(RTLD_NEXT)). Between start() and stop() they also record a systematic subsample of
+// the rays of each kind: single intersection rays (bounces), occlusion (shadow) rays, and
+// the camera rays the renderer traces as coherent streams (rtcIntersect1M, kept as whole
+// streams). The benchmark calls stop() and replay() from RenderSettings::on_pass at the end
+// of a render's single pass, while the render's Embree scene and the buffers it shares are
+// alive: replay() traces the recorded rays again with raw Embree calls on that scene, on
+// the caller's arena, singles and shadow rays one at a time, streams as the same streams
+// with a coherent context, each ray with the primitive the path tracer's ray skipped.
+//
+// The figures: the trace is the span from the first Embree call after start() (the first
+// ray of the pixel loop: the set-up traces none) to stop(), in wall and process CPU
+// seconds. Each kind is replayed again and again until it has taken 0.1 CPU s (a replay of
+// a few milliseconds is mostly thread wake-up). Raw Embree's CPU seconds for the same rays
+// are, per kind, the traced count times the replay's CPU seconds per replayed ray;
+// path_tracer_fraction_of_raw_cpu is
+// their sum over the trace's CPU seconds (CPU time, unlike wall time, does not measure
+// the neighbours on a loaded machine).
+//
+// What recording costs the trace (it is charged to the path tracer): a relaxed load and
+// a per-thread add per ray, and a 48-byte store (plus 12 bytes for the skipped
+// primitive) per recorded ray. To keep that small the recorder keeps only every k-th
+// group of each thread's rays (runs of RayLog::chunk consecutive rays, or of whole streams
+// of about as many), k chosen per kind from the expected count; the slots are
+// handed out a chunk at a time (one atomic add per chunk) and allocated and touched in
+// prepare(), before the trace starts.
+#pragma once
+
+#include <embree3/rtcore.h>
+
+#include <atomic>
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <mutex>
+#include <vector>
+
+#include "render/accel.h"
+#include "render/ray_counter.h"
+
+namespace cambium::bench {
+
+using Clock = std::chrono::steady_clock;
+
+/// CPU seconds of the whole process (all threads): on a loaded machine wall time also
+/// measures the neighbours, CPU time only this process's work.
+double process_cpu_seconds();
+/// The process's peak resident memory so far, in MB.
+double peak_rss_mb();
+
+/// Where one thread is in a RayLog: its chunk of slots [next, end), and the groups of
+/// rays it has seen (for the subsample). A log's `epoch` tells a cursor left over from an
+/// earlier recording to start afresh.
+struct LogCursor {
+    std::size_t next = 0, end = 0;
+    std::size_t left = 0;     ///< rays still to see in the current group
+    std::uint64_t groups = 0;  ///< groups seen (`chunk` rays, or whole streams of as many)
+    bool keeping = false;      ///< whether the current group is recorded
+    std::uint32_t epoch = 0;
+};
+
+/// Slots for recorded rays of one kind, handed to each thread a chunk at a time: one
+/// atomic add per chunk rather than per ray (a counter shared by all threads would charge
+/// the path tracer for cache-line contention that only the benchmark causes). Each thread
+/// records one group of its rays in `every`, a group being `chunk` consecutive rays (or
+/// consecutive whole streams of about as many rays): runs of neighbouring rays, so that the
+/// replay keeps the locality between them that the trace had. Slots never filled keep the
+/// sentinel tnear = -1 and are dropped before the replay.
+struct RayLog {
+    static constexpr std::size_t chunk = 4096;
+    /// A thread's next and end once the log is full (before, each later ray took a chunk
+    /// number from the shared counter: contention charged to the path tracer).
+    static constexpr std::size_t full = SIZE_MAX;
+    std::vector<RTCRay> rays;
+    /// Beside each single ray, the primitive it skips (the one it leaves, which the round
+    /// shapes' filters reject), so that the replay asks Embree the same question as the
+    /// path tracer did; empty for the camera streams, which skip nothing.
+    std::vector<render::PrimId> skips;
+    std::atomic<std::size_t> chunks_taken{0};
+    std::size_t every = 1;  ///< one group in `every` is recorded
+    std::atomic<std::uint32_t> epoch{1};
+
+    /// Makes `count` sentinel slots (before the clock starts: they are touched here), with
+    /// room for each ray's skipped primitive when `with_skips`, recording one group in
+    /// `every`; cursors of an earlier recording start afresh.
+    void prepare(std::size_t count, bool with_skips, std::size_t every);
+    /// Records r (which skips `skip`) if its group is kept.
+    void record(const RTCRay& r, LogCursor& at, const render::PrimId& skip = {})
+    {
+        if (at.epoch != epoch.load(std::memory_order_relaxed))
+            at = LogCursor{0, 0, 0, 0, false, epoch.load(std::memory_order_relaxed)};
+        if (at.left == 0) {  // a new group
+            at.left = chunk;
+            at.keeping = at.groups++ % every == 0;
+        }
+        --at.left;
+        if (at.keeping)
+            store(r, at, skip);
+    }
+    /// Records the m rays of one stream call together in the calling thread's chunk (a
+    /// new chunk when they do not fit; the old one's rest stays empty) if its group is
+    /// kept, the first with its stream's size in `id` (Embree does not read it; the
+    /// replay restores it).
+    void record_stream(const RTCRayHit* rayhit, unsigned m, std::size_t stride, LogCursor& at);
+    /// Drops the slots never filled.
+    void compact();
+    std::size_t bytes() const
+    {
+        return rays.size() * sizeof(RTCRay) + skips.size() * sizeof(render::PrimId);
+    }
+
+private:
+    /// Stores r in the thread's chunk, taking a new one when it is full.
+    void store(const RTCRay& r, LogCursor& at, const render::PrimId& skip)
+    {
+        if (at.next == at.end && !take_chunk(at))
+            return;
+        if (!skips.empty())
+            skips[at.next] = skip;
+        rays[at.next++] = r;
+    }
+    bool take_chunk(LogCursor& at);
+};
+
+/// One group in how many to record so that about `keep` of `expected` rays are kept
+/// (1 when expected is 0 or at most keep).
+std::size_t one_in(std::size_t keep, std::uint64_t expected);
+
+/// Raw Embree on the recorded rays of each kind: rays replayed (each recorded ray as many
+/// times as its kind was replayed), hits, wall and CPU seconds.
+struct RawFigures {
+    std::size_t singles = 0, occlusions = 0, streams = 0;  ///< rays replayed
+    std::uint64_t hits = 0, occluded = 0, stream_hits = 0;
+    double intersect_s = 0, occluded_s = 0, stream_s = 0;
+    double intersect_cpu_s = 0, occluded_cpu_s = 0, stream_cpu_s = 0;
+};
+
+/// What the trace did and what raw Embree needs for the same rays (see the top).
+struct TraceFigures {
+    std::uint64_t intersections = 0, occlusions = 0;  ///< traced between start and stop
+    std::uint64_t stream_intersections = 0;  ///< of `intersections`: camera rays in streams
+    double trace_s = 0, trace_cpu_s = 0;  ///< first Embree call to stop()
+    RawFigures raw;
+
+    std::uint64_t rays() const { return intersections + occlusions; }
+    std::uint64_t single_intersections() const { return intersections - stream_intersections; }
+    /// Raw Embree's wall seconds for the trace's mix of rays, at the replayed rates.
+    double raw_mix_s() const;
+    /// Raw Embree's CPU seconds for the trace's mix of rays, at the replayed rates.
+    double raw_mix_cpu_s() const;
+    double raw_rays_per_s() const;  ///< wall
+    double path_tracer_fraction_of_raw() const;      ///< wall rates
+    double path_tracer_fraction_of_raw_cpu() const;  ///< raw_mix_cpu_s / trace_cpu_s
+};
+
+/// The process's one recorder (the interposed entry points write into it).
+struct Recorder {
+    render::RayCounter intersections, occlusions;  // per thread, uncontended; every ray
+    render::RayCounter stream_intersections;  // of `intersections`: in streams
+    RayLog singles, occlusion_rays, streams;
+    std::atomic<bool> recording{false};
+    std::atomic<bool> started{false};  ///< the first Embree call since start() was seen
+    Clock::time_point first_call;
+    double first_call_cpu = 0;
+    double rss_at_first_call = 0;  ///< peak RSS then, less the logs
+    RTCScene scene = nullptr;      ///< the render's, alive until render() returns
+    std::mutex mutex;
+
+    /// Allocates and touches logs of `keep` slots for each kind. Given the count of a kind
+    /// expected in the trace, one group in k is recorded so that about 3/4 keep are
+    /// (0 or at most that many expected: every ray, up to `keep`).
+    void prepare(std::size_t keep, std::uint64_t expected_singles,
+                 std::uint64_t expected_occlusions, std::uint64_t expected_streams);
+    /// Starts a trace: the next Embree call opens it.
+    void start();
+    /// Ends the trace (call it first thing in on_pass) and keeps the rays recorded.
+    void stop();
+    /// Raw Embree on the recorded rays, on the render's scene, in the caller's arena (in
+    /// on_pass, after stop()). Returns the trace's figures.
+    TraceFigures replay();
+    /// Rays counted so far, of every kind.
+    std::uint64_t rays_traced() const
+    {
+        return intersections.total() + occlusions.total();
+    }
+    /// The logs' memory.
+    std::size_t log_bytes() const
+    {
+        return singles.bytes() + occlusion_rays.bytes() + streams.bytes();
+    }
+
+private:
+    std::uint64_t m_intersections0 = 0, m_occlusions0 = 0, m_streams0 = 0;
+    TraceFigures m_trace;
+};
+
+extern Recorder recorder;
+
+}  // namespace cambium::bench
