@@ -32,6 +32,7 @@
 #include "render/float_mode.h"
 #include "render/integrator.h"
 #include "render/labels.h"
+#include "render/screen_mask.h"
 #include "render/texture.h"
 
 namespace cambium::render {
@@ -130,6 +131,8 @@ public:
     }
 
     bool box() const { return m_cdf.empty(); }
+    /// How far from the pixel centre a sample may lie, in pixels.
+    double radius() const { return m_radius; }
 
     /// The offset from the pixel centre for the uniform u.
     double offset(float u) const
@@ -358,6 +361,29 @@ void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uin
         for (std::uint32_t k = 0; k < n; ++k)
             take_sample(f, b.samples[k], b.rays[k], start + k, st, &b.hits[k]);
     }
+}
+
+/// Samples i0 .. i1 - 1 of a pixel whose camera rays are known to meet nothing
+/// (ScreenMask): each adds what a traced camera ray that missed adds (take_sample), with
+/// neither a sampler nor a ray. Only where a miss sees the same in every direction.
+void take_background_samples(const RenderState& f, std::uint32_t i0, std::uint32_t i1,
+                             PixelState& st)
+{
+    static const std::optional<SurfaceHit> miss;
+    const CameraSample c;
+    const CameraRayF ray{};
+    for (std::uint32_t i = i0; i < i1; ++i)
+        take_sample(f, c, ray, i, st, &miss);
+}
+
+/// The pixels whose camera rays may meet the scene, for a view where a camera ray that
+/// meets nothing shows one background colour (no environment seen, no ground plane,
+/// no lens): elsewhere every pixel is traced.
+ScreenMask screen_mask(const geom::Scene& scene, const RenderState& f)
+{
+    if (!f.settings.skip_empty_pixels || f.ctx.ground || f.ctx.environment_visible || f.lens)
+        return {};
+    return ScreenMask(scene, f.camera, f.filter.radius());
 }
 
 /// The pass schedule: cumulative samples per pixel at the end of each pass.
@@ -709,6 +735,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                         camera.projection() == Camera::Projection::perspective,
                     &nonfinite};
 
+        const ScreenMask mask = screen_mask(scene, state);
         if (view == 0) {
             rep.setup_seconds = elapsed();
             rep.setup_cpu_seconds = double(std::clock() - cpu_start) / CLOCKS_PER_SEC;
@@ -718,6 +745,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         const int tiles_y = (h + tile_size - 1) / tile_size;
         ProgressLine progress(settings.progress, start);
         std::atomic<bool> stop{false}, cancelled{false}, out_of_time{false};
+        std::atomic<std::uint64_t> background_samples{0};
         double last_pass_s = 0;
         std::uint64_t last_pass_samples = 0;
         // The time budget may stop a render only once every pixel has a sample: an
@@ -761,7 +789,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                               [&](const tbb::blocked_range<int>& r) {
                 for (int t = r.begin(); t != r.end(); ++t) {
                     int x0 = (t % tiles_x) * tile_size, y0 = (t / tiles_x) * tile_size;
-                    std::uint64_t taken = 0;
+                    std::uint64_t taken = 0, background_only = 0;
                     CameraBatch batch;
                     // Checked every row, so even passes of thousands of samples stop soon.
                     for (int y = y0; y < std::min(y0 + tile_size, h) && !should_stop(); ++y)
@@ -772,9 +800,15 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                             if (st.samples >= target)
                                 continue;
                             taken += target - st.samples;
+                            if (!mask.may_hit(region.x + x, region.y + y)) {
+                                background_only += target - st.samples;
+                                take_background_samples(state, st.samples, target, st);
+                                continue;
+                            }
                             take_samples(state, region.x + x, region.y + y, st.samples, target, st, batch);
                         }
                     progress.add(taken);
+                    background_samples.fetch_add(background_only, std::memory_order_relaxed);
                 }
             });
             if (stop)
@@ -790,6 +824,8 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         progress.finish();
         rep.cancelled = cancelled;
         rep.out_of_time = out_of_time;
+        rep.background_only_samples = background_samples.load();
+        rep.empty_pixel_share = mask.empty_share();
         rep.skipped_rays = accel->skipped_rays();
         rep.rays = accel->rays_traced() - rays_before;
         rays_before += rep.rays;
