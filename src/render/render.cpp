@@ -33,6 +33,7 @@
 #include "render/float_mode.h"
 #include "render/integrator.h"
 #include "render/labels.h"
+#include "render/screen_mask.h"
 #include "render/texture.h"
 
 namespace cambium::render {
@@ -131,6 +132,8 @@ public:
     }
 
     bool box() const { return m_cdf.empty(); }
+    /// How far from the pixel centre a sample may lie, in pixels.
+    double radius() const { return m_radius; }
 
     /// The offset from the pixel centre for the uniform u.
     double offset(float u) const
@@ -201,6 +204,9 @@ struct RenderState {
     bool float_rays = camera.single_precision() && filter.box();
     bool adaptive = settings.noise_target > 0;
     std::optional<FlatMiss> miss = flat_miss(ctx, settings);
+    /// The pixels that may meet the scene (screen_mask); the others take
+    /// take_background_samples. Null: every pixel is traced.
+    const ScreenMask* mask = nullptr;
 };
 
 /// A camera ray's cone: a parallel camera's rays are a pixel wide; a perspective one's
@@ -434,6 +440,18 @@ void add_batch(const RenderState& f, const PixelReplicas& replicas, std::uint32_
     st.radiance = radiance;
 }
 
+/// Samples i0 .. i1 - 1 of a pixel whose camera rays are known to meet nothing
+/// (ScreenMask): each adds what a traced camera ray that missed adds (take_flat_miss),
+/// with neither a sampler nor a ray.
+void take_background_samples(const RenderState& f, std::uint32_t i0, std::uint32_t i1,
+                             PixelState& st)
+{
+    Vec3f radiance = st.radiance;
+    for (std::uint32_t i = i0; i < i1; ++i)
+        take_flat_miss(f, *f.miss, i, st, radiance);
+    st.radiance = radiance;
+}
+
 /// A tile row's camera batches and pixel hashes (take_row), made once per tile.
 struct RowBatches {
     std::array<CameraBatch, tile_size> batch;
@@ -470,7 +488,12 @@ void take_row(const RenderState& f, const PixelRect& region, int y, int x0, int 
     for (int x = x0; x < x1; ++x) {
         auto& replicas = row.replicas[std::size_t(x - x0)];
         replicas.reset();
-        if (!pixel(x).done && pixel(x).samples < target)
+        PixelState& st = pixel(x);
+        if (st.done || st.samples >= target)
+            continue;
+        if (f.mask && !f.mask->may_hit(region.x + x, region.y + y))
+            take_background_samples(f, st.samples, target, st);
+        else
             replicas.emplace(region.x + x, region.y + y, f.settings.seed, f.adaptive);
     }
     if (f.ctx.ground) {  // no streams: each path traces its own camera ray
@@ -495,6 +518,16 @@ void take_row(const RenderState& f, const PixelRect& region, int y, int x0, int 
             more |= st.samples < target;
         }
     }
+}
+
+/// The pixels whose camera rays may meet the scene, for a view where a camera ray that
+/// meets nothing shows one background colour (a FlatMiss: no environment seen), with no
+/// ground plane and no lens: elsewhere every pixel is traced.
+ScreenMask screen_mask(const geom::Scene& scene, const RenderState& f)
+{
+    if (!f.settings.skip_empty_pixels || f.ctx.ground || !f.miss || f.lens)
+        return {};
+    return ScreenMask(scene, f.camera, f.filter.radius());
 }
 
 /// The pass schedule: cumulative samples per pixel at the end of each pass.
@@ -846,6 +879,8 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                         camera.projection() == Camera::Projection::perspective,
                     &nonfinite};
 
+        const ScreenMask mask = screen_mask(scene, state);
+        state.mask = &mask;
         if (view == 0) {
             rep.setup_seconds = elapsed();
             rep.setup_cpu_seconds = double(std::clock() - cpu_start) / CLOCKS_PER_SEC;
@@ -855,6 +890,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         const int tiles_y = (h + tile_size - 1) / tile_size;
         ProgressLine progress(settings.progress, start);
         std::atomic<bool> stop{false}, cancelled{false}, out_of_time{false};
+        std::atomic<std::uint64_t> background_samples{0};
         double last_pass_s = 0;
         std::uint64_t last_pass_samples = 0;
         // The time budget may stop a render only once every pixel has a sample: an
@@ -898,19 +934,23 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                               [&](const tbb::blocked_range<int>& r) {
                 for (int t = r.begin(); t != r.end(); ++t) {
                     int x0 = (t % tiles_x) * tile_size, y0 = (t / tiles_x) * tile_size;
-                    std::uint64_t taken = 0;
+                    std::uint64_t taken = 0, background_only = 0;
                     auto row = std::make_unique_for_overwrite<RowBatches>();  // no zero fill
                     const int x1 = std::min(x0 + tile_size, w);
                     // Checked every row, so even passes of thousands of samples stop soon.
                     for (int y = y0; y < std::min(y0 + tile_size, h) && !should_stop(); ++y) {
                         for (int x = x0; x < x1; ++x) {
                             const PixelState& st = pixels[std::size_t(y) * w + x];
-                            if (!st.done && st.samples < target)
-                                taken += target - st.samples;
+                            if (st.done || st.samples >= target)
+                                continue;
+                            taken += target - st.samples;
+                            if (!mask.may_hit(region.x + x, region.y + y))
+                                background_only += target - st.samples;
                         }
                         take_row(state, region, y, x0, x1, target, pixels, w, *row);
                     }
                     progress.add(taken);
+                    background_samples.fetch_add(background_only, std::memory_order_relaxed);
                 }
             });
             if (stop)
@@ -926,6 +966,8 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         progress.finish();
         rep.cancelled = cancelled;
         rep.out_of_time = out_of_time;
+        rep.background_only_samples = background_samples.load();
+        rep.empty_pixel_share = mask.empty_share();
         rep.skipped_rays = accel->skipped_rays();
         rep.rays = accel->rays_traced() - rays_before;
         rays_before += rep.rays;

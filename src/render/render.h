@@ -148,6 +148,11 @@ struct RenderSettings {
     /// Compute the albedo, normal and depth layers (Image::albedo/normal/depth): one
     /// extra camera-ray intersection per sample.
     bool aovs = true;
+    /// Pixels no primitive's projection reaches (ScreenMask) show the background without
+    /// tracing their camera rays, where a ray that meets nothing shows one colour (no
+    /// environment seen, no ground, no lens). The image is the same either way; off only
+    /// to check that (tests) or to trace every ray (benchmarks).
+    bool skip_empty_pixels = true;
 
     /// Print progress to stderr as one updating line (percentage, elapsed, remaining).
     bool progress = false;
@@ -168,6 +173,10 @@ struct RenderReport {
     bool out_of_time = false;   ///< stopped by the time budget
     std::uint64_t nonfinite_samples = 0;  ///< samples with NaN or infinite radiance, counted as black
     std::uint64_t skipped_rays = 0;  ///< rays Embree could not take (EmbreeScene::skipped_rays)
+    /// Camera samples of pixels known to show the background (RenderSettings::
+    /// skip_empty_pixels): taken without a ray. And those pixels' share of the image.
+    std::uint64_t background_only_samples = 0;
+    double empty_pixel_share = 0;
     double seconds = 0;         ///< wall time, including the Embree build
     /// --stats: from the call to the first sample (textures, the Embree build, lights),
     /// and of it the Embree build alone (the first view's; 0 for later views).
