@@ -74,6 +74,13 @@ using Key = std::array<float, 4>;
 Vec3f vec(const geom::Float3& a) { return {a[0], a[1], a[2]}; }
 Vec3f vec(const geom::Float4& a) { return {a[0], a[1], a[2]}; }
 
+/// The largest magnitude among p's coordinates. std::max, not std::fmax: for numbers they
+/// agree, and fmax's NaN rule keeps the compiler from inlining it (a libm call per use).
+float largest_coordinate(const Vec3f& p)
+{
+    return std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
+}
+
 /// An intersection context that carries the primitive to ignore (Embree 3 passes the
 /// context to filter functions, so it may be extended C-style). Every ray this file traces
 /// has one: the self-hit filter of curves and spheres reads it.
@@ -143,9 +150,9 @@ struct Placement {
     float largest_scale() const
     {
         const Vec3f &a = linear.c0, &b = linear.c1, &c = linear.c2;
-        return std::fmax(std::fmax(std::fabs(a.x) + std::fabs(b.x) + std::fabs(c.x),
-                                   std::fabs(a.y) + std::fabs(b.y) + std::fabs(c.y)),
-                         std::fabs(a.z) + std::fabs(b.z) + std::fabs(c.z));
+        return std::max({std::fabs(a.x) + std::fabs(b.x) + std::fabs(c.x),
+                         std::fabs(a.y) + std::fabs(b.y) + std::fabs(c.y),
+                         std::fabs(a.z) + std::fabs(b.z) + std::fabs(c.z)});
     }
 };
 
@@ -218,6 +225,8 @@ struct GeometrySource {
     const std::vector<std::uint16_t>* material = nullptr;
     const std::vector<std::uint16_t>* back_material = nullptr;
     const std::vector<std::int16_t>* texture = nullptr;
+    /// Some primitive names a texture in `texture` (else only an instance's can apply).
+    bool own_textures = false;
     /// Caps and joints: the line segment each belongs to (their attributes are its).
     const std::vector<std::uint32_t>* segment = nullptr;
     /// The filters its Embree geometry runs on each candidate hit (none: no filter at all):
@@ -277,7 +286,7 @@ struct ShapeKind {
 /// are drawn to OpenGL's exact pixels.)
 Vec3f off_axis(const Vec3f& d)
 {
-    float least = 1e-6f * std::fmax(std::fabs(d.x), std::fmax(std::fabs(d.y), std::fabs(d.z)));
+    float least = 1e-6f * largest_coordinate(d);
     auto raise = [least](float c) { return std::fabs(c) < least ? std::copysign(least, c) : c; };
     return {raise(d.x), raise(d.y), raise(d.z)};
 }
@@ -405,7 +414,7 @@ TextureTangents line_tangents(const GeometrySource& part, std::uint32_t prim, fl
 /// The largest coordinate of a disc (centre and radius).
 float disc_extent(const Key& c)
 {
-    return std::fmax(std::fabs(c[0]), std::fmax(std::fabs(c[1]), std::fabs(c[2]))) + c[3];
+    return largest_coordinate(vec(c)) + c[3];
 }
 
 RTCGeometry build_caps(RTCDevice device, const GeometrySource& part)
@@ -607,9 +616,7 @@ LocalSurface triangle_surface(const GeometrySource& part, std::uint32_t prim, fl
     // The front is where the vertex normals point; a flat face's winding if they vanish.
     if (dot(face, n0 + n1 + n2) < 0)
         face = -face;
-    float extent = 0;
-    for (const Vec3f& p : {p0, p1, p2})
-        extent = std::fmax(extent, std::fmax(std::fabs(p.x), std::fmax(std::fabs(p.y), std::fabs(p.z))));
+    float extent = std::max({largest_coordinate(p0), largest_coordinate(p1), largest_coordinate(p2)});
     return {face, n0 * (1 - u - v) + n1 * u + n2 * v, 0, true, extent};
 }
 
@@ -814,8 +821,9 @@ struct EmbreeScene::Impl : HitResolver {
     bool tilt_rays = false;  ///< some Hermite curves are built: rays are traced off_axis()
 
     Vec3f traced(const Vec3f& dir) const { return tilt_rays ? off_axis(dir) : dir; }
-    /// The hit Embree reported for the ray org + t dir, ready for shading.
-    SurfaceHit surface_hit(const RTCRayHit& rh, const Vec3f& org, const Vec3f& dir) const;
+    /// The hit Embree reported for the ray org + t dir, ready for shading, into `out`.
+    void surface_hit(const RTCRayHit& rh, const Vec3f& org, const Vec3f& dir,
+                     std::optional<SurfaceHit>& out) const;
     mutable std::atomic<std::uint64_t> skipped_rays{0};
     RayCounter rays;
     double build_seconds = 0;
@@ -1024,7 +1032,10 @@ int HitResolver::texture_of(const GeometrySource& part, std::uint32_t prim,
 {
     if (!part.texture)
         return geom::no_texture;
-    std::int16_t t = at_or(*part.texture, part.attribute_index(prim), geom::no_texture);
+    // Untextured parts (most) read no per-primitive entry: a cache miss on large ones.
+    std::int16_t t = part.own_textures
+                         ? at_or(*part.texture, part.attribute_index(prim), geom::no_texture)
+                         : geom::no_texture;
     // A prototype's untextured primitives take their instance's texture.
     if (t == geom::no_texture && p)
         t = p->texture;
@@ -1109,6 +1120,7 @@ void EmbreeScene::Impl::attach(RTCScene s, GeometrySource part,
     part.skips_self = shape.self_hits;
     part.pixel_line = part.shape == Shape::line && part.unlit;
     part.cut_out = textures && (alpha || part.pixel_line);
+    part.own_textures = part.texture && any_texture(*part.texture);
     parts.push_back(part);
     rtcSetGeometryUserData(g, &parts.back());
     if (part.skips_self || part.pixel_line || part.cut_out) {
@@ -1375,9 +1387,11 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
 {
     const Impl& m = *m_impl;
     m.rays.add();
+    // One named result, returned on every path: the caller's hit is written in place.
+    std::optional<SurfaceHit> hit;
     if (!traceable(org, dir, tnear, tfar)) {
         ++m.skipped_rays;
-        return std::nullopt;
+        return hit;
     }
     SkipContext context = make_context(skip, coherent);
     RTCRayHit rh;
@@ -1385,9 +1399,9 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(m.scene, &context.context, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
-        return std::nullopt;
-    return m.surface_hit(rh, org, dir);
+    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
+        m.surface_hit(rh, org, dir, hit);
+    return hit;
 }
 
 void EmbreeScene::intersect_coherent(std::span<const CameraRayF> rays,
@@ -1424,78 +1438,87 @@ void EmbreeScene::intersect_coherent(std::span<const CameraRayF> rays,
             __builtin_prefetch(m.instance(rh[k].hit.instID[0]));
     for (std::size_t k = 0; k < traced; ++k)
         if (rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID)
-            hits[index[k]] = m.surface_hit(rh[k], rays[index[k]].org, rays[index[k]].dir);
+            m.surface_hit(rh[k], rays[index[k]].org, rays[index[k]].dir, hits[index[k]]);
 }
 
-SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
-                                          const Vec3f& dir) const
+void EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org, const Vec3f& dir,
+                                    std::optional<SurfaceHit>& out) const
 {
-    const Impl& m = *this;
-    SurfaceHit h;
-    h.t = rh.ray.tfar;
+    const float t = rh.ray.tfar;
     // Where Embree found it: along the direction it traced (make_ray).
-    h.position = org + m.traced(dir) * h.t;
-    h.geom_id = rh.hit.geomID;
-    h.prim_id = rh.hit.primID;
-    h.inst_id = rh.hit.instID[0];
-    const std::optional<Placement> placement = m.placement(h.inst_id);
-    if (placement)
-        h.instance = placement->index;
+    const Vec3f position = org + traced(dir) * t;
+    const std::uint32_t prim = rh.hit.primID, inst_id = rh.hit.instID[0];
+    const std::optional<Placement> placement = this->placement(inst_id);
     const InstanceStyle* style = placement ? &placement->style : nullptr;
-    const GeometrySource& part = *m.part(h.inst_id, h.geom_id, placement);
-    h.shape = part.shape;
-    h.unlit = part.unlit;
+    const GeometrySource& part = *this->part(inst_id, rh.hit.geomID, placement);
 
     // Embree reports an instanced hit's normal in the prototype's frame.
     Vec3f ng(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
     const ShapeKind& shape = kind(part.shape);
-    LocalSurface local = shape.surface(part, h.prim_id, rh.hit.u, rh.hit.v, ng);
+    LocalSurface local = shape.surface(part, prim, rh.hit.u, rh.hit.v, ng);
     Vec3f geometric = local.geometric, shading = local.shading;
-    h.radius = local.radius;
+    float radius = local.radius;
     if (placement) {
         geometric = placement->normals * geometric;
         shading = placement->normals * shading;
-        if (h.radius != 0)
-            h.radius *= placement->radius_scale();
+        if (radius != 0)
+            radius *= placement->radius_scale();
     }
     geometric = normalize(geometric);
-    h.back = local.two_sided && dot(geometric, dir) > 0;
-    // Curves' and spheres' true normals point out of them.
-    h.inside = !local.two_sided && dot(geometric, dir) > 0;
-    if (dot(geometric, dir) > 0)
+    const bool facing_away = dot(geometric, dir) > 0;
+    const bool back = local.two_sided && facing_away;
+    if (facing_away)
         geometric = -geometric;
-    h.geometric_normal = geometric;
-    shading = normalize(h.back ? -shading : shading);
-    // A shading normal turned away from the ray (or absent) gives way to the true one.
-    h.normal = dot(shading, dir) < 0 ? shading : geometric;
+    shading = normalize(back ? -shading : shading);
 
-    HitMaterials materials = materials_at(part, h.prim_id, h.back, style, rh.hit.u);
-    h.material = materials.material;
-    h.end_material = materials.end_material;
-    h.material_blend = materials.blend;
-    int texture = m.texture_of(part, h.prim_id, style);
-    h.texture = static_cast<std::int16_t>(texture);
+    HitMaterials materials = materials_at(part, prim, back, style, rh.hit.u);
+    const int texture = texture_of(part, prim, style);
+    TextureCoords st{0, 0};
+    TextureTangents tangents{};
     if (texture != geom::no_texture) {
-        auto st = shape.texture_coords(part, h.prim_id, rh.hit.u, rh.hit.v, ng);
-        h.u = st[0];
-        h.v = st[1];
-        auto [dpds, dpdt] = shape.texture_tangents(part, h.prim_id, rh.hit.u, ng, local.radius);
-        h.dpds = placement ? placement->linear * dpds : dpds;
-        h.dpdt = placement ? placement->linear * dpdt : dpdt;
+        st = shape.texture_coords(part, prim, rh.hit.u, rh.hit.v, ng);
+        tangents = shape.texture_tangents(part, prim, rh.hit.u, ng, local.radius);
+        if (placement)
+            tangents = {placement->linear * tangents[0], placement->linear * tangents[1]};
     }
 
-    float scale = std::fmax(std::fabs(h.position.x),
-                            std::fmax(std::fabs(h.position.y), std::fabs(h.position.z)));
+    float scale = largest_coordinate(position);
     if (!shape.self_hits) {
         // Nothing skips a flat primitive: its offset must clear the float error of the hit,
         // which grows with the primitive's coordinates and (through the hit distance's
         // error) with the ray's length.
         float extent = local.extent * (placement ? placement->largest_scale() : 1);
-        scale = std::fmax(scale, extent) + 0.2f * h.t;
+        scale = std::max(scale, extent) + 0.2f * t;
     }
-    h.spawn_offset = shape.offset_per_radius * h.radius + shape.offset_per_scale * scale +
-                     shape.offset_absolute;
-    return h;
+    // Every field named, so the hit is written once, in place (a default-made hit was
+    // zeroed first with a string store, then overwritten, then copied).
+    out.emplace(SurfaceHit{
+        .t = t,
+        .position = position,
+        // A shading normal turned away from the ray (or absent) gives way to the true one.
+        .normal = dot(shading, dir) < 0 ? shading : geometric,
+        .geometric_normal = geometric,
+        .geom_id = rh.hit.geomID,
+        .prim_id = prim,
+        .inst_id = inst_id,
+        .instance = placement ? placement->index : PrimId::none,
+        .material = materials.material,
+        .end_material = materials.end_material,
+        .material_blend = materials.blend,
+        .texture = static_cast<std::int16_t>(texture),
+        .u = st[0],
+        .v = st[1],
+        .dpds = tangents[0],
+        .dpdt = tangents[1],
+        .shape = part.shape,
+        .back = back,
+        // Curves' and spheres' true normals point out of them.
+        .inside = !local.two_sided && facing_away,
+        .radius = radius,
+        .spawn_offset = shape.offset_per_radius * radius + shape.offset_per_scale * scale +
+                        shape.offset_absolute,
+        .unlit = part.unlit,
+    });
 }
 
 float EmbreeScene::transmittance(const Vec3f& org, const Vec3f& dir, float tnear, float tfar,

@@ -511,10 +511,13 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
     PassThroughDraws pass_through(sampler, sample_dimension::vertex(0) + sample_dimension::opacity);
     for (int depth = 0; depth < ctx.max_depth;) {
         const std::uint32_t block = sample_dimension::vertex(depth);
-        std::optional<SurfaceHit> hit = depth == 0 && passes == 0 && camera_hit
-                                            ? *camera_hit
-                                            : first_hit(ctx, org, dir, tfar, leaving, depth == 0);
-        if (!hit) {
+        // The camera ray's hit, when given, is read where it lies (not copied); a ray
+        // traced here writes its hit in place.
+        const bool given = depth == 0 && passes == 0 && camera_hit;
+        std::optional<SurfaceHit> traced =
+            given ? std::nullopt : first_hit(ctx, org, dir, tfar, leaving, depth == 0);
+        const std::optional<SurfaceHit>& found = given ? *camera_hit : traced;
+        if (!found) {
             if (depth == 0) {
                 result.radiance += beta * seen_by_camera(ctx, dir);
             } else if (!facts.environment_black) {
@@ -523,9 +526,13 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             }
             break;
         }
+        std::optional<SurfaceHit> facet;  // `render mode: flat`: shaded by the true normal
+        if (ctx.facet_normals) {
+            facet = found;
+            facet->normal = facet->geometric_normal;
+        }
+        const SurfaceHit* const hit = ctx.facet_normals ? &*facet : &*found;
         travelled += hit->t;
-        if (ctx.facet_normals)
-            hit->normal = hit->geometric_normal;
         SurfaceMaterial blended;
         const SurfaceMaterial& material = hit_material(ctx, *hit, blended);
         auto textured_diffuse = [&] {

@@ -20,7 +20,8 @@ float mean(const Vec3f& v) { return (v.x + v.y + v.z) / 3; }
 /// A direction about the unit axis a with cos(angle to a) = cos_theta.
 Vec3f around(const Vec3f& a, float cos_theta, float phi)
 {
-    float sin_theta = std::sqrt(std::fmax(0.0f, 1 - cos_theta * cos_theta));
+    // std::max(0, x) is std::fmax(0, x) for any x, NaN too, without a libm call.
+    float sin_theta = std::sqrt(std::max(0.0f, 1 - cos_theta * cos_theta));
     Vec3f t, b;
     make_basis(a, t, b);
     return normalize(t * (sin_theta * std::cos(phi)) + b * (sin_theta * std::sin(phi)) +
@@ -30,7 +31,7 @@ Vec3f around(const Vec3f& a, float cos_theta, float phi)
 /// Cosine-weighted direction about n.
 Vec3f sample_cosine(const Vec3f& n, float u1, float u2)
 {
-    return around(n, std::sqrt(std::fmax(0.0f, 1 - u1)), 2 * pi * u2);
+    return around(n, std::sqrt(std::max(0.0f, 1 - u1)), 2 * pi * u2);
 }
 
 Vec3f mirror(const Vec3f& wo, const Vec3f& n) { return n * (2 * dot(n, wo)) - wo; }
@@ -74,13 +75,6 @@ SurfaceMaterial mix(const SurfaceMaterial& a, const SurfaceMaterial& b, float w)
     return m;
 }
 
-Bsdf make_bsdf(const SurfaceMaterial& m, const Vec3f& diffuse)
-{
-    float keep = 1 - std::clamp(max_component(m.specular), 0.0f, 1.0f);
-    Vec3f d = diffuse * keep;
-    return {d * (1 - m.translucency), d * m.translucency, m.specular, m.exponent};
-}
-
 Vec3f bsdf_eval(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3f& wi)
 {
     float cos_i = dot(n, wi);
@@ -92,9 +86,12 @@ Vec3f bsdf_eval(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3f& wi)
     return f;
 }
 
-float bsdf_pdf(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3f& wi)
+namespace {
+
+/// bsdf_pdf() with the lobes' selection probabilities already made.
+float pdf_with(const Bsdf& b, const LobeWeights& w, const Vec3f& n, const Vec3f& wo,
+               const Vec3f& wi)
 {
-    LobeWeights w = lobe_weights(b);
     float cos_i = dot(n, wi);
     if (cos_i < 0)
         return w.transmit * -cos_i * inv_pi;
@@ -102,6 +99,13 @@ float bsdf_pdf(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3f& wi)
     if (w.glossy > 0)
         p += w.glossy * (b.exponent + 1) / (2 * pi) * phong_term(b, n, wo, wi);
     return p;
+}
+
+}  // namespace
+
+float bsdf_pdf(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3f& wi)
+{
+    return pdf_with(b, lobe_weights(b), n, wo, wi);
 }
 
 BsdfSample bsdf_sample(const Bsdf& b, const Vec3f& n, const Vec3f& wo, float u1, float u2)
@@ -122,7 +126,7 @@ BsdfSample bsdf_sample(const Bsdf& b, const Vec3f& n, const Vec3f& wo, float u1,
     } else {
         return {};
     }
-    float pdf = bsdf_pdf(b, n, wo, wi);
+    float pdf = pdf_with(b, w, n, wo, wi);
     if (pdf <= 0)
         return {};
     return {wi, bsdf_eval(b, n, wo, wi) * (std::fabs(dot(n, wi)) / pdf), pdf};

@@ -2,6 +2,7 @@
 // Surface materials: cpfg materials mapped to a small physically-based model.
 #pragma once
 
+#include <algorithm>
 #include <vector>
 
 #include "geom/scene.h"
@@ -45,7 +46,13 @@ SurfaceMaterial mix(const SurfaceMaterial& a, const SurfaceMaterial& b, float w)
 
 /// The BSDF of `m` with the (possibly textured) diffuse albedo `diffuse`. The glossy
 /// lobe takes its share first: the diffuse lobes keep (1 - max specular) of theirs.
-Bsdf make_bsdf(const SurfaceMaterial& m, const Vec3f& diffuse);
+/// (Inline: made at every path vertex.)
+inline Bsdf make_bsdf(const SurfaceMaterial& m, const Vec3f& diffuse)
+{
+    float keep = 1 - std::clamp(max_component(m.specular), 0.0f, 1.0f);
+    Vec3f d = diffuse * keep;
+    return {d * (1 - m.translucency), d * m.translucency, m.specular, m.exponent};
+}
 inline Bsdf make_bsdf(const SurfaceMaterial& m) { return make_bsdf(m, m.diffuse); }
 
 /// The colour a surface shows unlit (cpfg's flat colour): its diffuse albedo plus emission.
