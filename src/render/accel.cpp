@@ -254,13 +254,11 @@ using TextureCoords = std::array<float, 2>;
 using TextureTangents = std::array<Vec3f, 2>;
 
 /// Everything accel does that depends on the kind of primitive: one entry per Shape in
-/// `shape_kinds`, so a new kind of primitive is added in one place.
+/// `shape_kinds`, so a new kind of primitive is added in one place (and a case in
+/// local_surface(), which every hit calls).
 struct ShapeKind {
     /// Embree's geometry of the part's primitives (throws cambium::Error on a bad index).
     RTCGeometry (*build)(RTCDevice device, const GeometrySource& part);
-    /// The hit's surface in object space from Embree's (u, v) and normal ng.
-    LocalSurface (*surface)(const GeometrySource& part, std::uint32_t prim, float u, float v,
-                            const Vec3f& ng);
     /// Texture coordinates (s, t) of a hit.
     TextureCoords (*texture_coords)(const GeometrySource& part, std::uint32_t prim, float u,
                                     float v, const Vec3f& ng);
@@ -660,20 +658,35 @@ TextureTangents triangle_tangents(const GeometrySource& part, std::uint32_t prim
 // largest coordinate or the primitive's (see EmbreeScene::intersect), which clears the
 // error of Embree's hit distance at any angle (physics_test: a plane lit at grazing angles).
 constexpr std::array<ShapeKind, 7> shape_kinds{{
-    /* line */ {build_lines, line_surface, line_coords, line_tangents, 1e-3f, 1e-6f, 0, true},
-    /* curve */
-    {build_curves, curve_surface, curve_coords, curve_tangents, 1e-3f, 1e-6f, 0, true},
-    /* sphere */
-    {build_spheres, sphere_surface, sphere_coords, sphere_tangents, 1e-4f, 1e-6f, 0, true},
-    /* disc */ {build_discs, disc_surface, no_coords, no_tangents, 0, 1e-5f, 1e-7f, false},
-    /* triangle */
-    {build_triangles, triangle_surface, triangle_coords, triangle_tangents, 0, 1e-5f, 1e-7f,
-     false},
-    /* cap */ {build_caps, cap_surface, cap_coords, no_tangents, 1e-3f, 1e-5f, 1e-7f, false},
-    /* joint */ {build_joints, joint_surface, joint_coords, no_tangents, 1e-3f, 1e-6f, 0, true},
+    /* line */ {build_lines, line_coords, line_tangents, 1e-3f, 1e-6f, 0, true},
+    /* curve */ {build_curves, curve_coords, curve_tangents, 1e-3f, 1e-6f, 0, true},
+    /* sphere */ {build_spheres, sphere_coords, sphere_tangents, 1e-4f, 1e-6f, 0, true},
+    /* disc */ {build_discs, no_coords, no_tangents, 0, 1e-5f, 1e-7f, false},
+    /* triangle */ {build_triangles, triangle_coords, triangle_tangents, 0, 1e-5f, 1e-7f, false},
+    /* cap */ {build_caps, cap_coords, no_tangents, 1e-3f, 1e-5f, 1e-7f, false},
+    /* joint */ {build_joints, joint_coords, no_tangents, 1e-3f, 1e-6f, 0, true},
 }};
 
 const ShapeKind& kind(Shape s) { return shape_kinds[static_cast<std::size_t>(s)]; }
+
+/// The hit's surface in object space from Embree's (u, v) and normal ng, by the part's
+/// shape. A switch, not a ShapeKind entry: called for every hit, the shapes' functions
+/// are inlined here, and their result is not returned through memory (reading it back
+/// stalled on store forwarding); always inlined, as the compiler kept it a call.
+[[gnu::always_inline]] inline LocalSurface local_surface(const GeometrySource& part, std::uint32_t prim, float u, float v,
+                           const Vec3f& ng)
+{
+    switch (part.shape) {
+    case Shape::line: return line_surface(part, prim, u, v, ng);
+    case Shape::curve: return curve_surface(part, prim, u, v, ng);
+    case Shape::sphere: return sphere_surface(part, prim, u, v, ng);
+    case Shape::disc: return disc_surface(part, prim, u, v, ng);
+    case Shape::triangle: return triangle_surface(part, prim, u, v, ng);
+    case Shape::cap: return cap_surface(part, prim, u, v, ng);
+    case Shape::joint: return joint_surface(part, prim, u, v, ng);
+    }
+    return {ng, Vec3f(), 0, false};
+}
 
 /// The sources of a Geometry's primitives of each kind, attributes pointed at.
 GeometrySource lines_source(const geom::Geometry& g, const Key* keys, bool unlit)
@@ -1013,7 +1026,7 @@ void opacity_filter(const RTCFilterFunctionNArguments* args)
                  RTCHitN_Ng_z(args->hit, args->N, i));
         Vec3f dir(RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i),
                   RTCRayN_dir_z(args->ray, args->N, i));
-        LocalSurface local = kind(part.shape).surface(part, c.prim, u, v, ng);
+        LocalSurface local = local_surface(part, c.prim, u, v, ng);
         bool back = local.two_sided && dot(local.geometric, dir) > 0;
         HitMaterials m = materials_at(part, c.prim, back, p, u);
         float opacity = ctx->opacity_of(m.material);
@@ -1385,13 +1398,20 @@ RTCRay make_ray(const Vec3f& org, const Vec3f& dir, float tnear, float tfar)
 std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& dir, float tnear,
                                                  float tfar, PrimId skip, bool coherent) const
 {
+    std::optional<SurfaceHit> hit;
+    intersect(hit, org, dir, tnear, tfar, skip, coherent);
+    return hit;
+}
+
+void EmbreeScene::intersect(std::optional<SurfaceHit>& hit, const Vec3f& org, const Vec3f& dir,
+                            float tnear, float tfar, PrimId skip, bool coherent) const
+{
     const Impl& m = *m_impl;
     m.rays.add();
-    // One named result, returned on every path: the caller's hit is written in place.
-    std::optional<SurfaceHit> hit;
+    hit.reset();
     if (!traceable(org, dir, tnear, tfar)) {
         ++m.skipped_rays;
-        return hit;
+        return;
     }
     SkipContext context = make_context(skip, coherent);
     RTCRayHit rh;
@@ -1401,7 +1421,6 @@ std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& 
     rtcIntersect1(m.scene, &context.context, &rh);
     if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID)
         m.surface_hit(rh, org, dir, hit);
-    return hit;
 }
 
 void EmbreeScene::intersect_coherent(std::span<const CameraRayF> rays,
@@ -1455,7 +1474,7 @@ void EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org, const
     // Embree reports an instanced hit's normal in the prototype's frame.
     Vec3f ng(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
     const ShapeKind& shape = kind(part.shape);
-    LocalSurface local = shape.surface(part, prim, rh.hit.u, rh.hit.v, ng);
+    LocalSurface local = local_surface(part, prim, rh.hit.u, rh.hit.v, ng);
     Vec3f geometric = local.geometric, shading = local.shading;
     float radius = local.radius;
     if (placement) {

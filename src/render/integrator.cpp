@@ -99,21 +99,18 @@ bool ground_blocks(const PathContext& ctx, const PrimId& leaving)
     return ctx.ground && !ctx.ground->shadow_catcher && leaving.geom != ground_geom_id;
 }
 
-/// The first hit along org + t dir, t < tfar: the Embree scene's or the ground's. The
-/// camera ray meets the ground beyond the far clipping plane too (the plane is staging,
-/// not part of the plant, and reaches the horizon).
-std::optional<SurfaceHit> first_hit(const PathContext& ctx, const Vec3f& org, const Vec3f& dir,
-                                    float tfar, PrimId leaving, bool camera)
+/// The first hit along org + t dir, t < tfar, into `hit`: the Embree scene's or the
+/// ground's. The camera ray meets the ground beyond the far clipping plane too (the plane
+/// is staging, not part of the plant, and reaches the horizon).
+void first_hit(const PathContext& ctx, const Vec3f& org, const Vec3f& dir, float tfar,
+               PrimId leaving, bool camera, std::optional<SurfaceHit>& hit)
 {
-    // One named result, returned on every path: the hit (some 130 bytes) is built in
-    // place, not copied (a copy right after Embree's stores stalled on store forwarding).
-    std::optional<SurfaceHit> hit = ctx.accel->intersect(org, dir, 0, tfar, leaving, camera);
+    ctx.accel->intersect(hit, org, dir, 0, tfar, leaving, camera);
     bool sees_ground = camera ? ctx.ground && leaving.geom != ground_geom_id
                               : ground_blocks(ctx, leaving);
     if (sees_ground)
         if (std::optional<float> t = ctx.ground->distance(org, dir, hit ? hit->t : infinity))
             hit = ctx.ground->hit(org, dir, *t);
-    return hit;
 }
 
 /// The fraction of light passing from s.origin along wi for t < tfar: 0 if an opaque
@@ -172,18 +169,18 @@ struct LightUniforms {
     float choose, u0, u1, u2;
 };
 
-/// The fraction of light from a light sample that reaches the shading point: the spawned
-/// origin is off the surface, so the shadow ray aims from it at the point where the light
-/// sample's ray ends (just short of the light), as a ray parallel to wi could meet a curved
-/// light sooner; 0 where blocked.
+/// The fraction of light from a light sample (toward wi, its ray ending at `ends_at`) that
+/// reaches the shading point: the spawned origin is off the surface, so the shadow ray
+/// aims from it at the point where the light sample's ray ends (just short of the light),
+/// as a ray parallel to wi could meet a curved light sooner; 0 where blocked.
 float light_visibility(const PathContext& ctx, const PathContext::SceneFlags& facts,
-                       const SurfaceHit& hit, const LightLiSample& ls)
+                       const SurfaceHit& hit, const Vec3f& wi, float ends_at)
 {
-    Spawn s = spawn(hit, ls.wi);
-    Vec3f toward = ls.wi;
-    float tfar = ls.tfar;
+    Spawn s = spawn(hit, wi);
+    Vec3f toward = wi;
+    float tfar = ends_at;
     if (!std::isinf(tfar)) {
-        Vec3f to = hit.position + ls.wi * ls.tfar - s.origin;
+        Vec3f to = hit.position + wi * ends_at - s.origin;
         tfar = length(to);
         if (!(tfar > 0))
             return 0;
@@ -223,15 +220,20 @@ std::optional<Vec3f> sample_delta_ld(const PathContext& ctx,
     const std::uint32_t n = static_cast<std::uint32_t>(lights.size());
     std::array<float, LightSet::max_delta_choice> weight;  // luminance of each contribution
     float total = 0;
-    LightLiSample ls;  // the last light's, kept: a single light's is not made twice
-    Vec3f contribution;
+    // The last light's direction, end and contribution, kept: a single light's are not
+    // made twice. (Kept as values, not as its LightLiSample: copying that struct in the
+    // loop stalled on store forwarding.)
+    Vec3f wi, contribution;
+    float ends_at = 0;
     for (std::uint32_t i = 0; i < n; ++i) {
-        ls = lights.sample_li(i, v.hit.position, 0, 0, 0);  // delta: no point to draw
+        const LightLiSample ls = lights.sample_li(i, v.hit.position, 0, 0, 0);  // no point
         contribution = unshadowed(v, ls);
+        wi = ls.wi;
+        ends_at = ls.tfar;
         float w = luminance(contribution);
         if (!std::isfinite(w))
             return std::nullopt;
-        weight[i] = std::fmax(w, 0.0f);
+        weight[i] = std::max(w, 0.0f);  // w is finite: as std::fmax, without a libm call
         total += weight[i];
     }
     if (!(total > 0) || !std::isfinite(total))
@@ -249,10 +251,12 @@ std::optional<Vec3f> sample_delta_ld(const PathContext& ctx,
         target -= weight[i];
     }
     if (chosen + 1 != n) {
-        ls = lights.sample_li(chosen, v.hit.position, 0, 0, 0);
+        const LightLiSample ls = lights.sample_li(chosen, v.hit.position, 0, 0, 0);
         contribution = unshadowed(v, ls);
+        wi = ls.wi;
+        ends_at = ls.tfar;
     }
-    float through = light_visibility(ctx, facts, v.hit, ls);
+    float through = light_visibility(ctx, facts, v.hit, wi, ends_at);
     if (through <= 0)
         return Vec3f();
     return contribution * (through * total / weight[chosen]);
@@ -314,7 +318,7 @@ Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, co
     Vec3f c = unshadowed(v, ls);
     if (is_black(c))
         return {};
-    float through = light_visibility(ctx, facts, v.hit, ls);
+    float through = light_visibility(ctx, facts, v.hit, ls.wi, ls.tfar);
     if (through <= 0)
         return {};
     float pdf = chosen->probability * ls.pdf;
@@ -509,14 +513,19 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
     int passes = 0;
     float travelled = 0;  // along the path, for the ray cone
     PassThroughDraws pass_through(sampler, sample_dimension::vertex(0) + sample_dimension::opacity);
+    // The hit of each ray traced here, one object reused: GCC 12's std::optional zeroes
+    // an empty one whole when it is made (120 bytes by a string store, per vertex).
+    std::optional<SurfaceHit> traced;
     for (int depth = 0; depth < ctx.max_depth;) {
         const std::uint32_t block = sample_dimension::vertex(depth);
         // The camera ray's hit, when given, is read where it lies (not copied); a ray
-        // traced here writes its hit in place.
+        // traced here writes its hit into `traced` in place.
         const bool given = depth == 0 && passes == 0 && camera_hit;
-        std::optional<SurfaceHit> traced =
-            given ? std::nullopt : first_hit(ctx, org, dir, tfar, leaving, depth == 0);
-        const std::optional<SurfaceHit>& found = given ? *camera_hit : traced;
+        if (!given)
+            first_hit(ctx, org, dir, tfar, leaving, depth == 0, traced);
+        else if (ctx.facet_normals)
+            traced = *camera_hit;  // changed below
+        const std::optional<SurfaceHit>& found = given && !ctx.facet_normals ? *camera_hit : traced;
         if (!found) {
             if (depth == 0) {
                 result.radiance += beta * seen_by_camera(ctx, dir);
@@ -526,12 +535,9 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             }
             break;
         }
-        std::optional<SurfaceHit> facet;  // `render mode: flat`: shaded by the true normal
-        if (ctx.facet_normals) {
-            facet = found;
-            facet->normal = facet->geometric_normal;
-        }
-        const SurfaceHit* const hit = ctx.facet_normals ? &*facet : &*found;
+        if (ctx.facet_normals)  // `render mode: flat`: shaded by the true normal
+            traced->normal = traced->geometric_normal;
+        const SurfaceHit* const hit = &*found;
         travelled += hit->t;
         SurfaceMaterial blended;
         const SurfaceMaterial& material = hit_material(ctx, *hit, blended);
