@@ -11,6 +11,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <numbers>
 #include <stdexcept>
 #include <utility>
@@ -99,19 +100,30 @@ bool ground_blocks(const PathContext& ctx, const PrimId& leaving)
     return ctx.ground && !ctx.ground->shadow_catcher && leaving.geom != ground_geom_id;
 }
 
-/// The first hit along org + t dir, t < tfar, into `hit`: the Embree scene's or the
-/// ground's. The camera ray meets the ground beyond the far clipping plane too (the plane
-/// is staging, not part of the plant, and reaches the horizon).
-void first_hit(const PathContext& ctx, const Vec3f& org, const Vec3f& dir, float tfar,
-               PrimId leaving, bool camera, std::optional<SurfaceHit>& hit)
+/// The first hit along org + t dir, t < tfar, made in `hit` (storage for one): the Embree
+/// scene's or the ground's; whether there is one. The camera ray meets the ground beyond
+/// the far clipping plane too (the plane is staging, not part of the plant, and reaches
+/// the horizon).
+bool first_hit(const PathContext& ctx, const Vec3f& org, const Vec3f& dir, float tfar,
+               PrimId leaving, bool camera, SurfaceHit& hit)
 {
-    ctx.accel->intersect(hit, org, dir, 0, tfar, leaving, camera);
+    bool found = ctx.accel->intersect(hit, org, dir, 0, tfar, leaving, camera);
     bool sees_ground = camera ? ctx.ground && leaving.geom != ground_geom_id
                               : ground_blocks(ctx, leaving);
     if (sees_ground)
-        if (std::optional<float> t = ctx.ground->distance(org, dir, hit ? hit->t : infinity))
-            hit = ctx.ground->hit(org, dir, *t);
+        if (std::optional<float> t = ctx.ground->distance(org, dir, found ? hit.t : infinity)) {
+            ::new (&hit) SurfaceHit(ctx.ground->hit(org, dir, *t));
+            found = true;
+        }
+    return found;
 }
+
+/// Room for a hit, not made until a ray's hit is made in it: an empty
+/// std::optional<SurfaceHit> would be zeroed whole (GCC 12's library), 8 ns per path.
+union HitRoom {
+    HitRoom() {}
+    SurfaceHit hit;
+};
 
 /// The fraction of light passing from s.origin along wi for t < tfar: 0 if an opaque
 /// surface blocks it, the product of transparencies through transparent ones (one
@@ -513,20 +525,17 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
     int passes = 0;
     float travelled = 0;  // along the path, for the ray cone
     PassThroughDraws pass_through(sampler, sample_dimension::vertex(0) + sample_dimension::opacity);
-    // The hit of each ray traced here, one object reused: GCC 12's std::optional zeroes
-    // an empty one whole when it is made (120 bytes by a string store, per vertex).
-    std::optional<SurfaceHit> traced;
+    HitRoom traced;  // the hit of each ray traced here, made in place
     for (int depth = 0; depth < ctx.max_depth;) {
         const std::uint32_t block = sample_dimension::vertex(depth);
         // The camera ray's hit, when given, is read where it lies (not copied); a ray
-        // traced here writes its hit into `traced` in place.
-        const bool given = depth == 0 && passes == 0 && camera_hit;
-        if (!given)
-            first_hit(ctx, org, dir, tfar, leaving, depth == 0, traced);
-        else if (ctx.facet_normals)
-            traced = *camera_hit;  // changed below
-        const std::optional<SurfaceHit>& found = given && !ctx.facet_normals ? *camera_hit : traced;
-        if (!found) {
+        // traced here has its hit made in `traced`.
+        const SurfaceHit* hit = nullptr;
+        if (depth == 0 && passes == 0 && camera_hit)
+            hit = *camera_hit ? &**camera_hit : nullptr;
+        else if (first_hit(ctx, org, dir, tfar, leaving, depth == 0, traced.hit))
+            hit = &traced.hit;
+        if (!hit) {
             if (depth == 0) {
                 result.radiance += beta * seen_by_camera(ctx, dir);
             } else if (!facts.environment_black) {
@@ -535,9 +544,12 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             }
             break;
         }
-        if (ctx.facet_normals)  // `render mode: flat`: shaded by the true normal
-            traced->normal = traced->geometric_normal;
-        const SurfaceHit* const hit = &*found;
+        if (ctx.facet_normals) {  // `render mode: flat`: shaded by the true normal
+            if (hit != &traced.hit)
+                ::new (&traced.hit) SurfaceHit(*hit);
+            traced.hit.normal = traced.hit.geometric_normal;
+            hit = &traced.hit;
+        }
         travelled += hit->t;
         SurfaceMaterial blended;
         const SurfaceMaterial& material = hit_material(ctx, *hit, blended);
