@@ -75,6 +75,13 @@ using Key = std::array<float, 4>;
 Vec3f vec(const geom::Float3& a) { return {a[0], a[1], a[2]}; }
 Vec3f vec(const geom::Float4& a) { return {a[0], a[1], a[2]}; }
 
+/// v normalised (zero stays zero) by one division, not three: the hit's normals.
+Vec3f unit(const Vec3f& v)
+{
+    float l = length(v);
+    return l > 0 ? v * (1 / l) : v;
+}
+
 /// The largest magnitude among p's coordinates. std::max, not std::fmax: for numbers they
 /// agree, and fmax's NaN rule keeps the compiler from inlining it (a libm call per use).
 float largest_coordinate(const Vec3f& p)
@@ -1510,12 +1517,12 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
         if (radius != 0)
             radius *= placement->radius_scale();
     }
-    geometric = normalize(geometric);
+    geometric = unit(geometric);
     const bool facing_away = dot(geometric, dir) > 0;
     const bool back = local.two_sided && facing_away;
     if (facing_away)
         geometric = -geometric;
-    shading = normalize(back ? -shading : shading);
+    shading = unit(back ? -shading : shading);
 
     HitMaterials materials = materials_at(part, prim, back, style, rh.hit.u);
     const int texture = texture_of(part, prim, style);

@@ -53,11 +53,9 @@ inline constexpr float inv_pi = std::numbers::inv_pi_v<float>;
 
 inline float mean(const Vec3f& v) { return (v.x + v.y + v.z) / 3; }
 
-/// A direction about the unit axis a with cos(angle to a) = cos_theta.
-inline Vec3f around(const Vec3f& a, float cos_theta, float phi)
+/// A direction about the unit axis a at the angle whose cosine and sine are given.
+inline Vec3f around(const Vec3f& a, float cos_theta, float sin_theta, float phi)
 {
-    // std::max(0, x) is std::fmax(0, x) for any x, NaN too, without a libm call.
-    float sin_theta = std::sqrt(std::max(0.0f, 1 - cos_theta * cos_theta));
     Vec3f t, b;
     make_basis(a, t, b);
     // (t, b, a) is orthonormal and sin^2 + cos^2 = 1 in both angles, so the sum is a unit
@@ -66,10 +64,19 @@ inline Vec3f around(const Vec3f& a, float cos_theta, float phi)
     return t * (sin_theta * std::cos(phi)) + b * (sin_theta * std::sin(phi)) + a * cos_theta;
 }
 
-/// Cosine-weighted direction about n.
+/// A direction about the unit axis a with cos(angle to a) = cos_theta.
+inline Vec3f around(const Vec3f& a, float cos_theta, float phi)
+{
+    // std::max(0, x) is std::fmax(0, x) for any x, NaN too, without a libm call.
+    return around(a, cos_theta, std::sqrt(std::max(0.0f, 1 - cos_theta * cos_theta)), phi);
+}
+
+/// Cosine-weighted direction about n: cos^2 = 1 - u1, so sin^2 = u1. (Both roots at once,
+/// not the sine from the rounded cosine: shorter, and exact near the normal.)
 inline Vec3f sample_cosine(const Vec3f& n, float u1, float u2)
 {
-    return around(n, std::sqrt(std::max(0.0f, 1 - u1)), 2 * pi * u2);
+    return around(n, std::sqrt(std::max(0.0f, 1 - u1)), std::sqrt(std::max(0.0f, u1)),
+                  2 * pi * u2);
 }
 
 inline Vec3f mirror(const Vec3f& wo, const Vec3f& n) { return n * (2 * dot(n, wo)) - wo; }
