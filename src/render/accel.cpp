@@ -14,8 +14,8 @@
 #include <cmath>
 #include <cstring>
 #include <deque>
-#include <map>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <new>
 #include <numbers>
@@ -382,8 +382,9 @@ RTCGeometry build_lines(RTCDevice device, const GeometrySource& part)
     return g;
 }
 
-LocalSurface line_surface(const GeometrySource& part, std::uint32_t prim, float u, float,
-                          const Vec3f& ng)
+[[gnu::always_inline]] inline LocalSurface line_surface(const GeometrySource& part,
+                                                        std::uint32_t prim, float u, float,
+                                                        const Vec3f& ng)
 {
     const geom::LinearCurves& l = part.geometry->lines;
     const Key& k0 = part.line_keys[l.segments[prim]];
@@ -418,10 +419,7 @@ TextureTangents line_tangents(const GeometrySource& part, std::uint32_t prim, fl
 // ---- Caps and joints: the flat free ends and round bends of shaded lines ------------
 
 /// The largest coordinate of a disc (centre and radius).
-float disc_extent(const Key& c)
-{
-    return largest_coordinate(vec(c)) + c[3];
-}
+float disc_extent(const Key& c) { return largest_coordinate(vec(c)) + c[3]; }
 
 RTCGeometry build_caps(RTCDevice device, const GeometrySource& part)
 {
@@ -436,8 +434,9 @@ RTCGeometry build_caps(RTCDevice device, const GeometrySource& part)
     return g;
 }
 
-LocalSurface cap_surface(const GeometrySource& part, std::uint32_t prim, float, float,
-                         const Vec3f&)
+[[gnu::always_inline]] inline LocalSurface cap_surface(const GeometrySource& part,
+                                                       std::uint32_t prim, float, float,
+                                                       const Vec3f&)
 {
     // the solid cylinder's end: its normal points out, like the tube's
     const Key& cap = part.ends->caps[prim];
@@ -460,8 +459,9 @@ RTCGeometry build_joints(RTCDevice device, const GeometrySource& part)
     return g;
 }
 
-LocalSurface joint_surface(const GeometrySource& part, std::uint32_t prim, float, float,
-                           const Vec3f& ng)
+[[gnu::always_inline]] inline LocalSurface joint_surface(const GeometrySource& part,
+                                                         std::uint32_t prim, float, float,
+                                                         const Vec3f& ng)
 {
     return {ng, Vec3f(), part.ends->joints[prim][3], false};
 }
@@ -496,8 +496,9 @@ Vec3f hermite_axis(const geom::HermiteCurves& c, std::uint32_t k, float u)
            vec(c.tangents[k + 1]) * d[3];
 }
 
-LocalSurface curve_surface(const GeometrySource& part, std::uint32_t prim, float u, float,
-                           const Vec3f& ng)
+[[gnu::always_inline]] inline LocalSurface curve_surface(const GeometrySource& part,
+                                                         std::uint32_t prim, float u, float,
+                                                         const Vec3f& ng)
 {
     const geom::HermiteCurves& c = part.geometry->curves;
     std::uint32_t k = c.segments[prim];
@@ -539,8 +540,9 @@ RTCGeometry build_spheres(RTCDevice device, const GeometrySource& part)
     return g;
 }
 
-LocalSurface sphere_surface(const GeometrySource& part, std::uint32_t prim, float, float,
-                            const Vec3f& ng)
+[[gnu::always_inline]] inline LocalSurface sphere_surface(const GeometrySource& part,
+                                                          std::uint32_t prim, float, float,
+                                                          const Vec3f& ng)
 {
     return {ng, Vec3f(), part.geometry->spheres.centres[prim][3], false};
 }
@@ -576,8 +578,9 @@ RTCGeometry build_discs(RTCDevice device, const GeometrySource& part)
     return g;
 }
 
-LocalSurface disc_surface(const GeometrySource& part, std::uint32_t prim, float, float,
-                          const Vec3f&)
+[[gnu::always_inline]] inline LocalSurface disc_surface(const GeometrySource& part,
+                                                        std::uint32_t prim, float, float,
+                                                        const Vec3f&)
 {
     return {vec(part.geometry->discs.normals[prim]), Vec3f(), 0, true,
             disc_extent(part.geometry->discs.centres[prim])};
@@ -610,8 +613,9 @@ RTCGeometry build_triangles(RTCDevice device, const GeometrySource& part)
     return g;
 }
 
-LocalSurface triangle_surface(const GeometrySource& part, std::uint32_t prim, float u, float v,
-                              const Vec3f&)
+[[gnu::always_inline]] inline LocalSurface triangle_surface(const GeometrySource& part,
+                                                            std::uint32_t prim, float u, float v,
+                                                            const Vec3f&)
 {
     const geom::TriangleMesh& m = part.geometry->mesh;
     const auto& tri = m.triangles[prim];
@@ -622,7 +626,8 @@ LocalSurface triangle_surface(const GeometrySource& part, std::uint32_t prim, fl
     // The front is where the vertex normals point; a flat face's winding if they vanish.
     if (dot(face, n0 + n1 + n2) < 0)
         face = -face;
-    float extent = std::max({largest_coordinate(p0), largest_coordinate(p1), largest_coordinate(p2)});
+    float extent =
+        std::max({largest_coordinate(p0), largest_coordinate(p1), largest_coordinate(p2)});
     return {face, n0 * (1 - u - v) + n1 * u + n2 * v, 0, true, extent};
 }
 
@@ -680,18 +685,20 @@ const ShapeKind& kind(Shape s) { return shape_kinds[static_cast<std::size_t>(s)]
 /// The hit's surface in object space from Embree's (u, v) and normal ng, by the part's
 /// shape. A switch, not a ShapeKind entry: called for every hit, the shapes' functions
 /// are inlined here, and their result is not returned through memory (reading it back
-/// stalled on store forwarding); always inlined, as the compiler kept it a call.
-[[gnu::always_inline]] inline LocalSurface local_surface(const GeometrySource& part, std::uint32_t prim, float u, float v,
-                           const Vec3f& ng)
+/// stalled on store forwarding); inlined, as are the shapes' functions (always_inline:
+/// the compiler kept them calls).
+[[gnu::always_inline]] inline LocalSurface local_surface(const GeometrySource& part,
+                                                         std::uint32_t prim, float u, float v,
+                                                         const Vec3f& ng)
 {
     switch (part.shape) {
-    case Shape::line: return line_surface(part, prim, u, v, ng);
-    case Shape::curve: return curve_surface(part, prim, u, v, ng);
-    case Shape::sphere: return sphere_surface(part, prim, u, v, ng);
-    case Shape::disc: return disc_surface(part, prim, u, v, ng);
-    case Shape::triangle: return triangle_surface(part, prim, u, v, ng);
-    case Shape::cap: return cap_surface(part, prim, u, v, ng);
-    case Shape::joint: return joint_surface(part, prim, u, v, ng);
+        case Shape::line: return line_surface(part, prim, u, v, ng);
+        case Shape::curve: return curve_surface(part, prim, u, v, ng);
+        case Shape::sphere: return sphere_surface(part, prim, u, v, ng);
+        case Shape::disc: return disc_surface(part, prim, u, v, ng);
+        case Shape::triangle: return triangle_surface(part, prim, u, v, ng);
+        case Shape::cap: return cap_surface(part, prim, u, v, ng);
+        case Shape::joint: return joint_surface(part, prim, u, v, ng);
     }
     return {ng, Vec3f(), 0, false};
 }

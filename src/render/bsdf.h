@@ -75,8 +75,7 @@ inline Vec3f around(const Vec3f& a, float cos_theta, float phi)
 /// not the sine from the rounded cosine: shorter, and exact near the normal.)
 inline Vec3f sample_cosine(const Vec3f& n, float u1, float u2)
 {
-    return around(n, std::sqrt(std::max(0.0f, 1 - u1)), std::sqrt(std::max(0.0f, u1)),
-                  2 * pi * u2);
+    return around(n, std::sqrt(std::max(0.0f, 1 - u1)), std::sqrt(std::max(0.0f, u1)), 2 * pi * u2);
 }
 
 inline Vec3f mirror(const Vec3f& wo, const Vec3f& n) { return n * (2 * dot(n, wo)) - wo; }
@@ -136,8 +135,7 @@ inline float bsdf_pdf(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3
     return bsdf_detail::pdf_with(b, bsdf_detail::lobe_weights(b), n, wo, wi);
 }
 
-inline BsdfSample bsdf_sample(const Bsdf& b, const Vec3f& n, const Vec3f& wo, float u1,
-                              float u2)
+inline BsdfSample bsdf_sample(const Bsdf& b, const Vec3f& n, const Vec3f& wo, float u1, float u2)
 {
     using namespace bsdf_detail;
     LobeWeights w = lobe_weights(b);

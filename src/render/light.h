@@ -106,8 +106,7 @@ public:
     /// Light from light `index` at p, from three uniforms; pdf 0 when it sends none.
     /// (A directional light, most scenes' sun, is answered inline: asked at every vertex,
     /// the call's result came back through memory and stalled its reader.)
-    LightLiSample sample_li(std::uint32_t index, const Vec3f& p, float u0, float u1,
-                            float u2) const
+    LightLiSample sample_li(std::uint32_t index, const Vec3f& p, float u0, float u1, float u2) const
     {
         const Entry& e = m_lights[index];
         if (e.kind == LightKind::directional)
