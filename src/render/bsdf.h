@@ -5,6 +5,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -53,29 +54,49 @@ inline constexpr float inv_pi = std::numbers::inv_pi_v<float>;
 
 inline float mean(const Vec3f& v) { return (v.x + v.y + v.z) / 3; }
 
-/// A direction about the unit axis a at the angle whose cosine and sine are given.
-inline Vec3f around(const Vec3f& a, float cos_theta, float sin_theta, float phi)
+/// The cosine and sine of `turns` whole turns (an angle of 2 pi turns), turns in [0, 1]:
+/// Taylor polynomials on the nearest quarter turn's eighth either side, within 1e-7 of
+/// std::cos and std::sin (float rounding). Inline, where those two made a libm call
+/// (sincosf, through the PLT) at every BSDF sample.
+inline std::array<float, 2> cos_sin_turns(float turns)
+{
+    float x = 4 * turns;  // in quarter turns
+    int quarter = static_cast<int>(x + 0.5f);
+    float a = (x - static_cast<float>(quarter)) * (pi / 2);  // exact difference; |a| <= pi/4
+    float a2 = a * a;
+    float s = a * (1 + a2 * (-1.0f / 6 + a2 * (1.0f / 120 + a2 * (-1.0f / 5040 + a2 * (1.0f / 362880)))));
+    float c = 1 + a2 * (-0.5f + a2 * (1.0f / 24 + a2 * (-1.0f / 720 + a2 * (1.0f / 40320))));
+    // Turned by `quarter` quarter turns: (c, s) -> (-s, c) each.
+    bool odd = (quarter & 1) != 0;
+    float cos = odd ? s : c, sin = odd ? c : s;
+    return {(quarter + 1) & 2 ? -cos : cos, quarter & 2 ? -sin : sin};
+}
+
+/// A direction about the unit axis a at the angle whose cosine and sine are given, turned
+/// `turns` whole turns about a.
+inline Vec3f around(const Vec3f& a, float cos_theta, float sin_theta, float turns)
 {
     Vec3f t, b;
     make_basis(a, t, b);
+    auto [cos_phi, sin_phi] = cos_sin_turns(turns);
     // (t, b, a) is orthonormal and sin^2 + cos^2 = 1 in both angles, so the sum is a unit
     // vector to float rounding: normalising it again (a square root and a division in
     // every BSDF sample's dependency chain) changed nothing but the rounding.
-    return t * (sin_theta * std::cos(phi)) + b * (sin_theta * std::sin(phi)) + a * cos_theta;
+    return t * (sin_theta * cos_phi) + b * (sin_theta * sin_phi) + a * cos_theta;
 }
 
 /// A direction about the unit axis a with cos(angle to a) = cos_theta.
-inline Vec3f around(const Vec3f& a, float cos_theta, float phi)
+inline Vec3f around(const Vec3f& a, float cos_theta, float turns)
 {
     // std::max(0, x) is std::fmax(0, x) for any x, NaN too, without a libm call.
-    return around(a, cos_theta, std::sqrt(std::max(0.0f, 1 - cos_theta * cos_theta)), phi);
+    return around(a, cos_theta, std::sqrt(std::max(0.0f, 1 - cos_theta * cos_theta)), turns);
 }
 
 /// Cosine-weighted direction about n: cos^2 = 1 - u1, so sin^2 = u1. (Both roots at once,
 /// not the sine from the rounded cosine: shorter, and exact near the normal.)
 inline Vec3f sample_cosine(const Vec3f& n, float u1, float u2)
 {
-    return around(n, std::sqrt(std::max(0.0f, 1 - u1)), std::sqrt(std::max(0.0f, u1)), 2 * pi * u2);
+    return around(n, std::sqrt(std::max(0.0f, 1 - u1)), std::sqrt(std::max(0.0f, u1)), u2);
 }
 
 inline Vec3f mirror(const Vec3f& wo, const Vec3f& n) { return n * (2 * dot(n, wo)) - wo; }
@@ -116,6 +137,24 @@ inline float pdf_with(const Bsdf& b, const LobeWeights& w, const Vec3f& n, const
     return p;
 }
 
+/// Whether the BSDF only reflects diffusely (most surfaces): its lobe weights are then
+/// (1, 0, 0) when it reflects at all, exactly what lobe_weights() computes (r / r), and
+/// sampling needs none of their divisions.
+inline bool diffuse_only(const Bsdf& b) { return is_black(b.transmit) && is_black(b.glossy); }
+
+/// bsdf_sample() of a diffuse_only() BSDF: the same arithmetic with weights (1, 0, 0).
+inline BsdfSample sample_diffuse(const Bsdf& b, const Vec3f& n, float u1, float u2)
+{
+    if (!(mean(b.reflect) > 0) || !(u1 < 1))
+        return {};
+    Vec3f wi = sample_cosine(n, u1, u2);
+    float cos_i = dot(n, wi);
+    float pdf = cos_i < 0 ? 0.0f : cos_i * inv_pi;
+    if (pdf <= 0)
+        return {};
+    return {wi, b.reflect * inv_pi * (std::fabs(cos_i) / pdf), pdf};
+}
+
 }  // namespace bsdf_detail
 
 inline Vec3f bsdf_eval(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3f& wi)
@@ -138,6 +177,8 @@ inline float bsdf_pdf(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3
 inline BsdfSample bsdf_sample(const Bsdf& b, const Vec3f& n, const Vec3f& wo, float u1, float u2)
 {
     using namespace bsdf_detail;
+    if (diffuse_only(b))
+        return sample_diffuse(b, n, u1, u2);
     LobeWeights w = lobe_weights(b);
     Vec3f wi;
     if (u1 < w.reflect) {
@@ -148,7 +189,7 @@ inline BsdfSample bsdf_sample(const Bsdf& b, const Vec3f& n, const Vec3f& wo, fl
         float u = std::fmin((u1 - w.reflect - w.transmit) / w.glossy, 1.0f);
         // pdf (n+1)/(2 pi) cos^n about the mirror direction: cos = u^(1/(n+1)).
         float cos_a = std::pow(u, 1 / (b.exponent + 1));
-        wi = around(mirror(wo, n), cos_a, 2 * pi * u2);
+        wi = around(mirror(wo, n), cos_a, u2);
         if (dot(n, wi) <= 0)
             return {};  // below the surface: the lobe's lost energy
     } else {
