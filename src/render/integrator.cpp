@@ -14,6 +14,7 @@
 #include <new>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace cambium::render {
@@ -339,19 +340,6 @@ Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, co
     return c * (through * w / pdf);
 }
 
-/// What a ray that escapes along d sees: the environment, or the uniform ambient.
-Vec3f escaped_radiance(const PathContext& ctx, const Vec3f& d)
-{
-    return ctx.environment ? ctx.environment->radiance(d) : ctx.ambient;
-}
-
-/// What a camera ray that meets nothing along d sees: the environment where the camera
-/// sees it, else the view's background.
-Vec3f seen_by_camera(const PathContext& ctx, const Vec3f& d)
-{
-    return ctx.environment_visible ? escaped_radiance(ctx, d) : ctx.background;
-}
-
 /// A direction about the unit normal n drawn with density cos / pi (Malley's method).
 Vec3f cosine_direction(const Vec3f& n, float u1, float u2)
 {
@@ -494,15 +482,9 @@ VisibleSurface visible_surface(const SurfaceHit& hit, const SurfaceMaterial& mat
 
 }  // namespace
 
-PathResult camera_miss(const PathContext& ctx, const Vec3f& dir)
+void unprepared_path_context(const char* caller)
 {
-    if (!ctx.prepared)
-        throw std::logic_error("camera_miss: prepare_path_context() was not called");
-    // As trace_path's first vertex without a hit (bit-identical: its throughput is 1).
-    PathResult result;
-    if (ctx.max_depth > 0)
-        result.radiance += seen_by_camera(ctx, dir);
-    return result;
+    throw std::logic_error(std::string(caller) + ": prepare_path_context() was not called");
 }
 
 PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec3f& camera_dir,
@@ -510,7 +492,7 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
                       const std::optional<SurfaceHit>* camera_hit)
 {
     if (!ctx.prepared)
-        throw std::logic_error("trace_path: prepare_path_context() was not called");
+        unprepared_path_context("trace_path");
     const PathContext::SceneFlags& facts = *ctx.prepared;
     const LightSet& lights = facts.lights;
     auto env_radiance = [&](const Vec3f& d) { return escaped_radiance(ctx, d); };
