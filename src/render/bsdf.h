@@ -145,7 +145,10 @@ inline float pdf_with(const Bsdf& b, const LobeWeights& w, const Vec3f& n, const
 /// sampling needs none of their divisions.
 inline bool diffuse_only(const Bsdf& b) { return is_black(b.transmit) && is_black(b.glossy); }
 
-/// bsdf_sample() of a diffuse_only() BSDF: the same arithmetic with weights (1, 0, 0).
+/// bsdf_sample() of a diffuse_only() BSDF: the same directions and densities as with
+/// weights (1, 0, 0), and the weight f cos / pdf = (reflect / pi) cos / (cos / pi) as the
+/// albedo itself (the general path's division gives it to rounding, and the path's
+/// throughput waited on that division).
 inline BsdfSample sample_diffuse(const Bsdf& b, const Vec3f& n, float u1, float u2)
 {
     if (!(mean(b.reflect) > 0) || !(u1 < 1))
@@ -155,7 +158,7 @@ inline BsdfSample sample_diffuse(const Bsdf& b, const Vec3f& n, float u1, float 
     float pdf = cos_i < 0 ? 0.0f : cos_i * inv_pi;
     if (pdf <= 0)
         return {};
-    return {wi, b.reflect * inv_pi * (std::fabs(cos_i) / pdf), pdf};
+    return {wi, b.reflect, pdf};
 }
 
 }  // namespace bsdf_detail
