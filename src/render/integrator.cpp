@@ -11,8 +11,10 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 namespace cambium::render {
@@ -99,22 +101,30 @@ bool ground_blocks(const PathContext& ctx, const PrimId& leaving)
     return ctx.ground && !ctx.ground->shadow_catcher && leaving.geom != ground_geom_id;
 }
 
-/// The first hit along org + t dir, t < tfar: the Embree scene's or the ground's. The
-/// camera ray meets the ground beyond the far clipping plane too (the plane is staging,
-/// not part of the plant, and reaches the horizon).
-std::optional<SurfaceHit> first_hit(const PathContext& ctx, const Vec3f& org, const Vec3f& dir,
-                                    float tfar, PrimId leaving, bool camera)
+/// The first hit along org + t dir, t < tfar, made in `hit` (storage for one): the Embree
+/// scene's or the ground's; whether there is one. The camera ray meets the ground beyond
+/// the far clipping plane too (the plane is staging, not part of the plant, and reaches
+/// the horizon).
+bool first_hit(const PathContext& ctx, const Vec3f& org, const Vec3f& dir, float tfar,
+               PrimId leaving, bool camera, SurfaceHit& hit)
 {
-    // One named result, returned on every path: the hit (some 130 bytes) is built in
-    // place, not copied (a copy right after Embree's stores stalled on store forwarding).
-    std::optional<SurfaceHit> hit = ctx.accel->intersect(org, dir, 0, tfar, leaving, camera);
+    bool found = ctx.accel->intersect(hit, org, dir, 0, tfar, leaving, camera);
     bool sees_ground = camera ? ctx.ground && leaving.geom != ground_geom_id
                               : ground_blocks(ctx, leaving);
     if (sees_ground)
-        if (std::optional<float> t = ctx.ground->distance(org, dir, hit ? hit->t : infinity))
-            hit = ctx.ground->hit(org, dir, *t);
-    return hit;
+        if (std::optional<float> t = ctx.ground->distance(org, dir, found ? hit.t : infinity)) {
+            ::new (&hit) SurfaceHit(ctx.ground->hit(org, dir, *t));
+            found = true;
+        }
+    return found;
 }
+
+/// Room for a hit, not made until a ray's hit is made in it: an empty
+/// std::optional<SurfaceHit> would be zeroed whole (GCC 12's library), 8 ns per path.
+union HitRoom {
+    HitRoom() {}
+    SurfaceHit hit;
+};
 
 /// The fraction of light passing from s.origin along wi for t < tfar: 0 if an opaque
 /// surface blocks it, the product of transparencies through transparent ones (one
@@ -172,18 +182,18 @@ struct LightUniforms {
     float choose, u0, u1, u2;
 };
 
-/// The fraction of light from a light sample that reaches the shading point: the spawned
-/// origin is off the surface, so the shadow ray aims from it at the point where the light
-/// sample's ray ends (just short of the light), as a ray parallel to wi could meet a curved
-/// light sooner; 0 where blocked.
+/// The fraction of light from a light sample (toward wi, its ray ending at `ends_at`) that
+/// reaches the shading point: the spawned origin is off the surface, so the shadow ray
+/// aims from it at the point where the light sample's ray ends (just short of the light),
+/// as a ray parallel to wi could meet a curved light sooner; 0 where blocked.
 float light_visibility(const PathContext& ctx, const PathContext::SceneFlags& facts,
-                       const SurfaceHit& hit, const LightLiSample& ls)
+                       const SurfaceHit& hit, const Vec3f& wi, float ends_at)
 {
-    Spawn s = spawn(hit, ls.wi);
-    Vec3f toward = ls.wi;
-    float tfar = ls.tfar;
+    Spawn s = spawn(hit, wi);
+    Vec3f toward = wi;
+    float tfar = ends_at;
     if (!std::isinf(tfar)) {
-        Vec3f to = hit.position + ls.wi * ls.tfar - s.origin;
+        Vec3f to = hit.position + wi * ends_at - s.origin;
         tfar = length(to);
         if (!(tfar > 0))
             return 0;
@@ -223,15 +233,20 @@ std::optional<Vec3f> sample_delta_ld(const PathContext& ctx,
     const std::uint32_t n = static_cast<std::uint32_t>(lights.size());
     std::array<float, LightSet::max_delta_choice> weight;  // luminance of each contribution
     float total = 0;
-    LightLiSample ls;  // the last light's, kept: a single light's is not made twice
-    Vec3f contribution;
+    // The last light's direction, end and contribution, kept: a single light's are not
+    // made twice. (Kept as values, not as its LightLiSample: copying that struct in the
+    // loop stalled on store forwarding.)
+    Vec3f wi, contribution;
+    float ends_at = 0;
     for (std::uint32_t i = 0; i < n; ++i) {
-        ls = lights.sample_li(i, v.hit.position, 0, 0, 0);  // delta: no point to draw
+        const LightLiSample ls = lights.sample_li(i, v.hit.position, 0, 0, 0);  // no point
         contribution = unshadowed(v, ls);
+        wi = ls.wi;
+        ends_at = ls.tfar;
         float w = luminance(contribution);
         if (!std::isfinite(w))
             return std::nullopt;
-        weight[i] = std::fmax(w, 0.0f);
+        weight[i] = std::max(w, 0.0f);  // w is finite: as std::fmax, without a libm call
         total += weight[i];
     }
     if (!(total > 0) || !std::isfinite(total))
@@ -249,10 +264,12 @@ std::optional<Vec3f> sample_delta_ld(const PathContext& ctx,
         target -= weight[i];
     }
     if (chosen + 1 != n) {
-        ls = lights.sample_li(chosen, v.hit.position, 0, 0, 0);
+        const LightLiSample ls = lights.sample_li(chosen, v.hit.position, 0, 0, 0);
         contribution = unshadowed(v, ls);
+        wi = ls.wi;
+        ends_at = ls.tfar;
     }
-    float through = light_visibility(ctx, facts, v.hit, ls);
+    float through = light_visibility(ctx, facts, v.hit, wi, ends_at);
     if (through <= 0)
         return Vec3f();
     return contribution * (through * total / weight[chosen]);
@@ -314,26 +331,13 @@ Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, co
     Vec3f c = unshadowed(v, ls);
     if (is_black(c))
         return {};
-    float through = light_visibility(ctx, facts, v.hit, ls);
+    float through = light_visibility(ctx, facts, v.hit, ls.wi, ls.tfar);
     if (through <= 0)
         return {};
     float pdf = chosen->probability * ls.pdf;
     float w = ls.delta || last ? 1.0f
                                : power_heuristic(pdf, bsdf_pdf(v.bsdf, v.hit.normal, v.wo, ls.wi));
     return c * (through * w / pdf);
-}
-
-/// What a ray that escapes along d sees: the environment, or the uniform ambient.
-Vec3f escaped_radiance(const PathContext& ctx, const Vec3f& d)
-{
-    return ctx.environment ? ctx.environment->radiance(d) : ctx.ambient;
-}
-
-/// What a camera ray that meets nothing along d sees: the environment where the camera
-/// sees it, else the view's background.
-Vec3f seen_by_camera(const PathContext& ctx, const Vec3f& d)
-{
-    return ctx.environment_visible ? escaped_radiance(ctx, d) : ctx.background;
 }
 
 /// A direction about the unit normal n drawn with density cos / pi (Malley's method).
@@ -478,15 +482,9 @@ VisibleSurface visible_surface(const SurfaceHit& hit, const SurfaceMaterial& mat
 
 }  // namespace
 
-PathResult camera_miss(const PathContext& ctx, const Vec3f& dir)
+void unprepared_path_context(const char* caller)
 {
-    if (!ctx.prepared)
-        throw std::logic_error("camera_miss: prepare_path_context() was not called");
-    // As trace_path's first vertex without a hit (bit-identical: its throughput is 1).
-    PathResult result;
-    if (ctx.max_depth > 0)
-        result.radiance += seen_by_camera(ctx, dir);
-    return result;
+    throw std::logic_error(std::string(caller) + ": prepare_path_context() was not called");
 }
 
 PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec3f& camera_dir,
@@ -494,7 +492,7 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
                       const std::optional<SurfaceHit>* camera_hit)
 {
     if (!ctx.prepared)
-        throw std::logic_error("trace_path: prepare_path_context() was not called");
+        unprepared_path_context("trace_path");
     const PathContext::SceneFlags& facts = *ctx.prepared;
     const LightSet& lights = facts.lights;
     auto env_radiance = [&](const Vec3f& d) { return escaped_radiance(ctx, d); };
@@ -509,11 +507,16 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
     int passes = 0;
     float travelled = 0;  // along the path, for the ray cone
     PassThroughDraws pass_through(sampler, sample_dimension::vertex(0) + sample_dimension::opacity);
+    HitRoom traced;  // the hit of each ray traced here, made in place
     for (int depth = 0; depth < ctx.max_depth;) {
         const std::uint32_t block = sample_dimension::vertex(depth);
-        std::optional<SurfaceHit> hit = depth == 0 && passes == 0 && camera_hit
-                                            ? *camera_hit
-                                            : first_hit(ctx, org, dir, tfar, leaving, depth == 0);
+        // The camera ray's hit, when given, is read where it lies (not copied); a ray
+        // traced here has its hit made in `traced`.
+        const SurfaceHit* hit = nullptr;
+        if (depth == 0 && passes == 0 && camera_hit)
+            hit = *camera_hit ? &**camera_hit : nullptr;
+        else if (first_hit(ctx, org, dir, tfar, leaving, depth == 0, traced.hit))
+            hit = &traced.hit;
         if (!hit) {
             if (depth == 0) {
                 result.radiance += beta * seen_by_camera(ctx, dir);
@@ -523,9 +526,13 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             }
             break;
         }
+        if (ctx.facet_normals) {  // `render mode: flat`: shaded by the true normal
+            if (hit != &traced.hit)
+                ::new (&traced.hit) SurfaceHit(*hit);
+            traced.hit.normal = traced.hit.geometric_normal;
+            hit = &traced.hit;
+        }
         travelled += hit->t;
-        if (ctx.facet_normals)
-            hit->normal = hit->geometric_normal;
         SurfaceMaterial blended;
         const SurfaceMaterial& material = hit_material(ctx, *hit, blended);
         auto textured_diffuse = [&] {

@@ -113,10 +113,36 @@ struct VisibleSurface {
     float t = 0;   ///< distance along the camera ray
 };
 
+/// Throws std::logic_error: `caller` was given a context prepare_path_context() did not fill.
+[[noreturn]] void unprepared_path_context(const char* caller);
+
+/// What a ray that escapes along d sees: the environment, or the uniform ambient.
+inline Vec3f escaped_radiance(const PathContext& ctx, const Vec3f& d)
+{
+    return ctx.environment ? ctx.environment->radiance(d) : ctx.ambient;
+}
+
+/// What a camera ray that meets nothing along d sees: the environment where the camera
+/// sees it, else the view's background.
+inline Vec3f seen_by_camera(const PathContext& ctx, const Vec3f& d)
+{
+    return ctx.environment_visible ? escaped_radiance(ctx, d) : ctx.background;
+}
+
 /// What trace_path returns for a camera ray already traced that met nothing (an empty
 /// `camera_hit`): the background or the environment it sees, without setting up a path.
-/// Most camera rays of a plant miss, so their cost per sample counts.
-PathResult camera_miss(const PathContext& ctx, const Vec3f& dir);
+/// Most camera rays of a plant miss, so their cost per sample counts (inline: a call per
+/// miss was a visible share of the trace).
+inline PathResult camera_miss(const PathContext& ctx, const Vec3f& dir)
+{
+    if (!ctx.prepared)
+        unprepared_path_context("camera_miss");
+    // As trace_path's first vertex without a hit (bit-identical: its throughput is 1).
+    PathResult result;
+    if (ctx.max_depth > 0)
+        result.radiance += seen_by_camera(ctx, dir);
+    return result;
+}
 
 /// Traces the camera ray (org, dir), which ends at tfar (far clipping), with the sampler's
 /// dimensions; fills `first` when given. `camera_hit`, when given: the camera ray's first

@@ -202,8 +202,8 @@ std::optional<ChosenLight> LightSet::choose(float u) const
                        static_cast<float>(m_cdf[i + 1] - m_cdf[i])};
 }
 
-LightLiSample LightSet::sample_li(std::uint32_t index, const Vec3f& p, float u0, float u1,
-                                  float u2) const
+LightLiSample LightSet::sample_li_other(std::uint32_t index, const Vec3f& p, float u0, float u1,
+                                        float u2) const
 {
     const Entry& e = m_lights[index];
     switch (e.kind) {

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <limits>
+#include <numbers>
 #include <optional>
 #include <vector>
 
@@ -103,8 +104,15 @@ public:
     /// The light for the uniform u; nullopt when the set is empty.
     std::optional<ChosenLight> choose(float u) const;
     /// Light from light `index` at p, from three uniforms; pdf 0 when it sends none.
-    LightLiSample sample_li(std::uint32_t index, const Vec3f& p, float u0, float u1,
-                            float u2) const;
+    /// (A directional light, most scenes' sun, is answered inline: asked at every vertex,
+    /// the call's result came back through memory and stalled its reader.)
+    LightLiSample sample_li(std::uint32_t index, const Vec3f& p, float u0, float u1, float u2) const
+    {
+        const Entry& e = m_lights[index];
+        if (e.kind == LightKind::directional)
+            return directional_li(e.delta);
+        return sample_li_other(index, p, u0, u1, u2);
+    }
     /// The density (choice included) with which sampling the set finds the emissive
     /// point `hit` seen from p; 0 when it is not a sampled area light.
     float pdf_li(const Vec3f& p, const SurfaceHit& hit) const;
@@ -118,6 +126,16 @@ private:
         RenderLight delta;  ///< point, spot, directional
     };
     void add(const Entry& entry, double weight);
+    /// sample_li() of a directional light: its irradiance along its direction, no end.
+    static LightLiSample directional_li(const RenderLight& l)
+    {
+        Vec3f li = l.colour * std::numbers::pi_v<float>;  // as sample_light() gives it
+        return {l.toward_light, li, is_black(li) ? 0.0f : 1.0f,
+                std::numeric_limits<float>::infinity(), true};
+    }
+    /// sample_li() of every other kind.
+    LightLiSample sample_li_other(std::uint32_t index, const Vec3f& p, float u0, float u1,
+                                  float u2) const;
 
     std::vector<Entry> m_lights;
     std::vector<double> m_cdf;      ///< m_lights.size() + 1 entries, last 1

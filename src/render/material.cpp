@@ -4,61 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 
 #include "render/color.h"
 
 namespace cambium::render {
-
-namespace {
-
-constexpr float pi = std::numbers::pi_v<float>;
-constexpr float inv_pi = std::numbers::inv_pi_v<float>;
-
-float mean(const Vec3f& v) { return (v.x + v.y + v.z) / 3; }
-
-/// A direction about the unit axis a with cos(angle to a) = cos_theta.
-Vec3f around(const Vec3f& a, float cos_theta, float phi)
-{
-    float sin_theta = std::sqrt(std::fmax(0.0f, 1 - cos_theta * cos_theta));
-    Vec3f t, b;
-    make_basis(a, t, b);
-    return normalize(t * (sin_theta * std::cos(phi)) + b * (sin_theta * std::sin(phi)) +
-                     a * cos_theta);
-}
-
-/// Cosine-weighted direction about n.
-Vec3f sample_cosine(const Vec3f& n, float u1, float u2)
-{
-    return around(n, std::sqrt(std::fmax(0.0f, 1 - u1)), 2 * pi * u2);
-}
-
-Vec3f mirror(const Vec3f& wo, const Vec3f& n) { return n * (2 * dot(n, wo)) - wo; }
-
-/// The lobes' selection probabilities, in proportion to their mean albedo.
-struct LobeWeights {
-    float reflect = 0, transmit = 0, glossy = 0;
-};
-
-LobeWeights lobe_weights(const Bsdf& b)
-{
-    float r = mean(b.reflect), t = mean(b.transmit), g = mean(b.glossy);
-    float sum = r + t + g;
-    if (sum <= 0)
-        return {};
-    return {r / sum, t / sum, g / sum};
-}
-
-/// cos^exponent of the angle between wi and the mirror direction (0 behind it).
-float phong_term(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3f& wi)
-{
-    float c = dot(mirror(wo, n), wi);
-    if (c <= 0)
-        return 0;
-    return b.exponent > 0 ? std::pow(c, b.exponent) : 1.0f;
-}
-
-}  // namespace
 
 SurfaceMaterial mix(const SurfaceMaterial& a, const SurfaceMaterial& b, float w)
 {
@@ -72,60 +21,6 @@ SurfaceMaterial mix(const SurfaceMaterial& a, const SurfaceMaterial& b, float w)
     m.opacity = lerp(a.opacity, b.opacity);
     m.ambient_glow = lerp(a.ambient_glow, b.ambient_glow);
     return m;
-}
-
-Bsdf make_bsdf(const SurfaceMaterial& m, const Vec3f& diffuse)
-{
-    float keep = 1 - std::clamp(max_component(m.specular), 0.0f, 1.0f);
-    Vec3f d = diffuse * keep;
-    return {d * (1 - m.translucency), d * m.translucency, m.specular, m.exponent};
-}
-
-Vec3f bsdf_eval(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3f& wi)
-{
-    float cos_i = dot(n, wi);
-    if (cos_i < 0)
-        return b.transmit * inv_pi;
-    Vec3f f = b.reflect * inv_pi;
-    if (!is_black(b.glossy))
-        f += b.glossy * ((b.exponent + 2) / (2 * pi) * phong_term(b, n, wo, wi));
-    return f;
-}
-
-float bsdf_pdf(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3f& wi)
-{
-    LobeWeights w = lobe_weights(b);
-    float cos_i = dot(n, wi);
-    if (cos_i < 0)
-        return w.transmit * -cos_i * inv_pi;
-    float p = w.reflect * cos_i * inv_pi;
-    if (w.glossy > 0)
-        p += w.glossy * (b.exponent + 1) / (2 * pi) * phong_term(b, n, wo, wi);
-    return p;
-}
-
-BsdfSample bsdf_sample(const Bsdf& b, const Vec3f& n, const Vec3f& wo, float u1, float u2)
-{
-    LobeWeights w = lobe_weights(b);
-    Vec3f wi;
-    if (u1 < w.reflect) {
-        wi = sample_cosine(n, u1 / w.reflect, u2);
-    } else if (u1 < w.reflect + w.transmit) {
-        wi = sample_cosine(-n, (u1 - w.reflect) / w.transmit, u2);
-    } else if (w.glossy > 0) {
-        float u = std::fmin((u1 - w.reflect - w.transmit) / w.glossy, 1.0f);
-        // pdf (n+1)/(2 pi) cos^n about the mirror direction: cos = u^(1/(n+1)).
-        float cos_a = std::pow(u, 1 / (b.exponent + 1));
-        wi = around(mirror(wo, n), cos_a, 2 * pi * u2);
-        if (dot(n, wi) <= 0)
-            return {};  // below the surface: the lobe's lost energy
-    } else {
-        return {};
-    }
-    float pdf = bsdf_pdf(b, n, wo, wi);
-    if (pdf <= 0)
-        return {};
-    return {wi, bsdf_eval(b, n, wo, wi) * (std::fabs(dot(n, wi)) / pdf), pdf};
 }
 
 geom::Rgb opengl_ambient_light(const std::vector<geom::Light>& lights)

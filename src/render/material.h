@@ -2,28 +2,14 @@
 // Surface materials: cpfg materials mapped to a small physically-based model.
 #pragma once
 
+#include <algorithm>
 #include <vector>
 
 #include "geom/scene.h"
+#include "render/bsdf.h"
 #include "render/vecf.h"
 
 namespace cambium::render {
-
-/// The scattering at one surface point (docs/materials.md): three lobes summed,
-///  - Lambertian reflection with albedo `reflect`,
-///  - Lambertian transmission to the other side with albedo `transmit` (leaves),
-///  - an energy-conserving normalized Phong lobe (Lafortune & Willems 1994)
-///    f = glossy (exponent + 2) / (2 pi) cos^exponent(alpha) about the mirror direction.
-/// reflect + transmit + glossy <= 1 per channel keeps every lobe's sum energy-conserving.
-struct Bsdf {
-    Vec3f reflect;
-    Vec3f transmit;
-    Vec3f glossy;
-    float exponent = 0;
-};
-
-/// An ideal diffuse reflector.
-inline Bsdf lambertian(const Vec3f& albedo) { return Bsdf{albedo, Vec3f(), Vec3f(), 0}; }
 
 /// A surface's parameters in linear RGB, before any texture: `diffuse` is the albedo the
 /// texture modulates or replaces, split into reflection and transmission by translucency.
@@ -45,26 +31,17 @@ SurfaceMaterial mix(const SurfaceMaterial& a, const SurfaceMaterial& b, float w)
 
 /// The BSDF of `m` with the (possibly textured) diffuse albedo `diffuse`. The glossy
 /// lobe takes its share first: the diffuse lobes keep (1 - max specular) of theirs.
-Bsdf make_bsdf(const SurfaceMaterial& m, const Vec3f& diffuse);
+/// (Inline: made at every path vertex.)
+inline Bsdf make_bsdf(const SurfaceMaterial& m, const Vec3f& diffuse)
+{
+    float keep = 1 - std::clamp(max_component(m.specular), 0.0f, 1.0f);
+    Vec3f d = diffuse * keep;
+    return {d * (1 - m.translucency), d * m.translucency, m.specular, m.exponent};
+}
 inline Bsdf make_bsdf(const SurfaceMaterial& m) { return make_bsdf(m, m.diffuse); }
 
 /// The colour a surface shows unlit (cpfg's flat colour): its diffuse albedo plus emission.
 inline Vec3f flat_colour(const SurfaceMaterial& m) { return m.diffuse + m.emission; }
-
-/// A direction sampled from a BSDF: `weight` = f |cos| / pdf, `pdf` per steradian (the
-/// whole mixture's, for multiple importance sampling). pdf = 0: no direction.
-struct BsdfSample {
-    Vec3f wi;
-    Vec3f weight;
-    float pdf = 0;
-};
-
-/// f(wo, wi); n is the shading normal on wo's side, all vectors unit.
-Vec3f bsdf_eval(const Bsdf& bsdf, const Vec3f& n, const Vec3f& wo, const Vec3f& wi);
-/// The solid-angle density bsdf_sample() draws wi with.
-float bsdf_pdf(const Bsdf& bsdf, const Vec3f& n, const Vec3f& wo, const Vec3f& wi);
-/// Draws wi from two uniforms: a lobe in proportion to its albedo, then a direction.
-BsdfSample bsdf_sample(const Bsdf& bsdf, const Vec3f& n, const Vec3f& wo, float u1, float u2);
 
 /// The cpfg materials decoded to linear RGB (display values decoded as sRGB). Each
 /// material's ambient (display value) times `ambient_light` is its ambient_glow.
