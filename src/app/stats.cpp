@@ -76,6 +76,7 @@ void RunStats::add_render(const render::RenderReport& report, double render_star
     height = h;
     samples = report.samples;
     rays = report.rays;
+    background_only_samples = report.background_only_samples;
     embree_bytes = report.embree_bytes;
     embree_peak_bytes = report.embree_peak_bytes;
     render_buffer_bytes = report.render_buffer_bytes;
@@ -95,6 +96,7 @@ void RunStats::add_frame(FrameStats f, const geom::Scene& scene,
     f.render_s = report.seconds - report.setup_seconds;
     f.samples = report.samples;
     f.rays = report.rays;
+    f.background_only_samples = report.background_only_samples;
     f.embree_bytes = report.embree_bytes;
     RunStats counted;
     counted.add_scene(scene);
@@ -112,6 +114,7 @@ void RunStats::add_frame(FrameStats f, const geom::Scene& scene,
     render_s += f.render_s;
     samples += f.samples;
     rays += f.rays;
+    background_only_samples += f.background_only_samples;
     embree_bytes = std::max(embree_bytes, report.embree_bytes);
     embree_peak_bytes = std::max(embree_peak_bytes, report.embree_peak_bytes);
     f.peak_process_bytes = app::peak_process_bytes();
@@ -271,8 +274,9 @@ std::string format_stats(const RunStats& s)
         out += "  memory: Cambium " + mib(s.cambium_bytes) + "\n";
     out += "  peak process memory " + mib(s.peak_process_bytes) + "\n";
     if (s.rendered)
-        out += fmt::format("  {}x{}: {} samples, {} rays; {:.3g} samples/s, {:.3g} rays/s\n",
-                           s.width, s.height, s.samples, s.rays,
+        out += fmt::format("  {}x{}: {} samples ({} of empty pixels, without a ray), {} rays; "
+                           "{:.3g} samples/s, {:.3g} rays/s\n",
+                           s.width, s.height, s.samples, s.background_only_samples, s.rays,
                            per_second(double(s.samples), s.render_s),
                            per_second(double(s.rays), s.render_s));
     return out;
@@ -314,6 +318,7 @@ nlohmann::json stats_json(const RunStats& s)
                    {"height", s.height},
                    {"samples", s.samples},
                    {"rays", s.rays},
+                   {"background_only_samples", s.background_only_samples},
                    {"samples_per_s", per_second(double(s.samples), s.render_s)},
                    {"rays_per_s", per_second(double(s.rays), s.render_s)}};
     j["sequence"] = s.sequence;
@@ -329,6 +334,7 @@ nlohmann::json stats_json(const RunStats& s)
                               {"placed_primitives", f.primitives},
                               {"samples", f.samples},
                               {"rays", f.rays},
+                              {"background_only_samples", f.background_only_samples},
                               {"embree_bytes", f.embree_bytes},
                               {"peak_process_bytes", f.peak_process_bytes}});
         j["frames"] = std::move(frames);

@@ -44,6 +44,8 @@ struct FrameStats {
     double derive_s = 0, interpret_s = 0, build_s = 0, render_s = 0;
     std::uint64_t primitives = 0;  ///< as placed
     std::uint64_t samples = 0, rays = 0;
+    /// Of the samples, those of pixels no primitive reaches: taken without a ray.
+    std::uint64_t background_only_samples = 0;
     std::uint64_t embree_bytes = 0;
     std::uint64_t peak_process_bytes = 0;  ///< the process's peak so far, after the frame
 };
@@ -77,6 +79,9 @@ struct RunStats {
 
     int width = 0, height = 0;
     std::uint64_t samples = 0, rays = 0;
+    /// Of the samples, those of pixels no primitive reaches (render::ScreenMask): taken
+    /// without a ray.
+    std::uint64_t background_only_samples = 0;
 
     /// A sequence: its frames rendered by this process, in order. The run's times, samples
     /// and rays are then sums over them plus the shared work; its primitive counts and
