@@ -12,6 +12,7 @@
 //   build/benchmarks/convergence [--plant NAME]... [--sampler sobol|white|both]
 //       [--size WxH] [--threads N] [--max-spp N] [--reference-spp N] [--target NOISE]
 //       [--adaptive NOISE] [--export-scene FOLDER] [--raw-embree-only | --no-raw-embree]
+//       [--trace-empty-pixels]
 //
 // Defaults: the five plants below, both samplers, 320x240, 2 threads, up to 64 spp, a
 // 1024-spp Sobol reference. The noise target (time_to_target_s) is, unless given, white
@@ -40,7 +41,8 @@
 // `path_tracer_fraction_of_raw_cpu` (raw_embree_cpu_s / trace_cpu_s: issue 16 asks for at
 // least 0.8). These renders come after every series so that the logs' memory stays out
 // of the series' peak RSS. --raw-embree-only runs only them (no references are needed);
-// --no-raw-embree leaves them out.
+// --no-raw-embree leaves them out. --trace-empty-pixels traces the camera rays of pixels
+// no primitive reaches too (RenderSettings::skip_empty_pixels off: the same images).
 //
 // --adaptive NOISE instead renders once with adaptive sampling to that noise target (up
 // to --max-spp) and prints its mean spp, wall and CPU seconds and the error reached:
@@ -116,6 +118,7 @@ struct Settings {
     fs::path save_folder;    ///< --save-images: each render as raw RGBA floats there
     bool series = true;      ///< the convergence series (off: --raw-embree-only)
     bool raw_embree = true;  ///< the raw-Embree measurement (off: --no-raw-embree)
+    bool skip_empty_pixels = true;  ///< off: --trace-empty-pixels
 };
 
 /// The process's CPU time so far, user + sys, in seconds.
@@ -181,6 +184,7 @@ render::RenderSettings render_settings(const Settings& s, int spp, render::Sampl
     if (s.max_depth > 0)
         rs.max_depth = s.max_depth;
     rs.noise_target = static_cast<float>(noise_target);
+    rs.skip_empty_pixels = s.skip_empty_pixels;
     return rs;
 }
 
@@ -546,6 +550,8 @@ Settings parse(int argc, char** argv)
             s.series = false;
         } else if (arg == "--no-raw-embree") {
             s.raw_embree = false;
+        } else if (arg == "--trace-empty-pixels") {
+            s.skip_empty_pixels = false;
         } else if (arg == "--export-scene") {
             s.export_folder = fs::absolute(value());
         } else {

@@ -3,6 +3,9 @@
 // synthetic plant, beside raw Embree rtcIntersect1 on the same rays. Prints one JSON object.
 //
 // Usage: render [--scale S] [--threads N] [--size WxH] [--spp N] [--depth N]
+//               [--trace-empty-pixels]
+// (--trace-empty-pixels: the camera rays of pixels no primitive reaches are traced too,
+// RenderSettings::skip_empty_pixels off; the same image.)
 // Default (scale 1): 1 M round linear segments in 5 000 branches plus 100 000 instances
 // of a 6-triangle leaf prototype; 320x240 at 16 spp, depth 4.
 //
@@ -196,6 +199,7 @@ int run(int argc, char** argv)
 {
     double scale = 1;
     int threads = 0, width = 320, height = 240, spp = 16, depth = 4;
+    bool skip_empty_pixels = true;
     for (int i = 1; i < argc; ++i) {
         std::string a = argv[i];
         auto value = [&]() -> std::string {
@@ -211,13 +215,16 @@ int run(int argc, char** argv)
             spp = std::stoi(value());
         else if (a == "--depth")
             depth = std::stoi(value());
+        else if (a == "--trace-empty-pixels")
+            skip_empty_pixels = false;
         else if (a == "--size") {
             std::string v = value();
             if (std::sscanf(v.c_str(), "%dx%d", &width, &height) != 2)
                 throw std::runtime_error("--size wants WxH");
         } else
             throw std::runtime_error("unknown option " + a +
-                                     " (--scale S --threads N --size WxH --spp N --depth N)");
+                                     " (--scale S --threads N --size WxH --spp N --depth N "
+                                     "--trace-empty-pixels)");
     }
     if (!(scale > 0) || scale > 100)
         throw std::runtime_error("--scale must be in (0, 100]");
@@ -239,6 +246,7 @@ int run(int argc, char** argv)
     settings.ambient = {0.1f, 0.1f, 0.1f};
     settings.aovs = false;  // the path tracer alone
     settings.passes = 1;    // one pass: its end (on_pass) is the end of tracing
+    settings.skip_empty_pixels = skip_empty_pixels;
     auto camera = cambium::render::make_camera(scene.view, scene.bounds, width, height);
     std::size_t built_segments = 0;
     arena.execute([&] {
