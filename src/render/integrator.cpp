@@ -208,9 +208,13 @@ Vec3f unshadowed(const Vertex& v, const LightLiSample& ls)
 {
     if (!(ls.pdf > 0) || is_black(ls.li))
         return {};
-    Vec3f f = bsdf_eval(v.bsdf, v.hit.normal, v.wo, ls.wi);
+    // The geometric tests first: a light on the far side of the true surface (or grazing
+    // it) is refused before the BSDF (the Phong lobe's power) is evaluated for nothing.
     float cos = std::fabs(dot(v.hit.normal, ls.wi));
-    if (is_black(f) || cos <= 0 || !same_side(v.hit, ls.wi))
+    if (cos <= 0 || !same_side(v.hit, ls.wi))
+        return {};
+    Vec3f f = bsdf_eval(v.bsdf, v.hit.normal, v.wo, ls.wi);
+    if (is_black(f))
         return {};
     return f * ls.li * cos;
 }
@@ -233,17 +237,18 @@ std::optional<Vec3f> sample_delta_ld(const PathContext& ctx,
     const std::uint32_t n = static_cast<std::uint32_t>(lights.size());
     std::array<float, LightSet::max_delta_choice> weight;  // luminance of each contribution
     float total = 0;
-    // The last light's direction, end and contribution, kept: a single light's are not
-    // made twice. (Kept as values, not as its LightLiSample: copying that struct in the
-    // loop stalled on store forwarding.)
-    Vec3f wi, contribution;
-    float ends_at = 0;
+    // Each light's direction, end and contribution, kept: the chosen light's are not made
+    // twice (its BSDF evaluation, with the Phong lobe's power, is most of the loop's
+    // cost). (Kept as values, not as LightLiSamples: copying that struct in the loop
+    // stalled on store forwarding.)
+    std::array<Vec3f, LightSet::max_delta_choice> wi, contribution;
+    std::array<float, LightSet::max_delta_choice> ends_at;
     for (std::uint32_t i = 0; i < n; ++i) {
         const LightLiSample ls = lights.sample_li(i, v.hit.position, 0, 0, 0);  // no point
-        contribution = unshadowed(v, ls);
-        wi = ls.wi;
-        ends_at = ls.tfar;
-        float w = luminance(contribution);
+        contribution[i] = unshadowed(v, ls);
+        wi[i] = ls.wi;
+        ends_at[i] = ls.tfar;
+        float w = luminance(contribution[i]);
         if (!std::isfinite(w))
             return std::nullopt;
         weight[i] = std::max(w, 0.0f);  // w is finite: as std::fmax, without a libm call
@@ -263,16 +268,10 @@ std::optional<Vec3f> sample_delta_ld(const PathContext& ctx,
             break;
         target -= weight[i];
     }
-    if (chosen + 1 != n) {
-        const LightLiSample ls = lights.sample_li(chosen, v.hit.position, 0, 0, 0);
-        contribution = unshadowed(v, ls);
-        wi = ls.wi;
-        ends_at = ls.tfar;
-    }
-    float through = light_visibility(ctx, facts, v.hit, wi, ends_at);
+    float through = light_visibility(ctx, facts, v.hit, wi[chosen], ends_at[chosen]);
     if (through <= 0)
         return Vec3f();
-    return contribution * (through * total / weight[chosen]);
+    return contribution[chosen] * (through * total / weight[chosen]);
 }
 
 /// The vertex's next-event uniforms, drawn from its block only where they matter: the
