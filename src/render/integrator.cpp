@@ -229,14 +229,18 @@ float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f
 /// is never chosen, and noise is left only where lights are partly shadowed. Unbiased:
 /// every light that gives the point anything keeps a non-zero chance. Nullopt where a
 /// contribution is not finite (a broken light): the choice by power then shows it.
+/// The choice's uniform (dimension `choice`) is drawn only where two lights or more give
+/// the point something: with one, that one is chosen whatever it would be (FernLeaf's
+/// lights, opposite each other, light most points from one side only).
 std::optional<Vec3f> sample_delta_ld(const PathContext& ctx,
                                      const PathContext::SceneFlags& facts, const Vertex& v,
-                                     float u_choose)
+                                     const Sampler& sampler, std::uint32_t choice)
 {
     const LightSet& lights = facts.lights;
     const std::uint32_t n = static_cast<std::uint32_t>(lights.size());
     std::array<float, LightSet::max_delta_choice> weight;  // luminance of each contribution
     float total = 0;
+    std::uint32_t lit = 0;  // lights that give the point something
     // Each light's direction, end and contribution, kept: the chosen light's are not made
     // twice (its BSDF evaluation, with the Phong lobe's power, is most of the loop's
     // cost). (Kept as values, not as LightLiSamples: copying that struct in the loop
@@ -253,11 +257,13 @@ std::optional<Vec3f> sample_delta_ld(const PathContext& ctx,
             return std::nullopt;
         weight[i] = std::max(w, 0.0f);  // w is finite: as std::fmax, without a libm call
         total += weight[i];
+        lit += weight[i] > 0;
     }
     if (!(total > 0) || !std::isfinite(total))
         return Vec3f();
     // The light whose share of the total holds u_choose; the last lit one if rounding
     // leaves u past the sum.
+    const float u_choose = lit > 1 ? sampler.get1d(choice) : 0.0f;
     float target = u_choose * total;
     std::uint32_t chosen = n;
     for (std::uint32_t i = 0; i < n; ++i) {
@@ -317,9 +323,8 @@ Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, co
     if (lights.delta_only()) {
         // A delta light needs no point on it: only the choice is drawn, and only when
         // there is a choice.
-        float u_choose =
-            lights.size() > 1 ? sampler.get1d(block + sample_dimension::light_choice) : 0.0f;
-        if (std::optional<Vec3f> ld = sample_delta_ld(ctx, facts, v, u_choose))
+        if (std::optional<Vec3f> ld =
+                sample_delta_ld(ctx, facts, v, sampler, block + sample_dimension::light_choice))
             return *ld;
     }
     std::optional<ChosenLight> chosen;
