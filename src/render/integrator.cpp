@@ -221,6 +221,14 @@ Vec3f unshadowed(const Vertex& v, const LightLiSample& ls)
 
 float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
+/// Room for a vector per delta light, each made in place as its light is met: a
+/// std::array<Vec3f> would be zeroed whole (Vec3f's members are initialised), a
+/// `rep stos` at every vertex.
+union DeltaRoom {
+    DeltaRoom() {}
+    std::array<Vec3f, LightSet::max_delta_choice> at;
+};
+
 /// Direct light from a set of delta lights only (a view file's lights): each light's
 /// unshadowed contribution is known exactly for the price of a BSDF evaluation, so one
 /// light is chosen in proportion to it (its luminance) and one shadow ray traced. The
@@ -245,14 +253,14 @@ std::optional<Vec3f> sample_delta_ld(const PathContext& ctx,
     // twice (its BSDF evaluation, with the Phong lobe's power, is most of the loop's
     // cost). (Kept as values, not as LightLiSamples: copying that struct in the loop
     // stalled on store forwarding.)
-    std::array<Vec3f, LightSet::max_delta_choice> wi, contribution;
+    DeltaRoom wi, contribution;
     std::array<float, LightSet::max_delta_choice> ends_at;
     for (std::uint32_t i = 0; i < n; ++i) {
         const LightLiSample ls = lights.sample_li(i, v.hit.position, 0, 0, 0);  // no point
-        contribution[i] = unshadowed(v, ls);
-        wi[i] = ls.wi;
+        ::new (&contribution.at[i]) Vec3f(unshadowed(v, ls));
+        ::new (&wi.at[i]) Vec3f(ls.wi);
         ends_at[i] = ls.tfar;
-        float w = luminance(contribution[i]);
+        float w = luminance(contribution.at[i]);
         if (!std::isfinite(w))
             return std::nullopt;
         weight[i] = std::max(w, 0.0f);  // w is finite: as std::fmax, without a libm call
@@ -274,10 +282,10 @@ std::optional<Vec3f> sample_delta_ld(const PathContext& ctx,
             break;
         target -= weight[i];
     }
-    float through = light_visibility(ctx, facts, v.hit, wi[chosen], ends_at[chosen]);
+    float through = light_visibility(ctx, facts, v.hit, wi.at[chosen], ends_at[chosen]);
     if (through <= 0)
         return Vec3f();
-    return contribution[chosen] * (through * total / weight[chosen]);
+    return contribution.at[chosen] * (through * total / weight[chosen]);
 }
 
 /// The vertex's next-event uniforms, drawn from its block only where they matter: the
