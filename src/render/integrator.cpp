@@ -208,14 +208,26 @@ Vec3f unshadowed(const Vertex& v, const LightLiSample& ls)
 {
     if (!(ls.pdf > 0) || is_black(ls.li))
         return {};
-    Vec3f f = bsdf_eval(v.bsdf, v.hit.normal, v.wo, ls.wi);
+    // The geometric tests first: a light on the far side of the true surface (or grazing
+    // it) is refused before the BSDF (the Phong lobe's power) is evaluated for nothing.
     float cos = std::fabs(dot(v.hit.normal, ls.wi));
-    if (is_black(f) || cos <= 0 || !same_side(v.hit, ls.wi))
+    if (cos <= 0 || !same_side(v.hit, ls.wi))
+        return {};
+    Vec3f f = bsdf_eval(v.bsdf, v.hit.normal, v.wo, ls.wi);
+    if (is_black(f))
         return {};
     return f * ls.li * cos;
 }
 
 float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+/// Room for a vector per delta light, each made in place as its light is met: a
+/// std::array<Vec3f> would be zeroed whole (Vec3f's members are initialised), a
+/// `rep stos` at every vertex.
+union DeltaRoom {
+    DeltaRoom() {}
+    std::array<Vec3f, LightSet::max_delta_choice> at;
+};
 
 /// Direct light from a set of delta lights only (a view file's lights): each light's
 /// unshadowed contribution is known exactly for the price of a BSDF evaluation, so one
@@ -225,34 +237,41 @@ float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f
 /// is never chosen, and noise is left only where lights are partly shadowed. Unbiased:
 /// every light that gives the point anything keeps a non-zero chance. Nullopt where a
 /// contribution is not finite (a broken light): the choice by power then shows it.
+/// The choice's uniform (dimension `choice`) is drawn only where two lights or more give
+/// the point something: with one, that one is chosen whatever it would be (FernLeaf's
+/// lights, opposite each other, light most points from one side only).
 std::optional<Vec3f> sample_delta_ld(const PathContext& ctx,
                                      const PathContext::SceneFlags& facts, const Vertex& v,
-                                     float u_choose)
+                                     const Sampler& sampler, std::uint32_t choice)
 {
     const LightSet& lights = facts.lights;
     const std::uint32_t n = static_cast<std::uint32_t>(lights.size());
     std::array<float, LightSet::max_delta_choice> weight;  // luminance of each contribution
     float total = 0;
-    // The last light's direction, end and contribution, kept: a single light's are not
-    // made twice. (Kept as values, not as its LightLiSample: copying that struct in the
-    // loop stalled on store forwarding.)
-    Vec3f wi, contribution;
-    float ends_at = 0;
+    std::uint32_t lit = 0;  // lights that give the point something
+    // Each light's direction, end and contribution, kept: the chosen light's are not made
+    // twice (its BSDF evaluation, with the Phong lobe's power, is most of the loop's
+    // cost). (Kept as values, not as LightLiSamples: copying that struct in the loop
+    // stalled on store forwarding.)
+    DeltaRoom wi, contribution;
+    std::array<float, LightSet::max_delta_choice> ends_at;
     for (std::uint32_t i = 0; i < n; ++i) {
         const LightLiSample ls = lights.sample_li(i, v.hit.position, 0, 0, 0);  // no point
-        contribution = unshadowed(v, ls);
-        wi = ls.wi;
-        ends_at = ls.tfar;
-        float w = luminance(contribution);
+        ::new (&contribution.at[i]) Vec3f(unshadowed(v, ls));
+        ::new (&wi.at[i]) Vec3f(ls.wi);
+        ends_at[i] = ls.tfar;
+        float w = luminance(contribution.at[i]);
         if (!std::isfinite(w))
             return std::nullopt;
         weight[i] = std::max(w, 0.0f);  // w is finite: as std::fmax, without a libm call
         total += weight[i];
+        lit += weight[i] > 0;
     }
     if (!(total > 0) || !std::isfinite(total))
         return Vec3f();
     // The light whose share of the total holds u_choose; the last lit one if rounding
     // leaves u past the sum.
+    const float u_choose = lit > 1 ? sampler.get1d(choice) : 0.0f;
     float target = u_choose * total;
     std::uint32_t chosen = n;
     for (std::uint32_t i = 0; i < n; ++i) {
@@ -263,16 +282,10 @@ std::optional<Vec3f> sample_delta_ld(const PathContext& ctx,
             break;
         target -= weight[i];
     }
-    if (chosen + 1 != n) {
-        const LightLiSample ls = lights.sample_li(chosen, v.hit.position, 0, 0, 0);
-        contribution = unshadowed(v, ls);
-        wi = ls.wi;
-        ends_at = ls.tfar;
-    }
-    float through = light_visibility(ctx, facts, v.hit, wi, ends_at);
+    float through = light_visibility(ctx, facts, v.hit, wi.at[chosen], ends_at[chosen]);
     if (through <= 0)
         return Vec3f();
-    return contribution * (through * total / weight[chosen]);
+    return contribution.at[chosen] * (through * total / weight[chosen]);
 }
 
 /// The vertex's next-event uniforms, drawn from its block only where they matter: the
@@ -318,9 +331,8 @@ Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, co
     if (lights.delta_only()) {
         // A delta light needs no point on it: only the choice is drawn, and only when
         // there is a choice.
-        float u_choose =
-            lights.size() > 1 ? sampler.get1d(block + sample_dimension::light_choice) : 0.0f;
-        if (std::optional<Vec3f> ld = sample_delta_ld(ctx, facts, v, u_choose))
+        if (std::optional<Vec3f> ld =
+                sample_delta_ld(ctx, facts, v, sampler, block + sample_dimension::light_choice))
             return *ld;
     }
     std::optional<ChosenLight> chosen;

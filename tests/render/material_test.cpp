@@ -89,6 +89,62 @@ TEST(Material, CosineAndSineOfTurnsAreWithinFloatRounding)
     }
 }
 
+// The Phong lobe's inline power agrees with std::pow (in double, rounded to float) for
+// every exponent a cpfg material can have (shininess 0..128 / 4: whole quarters), within
+// one unit in the last place and exactly in nearly every case; other exponents are
+// std::pow's own.
+TEST(Material, PhongPowerIsStdPowToFloatRounding)
+{
+    long checked = 0, differ = 0;
+    for (int q = 1; q <= 512; ++q) {
+        const float e = static_cast<float>(q) / 4;
+        for (int i = 1; i <= 4000; ++i) {
+            // Cosines over (0, 1], denser near 1, where a narrow lobe lives.
+            const float c = i % 2 ? static_cast<float>(i) / 4000
+                                  : 1 - static_cast<float>(i) / 4000 * 1e-3f;
+            const float got = bsdf_detail::power(c, e);
+            const float want = static_cast<float>(std::pow(static_cast<double>(c), e));
+            ++checked;
+            if (got == want)
+                continue;
+            ++differ;
+            ASSERT_EQ(std::nextafter(want, got), got) << c << "^" << e;  // one ulp at most
+        }
+    }
+    EXPECT_LT(differ, checked / 100000) << differ << " of " << checked;
+    for (float e : {0.3f, 12.7f, 200.0f})  // not whole quarters, or beyond cpfg's range
+        EXPECT_EQ(bsdf_detail::power(0.9f, e), std::pow(0.9f, e)) << e;
+    EXPECT_EQ(bsdf_detail::power(1.0f, 32), 1.0f);
+    EXPECT_EQ(bsdf_detail::power(0.5f, 0.25f), static_cast<float>(std::pow(0.5, 0.25)));
+}
+
+// bsdf_sample()'s weight and pdf are bsdf_eval() |cos| / bsdf_pdf() and bsdf_pdf() of the
+// direction it draws, for every lobe (it makes the Phong term once for both).
+TEST(Material, SampleWeightAndPdfAreEvalAndPdf)
+{
+    SurfaceMaterial m;
+    m.diffuse = {0.6f, 0.3f, 0.1f};
+    m.translucency = 0.3f;
+    m.specular = {0.3f, 0.2f, 0.4f};
+    m.exponent = 12.75f;
+    const Bsdf b = make_bsdf(m);
+    const Vec3f wo = incidence(0.5f);
+    int glossy = 0;
+    for (int i = 0; i < 2000; ++i) {
+        Sampler s(static_cast<std::uint32_t>(i), 0, 0, 1);
+        const BsdfSample bs = bsdf_sample(b, up, wo, s.next(), s.next());
+        if (!(bs.pdf > 0))
+            continue;
+        const float pdf = bsdf_pdf(b, up, wo, bs.wi);
+        const Vec3f w = bsdf_eval(b, up, wo, bs.wi) * (std::fabs(bs.wi.z) / pdf);
+        ASSERT_EQ(bs.pdf, pdf) << i;
+        ASSERT_EQ(bs.weight.x, w.x) << i;
+        ASSERT_EQ(bs.weight.z, w.z) << i;
+        glossy += bsdf_detail::phong_term(b, up, wo, bs.wi) > 0.5f;
+    }
+    EXPECT_GT(glossy, 20);  // the glossy lobe was drawn and checked too
+}
+
 // Sampling agrees with quadrature of eval for every lobe mixture: pdf and eval match.
 TEST(Material, SamplingMatchesQuadrature)
 {
