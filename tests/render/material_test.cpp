@@ -20,6 +20,18 @@ const Vec3f up(0, 0, 1);
 
 Vec3f incidence(float theta) { return {std::sin(theta), 0, std::cos(theta)}; }
 
+/// Every lobe in colour (each channel weighs diffuse, translucent and glossy
+/// differently), with the Phong exponent `exponent`.
+SurfaceMaterial coloured_lobes(float exponent)
+{
+    SurfaceMaterial m;
+    m.diffuse = {0.6f, 0.3f, 0.1f};
+    m.translucency = 0.3f;
+    m.specular = {0.3f, 0.2f, 0.4f};
+    m.exponent = exponent;
+    return m;
+}
+
 /// Mean of bsdf_sample's weights: the BSDF's directional albedo by importance sampling.
 Vec3f sampled_albedo(const Bsdf& b, const Vec3f& wo, int n = 200000)
 {
@@ -122,12 +134,7 @@ TEST(Material, PhongPowerIsStdPowToFloatRounding)
 // direction it draws, for every lobe (it makes the Phong term once for both).
 TEST(Material, SampleWeightAndPdfAreEvalAndPdf)
 {
-    SurfaceMaterial m;
-    m.diffuse = {0.6f, 0.3f, 0.1f};
-    m.translucency = 0.3f;
-    m.specular = {0.3f, 0.2f, 0.4f};
-    m.exponent = 12.75f;
-    const Bsdf b = make_bsdf(m);
+    const Bsdf b = make_bsdf(coloured_lobes(12.75f));
     const Vec3f wo = incidence(0.5f);
     int glossy = 0;
     for (int i = 0; i < 2000; ++i) {
@@ -148,13 +155,7 @@ TEST(Material, SampleWeightAndPdfAreEvalAndPdf)
 // Sampling agrees with quadrature of eval for every lobe mixture: pdf and eval match.
 TEST(Material, SamplingMatchesQuadrature)
 {
-    SurfaceMaterial m;
-    // Coloured lobes, so that each channel weighs diffuse and glossy differently.
-    m.diffuse = {0.6f, 0.3f, 0.1f};
-    m.translucency = 0.3f;
-    m.specular = {0.3f, 0.2f, 0.4f};
-    m.exponent = 8;
-    Bsdf b = make_bsdf(m);
+    Bsdf b = make_bsdf(coloured_lobes(8));
     for (float theta : {0.0f, 0.7f, 1.3f}) {
         double pdf_integral = 0;
         Vec3f q = quadrature_albedo(b, incidence(theta), &pdf_integral);
