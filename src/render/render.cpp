@@ -478,9 +478,12 @@ void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uin
 /// stay in cache) instead of between the paths of the hits (and the hits' paths follow
 /// each other too); each pixel's sums take the same samples in the same order. (Rounds
 /// over one row measured as fast as over two and faster than over four or a whole tile.)
-void take_row(const RenderState& f, const PixelRect& region, int y, int x0, int x1,
-              std::uint32_t target, std::vector<PixelState>& pixels, int w, RowBatches& row)
+/// Pixels the screen mask skips take their background samples at once; returns how many.
+std::uint64_t take_row(const RenderState& f, const PixelRect& region, int y, int x0, int x1,
+                       std::uint32_t target, std::vector<PixelState>& pixels, int w,
+                       RowBatches& row)
 {
+    std::uint64_t background_only = 0;
     auto pixel = [&](int x) -> PixelState& { return pixels[std::size_t(y) * w + x]; };
     auto batch_size = [&](const PixelState& st) {
         return std::min(CameraBatch::size, target - st.samples);
@@ -491,17 +494,19 @@ void take_row(const RenderState& f, const PixelRect& region, int y, int x0, int 
         PixelState& st = pixel(x);
         if (st.done || st.samples >= target)
             continue;
-        if (f.mask && !f.mask->may_hit(region.x + x, region.y + y))
+        if (f.mask && !f.mask->may_hit(region.x + x, region.y + y)) {
+            background_only += target - st.samples;
             take_background_samples(f, st.samples, target, st);
-        else
+        } else {
             replicas.emplace(region.x + x, region.y + y, f.settings.seed, f.adaptive);
+        }
     }
     if (f.ctx.ground) {  // no streams: each path traces its own camera ray
         for (int x = x0; x < x1; ++x)
             if (const auto& replicas = row.replicas[std::size_t(x - x0)])
                 take_samples(f, region.x + x, region.y + y, pixel(x).samples, target, pixel(x),
                              row.batch[0], *replicas);
-        return;
+        return background_only;
     }
     for (bool more = true; more;) {
         more = false;
@@ -518,6 +523,7 @@ void take_row(const RenderState& f, const PixelRect& region, int y, int x0, int 
             more |= st.samples < target;
         }
     }
+    return background_only;
 }
 
 /// The pixels whose camera rays may meet the scene, for a view where a camera ray that
@@ -944,10 +950,8 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                             if (st.done || st.samples >= target)
                                 continue;
                             taken += target - st.samples;
-                            if (!mask.may_hit(region.x + x, region.y + y))
-                                background_only += target - st.samples;
                         }
-                        take_row(state, region, y, x0, x1, target, pixels, w, *row);
+                        background_only += take_row(state, region, y, x0, x1, target, pixels, w, *row);
                     }
                     progress.add(taken);
                     background_samples.fetch_add(background_only, std::memory_order_relaxed);
