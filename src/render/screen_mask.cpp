@@ -2,6 +2,7 @@
 #include "render/screen_mask.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/combinable.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -44,6 +45,18 @@ WorldBox empty_box()
 }
 
 bool is_empty(const WorldBox& b) { return b.finite && !(b.lo.x <= b.hi.x); }
+
+/// The box holding a and b, with the larger growth; not finite if either is not.
+WorldBox joined(const WorldBox& a, const WorldBox& b)
+{
+    if (is_empty(b))
+        return a;
+    if (is_empty(a))
+        return b;
+    return {{std::min(a.lo.x, b.lo.x), std::min(a.lo.y, b.lo.y), std::min(a.lo.z, b.lo.z)},
+            {std::max(a.hi.x, b.hi.x), std::max(a.hi.y, b.hi.y), std::max(a.hi.z, b.hi.z)},
+            std::max(a.grow_px, b.grow_px), a.finite && b.finite};
+}
 
 /// A rectangle in continuous pixel coordinates (PixelPoint's).
 struct PixelRect {
@@ -117,36 +130,6 @@ private:
     Vec3 m_origin, m_right, m_up, m_forward;
     double m_cx = 0, m_cy = 0, m_scale = 1;
 };
-
-/// The bounds of a geometry in its own frame, with the pixels its pixel-width lines add.
-WorldBox geometry_box(const geom::Geometry& g, bool radius_in_pixels)
-{
-    WorldBox b = empty_box();
-    for (const geom::Float4& k : g.lines.keys) {
-        extend(b, point(k), radius_in_pixels ? 0.0 : std::fabs(double(k[3])));
-        if (radius_in_pixels)
-            b.grow_px = std::max(b.grow_px, double(k[3]));
-    }
-    const geom::HermiteCurves& c = g.curves;
-    for (std::size_t i = 0; i < c.points.size(); ++i) {
-        // Each segment lies within its Bézier control points (p +- t / 3) grown by the
-        // largest control radius.
-        double r = std::fabs(double(c.points[i][3])) + std::fabs(double(c.tangents[i][3])) / 3;
-        Vec3 p = point(c.points[i]), t = point(c.tangents[i]) * (1.0 / 3);
-        extend(b, p, r);
-        extend(b, p + t, r);
-        extend(b, p - t, r);
-    }
-    for (const geom::Float4& s : g.spheres.centres)
-        extend(b, point(s), std::fabs(double(s[3])));
-    for (const geom::Float4& d : g.discs.centres)
-        extend(b, point(d), std::fabs(double(d[3])));
-    for (const geom::Float3& p : g.mesh.positions)
-        extend(b, point(p), 0);
-    if (radius_in_pixels && b.grow_px > 0)
-        b.grow_px = 2 * (b.grow_px + pixel_line_margin);
-    return b;
-}
 
 /// The box holding `b` moved by an instance's 3x4 column-major transform.
 WorldBox placed_box(const WorldBox& b, const std::array<float, 12>& m)
@@ -315,6 +298,16 @@ void each_primitive_box(const geom::Geometry& g, bool radius_in_pixels, const Ad
         }
         add(box);
     });
+}
+
+/// The bounds of a geometry in its own frame (a prototype's), with the pixels its
+/// pixel-width lines add: the union of its primitives' boxes.
+WorldBox geometry_box(const geom::Geometry& g, bool radius_in_pixels)
+{
+    tbb::combinable<WorldBox> boxes(empty_box);
+    each_primitive_box(g, radius_in_pixels,
+                       [&](const WorldBox& b) { boxes.local() = joined(boxes.local(), b); });
+    return boxes.combine(joined);
 }
 
 }  // namespace

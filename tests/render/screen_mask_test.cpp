@@ -98,6 +98,27 @@ TEST(ScreenMask, NoSkippedPixelHasAHitInParallelWithAWideFilter)
     EXPECT_LT(skipped, 80 * 60);
 }
 
+// Instances alone: each is bounded by its prototype's box, placed (rotated, scaled),
+// so most of the frame is skipped and nothing skipped is hit.
+TEST(ScreenMask, InstancesAreBoundedByTheirPlacedPrototype)
+{
+    geom::Scene s;
+    geom::Prototype leaf;
+    add_quad(leaf.geometry, 0, 0, 1, 0.4f, 0, 1, 1);
+    add_sphere(leaf.geometry, {0.5, 0.8, 0}, 0.1f);
+    s.prototypes.push_back(leaf);
+    for (float x : {-2.0f, 0.5f, 2.5f}) {
+        geom::Instance inst;
+        inst.transform = testing::transform({0, -0.8f, 0, 0.8f, 0, 0, 0, 0, 0.8f}, {x, 1, 0});
+        inst.material = inst.back_material = 1;
+        s.instances.push_back(inst);
+    }
+    const Camera camera = perspective_camera(80, 60);
+    int skipped = expect_skipped_pixels_unhit(s, camera, 0.5);
+    EXPECT_GT(skipped, 80 * 60 * 3 / 4);
+    EXPECT_LT(skipped, 80 * 60);
+}
+
 // A sphere of radius 0.5 at the focus of a parallel camera with 0.1 units a pixel: a disc
 // 5 pixels in radius about the image centre (40, 30). Pixels within it are kept; pixels
 // beyond it, the samples' reach and the safety margin (with a pixel for rounding up to
