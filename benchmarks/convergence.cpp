@@ -192,7 +192,6 @@ Run render_at(const cambium::geom::Scene& scene, const Settings& s, int spp,
               render::SampleSequence sampler, std::uint64_t seed, double noise_target = 0)
 {
     render::RenderSettings rs = render_settings(s, spp, sampler, seed, noise_target);
-    std::uint64_t rays_before = cambium::bench::recorder.rays_traced();
     auto start = Clock::now();
     double cpu_start = cpu_seconds();
     render::RenderReport report;
@@ -201,7 +200,7 @@ Run render_at(const cambium::geom::Scene& scene, const Settings& s, int spp,
     run.cpu_seconds = cpu_seconds() - cpu_start;
     run.setup_seconds = report.setup_seconds;
     run.setup_cpu_seconds = report.setup_cpu_seconds;
-    run.rays = cambium::bench::recorder.rays_traced() - rays_before;
+    run.rays = report.rays;  // the renderer's own count
     run.samples = report.samples;
     return run;
 }
@@ -390,7 +389,9 @@ RayCounts expected_rays(const cambium::geom::Scene& scene, const Settings& s,
     const int pilot_spp = std::max(1, s.max_spp / 8);
     const std::uint64_t i0 = recorder.intersections.total(), o0 = recorder.occlusions.total(),
                         m0 = recorder.stream_intersections.total();
+    recorder.count();
     render_at(scene, s, pilot_spp, sampler, 0);
+    recorder.forward();
     const double scale = double(s.max_spp) / pilot_spp;
     auto scaled = [scale](std::uint64_t n) { return std::uint64_t(double(n) * scale); };
     const std::uint64_t streams = recorder.stream_intersections.total() - m0;
@@ -400,60 +401,63 @@ RayCounts expected_rays(const cambium::geom::Scene& scene, const Settings& s,
 
 /// One `"raw_embree_measurement":true` line (see the top of the file).
 void report_raw_embree(const std::string& plant, const Settings& s,
-                       render::SampleSequence sampler, std::uint64_t samples,
-                       const cambium::bench::TraceFigures& t)
+                       render::SampleSequence sampler, const cambium::bench::Measurement& m)
 {
     const cambium::bench::Recorder& r = cambium::bench::recorder;
+    const cambium::bench::TraceFigures& t = m.trace;
     const cambium::bench::RawFigures& raw = t.raw;
     std::printf("{\"plant\":\"%s\",\"sampler\":\"%s\",\"raw_embree_measurement\":true,"
                 "\"image\":\"%dx%d\",\"threads\":%d,\"spp\":%d,\"samples\":%llu,"
                 "\"intersect_rays\":%llu,\"stream_intersect_rays\":%llu,"
-                "\"occlusion_rays\":%llu,\"recorded\":{\"intersect_rays\":%zu,"
+                "\"occlusion_rays\":%llu,\"ray_hashes\":[\"%016llx\",\"%016llx\",\"%016llx\"],"
+                "\"recorded\":{\"intersect_rays\":%zu,"
                 "\"stream_rays\":%zu,\"occlusion_rays\":%zu,\"one_in\":[%zu,%zu,%zu]},"
                 "\"raw_embree\":{\"intersect_rays\":%zu,\"intersect_cpu_s\":%.3f,"
                 "\"stream_rays\":%zu,\"stream_cpu_s\":%.3f,\"occlusion_rays\":%zu,"
-                "\"occlusion_cpu_s\":%.3f},"
-                "\"trace_s\":%.3f,\"trace_cpu_s\":%.3f,\"raw_embree_cpu_s\":%.3f,"
+                "\"occlusion_cpu_s\":%.3f,\"first_round_cpu_s\":[%.4f,%.4f,%.4f]},"
+                "\"timed_render\":\"the second of two identical renders, not recorded\","
+                "\"same_render\":%s,\"renderer_rays\":%llu,"
+                "\"trace_s\":%.3f,\"trace_cpu_s\":%.3f,\"recording_trace_cpu_s\":%.3f,"
+                "\"raw_embree_cpu_s\":%.3f,\"raw_embree_first_round_cpu_s\":%.3f,"
                 "\"path_tracer_rays_per_s\":%.0f,\"raw_embree_rays_per_s\":%.0f,"
                 "\"path_tracer_fraction_of_raw\":%.3f,"
                 "\"path_tracer_fraction_of_raw_cpu\":%.3f}\n",
                 plant.c_str(), name(sampler), s.width, s.height, s.threads, s.max_spp,
-                static_cast<unsigned long long>(samples),
+                static_cast<unsigned long long>(m.timed.samples),
                 static_cast<unsigned long long>(t.intersections),
                 static_cast<unsigned long long>(t.stream_intersections),
-                static_cast<unsigned long long>(t.occlusions), r.singles.rays.size(),
+                static_cast<unsigned long long>(t.occlusions),
+                static_cast<unsigned long long>(t.singles_hash),
+                static_cast<unsigned long long>(t.streams_hash),
+                static_cast<unsigned long long>(t.occlusions_hash), r.singles.rays.size(),
                 r.streams.rays.size(), r.occlusion_rays.rays.size(), r.singles.every,
                 r.streams.every, r.occlusion_rays.every, raw.singles, raw.intersect_cpu_s,
-                raw.streams, raw.stream_cpu_s, raw.occlusions, raw.occluded_cpu_s, t.trace_s,
-                t.trace_cpu_s, t.raw_mix_cpu_s(),
+                raw.streams, raw.stream_cpu_s, raw.occlusions, raw.occluded_cpu_s,
+                raw.intersect_first_cpu_s, raw.stream_first_cpu_s, raw.occluded_first_cpu_s,
+                m.same_render ? "true" : "false",
+                static_cast<unsigned long long>(m.timed.rays), t.trace_s, t.trace_cpu_s,
+                t.recording_trace_cpu_s, t.raw_mix_cpu_s(), t.raw_mix_first_round_cpu_s(),
                 t.trace_s > 0 ? double(t.rays()) / t.trace_s : 0.0, t.raw_rays_per_s(),
                 t.path_tracer_fraction_of_raw(), t.path_tracer_fraction_of_raw_cpu());
     std::fflush(stdout);
 }
 
-/// The path tracer against raw Embree on the same rays (ray_replay.h): one render at
-/// --max-spp, as the measured renders but in one pass (its on_pass is the end of tracing),
-/// whose rays are recorded, a subsample of about 300 k of each kind, and replayed with raw
-/// Embree on the render's scene and threads while it is alive.
+/// The path tracer against raw Embree on the same rays (ray_replay.h): two renders at
+/// --max-spp, as the measured renders but each in one pass, in one render_views call (one
+/// BVH): the first records its rays (a subsample of about 300 k of each kind), the
+/// second, the same render again, is timed with the interposer out of its way and ends
+/// with the raw replay on its scene and threads.
 void run_raw_embree(const std::string& plant, const cambium::geom::Scene& scene,
                     const Settings& s, render::SampleSequence sampler)
 {
     using cambium::bench::recorder;
     const RayCounts expected = expected_rays(scene, s, sampler);
     render::RenderSettings rs = render_settings(s, s.max_spp, sampler, 0);
-    rs.passes = 1;
-    cambium::bench::TraceFigures t;
-    // on_pass runs in the render's arena, so the replay runs on the render's threads.
-    rs.on_pass = [&t](const render::Image&) {
-        recorder.stop();
-        t = recorder.replay();
-    };
-    // The logs are allocated and touched here, before the trace.
+    // As render(scene, settings) frames it (these settings have no lens).
+    const render::Camera camera = render::make_camera(scene.view, scene.bounds, s.width, s.height);
+    // The logs are allocated and touched here, before the renders.
     recorder.prepare(400'000, expected.singles, expected.occlusions, expected.streams);
-    recorder.start();
-    render::RenderReport report;
-    render::render(scene, rs, &report);
-    report_raw_embree(plant, s, sampler, report.samples, t);
+    report_raw_embree(plant, s, sampler, cambium::bench::measure(scene, camera, rs));
 }
 
 void run_plant(const std::string& plant, const fs::path& folder, const std::string& command,

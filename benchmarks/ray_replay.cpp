@@ -10,9 +10,11 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
 #include <ctime>
 
 #include "render/float_mode.h"
+#include "render/sampler.h"
 
 namespace cambium::bench {
 
@@ -105,28 +107,20 @@ using Intersect1 = void (*)(RTCScene, RTCIntersectContext*, RTCRayHit*);
 using Intersect1M = void (*)(RTCScene, RTCIntersectContext*, RTCRayHit*, unsigned int, size_t);
 using Occluded1 = void (*)(RTCScene, RTCIntersectContext*, RTCRay*);
 
-template <typename F>
-F embree_function(const char* name)
-{
-    return reinterpret_cast<F>(dlsym(RTLD_NEXT, name));
-}
+/// Embree's own entry points (the next definitions after this executable's).
+struct EmbreeEntries {
+    Intersect1 intersect;
+    Intersect1M intersect_stream;
+    Occluded1 occluded;
+};
 
-Intersect1 real_intersect()
+const EmbreeEntries& embree()
 {
-    static auto f = embree_function<Intersect1>("rtcIntersect1");
-    return f;
-}
-
-Intersect1M real_intersect_stream()
-{
-    static auto f = embree_function<Intersect1M>("rtcIntersect1M");
-    return f;
-}
-
-Occluded1 real_occluded()
-{
-    static auto f = embree_function<Occluded1>("rtcOccluded1");
-    return f;
+    static const EmbreeEntries e{
+        reinterpret_cast<Intersect1>(dlsym(RTLD_NEXT, "rtcIntersect1")),
+        reinterpret_cast<Intersect1M>(dlsym(RTLD_NEXT, "rtcIntersect1M")),
+        reinterpret_cast<Occluded1>(dlsym(RTLD_NEXT, "rtcOccluded1"))};
+    return e;
 }
 
 /// The primitive a path tracer's ray skips, read from its context: render/accel.cpp's
@@ -141,7 +135,7 @@ cambium::render::PrimId skip_of(const RTCIntersectContext* context)
     return reinterpret_cast<const Skipping*>(context)->skip;
 }
 
-/// The first Embree call of a trace opens it: its time, CPU time, memory and scene.
+/// The first Embree call of a recording opens it: its time, CPU time, memory and scene.
 void note_call(RTCScene scene)
 {
     if (recorder.started.load(std::memory_order_relaxed))
@@ -158,43 +152,151 @@ void note_call(RTCScene scene)
     recorder.started = true;
 }
 
-}  // namespace
+// What each entry point does now: Embree's own function (forwarding), or one of the
+// wrappers below. The entry points jump through these pointers (a relaxed load of a
+// pointer is a plain load), so forwarding costs what a call through the PLT does.
+void forward_intersect(RTCScene s, RTCIntersectContext* c, RTCRayHit* rh)
+{
+    embree().intersect(s, c, rh);
+}
+void forward_intersect_stream(RTCScene s, RTCIntersectContext* c, RTCRayHit* rh, unsigned m,
+                              size_t stride)
+{
+    embree().intersect_stream(s, c, rh, m, stride);
+}
+void forward_occluded(RTCScene s, RTCIntersectContext* c, RTCRay* r)
+{
+    embree().occluded(s, c, r);
+}
 
-extern "C" void rtcIntersect1(RTCScene scene, RTCIntersectContext* context, RTCRayHit* rayhit)
+// Before the first set_entries() they forward through embree() (resolved at first use).
+std::atomic<Intersect1> intersect_entry{&forward_intersect};
+std::atomic<Intersect1M> intersect_stream_entry{&forward_intersect_stream};
+std::atomic<Occluded1> occluded_entry{&forward_occluded};
+
+void set_entries(Intersect1 i, Intersect1M m, Occluded1 o)
+{
+    intersect_entry.store(i, std::memory_order_relaxed);
+    intersect_stream_entry.store(m, std::memory_order_relaxed);
+    occluded_entry.store(o, std::memory_order_relaxed);
+}
+
+void set_forwarding()
+{
+    const EmbreeEntries& e = embree();
+    set_entries(e.intersect, e.intersect_stream, e.occluded);
+}
+
+// ---- Counting (the pilot)
+
+void count_intersect(RTCScene s, RTCIntersectContext* c, RTCRayHit* rh)
 {
     recorder.intersections.add();
-    if (recorder.recording.load(std::memory_order_relaxed)) {
-        note_call(scene);
-        thread_local cambium::bench::LogCursor at;
-        recorder.singles.record(rayhit->ray, at, skip_of(context));
-    }
-    real_intersect()(scene, context, rayhit);
+    embree().intersect(s, c, rh);
+}
+void count_intersect_stream(RTCScene s, RTCIntersectContext* c, RTCRayHit* rh, unsigned m,
+                            size_t stride)
+{
+    recorder.intersections.add(m);
+    recorder.stream_intersections.add(m);
+    embree().intersect_stream(s, c, rh, m, stride);
+}
+void count_occluded(RTCScene s, RTCIntersectContext* c, RTCRay* r)
+{
+    recorder.occlusions.add();
+    embree().occluded(s, c, r);
+}
+
+// ---- Recording: count, hash and record a subsample
+
+void record_intersect(RTCScene s, RTCIntersectContext* c, RTCRayHit* rh)
+{
+    recorder.intersections.add();
+    note_call(s);
+    const cambium::render::PrimId skip = skip_of(c);
+    recorder.singles_hash.add(cambium::bench::ray_hash(rh->ray, skip));
+    thread_local cambium::bench::LogCursor at;
+    recorder.singles.record(rh->ray, at, skip);
+    embree().intersect(s, c, rh);
 }
 
 // Camera rays are traced as coherent streams (EmbreeScene::intersect_coherent): counted
 // apart and recorded stream by stream, so that the raw replay traces the same streams.
-extern "C" void rtcIntersect1M(RTCScene scene, RTCIntersectContext* context, RTCRayHit* rayhit,
-                               unsigned int m, size_t byte_stride)
+void record_intersect_stream(RTCScene s, RTCIntersectContext* c, RTCRayHit* rh, unsigned m,
+                             size_t stride)
 {
     recorder.intersections.add(m);
     recorder.stream_intersections.add(m);
-    if (recorder.recording.load(std::memory_order_relaxed)) {
-        note_call(scene);
-        thread_local cambium::bench::LogCursor at;
-        recorder.streams.record_stream(rayhit, m, byte_stride, at);
-    }
-    real_intersect_stream()(scene, context, rayhit, m, byte_stride);
+    note_call(s);
+    std::uint64_t hash = 0;
+    for (unsigned i = 0; i < m; ++i)
+        hash += cambium::bench::ray_hash(
+            reinterpret_cast<const RTCRayHit*>(reinterpret_cast<const char*>(rh) + i * stride)->ray);
+    recorder.streams_hash.add(hash);
+    thread_local cambium::bench::LogCursor at;
+    recorder.streams.record_stream(rh, m, stride, at);
+    embree().intersect_stream(s, c, rh, m, stride);
+}
+
+void record_occluded(RTCScene s, RTCIntersectContext* c, RTCRay* r)
+{
+    recorder.occlusions.add();
+    note_call(s);
+    const cambium::render::PrimId skip = skip_of(c);
+    recorder.occlusions_hash.add(cambium::bench::ray_hash(*r, skip));
+    thread_local cambium::bench::LogCursor at;
+    recorder.occlusion_rays.record(*r, at, skip);
+    embree().occluded(s, c, r);
+}
+
+// ---- The timed render: its first call notes the time, then every call forwards
+
+void open_timed_trace(RTCScene scene)
+{
+    std::lock_guard lock(recorder.mutex);
+    if (recorder.timed_started)
+        return;
+    recorder.timed_first_call = cambium::bench::Clock::now();
+    recorder.timed_first_call_cpu = cambium::bench::process_cpu_seconds();
+    recorder.scene = scene;
+    set_forwarding();
+    recorder.timed_started = true;
+}
+
+void timed_intersect(RTCScene s, RTCIntersectContext* c, RTCRayHit* rh)
+{
+    open_timed_trace(s);
+    embree().intersect(s, c, rh);
+}
+void timed_intersect_stream(RTCScene s, RTCIntersectContext* c, RTCRayHit* rh, unsigned m,
+                            size_t stride)
+{
+    open_timed_trace(s);
+    embree().intersect_stream(s, c, rh, m, stride);
+}
+void timed_occluded(RTCScene s, RTCIntersectContext* c, RTCRay* r)
+{
+    open_timed_trace(s);
+    embree().occluded(s, c, r);
+}
+
+}  // namespace
+
+extern "C" void rtcIntersect1(RTCScene scene, RTCIntersectContext* context, RTCRayHit* rayhit)
+{
+    intersect_entry.load(std::memory_order_relaxed)(scene, context, rayhit);
+}
+
+extern "C" void rtcIntersect1M(RTCScene scene, RTCIntersectContext* context, RTCRayHit* rayhit,
+                               unsigned int m, size_t byte_stride)
+{
+    intersect_stream_entry.load(std::memory_order_relaxed)(scene, context, rayhit, m,
+                                                           byte_stride);
 }
 
 extern "C" void rtcOccluded1(RTCScene scene, RTCIntersectContext* context, RTCRay* ray)
 {
-    recorder.occlusions.add();
-    if (recorder.recording.load(std::memory_order_relaxed)) {
-        note_call(scene);
-        thread_local cambium::bench::LogCursor at;
-        recorder.occlusion_rays.record(*ray, at, skip_of(context));
-    }
-    real_occluded()(scene, context, ray);
+    occluded_entry.load(std::memory_order_relaxed)(scene, context, ray);
 }
 
 // ---- The replay --------------------------------------------------------------------------
@@ -233,7 +335,7 @@ double replay(RTCScene scene, const RayLog& log, bool occlusion, std::uint64_t& 
                 c.skip = log.skips[i];
             if (occlusion) {
                 RTCRay ray = rays[i];
-                real_occluded()(scene, &c.context, &ray);
+                embree().occluded(scene, &c.context, &ray);
                 local += ray.tfar < 0 ? 1 : 0;
                 continue;
             }
@@ -241,7 +343,7 @@ double replay(RTCScene scene, const RayLog& log, bool occlusion, std::uint64_t& 
             rh.ray = rays[i];
             rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
             rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-            real_intersect()(scene, &c.context, &rh);
+            embree().intersect(scene, &c.context, &rh);
             local += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
         }
         hit_count += local;
@@ -276,7 +378,7 @@ double replay_streams(RTCScene scene, const std::vector<RTCRay>& rays, std::uint
                 batch[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
                 batch[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
             }
-            real_intersect_stream()(scene, &c.context, batch.data(), m, sizeof(RTCRayHit));
+            embree().intersect_stream(scene, &c.context, batch.data(), m, sizeof(RTCRayHit));
             for (unsigned k = 0; k < m; ++k)
                 local += batch[k].hit.geomID != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
         }
@@ -290,7 +392,25 @@ double replay_streams(RTCScene scene, const std::vector<RTCRay>& rays, std::uint
 
 std::size_t one_in(std::size_t keep, std::uint64_t expected)
 {
-    return keep > 0 && expected > keep ? std::size_t(expected / keep) : 1;
+    return keep > 0 && expected > keep ? std::size_t((expected + keep - 1) / keep) : 1;
+}
+
+std::uint64_t ray_hash(const RTCRay& r, const render::PrimId& skip)
+{
+    // RTCRay is twelve 4-byte fields; id (which the path tracer leaves unset) is left out.
+    const std::array<float, 9> f{r.org_x, r.org_y, r.org_z, r.tnear, r.dir_x,
+                                 r.dir_y, r.dir_z, r.time,  r.tfar};
+    std::uint64_t h = 0x243f6a8885a308d3ULL;
+    for (std::size_t i = 0; i < f.size(); i += 2) {
+        std::uint32_t lo = 0, hi = 0;
+        std::memcpy(&lo, &f[i], 4);
+        if (i + 1 < f.size())
+            std::memcpy(&hi, &f[i + 1], 4);
+        h = render::mix64(h ^ (std::uint64_t{hi} << 32 | lo));
+    }
+    h = render::mix64(h ^ (std::uint64_t{r.mask} << 32 | r.flags));
+    h = render::mix64(h ^ (std::uint64_t{skip.geom} << 32 | skip.prim));
+    return render::mix64(h ^ skip.inst);
 }
 
 void Recorder::prepare(std::size_t keep, std::uint64_t expected_singles,
@@ -304,6 +424,10 @@ void Recorder::prepare(std::size_t keep, std::uint64_t expected_singles,
     streams.prepare(keep, false, one_in(aim, expected_streams));
 }
 
+void Recorder::forward() { set_forwarding(); }
+
+void Recorder::count() { set_entries(&count_intersect, &count_intersect_stream, &count_occluded); }
+
 void Recorder::start()
 {
     started = false;
@@ -311,25 +435,49 @@ void Recorder::start()
     m_intersections0 = intersections.total();
     m_occlusions0 = occlusions.total();
     m_streams0 = stream_intersections.total();
-    recording = true;
+    m_hashes0[0] = singles_hash.total();
+    m_hashes0[1] = occlusions_hash.total();
+    m_hashes0[2] = streams_hash.total();
+    set_entries(&record_intersect, &record_intersect_stream, &record_occluded);
 }
 
 void Recorder::stop()
 {
     const Clock::time_point end = Clock::now();
     const double end_cpu = process_cpu_seconds();
-    recording = false;
+    set_forwarding();
     m_trace = {};
     m_trace.intersections = intersections.total() - m_intersections0;
     m_trace.occlusions = occlusions.total() - m_occlusions0;
     m_trace.stream_intersections = stream_intersections.total() - m_streams0;
+    m_trace.singles_hash = singles_hash.total() - m_hashes0[0];
+    m_trace.occlusions_hash = occlusions_hash.total() - m_hashes0[1];
+    m_trace.streams_hash = streams_hash.total() - m_hashes0[2];
     if (started) {  // else the render traced no ray: no trace to time
-        m_trace.trace_s = std::chrono::duration<double>(end - first_call).count();
-        m_trace.trace_cpu_s = end_cpu - first_call_cpu;
+        m_trace.recording_trace_s = std::chrono::duration<double>(end - first_call).count();
+        m_trace.recording_trace_cpu_s = end_cpu - first_call_cpu;
     }
     singles.compact();
     occlusion_rays.compact();
     streams.compact();
+}
+
+void Recorder::start_timed()
+{
+    timed_started = false;
+    scene = nullptr;
+    set_entries(&timed_intersect, &timed_intersect_stream, &timed_occluded);
+}
+
+void Recorder::stop_timed()
+{
+    const Clock::time_point end = Clock::now();
+    const double end_cpu = process_cpu_seconds();
+    set_forwarding();
+    if (timed_started) {
+        m_trace.trace_s = std::chrono::duration<double>(end - timed_first_call).count();
+        m_trace.trace_cpu_s = end_cpu - timed_first_call_cpu;
+    }
 }
 
 namespace {
@@ -340,7 +488,7 @@ namespace {
 /// adding up rays replayed, hits, wall and CPU seconds.
 template <typename Once>
 void replay_rounds(Once once, std::size_t recorded, std::size_t& replayed, std::uint64_t& hits,
-                   double& seconds, double& cpu_seconds)
+                   double& seconds, double& cpu_seconds, double& first_cpu_seconds)
 {
     constexpr double min_cpu_s = 0.1;
     for (int round = 0; recorded > 0 && round < 32 && cpu_seconds < min_cpu_s; ++round) {
@@ -348,6 +496,8 @@ void replay_rounds(Once once, std::size_t recorded, std::size_t& replayed, std::
         std::uint64_t round_hits = 0;
         seconds += once(round_hits);
         cpu_seconds += process_cpu_seconds() - cpu0;
+        if (round == 0)
+            first_cpu_seconds = cpu_seconds;
         hits += round_hits;
         replayed += recorded;
     }
@@ -361,16 +511,17 @@ TraceFigures Recorder::replay()
     RawFigures& raw = t.raw;
     if (!scene)
         return t;
+    t.first_rays = {singles.rays.size(), occlusion_rays.rays.size(), streams.rays.size()};
     replay_rounds([&](std::uint64_t& hits) { return bench::replay(scene, singles, false, hits); },
                   singles.rays.size(), raw.singles, raw.hits, raw.intersect_s,
-                  raw.intersect_cpu_s);
+                  raw.intersect_cpu_s, raw.intersect_first_cpu_s);
     replay_rounds(
         [&](std::uint64_t& hits) { return bench::replay(scene, occlusion_rays, true, hits); },
         occlusion_rays.rays.size(), raw.occlusions, raw.occluded, raw.occluded_s,
-        raw.occluded_cpu_s);
+        raw.occluded_cpu_s, raw.occluded_first_cpu_s);
     replay_rounds([&](std::uint64_t& hits) { return replay_streams(scene, streams.rays, hits); },
                   streams.rays.size(), raw.streams, raw.stream_hits, raw.stream_s,
-                  raw.stream_cpu_s);
+                  raw.stream_cpu_s, raw.stream_first_cpu_s);
     return t;
 }
 
@@ -401,6 +552,14 @@ double TraceFigures::raw_mix_cpu_s() const
            raw_seconds_for(occlusions, raw.occluded_cpu_s, raw.occlusions);
 }
 
+double TraceFigures::raw_mix_first_round_cpu_s() const
+{
+    // A first round replays each recorded ray of its kind once (first_rays).
+    return raw_seconds_for(single_intersections(), raw.intersect_first_cpu_s, first_rays[0]) +
+           raw_seconds_for(stream_intersections, raw.stream_first_cpu_s, first_rays[2]) +
+           raw_seconds_for(occlusions, raw.occluded_first_cpu_s, first_rays[1]);
+}
+
 double TraceFigures::raw_rays_per_s() const
 {
     double s = raw_mix_s();
@@ -416,6 +575,47 @@ double TraceFigures::path_tracer_fraction_of_raw() const
 double TraceFigures::path_tracer_fraction_of_raw_cpu() const
 {
     return trace_cpu_s > 0 ? raw_mix_cpu_s() / trace_cpu_s : 0;
+}
+
+}  // namespace cambium::bench
+
+namespace cambium::bench {
+
+Measurement measure(const geom::Scene& scene, const render::Camera& camera,
+                    render::RenderSettings settings)
+{
+    Measurement m;
+    settings.passes = 1;  // one pass a render: its on_pass is the end of its tracing
+    int renders_ended = 0;
+    settings.on_pass = [&](const render::Image&) {
+        if (renders_ended++ == 0) {
+            recorder.stop();
+            recorder.start_timed();
+        } else {
+            recorder.stop_timed();
+            m.trace = recorder.replay();  // in the render's arena: on its threads
+        }
+    };
+    render::Image recorded;
+    const std::array<render::Camera, 2> cameras{camera, camera};
+    recorder.start();
+    render::render_views(scene, cameras, settings,
+                         [&](std::size_t view, render::Image& image, const render::RenderReport& r) {
+        if (view == 0) {
+            m.recording = r;
+            recorded = std::move(image);
+            return true;
+        }
+        m.timed = r;
+        m.same_render = r.samples == m.recording.samples && r.rays == m.recording.rays &&
+                        image.rgba.size() == recorded.rgba.size() &&
+                        std::memcmp(image.rgba.data(), recorded.rgba.data(),
+                                    image.rgba.size() * sizeof(float)) == 0;
+        m.image = std::move(image);
+        return true;
+    });
+    recorder.forward();  // whatever happened (a render with no pass calls no on_pass)
+    return m;
 }
 
 }  // namespace cambium::bench

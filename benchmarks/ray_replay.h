@@ -34,6 +34,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstddef>
@@ -41,8 +42,11 @@
 #include <mutex>
 #include <vector>
 
+#include "geom/scene.h"
 #include "render/accel.h"
+#include "render/camera.h"
 #include "render/ray_counter.h"
+#include "render/render.h"
 
 namespace cambium::bench {
 
@@ -128,25 +132,42 @@ private:
     bool take_chunk(LogCursor& at);
 };
 
-/// One group in how many to record so that about `keep` of `expected` rays are kept
-/// (1 when expected is 0 or at most keep).
+/// One group in how many to record so that at most about `keep` of `expected` rays are
+/// kept (rounded up: rounded down, a log of `keep` slots filled before the trace ended and
+/// its last part was never replayed; 1 when expected is 0 or at most keep).
 std::size_t one_in(std::size_t keep, std::uint64_t expected);
 
+/// An order-independent fingerprint of rays: the sum of a hash of each ray's input (origin,
+/// direction, span, mask, flags) and, for single rays, the primitive it skips. Equal sums
+/// over two renders say they traced the same rays, whatever the threads' order.
+std::uint64_t ray_hash(const RTCRay& r, const render::PrimId& skip = {});
+
 /// Raw Embree on the recorded rays of each kind: rays replayed (each recorded ray as many
-/// times as its kind was replayed), hits, wall and CPU seconds.
+/// times as its kind was replayed), hits, wall and CPU seconds, and the first round's CPU
+/// seconds alone (a round traces every recorded ray of its kind once).
 struct RawFigures {
     std::size_t singles = 0, occlusions = 0, streams = 0;  ///< rays replayed
     std::uint64_t hits = 0, occluded = 0, stream_hits = 0;
     double intersect_s = 0, occluded_s = 0, stream_s = 0;
     double intersect_cpu_s = 0, occluded_cpu_s = 0, stream_cpu_s = 0;
+    double intersect_first_cpu_s = 0, occluded_first_cpu_s = 0, stream_first_cpu_s = 0;
 };
 
 /// What the trace did and what raw Embree needs for the same rays (see the top).
 struct TraceFigures {
-    std::uint64_t intersections = 0, occlusions = 0;  ///< traced between start and stop
+    /// Traced in the recording render (the timed render traces the same rays).
+    std::uint64_t intersections = 0, occlusions = 0;
     std::uint64_t stream_intersections = 0;  ///< of `intersections`: camera rays in streams
-    double trace_s = 0, trace_cpu_s = 0;  ///< first Embree call to stop()
+    /// ray_hash summed over the recording render's rays of each kind.
+    std::uint64_t singles_hash = 0, occlusions_hash = 0, streams_hash = 0;
+    double trace_s = 0, trace_cpu_s = 0;  ///< the timed render: first Embree call to its end
+    /// The recording render's span (the trace with the interposer counting, hashing and
+    /// recording every ray: what the timed render no longer pays).
+    double recording_trace_s = 0, recording_trace_cpu_s = 0;
     RawFigures raw;
+    /// Rays each kind's first replay round traced (singles, occlusions, streams): all
+    /// that were recorded.
+    std::array<std::size_t, 3> first_rays{};
 
     std::uint64_t rays() const { return intersections + occlusions; }
     std::uint64_t single_intersections() const { return intersections - stream_intersections; }
@@ -154,41 +175,56 @@ struct TraceFigures {
     double raw_mix_s() const;
     /// Raw Embree's CPU seconds for the trace's mix of rays, at the replayed rates.
     double raw_mix_cpu_s() const;
+    /// The same at the rates of each kind's first (coldest) replay round alone.
+    double raw_mix_first_round_cpu_s() const;
     double raw_rays_per_s() const;  ///< wall
     double path_tracer_fraction_of_raw() const;      ///< wall rates
     double path_tracer_fraction_of_raw_cpu() const;  ///< raw_mix_cpu_s / trace_cpu_s
 };
 
-/// The process's one recorder (the interposed entry points write into it).
+/// The process's one recorder (the interposed entry points write into it). The entry
+/// points do one of four things, set here (each a pointer they jump through):
+/// - forward (the default): straight to Embree's own function, counting nothing;
+/// - count(): count each ray by kind, then forward (the pilot render);
+/// - start() .. stop(): count, hash and record a subsample (the recording render);
+/// - start_timed() .. stop_timed(): the first call notes the time and switches to
+///   forwarding, so the timed render's rays go straight to Embree.
 struct Recorder {
     render::RayCounter intersections, occlusions;  // per thread, uncontended; every ray
     render::RayCounter stream_intersections;  // of `intersections`: in streams
+    render::RayCounter singles_hash, occlusions_hash, streams_hash;  // sums of ray_hash
     RayLog singles, occlusion_rays, streams;
-    std::atomic<bool> recording{false};
     std::atomic<bool> started{false};  ///< the first Embree call since start() was seen
     Clock::time_point first_call;
     double first_call_cpu = 0;
     double rss_at_first_call = 0;  ///< peak RSS then, less the logs
+    std::atomic<bool> timed_started{false};  ///< the same since start_timed()
+    Clock::time_point timed_first_call;
+    double timed_first_call_cpu = 0;
     RTCScene scene = nullptr;      ///< the render's, alive until render() returns
     std::mutex mutex;
 
     /// Allocates and touches logs of `keep` slots for each kind. Given the count of a kind
-    /// expected in the trace, one group in k is recorded so that about 3/4 keep are
-    /// (0 or at most that many expected: every ray, up to `keep`).
+    /// expected in the trace, one group in k is recorded so that at most about 3/4 keep
+    /// are (0 or at most that many expected: every ray, up to `keep`).
     void prepare(std::size_t keep, std::uint64_t expected_singles,
                  std::uint64_t expected_occlusions, std::uint64_t expected_streams);
-    /// Starts a trace: the next Embree call opens it.
+    /// The entry points forward every ray to Embree, counting nothing.
+    void forward();
+    /// The entry points count every ray by kind, then forward it.
+    void count();
+    /// Starts recording: the next Embree call opens the recording render's trace.
     void start();
-    /// Ends the trace (call it first thing in on_pass) and keeps the rays recorded.
+    /// Ends recording (call it first thing in the recording render's on_pass), keeps the
+    /// rays recorded and forwards from now on.
     void stop();
-    /// Raw Embree on the recorded rays, on the render's scene, in the caller's arena (in
-    /// on_pass, after stop()). Returns the trace's figures.
+    /// The next Embree call opens the timed trace; every call goes straight to Embree.
+    void start_timed();
+    /// Ends the timed trace (first thing in the timed render's on_pass).
+    void stop_timed();
+    /// Raw Embree on the recorded rays, on the timed render's scene, in the caller's arena
+    /// (in its on_pass, after stop_timed()). Returns the trace's figures.
     TraceFigures replay();
-    /// Rays counted so far, of every kind.
-    std::uint64_t rays_traced() const
-    {
-        return intersections.total() + occlusions.total();
-    }
     /// The logs' memory.
     std::size_t log_bytes() const
     {
@@ -197,9 +233,25 @@ struct Recorder {
 
 private:
     std::uint64_t m_intersections0 = 0, m_occlusions0 = 0, m_streams0 = 0;
+    std::uint64_t m_hashes0[3] = {0, 0, 0};
     TraceFigures m_trace;
 };
 
 extern Recorder recorder;
+
+/// The recording render and the timed render (one render_views call of two views of the
+/// same camera: one BVH, the same settings and rays), with the raw replay at the timed
+/// render's end. The logs must be prepared; settings.passes is set to 1 and on_pass used.
+struct Measurement {
+    TraceFigures trace;
+    render::RenderReport recording, timed;  ///< each render's report (its own ray count)
+    render::Image image;                    ///< the timed render's
+    /// Whether the two renders made the same image, bit for bit, with the same samples
+    /// and rays by the renderer's own count: the timed render traced the recorded rays.
+    bool same_render = false;
+};
+Measurement measure(const geom::Scene& scene, const render::Camera& camera,
+                    render::RenderSettings settings);
+
 
 }  // namespace cambium::bench

@@ -245,7 +245,6 @@ int run(int argc, char** argv)
     settings.threads = threads;
     settings.ambient = {0.1f, 0.1f, 0.1f};
     settings.aovs = false;  // the path tracer alone
-    settings.passes = 1;    // one pass: its end (on_pass) is the end of tracing
     settings.skip_empty_pixels = skip_empty_pixels;
     auto camera = cambium::render::make_camera(scene.view, scene.bounds, width, height);
     std::size_t built_segments = 0;
@@ -255,9 +254,9 @@ int run(int argc, char** argv)
             scene.geometry.lines.segment_count() + scene.geometry.curves.segment_count();
     });
 
-    // The path tracer, counted by the interposer; the raw replay at the end of its pass,
-    // while its Embree scene is alive.
-    // The logs are allocated and touched here, before the trace. Camera rays (streams):
+    // The path tracer twice, the first render recorded by the interposer, the second timed
+    // without it; the raw replay at the end of the second, while its Embree scene is alive.
+    // The logs are allocated and touched here, before the renders. Camera rays (streams):
     // their count is known, so one run of streams in k is recorded, about 300 k rays.
     // Bounces and shadow rays: every one, up to 2 M of each (their count is not known
     // before).
@@ -266,20 +265,15 @@ int run(int argc, char** argv)
     recorder.singles.prepare(2'000'000, true, 1);
     recorder.occlusion_rays.prepare(2'000'000, true, 1);
     recorder.streams.prepare(400'000, false, cambium::bench::one_in(300'000, camera_rays));
-    recorder.start();
-    cambium::bench::TraceFigures t;
-    settings.on_pass = [&](const cambium::render::Image&) {
-        recorder.stop();
-        arena.execute([&] { t = recorder.replay(); });
-    };
     auto r0 = Clock::now();
-    cambium::render::RenderReport report;
-    cambium::render::Image image = cambium::render::render(scene, camera, settings, &report);
+    const cambium::bench::Measurement m = cambium::bench::measure(scene, camera, settings);
+    const cambium::bench::TraceFigures& t = m.trace;
+    // From render_views() to the recording render's first ray (the BVH's build).
     double build_s = std::chrono::duration<double>(recorder.first_call - r0).count();
-    double render_s = build_s + t.trace_s;
+    double render_s = build_s + t.trace_s;  // as if the timed render had built the BVH
     double covered = 0;
-    for (std::size_t i = 3; i < image.rgba.size(); i += 4)
-        covered += image.rgba[i];
+    for (std::size_t i = 3; i < m.image.rgba.size(); i += 4)
+        covered += m.image.rgba[i];
 
     const cambium::bench::RawFigures& raw = t.raw;
     auto rate = [](std::size_t n, double s) { return s > 0 ? double(n) / s : 0.0; };
@@ -296,22 +290,29 @@ int run(int argc, char** argv)
         "\"stream_s\":%.3f,\"stream_rays_per_s\":%.0f,\"rays_per_s\":%.0f},"
         "\"stream_intersect_rays\":%llu,"
         "\"path_tracer_intersect_rays_per_s\":%.0f,\"path_tracer_fraction_of_raw\":%.3f,"
-        "\"trace_cpu_s\":%.3f,\"raw_embree_cpu_s\":%.3f,"
+        "\"timed_render\":\"the second of two identical renders, not recorded\","
+        "\"same_render\":%s,\"ray_hashes\":[\"%016llx\",\"%016llx\",\"%016llx\"],"
+        "\"trace_cpu_s\":%.3f,\"recording_trace_cpu_s\":%.3f,\"raw_embree_cpu_s\":%.3f,"
+        "\"raw_embree_first_round_cpu_s\":%.3f,"
         "\"path_tracer_fraction_of_raw_cpu\":%.3f,\"peak_rss_mb\":%.1f}\n",
         scale, threads, scene.geometry.lines.segment_count(), built_segments,
         scene.instances.size(), instances ? "true" : "false", generate_s, build_s,
         recorder.rss_at_first_call, width, height, spp, depth, render_s, t.trace_s,
-        static_cast<unsigned long long>(report.samples), covered / (double(width) * height),
+        static_cast<unsigned long long>(m.timed.samples), covered / (double(width) * height),
         static_cast<unsigned long long>(t.intersections),
         static_cast<unsigned long long>(t.occlusions), rays / t.trace_s,
-        double(report.samples) / t.trace_s, raw.singles, raw.intersect_s,
+        double(m.timed.samples) / t.trace_s, raw.singles, raw.intersect_s,
         rate(raw.singles, raw.intersect_s),
         raw.singles == 0 ? 0.0 : double(raw.hits) / double(raw.singles), raw.occlusions,
         raw.occluded_s, rate(raw.occlusions, raw.occluded_s), raw.streams, raw.stream_s,
         rate(raw.streams, raw.stream_s), t.raw_rays_per_s(),
         static_cast<unsigned long long>(t.stream_intersections),
-        double(t.intersections) / t.trace_s, t.path_tracer_fraction_of_raw(), t.trace_cpu_s,
-        t.raw_mix_cpu_s(), t.path_tracer_fraction_of_raw_cpu(), peak_rss_mb());
+        double(t.intersections) / t.trace_s, t.path_tracer_fraction_of_raw(),
+        m.same_render ? "true" : "false", static_cast<unsigned long long>(t.singles_hash),
+        static_cast<unsigned long long>(t.streams_hash),
+        static_cast<unsigned long long>(t.occlusions_hash), t.trace_cpu_s,
+        t.recording_trace_cpu_s, t.raw_mix_cpu_s(), t.raw_mix_first_round_cpu_s(),
+        t.path_tracer_fraction_of_raw_cpu(), peak_rss_mb());
     return 0;
 }
 
