@@ -181,6 +181,14 @@ void set_entries(Intersect1 i, Intersect1M m, Occluded1 o)
     occluded_entry.store(o, std::memory_order_relaxed);
 }
 
+/// Whether every entry point is Embree's own function.
+bool forwarding()
+{
+    const EmbreeEntries& e = embree();
+    return intersect_entry.load() == e.intersect &&
+           intersect_stream_entry.load() == e.intersect_stream && occluded_entry.load() == e.occluded;
+}
+
 void set_forwarding()
 {
     const EmbreeEntries& e = embree();
@@ -473,6 +481,7 @@ void Recorder::stop_timed()
 {
     const Clock::time_point end = Clock::now();
     const double end_cpu = process_cpu_seconds();
+    m_trace.timed_forwarded = timed_started && forwarding();
     set_forwarding();
     if (timed_started) {
         m_trace.trace_s = std::chrono::duration<double>(end - timed_first_call).count();

@@ -161,6 +161,9 @@ struct TraceFigures {
     /// ray_hash summed over the recording render's rays of each kind.
     std::uint64_t singles_hash = 0, occlusions_hash = 0, streams_hash = 0;
     double trace_s = 0, trace_cpu_s = 0;  ///< the timed render: first Embree call to its end
+    /// Whether the timed render's calls went straight to Embree's own entry points from
+    /// its first call to its end.
+    bool timed_forwarded = false;
     /// The recording render's span (the trace with the interposer counting, hashing and
     /// recording every ray: what the timed render no longer pays).
     double recording_trace_s = 0, recording_trace_cpu_s = 0;
