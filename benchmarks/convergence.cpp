@@ -12,7 +12,7 @@
 //   build/benchmarks/convergence [--plant NAME]... [--sampler sobol|white|both]
 //       [--size WxH] [--threads N] [--max-spp N] [--reference-spp N] [--target NOISE]
 //       [--adaptive NOISE] [--export-scene FOLDER] [--raw-embree-only | --no-raw-embree]
-//       [--trace-empty-pixels]
+//       [--trace-empty-pixels] [--record-slots N]
 //
 // Defaults: the five plants below, both samplers, 320x240, 2 threads, up to 64 spp, a
 // 1024-spp Sobol reference. The noise target (time_to_target_s) is, unless given, white
@@ -28,21 +28,30 @@
 // the target with the set-up (wall, CPU) and without it (`time_to_target_render_s`,
 // `time_to_target_render_cpu_s`).
 //
-// The path tracer against raw Embree (`"raw_embree_measurement":true` lines): one more
-// render of each plant at --max-spp, with Sobol (the renderer's default; white noise only
-// when it alone is asked for) and the measured renders' settings, in a single pass so
-// that on_pass marks the end of the trace. The interposer of ray_replay.h records a
-// subsample of its rays (about 300 k of each kind; a pilot render at an eighth of the spp
-// counts them first) and replays them with raw Embree on the render's scene and threads.
-// Fields: the rays traced by kind, what was recorded (`one_in`: one run of rays in k) and
-// replayed, `trace_s` / `trace_cpu_s` (first Embree call of the pixel loop to the end of
-// the pass), `raw_embree_cpu_s` (raw Embree's CPU seconds for the same numbers of rays of
-// each kind), `path_tracer_rays_per_s`, `raw_embree_rays_per_s` (wall) and
+// The path tracer against raw Embree (`"raw_embree_measurement":true` lines): two more
+// renders of each plant at --max-spp, with Sobol (the renderer's default; white noise only
+// when it alone is asked for) and the measured renders' settings, each in a single pass so
+// that on_pass marks the end of its trace, in one render_views call (one BVH;
+// bench::measure in ray_replay.h). The first, the recording render, has the interposer
+// count its rays by kind, hash them and record a subsample (about 300 k of each kind; a
+// pilot render at an eighth of the spp counts them first). The second, the timed render,
+// traces the same rays (same image, samples and renderer's ray count: `same_render`) with
+// the interposer forwarding straight to Embree, and ends with the raw replay of the
+// recorded rays on its scene and threads. Fields: the rays traced by kind (the recording's
+// count) and their hashes (`ray_hashes`: singles, streams, shadow rays; equal at any
+// thread count), what was recorded (`one_in`: one run of rays in k) and replayed,
+// `trace_s` / `trace_cpu_s` (the timed render: first Embree call of the pixel loop to the
+// end of the pass), `recording_trace_cpu_s` (the recording render's, with the interposer's
+// work), `raw_embree_cpu_s` (raw Embree's CPU seconds for the same numbers of rays of
+// each kind; `raw_embree_first_round_cpu_s` at the first replay round's rates alone),
+// `path_tracer_rays_per_s`, `raw_embree_rays_per_s` (wall) and
 // `path_tracer_fraction_of_raw_cpu` (raw_embree_cpu_s / trace_cpu_s: issue 16 asks for at
 // least 0.8). These renders come after every series so that the logs' memory stays out
 // of the series' peak RSS. --raw-embree-only runs only them (no references are needed);
-// --no-raw-embree leaves them out. --trace-empty-pixels traces the camera rays of pixels
-// no primitive reaches too (RenderSettings::skip_empty_pixels off: the same images).
+// --no-raw-embree leaves them out; --record-slots N sets the log's slots per kind
+// (400 000; enough slots for every ray records and replays all of them).
+// --trace-empty-pixels traces the camera rays of pixels no primitive reaches too
+// (RenderSettings::skip_empty_pixels off: the same images).
 //
 // --adaptive NOISE instead renders once with adaptive sampling to that noise target (up
 // to --max-spp) and prints its mean spp, wall and CPU seconds and the error reached:
@@ -78,10 +87,10 @@
 
 namespace fs = std::filesystem;
 
-// Rays are counted (and, for the raw-Embree measurement, recorded and replayed) by the
-// interposer of ray_replay.h: this executable's rtcIntersect1 / rtcIntersect1M /
-// rtcOccluded1 count each ray per thread and forward to Embree's (cambium_render is static
-// and links to them).
+// The series count rays with the renderer's own counter (RenderReport::rays). This
+// executable's rtcIntersect1 / rtcIntersect1M / rtcOccluded1 are the interposer of
+// ray_replay.h (cambium_render is static and links to them): they forward straight to
+// Embree's except in the pilot (counting) and the recording render.
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -119,6 +128,9 @@ struct Settings {
     bool series = true;      ///< the convergence series (off: --raw-embree-only)
     bool raw_embree = true;  ///< the raw-Embree measurement (off: --no-raw-embree)
     bool skip_empty_pixels = true;  ///< off: --trace-empty-pixels
+    /// --record-slots: the raw-Embree measurement's log slots per kind of ray (about 3/4
+    /// of them are aimed at; enough for every ray replays them all, once each).
+    std::size_t record_slots = 400'000;
 };
 
 /// The process's CPU time so far, user + sys, in seconds.
@@ -456,7 +468,7 @@ void run_raw_embree(const std::string& plant, const cambium::geom::Scene& scene,
     // As render(scene, settings) frames it (these settings have no lens).
     const render::Camera camera = render::make_camera(scene.view, scene.bounds, s.width, s.height);
     // The logs are allocated and touched here, before the renders.
-    recorder.prepare(400'000, expected.singles, expected.occlusions, expected.streams);
+    recorder.prepare(s.record_slots, expected.singles, expected.occlusions, expected.streams);
     report_raw_embree(plant, s, sampler, cambium::bench::measure(scene, camera, rs));
 }
 
@@ -554,6 +566,10 @@ Settings parse(int argc, char** argv)
             s.series = false;
         } else if (arg == "--no-raw-embree") {
             s.raw_embree = false;
+        } else if (arg == "--record-slots") {
+            s.record_slots = std::stoul(value());
+            if (s.record_slots < cambium::bench::RayLog::chunk)
+                throw std::runtime_error("--record-slots: at least 4096");
         } else if (arg == "--trace-empty-pixels") {
             s.skip_empty_pixels = false;
         } else if (arg == "--export-scene") {

@@ -4,32 +4,44 @@
 //
 // How it works: ray_replay.cpp defines rtcIntersect1, rtcIntersect1M and rtcOccluded1.
 // cambium_render is a static library, so the executable's calls resolve to these
-// definitions, which count each ray per thread and forward to Embree's own (found with
-// dlsym(RTLD_NEXT)). Between start() and stop() they also record a systematic subsample of
-// the rays of each kind: single intersection rays (bounces), occlusion (shadow) rays, and
+// definitions, which jump through a pointer to what they do now (Recorder below):
+// Embree's own function (found with dlsym(RTLD_NEXT); the default), or a wrapper that
+// counts each ray per thread, or one that also hashes it and records a systematic
+// subsample of each kind: single intersection rays (bounces), occlusion (shadow) rays, and
 // the camera rays the renderer traces as coherent streams (rtcIntersect1M, kept as whole
-// streams). The benchmark calls stop() and replay() from RenderSettings::on_pass at the end
-// of a render's single pass, while the render's Embree scene and the buffers it shares are
-// alive: replay() traces the recorded rays again with raw Embree calls on that scene, on
-// the caller's arena, singles and shadow rays one at a time, streams as the same streams
-// with a coherent context, each ray with the primitive the path tracer's ray skipped.
+// streams).
 //
-// The figures: the trace is the span from the first Embree call after start() (the first
-// ray of the pixel loop: the set-up traces none) to stop(), in wall and process CPU
-// seconds. Each kind is replayed again and again until it has taken 0.1 CPU s (a replay of
-// a few milliseconds is mostly thread wake-up). Raw Embree's CPU seconds for the same rays
-// are, per kind, the traced count times the replay's CPU seconds per replayed ray;
-// path_tracer_fraction_of_raw_cpu is
-// their sum over the trace's CPU seconds (CPU time, unlike wall time, does not measure
-// the neighbours on a loaded machine).
+// measure() renders the same view twice with the same settings in one render_views call
+// (one BVH, each render a single pass). Renders are deterministic: the same rays for the
+// same settings at any thread count (the rays' hashes agree; ray_replay_test checks it).
+// - The recording render counts, hashes and records its rays. Its on_pass stops the
+//   recording and sets the entry points to open the timed trace.
+// - The timed render's first Embree call notes the time and sets every entry point to
+//   Embree's own function: from then on the renderer's calls jump straight to Embree,
+//   through one pointer, as a call through the PLT does. Its on_pass ends the trace and
+//   replays the recorded rays with raw Embree calls on its scene, on its arena, singles
+//   and shadow rays one at a time, streams as the same streams with a coherent context,
+//   each ray with the primitive the path tracer's ray skipped.
+// The two renders must make the same image with the same samples and the same ray count
+// by the renderer's own counter (RenderReport::rays): `same_render`.
 //
-// What recording costs the trace (it is charged to the path tracer): a relaxed load and
-// a per-thread add per ray, and a 48-byte store (plus 12 bytes for the skipped
-// primitive) per recorded ray. To keep that small the recorder keeps only every k-th
-// group of each thread's rays (runs of RayLog::chunk consecutive rays, or of whole streams
-// of about as many), k chosen per kind from the expected count; the slots are
-// handed out a chunk at a time (one atomic add per chunk) and allocated and touched in
-// prepare(), before the trace starts.
+// The figures: the trace is the timed render's span from its first Embree call (the first
+// ray of the pixel loop: the set-up traces none) to its on_pass, in wall and process CPU
+// seconds; the rays it traced by kind are the recording render's counts. Each kind is
+// replayed again and again until it has taken 0.1 CPU s (a replay of a few milliseconds
+// is mostly thread wake-up). Raw Embree's CPU seconds for the same rays are, per kind, the
+// traced count times the replay's CPU seconds per replayed ray;
+// path_tracer_fraction_of_raw_cpu is their sum over the trace's CPU seconds (CPU time,
+// unlike wall time, does not measure the neighbours on a loaded machine). The recording
+// render's span is reported too (recording_trace_cpu_s): the trace with the interposer's
+// counting, hashing and recording, which the timed render no longer pays.
+//
+// What recording costs (the recording render only): a relaxed load and a per-thread add
+// per ray, a hash, and a 48-byte store (plus 12 bytes for the skipped primitive) per
+// recorded ray. The recorder keeps every k-th group of each thread's rays (runs of
+// RayLog::chunk consecutive rays, or of whole streams of about as many), k chosen per kind
+// from the expected count; the slots are handed out a chunk at a time (one atomic add per
+// chunk) and allocated and touched in prepare(), before the renders.
 #pragma once
 
 #include <embree3/rtcore.h>

@@ -9,17 +9,21 @@
 // Default (scale 1): 1 M round linear segments in 5 000 branches plus 100 000 instances
 // of a 6-triangle leaf prototype; 320x240 at 16 spp, depth 4.
 //
-// The path tracer's rays are counted, recorded and replayed with raw Embree by the
-// interposer in ray_replay.h (shared with the convergence benchmark): when the render's
-// one pass ends (on_pass, while its Embree scene and the buffers it shares are alive)
-// the recorded rays are traced again with raw rtcIntersect1 / rtcIntersect1M /
-// rtcOccluded1 on that same scene and the same threads (camera rays: a subsample of
-// about 300 k in runs of whole streams; bounce and shadow rays: every one, up to 2 M of
-// each; each kind replayed until it has taken 0.1 CPU s). The render builds the BVH once:
-// build_s is the time from render() to its first ray. path_tracer_fraction_of_raw
-// compares wall-clock rates; path_tracer_fraction_of_raw_cpu compares the CPU seconds of
-// the trace with raw Embree's CPU seconds for the same number of rays of each kind, which
-// a loaded machine does not skew.
+// The path tracer renders the plant twice in one render_views call (one BVH build;
+// bench::measure in ray_replay.h): the first render's rays are counted, hashed and
+// recorded by the interposer, the second, the same render again (`same_render`), is timed
+// with the interposer forwarding straight to Embree. At the end of its pass (on_pass,
+// while its Embree scene and the buffers it shares are alive) the recorded rays are traced
+// again with raw rtcIntersect1 / rtcIntersect1M / rtcOccluded1 on that scene and the
+// same threads (camera rays: a subsample of about 300 k in runs of whole streams; bounce
+// and shadow rays: every one, up to 2 M of each; each kind replayed until it has taken
+// 0.1 CPU s). build_s is the time from render_views() to the recording render's first
+// ray; render_s adds the timed trace. path_tracer_fraction_of_raw compares wall-clock
+// rates; path_tracer_fraction_of_raw_cpu compares the CPU seconds of the timed trace with
+// raw Embree's CPU seconds for the same number of rays of each kind, which a loaded
+// machine does not skew. recording_trace_cpu_s is the recording render's trace (with the
+// interposer's work), raw_embree_first_round_cpu_s raw Embree's at each kind's first
+// replay round alone.
 #include <array>
 #include <chrono>
 #include <cmath>
