@@ -33,8 +33,9 @@
 // when it alone is asked for) and the measured renders' settings, each in a single pass so
 // that on_pass marks the end of its trace, in one render_views call (one BVH;
 // bench::measure in ray_replay.h). The first, the recording render, has the interposer
-// count its rays by kind, hash them and record a subsample (about 300 k of each kind; a
-// pilot render at an eighth of the spp counts them first). The second, the timed render,
+// count its rays by kind, hash them and record every one (a pilot render at an eighth of
+// the spp counts them first, to size the logs; where every ray would take more than 2 GiB,
+// or with --record-slots N, a subsample: one run of rays in k, about 3/4 N of each kind). The second, the timed render,
 // traces the same rays (same image, samples and renderer's ray count: `same_render`) with
 // the interposer forwarding straight to Embree, and ends with the raw replay of the
 // recorded rays on its scene and threads. Fields: the rays traced by kind (the recording's
@@ -48,8 +49,7 @@
 // `path_tracer_fraction_of_raw_cpu` (raw_embree_cpu_s / trace_cpu_s: issue 16 asks for at
 // least 0.8). These renders come after every series so that the logs' memory stays out
 // of the series' peak RSS. --raw-embree-only runs only them (no references are needed);
-// --no-raw-embree leaves them out; --record-slots N sets the log's slots per kind
-// (400 000; enough slots for every ray records and replays all of them).
+// --no-raw-embree leaves them out.
 // --trace-empty-pixels traces the camera rays of pixels no primitive reaches too
 // (RenderSettings::skip_empty_pixels off: the same images).
 //
@@ -128,9 +128,9 @@ struct Settings {
     bool series = true;      ///< the convergence series (off: --raw-embree-only)
     bool raw_embree = true;  ///< the raw-Embree measurement (off: --no-raw-embree)
     bool skip_empty_pixels = true;  ///< off: --trace-empty-pixels
-    /// --record-slots: the raw-Embree measurement's log slots per kind of ray (about 3/4
-    /// of them are aimed at; enough for every ray replays them all, once each).
-    std::size_t record_slots = 400'000;
+    /// --record-slots: the raw-Embree measurement's log slots per kind of ray, for a
+    /// subsample (about 3/4 of them are aimed at); 0 (the default): every ray.
+    std::size_t record_slots = 0;
 };
 
 /// The process's CPU time so far, user + sys, in seconds.
@@ -456,8 +456,7 @@ void report_raw_embree(const std::string& plant, const Settings& s,
 
 /// The path tracer against raw Embree on the same rays (ray_replay.h): two renders at
 /// --max-spp, as the measured renders but each in one pass, in one render_views call (one
-/// BVH): the first records its rays (a subsample of about 300 k of each kind), the
-/// second, the same render again, is timed with the interposer out of its way and ends
+/// BVH): the first records its rays (every one, or a subsample, see the top), the second, the same render again, is timed with the interposer out of its way and ends
 /// with the raw replay on its scene and threads.
 void run_raw_embree(const std::string& plant, const cambium::geom::Scene& scene,
                     const Settings& s, render::SampleSequence sampler)
@@ -468,7 +467,18 @@ void run_raw_embree(const std::string& plant, const cambium::geom::Scene& scene,
     // As render(scene, settings) frames it (these settings have no lens).
     const render::Camera camera = render::make_camera(scene.view, scene.bounds, s.width, s.height);
     // The logs are allocated and touched here, before the renders.
-    recorder.prepare(s.record_slots, expected.singles, expected.occlusions, expected.streams);
+    // Every ray, unless its logs would pass 2 GiB (a large --size or --max-spp): then a
+    // subsample of about 300 k of each kind.
+    const double every_ray_bytes =
+        1.25 * (double(expected.singles + expected.occlusions) *
+                    double(sizeof(RTCRay) + sizeof(render::PrimId)) +
+                double(expected.streams) * double(sizeof(RTCRay)));
+    const std::size_t slots =
+        s.record_slots > 0 ? s.record_slots : every_ray_bytes > 0x1p31 ? 400'000 : 0;
+    if (slots > 0)
+        recorder.prepare(slots, expected.singles, expected.occlusions, expected.streams);
+    else
+        recorder.prepare_every_ray(expected.singles, expected.occlusions, expected.streams);
     report_raw_embree(plant, s, sampler, cambium::bench::measure(scene, camera, rs));
 }
 
@@ -568,8 +578,8 @@ Settings parse(int argc, char** argv)
             s.raw_embree = false;
         } else if (arg == "--record-slots") {
             s.record_slots = std::stoul(value());
-            if (s.record_slots < cambium::bench::RayLog::chunk)
-                throw std::runtime_error("--record-slots: at least 4096");
+            if (s.record_slots > 0 && s.record_slots < cambium::bench::RayLog::chunk)
+                throw std::runtime_error("--record-slots: 0 (every ray) or at least 4096");
         } else if (arg == "--trace-empty-pixels") {
             s.skip_empty_pixels = false;
         } else if (arg == "--export-scene") {

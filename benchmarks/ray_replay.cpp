@@ -432,6 +432,20 @@ void Recorder::prepare(std::size_t keep, std::uint64_t expected_singles,
     streams.prepare(keep, false, one_in(aim, expected_streams));
 }
 
+void Recorder::prepare_every_ray(std::uint64_t expected_singles,
+                                 std::uint64_t expected_occlusions,
+                                 std::uint64_t expected_streams)
+{
+    // Part-filled chunks: one per thread and, for streams, the end of each chunk a whole
+    // stream did not fit in (at most max_coherent_rays - 1 slots of each).
+    auto room = [](std::uint64_t expected) {
+        return std::size_t(expected + expected / 4 + 64 * RayLog::chunk);
+    };
+    singles.prepare(room(expected_singles), true, 1);
+    occlusion_rays.prepare(room(expected_occlusions), true, 1);
+    streams.prepare(room(expected_streams), false, 1);
+}
+
 void Recorder::forward() { set_forwarding(); }
 
 void Recorder::count() { set_entries(&count_intersect, &count_intersect_stream, &count_occluded); }

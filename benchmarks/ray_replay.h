@@ -6,8 +6,8 @@
 // cambium_render is a static library, so the executable's calls resolve to these
 // definitions, which jump through a pointer to what they do now (Recorder below):
 // Embree's own function (found with dlsym(RTLD_NEXT); the default), or a wrapper that
-// counts each ray per thread, or one that also hashes it and records a systematic
-// subsample of each kind: single intersection rays (bounces), occlusion (shadow) rays, and
+// counts each ray per thread, or one that also hashes it and records it, every ray or a
+// systematic subsample, by kind: single intersection rays (bounces), occlusion (shadow) rays, and
 // the camera rays the renderer traces as coherent streams (rtcIntersect1M, kept as whole
 // streams).
 //
@@ -36,9 +36,12 @@
 // render's span is reported too (recording_trace_cpu_s): the trace with the interposer's
 // counting, hashing and recording, which the timed render no longer pays.
 //
-// What recording costs (the recording render only): a relaxed load and a per-thread add
-// per ray, a hash, and a 48-byte store (plus 12 bytes for the skipped primitive) per
-// recorded ray. The recorder keeps every k-th group of each thread's rays (runs of
+// What recording costs (the recording render only, so the figures no longer depend on
+// it): a relaxed load and a per-thread add per ray, a hash, and a 48-byte store (plus 12
+// bytes for the skipped primitive) per recorded ray. Both benchmarks now record every ray
+// (prepare_every_ray; render: the camera rays): a subsample's raw rate moved from run to
+// run and with k by several percent (docs/benchmarks.md). For a subsample (prepare()),
+// the recorder keeps every k-th group of each thread's rays (runs of
 // RayLog::chunk consecutive rays, or of whole streams of about as many), k chosen per kind
 // from the expected count; the slots are handed out a chunk at a time (one atomic add per
 // chunk) and allocated and touched in prepare(), before the renders.
@@ -224,6 +227,10 @@ struct Recorder {
     /// are (0 or at most that many expected: every ray, up to `keep`).
     void prepare(std::size_t keep, std::uint64_t expected_singles,
                  std::uint64_t expected_occlusions, std::uint64_t expected_streams);
+    /// Logs for every ray of each kind: room for the expected count and a quarter more
+    /// (the expectation is a pilot's, scaled), plus part-filled chunks; one group in 1.
+    void prepare_every_ray(std::uint64_t expected_singles, std::uint64_t expected_occlusions,
+                           std::uint64_t expected_streams);
     /// The entry points forward every ray to Embree, counting nothing.
     void forward();
     /// The entry points count every ray by kind, then forward it.

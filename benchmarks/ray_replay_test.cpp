@@ -112,6 +112,33 @@ TEST(RayReplay, TheSameRaysAtAnyThreadCount)
     EXPECT_NE(fewer.singles_hash, two.singles_hash);
 }
 
+TEST(RayReplay, LogsSizedForEveryRayRecordEveryRay)
+{
+    const TraceFigures first = measure_lattice(2).trace;
+    const geom::Scene scene = lattice();
+    const render::RenderSettings rs = lattice_settings(2);
+    recorder.prepare_every_ray(first.single_intersections(), first.occlusions,
+                               first.stream_intersections);
+    const TraceFigures f =
+        measure(scene, render::make_camera(scene.view, scene.bounds, rs.width, rs.height), rs)
+            .trace;
+    EXPECT_EQ(recorder.singles.rays.size(), f.single_intersections());
+    EXPECT_EQ(recorder.occlusion_rays.rays.size(), f.occlusions);
+    EXPECT_EQ(recorder.streams.rays.size(), f.stream_intersections);
+    EXPECT_EQ(f.first_rays[2], f.stream_intersections);
+    // Every recorded ray's hash sums to the trace's: the logs hold the traced rays.
+    std::uint64_t singles = 0, occlusions = 0, streams = 0;
+    for (const RTCRay& r : recorder.streams.rays)  // (the id holds the stream's size)
+        streams += ray_hash(r);
+    for (std::size_t i = 0; i < recorder.singles.rays.size(); ++i)
+        singles += ray_hash(recorder.singles.rays[i], recorder.singles.skips[i]);
+    for (std::size_t i = 0; i < recorder.occlusion_rays.rays.size(); ++i)
+        occlusions += ray_hash(recorder.occlusion_rays.rays[i], recorder.occlusion_rays.skips[i]);
+    EXPECT_EQ(singles, f.singles_hash);
+    EXPECT_EQ(occlusions, f.occlusions_hash);
+    EXPECT_EQ(streams, f.streams_hash);
+}
+
 TEST(RayReplay, RayHashTellsRaysApart)
 {
     RTCRay r{};

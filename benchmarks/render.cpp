@@ -15,9 +15,9 @@
 // with the interposer forwarding straight to Embree. At the end of its pass (on_pass,
 // while its Embree scene and the buffers it shares are alive) the recorded rays are traced
 // again with raw rtcIntersect1 / rtcIntersect1M / rtcOccluded1 on that scene and the
-// same threads (camera rays: a subsample of about 300 k in runs of whole streams; bounce
-// and shadow rays: every one, up to 2 M of each; each kind replayed until it has taken
-// 0.1 CPU s). build_s is the time from render_views() to the recording render's first
+// same threads (camera rays: every one, as the same streams, up to 8 M, else a subsample
+// of about 300 k in runs of whole streams; bounce and shadow rays: every one, up to 2 M of
+// each; each kind replayed until it has taken 0.1 CPU s). build_s is the time from render_views() to the recording render's first
 // ray; render_s adds the timed trace. path_tracer_fraction_of_raw compares wall-clock
 // rates; path_tracer_fraction_of_raw_cpu compares the CPU seconds of the timed trace with
 // raw Embree's CPU seconds for the same number of rays of each kind, which a loaded
@@ -261,14 +261,16 @@ int run(int argc, char** argv)
     // The path tracer twice, the first render recorded by the interposer, the second timed
     // without it; the raw replay at the end of the second, while its Embree scene is alive.
     // The logs are allocated and touched here, before the renders. Camera rays (streams):
-    // their count is known, so one run of streams in k is recorded, about 300 k rays.
-    // Bounces and shadow rays: every one, up to 2 M of each (their count is not known
-    // before).
+    // every one (up to 8 M; more: one run of streams in k, about 300 k rays). Bounces and
+    // shadow rays: every one, up to 2 M of each (their count is not known before).
     const std::uint64_t camera_rays =
         std::uint64_t(width) * std::uint64_t(height) * std::uint64_t(spp);
     recorder.singles.prepare(2'000'000, true, 1);
     recorder.occlusion_rays.prepare(2'000'000, true, 1);
-    recorder.streams.prepare(400'000, false, cambium::bench::one_in(300'000, camera_rays));
+    if (camera_rays <= 8'000'000)  // every one (48 bytes each, with room for part-filled chunks)
+        recorder.streams.prepare(camera_rays + 64 * cambium::bench::RayLog::chunk, false, 1);
+    else
+        recorder.streams.prepare(400'000, false, cambium::bench::one_in(300'000, camera_rays));
     auto r0 = Clock::now();
     const cambium::bench::Measurement m = cambium::bench::measure(scene, camera, settings);
     const cambium::bench::TraceFigures& t = m.trace;
