@@ -61,7 +61,6 @@ private:
     /// The level's values at (s, t), unconverted: 4 values (grey filled out to RGB,
     /// missing alpha 1).
     void sample(const Level& level, float s, float t, float out[4]) const;
-    void fetch(const Level& level, int x, int y, float out[4]) const;
 
     std::vector<Level> m_levels;
     int m_channels;
