@@ -30,6 +30,7 @@
 #include "render/pixel_lines.h"
 #include "render/ray_counter.h"
 #include "render/texture.h"
+#include "render/tube_angle.h"
 
 namespace cambium::render {
 
@@ -202,14 +203,6 @@ std::array<float, 4> hermite_derivative(float u)
 {
     float u2 = u * u;
     return {6 * u2 - 6 * u, 3 * u2 - 4 * u + 1, -6 * u2 + 6 * u, 3 * u2 - 2 * u};
-}
-
-/// Texture s around a tube: the angle of the normal n about the axis, in [0, 1).
-float angle_around(const Vec3f& axis, const Vec3f& n)
-{
-    Vec3f t, b;
-    make_basis(normalize(axis), t, b);
-    return std::atan2(dot(n, b), dot(n, t)) / (2 * pi) + 0.5f;
 }
 
 template <class T>
