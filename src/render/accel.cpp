@@ -342,9 +342,12 @@ void set_flags(RTCGeometry g, const std::vector<std::uint8_t>& flags, std::size_
 }
 
 /// Around a tube, s runs once round the circumference; along it, t as its keys say.
+/// (The cross product's direction does not depend on ng's length: one root, one division.)
 TextureTangents tube_tangents(const Vec3f& axis, const Vec3f& ng, float radius, float dv)
 {
-    return {normalize(cross(axis, normalize(ng))) * (2 * pi * radius),
+    const Vec3f around = cross(axis, ng);
+    const float length = std::sqrt(dot(around, around));
+    return {length > 0 ? around * (2 * pi * radius / length) : around,
             dv != 0 ? axis * (1 / dv) : Vec3f()};
 }
 
