@@ -58,9 +58,9 @@ private:
         std::vector<std::uint8_t> bytes;
         std::vector<float> floats;
     };
-    /// The level's values at (s, t), unconverted: 4 values (grey filled out to RGB,
-    /// missing alpha 1).
-    void sample(const Level& level, float s, float t, float out[4]) const;
+    /// The level's values at s and `down` (both in [0, 1], down from the top row),
+    /// unconverted: 4 values (grey filled out to RGB, missing alpha 1).
+    void sample(const Level& level, float s, float down, float out[4]) const;
 
     std::vector<Level> m_levels;
     int m_channels;
