@@ -98,6 +98,12 @@ MipMap::MipMap(TexturePixels pixels, TextureFilter filter)
         (pixels.bytes.size() != values && pixels.floats.size() != values))
         throw std::invalid_argument("MipMap: empty pixels or a channel count out of 1..4");
     const bool bytes = pixels.bytes.size() == values;
+    if (has_alpha())
+        for (std::size_t i = std::size_t(m_channels) - 1; i < values; i += m_channels)
+            if (bytes ? pixels.bytes[i] < 128 : !(pixels.floats[i] >= 0.501f)) {
+                m_can_cut_out = true;
+                break;
+            }
     m_levels.push_back({pixels.width, pixels.height,
                         bytes ? std::move(pixels.bytes) : std::vector<std::uint8_t>{},
                         bytes ? std::vector<float>{} : std::move(pixels.floats)});

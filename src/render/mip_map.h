@@ -44,6 +44,10 @@ public:
 
     int channels() const { return m_channels; }
     bool has_alpha() const { return m_channels == 2 || m_channels == 4; }
+    /// Whether a lookup at the finest level can give alpha below 1/2 (the cut-out test):
+    /// false when every texel's alpha is at least 128/255 (floats: 0.501), since a blend
+    /// of such texels stays above 1/2 by far more than its rounding.
+    bool can_cut_out() const { return m_can_cut_out; }
     std::size_t levels() const { return m_levels.size(); }
     /// Bytes held by all levels.
     std::uint64_t bytes() const;
@@ -65,6 +69,7 @@ private:
     std::vector<Level> m_levels;
     int m_channels;
     bool m_srgb;
+    bool m_can_cut_out = false;
     TextureFilter m_filter;
 };
 
