@@ -30,6 +30,7 @@
 #include "render/pixel_lines.h"
 #include "render/ray_counter.h"
 #include "render/texture.h"
+#include "render/tube_angle.h"
 
 namespace cambium::render {
 
@@ -204,14 +205,6 @@ std::array<float, 4> hermite_derivative(float u)
     return {6 * u2 - 6 * u, 3 * u2 - 4 * u + 1, -6 * u2 + 6 * u, 3 * u2 - 2 * u};
 }
 
-/// Texture s around a tube: the angle of the normal n about the axis, in [0, 1).
-float angle_around(const Vec3f& axis, const Vec3f& n)
-{
-    Vec3f t, b;
-    make_basis(normalize(axis), t, b);
-    return std::atan2(dot(n, b), dot(n, t)) / (2 * pi) + 0.5f;
-}
-
 template <class T>
 T at_or(const std::vector<T>& v, std::size_t i, T fallback)
 {
@@ -349,9 +342,12 @@ void set_flags(RTCGeometry g, const std::vector<std::uint8_t>& flags, std::size_
 }
 
 /// Around a tube, s runs once round the circumference; along it, t as its keys say.
+/// (The cross product's direction does not depend on ng's length: one root, one division.)
 TextureTangents tube_tangents(const Vec3f& axis, const Vec3f& ng, float radius, float dv)
 {
-    return {normalize(cross(axis, normalize(ng))) * (2 * pi * radius),
+    const Vec3f around = cross(axis, ng);
+    const float length = std::sqrt(dot(around, around));
+    return {length > 0 ? around * (2 * pi * radius / length) : around,
             dv != 0 ? axis * (1 / dv) : Vec3f()};
 }
 
@@ -949,7 +945,7 @@ void alpha_filter(const RTCFilterFunctionNArguments* args)
         std::uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
         const InstanceStyle* p = owner.style(RTCHitN_instID(args->hit, args->N, i, 0));
         int texture = owner.texture_of(*part, prim, p);
-        if (!owner.textures->has_alpha(texture))
+        if (!owner.textures->cuts_out(texture))
             continue;
         Vec3f ng(RTCHitN_Ng_x(args->hit, args->N, i), RTCHitN_Ng_y(args->hit, args->N, i),
                  RTCHitN_Ng_z(args->hit, args->N, i));
@@ -966,6 +962,19 @@ bool any_texture(const std::vector<T>& textures)
     for (auto t : textures)
         if (t != geom::no_texture)
             return true;
+    return false;
+}
+
+/// Whether any of the textures cuts its surface out: only then do hits need the alpha
+/// test (an opaque RGBA image, as all of GeneralizedCylinder's, would pay a texture lookup
+/// per candidate hit for nothing).
+template <class T>
+bool any_cut_out(const TextureSet* set, const std::vector<T>& textures)
+{
+    if (set)
+        for (auto t : textures)
+            if (set->cuts_out(t))
+                return true;
     return false;
 }
 
@@ -1190,7 +1199,7 @@ void EmbreeScene::Impl::add_geometry(RTCScene s, const geom::Geometry& geo,
     const geom::LinearCurves& l = geo.lines;
     if (lines && !l.segments.empty()) {
         const Key* keys = line_keys ? line_keys : l.keys.data();
-        bool cut = alpha || any_texture(l.texture);
+        bool cut = alpha || any_cut_out(textures, l.texture);
         attach(s, lines_source(geo, keys, unlit), ids, cut);
         if (!unlit) {
             const LineEnds& e = line_ends.emplace_back(render::line_ends(l, keys));
@@ -1203,7 +1212,7 @@ void EmbreeScene::Impl::add_geometry(RTCScene s, const geom::Geometry& geo,
         }
     }
     if (!geo.curves.segments.empty()) {
-        attach(s, curves_source(geo), ids, alpha || any_texture(geo.curves.texture));
+        attach(s, curves_source(geo), ids, alpha || any_cut_out(textures, geo.curves.texture));
         tilt_rays = true;
     }
     // Spheres are textured but not cut out: cpfg's @O spheres are solid.
@@ -1212,7 +1221,7 @@ void EmbreeScene::Impl::add_geometry(RTCScene s, const geom::Geometry& geo,
     if (geo.discs.size() > 0)
         attach(s, discs_source(geo), ids, false);
     if (geo.mesh.size() > 0)
-        attach(s, triangles_source(geo), ids, alpha || any_texture(geo.mesh.texture));
+        attach(s, triangles_source(geo), ids, alpha || any_cut_out(textures, geo.mesh.texture));
 }
 
 void EmbreeScene::Impl::place_line_ends(RTCScene ends, PlacedEnds& e)
@@ -1284,14 +1293,14 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
     }
 
     // Prototypes: one Embree scene each, built only if some instance places it.
-    std::vector<bool> placed(scene.prototypes.size(), false), textured(placed);
+    std::vector<bool> placed(scene.prototypes.size(), false), cut_out(placed);
     for (const geom::Instance& inst : scene.instances) {
         if (inst.prototype >= scene.prototypes.size())
             throw Error("scene: instance of prototype " + std::to_string(inst.prototype) +
                         " of " + std::to_string(scene.prototypes.size()));
         placed[inst.prototype] = true;
-        if (inst.texture != geom::no_texture)
-            textured[inst.prototype] = true;
+        if (textures && textures->cuts_out(inst.texture))
+            cut_out[inst.prototype] = true;
     }
     m.prototype_scenes.assign(scene.prototypes.size(), nullptr);
     m.proto_parts.resize(scene.prototypes.size());
@@ -1303,7 +1312,7 @@ EmbreeScene::EmbreeScene(const geom::Scene& scene, const Camera& camera,
         if (!placed[i] || g.empty() || (scene.line_radius_in_pixels && lines_only))
             continue;
         m.prototype_scenes[i] = m.new_scene();
-        m.add_geometry(m.prototype_scenes[i], g, m.proto_parts[i], nullptr, false, textured[i],
+        m.add_geometry(m.prototype_scenes[i], g, m.proto_parts[i], nullptr, false, cut_out[i],
                        !scene.line_radius_in_pixels);
         rtcCommitScene(m.prototype_scenes[i]);
     }

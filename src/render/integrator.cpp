@@ -409,21 +409,31 @@ TextureFootprint texture_footprint(const SurfaceHit& hit, const Vec3f& dir, floa
     const Vec3f &dpds = hit.dpds, &dpdt = hit.dpdt;
     if (!(width > 0) || (is_black(dpds) && is_black(dpdt)))
         return {};
-    const Vec3f& n = hit.geometric_normal;
-    // Grazing views stretch the footprint; beyond 50:1 it would only blur.
-    float cos = std::fmax(std::fabs(dot(dir, n)), 0.02f);
+    const Vec3f& n = hit.geometric_normal;  // unit
+    // Grazing views stretch the footprint; beyond 50:1 it would only blur. (Compared by
+    // hand: std::fmax is a library call here; a NaN cosine gives 0.02 as it did.)
+    const float cos_abs = std::fabs(dot(dir, n));
+    const float cos = cos_abs > 0.02f ? cos_abs : 0.02f;
     Vec3f minor = cross(dir, n), unused;
-    if (dot(minor, minor) < 1e-12f)
+    float minor2 = dot(minor, minor);
+    if (minor2 < 1e-12f) {
         make_basis(n, minor, unused);
-    minor = normalize(minor);
-    Vec3f major = normalize(cross(n, minor)) * (width / cos);
+        minor2 = dot(minor, minor);
+    }
+    // One root and one division each, where normalize() takes three: the footprint only
+    // chooses MIP levels, and rounding there moves a blend weight by an ulp or so.
+    minor = minor * (1 / std::sqrt(minor2));
+    // n and minor are unit and perpendicular: their cross product is unit already.
+    const Vec3f major = cross(n, minor) * (width / cos);
     minor = minor * width;
-    float a = dot(dpds, dpds), b = dot(dpds, dpdt), c = dot(dpdt, dpdt);
-    float det = a * c - b * b;
+    const float a = dot(dpds, dpds), b = dot(dpds, dpdt), c = dot(dpdt, dpdt);
+    const float det = a * c - b * b;
+    const bool both = det > 1e-12f * a * c;
+    const float inv_det = both ? 1 / det : 0.0f;
     auto to_st = [&](const Vec3f& w) -> std::array<float, 2> {
-        float x = dot(dpds, w), y = dot(dpdt, w);
-        if (det > 1e-12f * a * c)
-            return {(c * x - b * y) / det, (a * y - b * x) / det};
+        const float x = dot(dpds, w), y = dot(dpdt, w);
+        if (both)
+            return {(c * x - b * y) * inv_det, (a * y - b * x) * inv_det};
         // One coordinate constant (or both parallel): each on its own.
         return {a > 0 ? x / a : 0.0f, c > 0 ? y / c : 0.0f};
     };

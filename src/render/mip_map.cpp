@@ -4,22 +4,20 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <type_traits>
 #include <utility>
 
 #include "render/color.h"
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace cambium::render {
 
 namespace {
-
-/// i modulo n, in [0, n) for negative i too.
-int wrap(int i, int n)
-{
-    int r = i % n;
-    return r < 0 ? r + n : r;
-}
 
 /// The fractional part of a texture coordinate: GL_REPEAT makes only it matter, and
 /// taking it first keeps the texel arithmetic in int range for any coordinate.
@@ -66,21 +64,26 @@ std::vector<T> reduce(const std::vector<T>& fine, int width, int height, int cha
     return coarse;
 }
 
-/// srgb_to_linear on [0, 1] from a table, linearly interpolated: within 5e-7 of the
+/// srgb_to_linear at i / srgb_steps for i in [0, srgb_steps], and the last value again
+/// (decode_srgb reads one past its index). Filled before main: no guard on each lookup.
+constexpr int srgb_steps = 1024;
+const std::array<float, srgb_steps + 2> srgb_table = [] {
+    std::array<float, srgb_steps + 2> t{};
+    for (int i = 0; i <= srgb_steps; ++i)
+        t[i] = srgb_to_linear(float(i) / srgb_steps);
+    t[srgb_steps + 1] = t[srgb_steps];
+    return t;
+}();
+
+/// srgb_to_linear on [0, 1] from the table, linearly interpolated: within 5e-7 of the
 /// curve (its second derivative is below 4), and without a powf per channel per lookup.
+/// (Filtering comes first, so the value is not one of 256 bytes: no byte table does.)
 float decode_srgb(float v)
 {
-    constexpr int steps = 1024;
-    static const std::array<float, steps + 2> table = [] {
-        std::array<float, steps + 2> t{};
-        for (int i = 0; i <= steps; ++i)
-            t[i] = srgb_to_linear(float(i) / steps);
-        t[steps + 1] = t[steps];
-        return t;
-    }();
-    const float x = std::fmin(std::fmax(v, 0.0f), 1.0f) * steps;  // NaN -> 0
+    // std::fmin and std::fmax are library calls here; NaN -> 0 as with them.
+    const float x = (v > 0 ? (v < 1 ? v : 1.0f) : 0.0f) * srgb_steps;
     const int i = static_cast<int>(x);
-    return table[i] + (x - float(i)) * (table[i + 1] - table[i]);
+    return srgb_table[i] + (x - float(i)) * (srgb_table[i + 1] - srgb_table[i]);
 }
 
 }  // namespace
@@ -95,6 +98,12 @@ MipMap::MipMap(TexturePixels pixels, TextureFilter filter)
         (pixels.bytes.size() != values && pixels.floats.size() != values))
         throw std::invalid_argument("MipMap: empty pixels or a channel count out of 1..4");
     const bool bytes = pixels.bytes.size() == values;
+    if (has_alpha())
+        for (std::size_t i = std::size_t(m_channels) - 1; i < values; i += m_channels)
+            if (bytes ? pixels.bytes[i] < 128 : !(pixels.floats[i] >= 0.501f)) {
+                m_can_cut_out = true;
+                break;
+            }
     m_levels.push_back({pixels.width, pixels.height,
                         bytes ? std::move(pixels.bytes) : std::vector<std::uint8_t>{},
                         bytes ? std::vector<float>{} : std::move(pixels.floats)});
@@ -119,65 +128,161 @@ std::uint64_t MipMap::bytes() const
     return total;
 }
 
-void MipMap::fetch(const Level& level, int x, int y, float out[4]) const
+namespace {
+
+/// A stored value as a float: bytes are display values over 255.
+inline float value(std::uint8_t v) { return v * (1.0f / 255.0f); }
+inline float value(float v) { return v; }
+
+/// A texel's RGBA from its C stored channels: grey fills out R, G and B, and a texture
+/// without alpha is opaque.
+template <int C, class T>
+inline void texel_rgba(const T* texel, float out[4])
 {
-    const std::size_t at = (std::size_t(y) * level.width + x) * m_channels;
-    float v[4];
-    if (!level.bytes.empty())
-        for (int c = 0; c < m_channels; ++c)
-            v[c] = level.bytes[at + c] * (1.0f / 255.0f);
-    else
-        for (int c = 0; c < m_channels; ++c)
-            v[c] = level.floats[at + c];
-    switch (m_channels) {
-    case 1: out[0] = out[1] = out[2] = v[0], out[3] = 1; break;
-    case 2: out[0] = out[1] = out[2] = v[0], out[3] = v[1]; break;
-    case 3: out[0] = v[0], out[1] = v[1], out[2] = v[2], out[3] = 1; break;
-    default: out[0] = v[0], out[1] = v[1], out[2] = v[2], out[3] = v[3]; break;
+    const float first = value(texel[0]);
+    if constexpr (C <= 2) {
+        out[0] = out[1] = out[2] = first;
+        out[3] = C == 2 ? value(texel[1]) : 1.0f;
+    } else {
+        out[0] = first, out[1] = value(texel[1]), out[2] = value(texel[2]);
+        out[3] = C == 4 ? value(texel[3]) : 1.0f;
     }
 }
 
-void MipMap::sample(const Level& level, float s, float t, float out[4]) const
+/// The index along an axis of n texels of i in [-n, 2n): GL_REPEAT without a division
+/// (a bilinear pair's first texel is at least -1, its second at most n).
+inline int wrap_near(int i, int n) { return i < 0 ? i + n : (i >= n ? i - n : i); }
+
+/// Where a sample falls in a level: the texels around it and the weights between them
+/// (nearest: x0, y0 only).
+struct Footing {
+    std::size_t row0, row1;  // first values of rows y0 and y1
+    int x0, x1;
+    float ax, ay;
+};
+
+/// The bilinear blend of the four texels of `at`, channel by channel (grey's three
+/// colour channels are one value, blended once).
+template <int C, class T>
+void blend4(const T* data, const Footing& at, float out[4])
 {
-    // Rows run top to bottom, OpenGL's t bottom to top.
-    const float x = repeat(s) * float(level.width), y = repeat(1 - t) * float(level.height);
+    float a[4], b[4], c[4], d[4];
+    texel_rgba<C>(data + at.row0 + std::size_t(at.x0) * C, a);
+    texel_rgba<C>(data + at.row0 + std::size_t(at.x1) * C, b);
+    texel_rgba<C>(data + at.row1 + std::size_t(at.x0) * C, c);
+    texel_rgba<C>(data + at.row1 + std::size_t(at.x1) * C, d);
+    const float ax = at.ax, ay = at.ay;
+    auto lerp2 = [&](int k) {
+        return (1 - ay) * ((1 - ax) * a[k] + ax * b[k]) + ay * ((1 - ax) * c[k] + ax * d[k]);
+    };
+    if constexpr (C <= 2) {
+        out[0] = out[1] = out[2] = lerp2(0);
+        out[3] = C == 2 ? lerp2(3) : 1.0f;
+    } else {
+        for (int k = 0; k < 3; ++k)
+            out[k] = lerp2(k);
+        out[3] = C == 4 ? lerp2(3) : 1.0f;
+    }
+}
+
+#if defined(__SSE2__)
+/// 8-bit RGBA, the usual texture, four channels to a register: the same operations
+/// lane by lane as the generic blend4, so the same values bit for bit.
+template <>
+void blend4<4, std::uint8_t>(const std::uint8_t* data, const Footing& at, float out[4])
+{
+    const __m128i zero = _mm_setzero_si128();
+    const __m128 scale = _mm_set1_ps(1.0f / 255.0f);
+    auto texel = [&](std::size_t first) {
+        std::int32_t bits;
+        std::memcpy(&bits, data + first, sizeof bits);
+        const __m128i bytes = _mm_cvtsi32_si128(bits);
+        const __m128i ints = _mm_unpacklo_epi16(_mm_unpacklo_epi8(bytes, zero), zero);
+        return _mm_mul_ps(_mm_cvtepi32_ps(ints), scale);
+    };
+    const __m128 a = texel(at.row0 + std::size_t(at.x0) * 4);
+    const __m128 b = texel(at.row0 + std::size_t(at.x1) * 4);
+    const __m128 c = texel(at.row1 + std::size_t(at.x0) * 4);
+    const __m128 d = texel(at.row1 + std::size_t(at.x1) * 4);
+    const __m128 one = _mm_set1_ps(1.0f), ax = _mm_set1_ps(at.ax), ay = _mm_set1_ps(at.ay);
+    const __m128 bx = _mm_sub_ps(one, ax), by = _mm_sub_ps(one, ay);
+    const __m128 top = _mm_add_ps(_mm_mul_ps(bx, a), _mm_mul_ps(ax, b));
+    const __m128 bottom = _mm_add_ps(_mm_mul_ps(bx, c), _mm_mul_ps(ax, d));
+    _mm_storeu_ps(out, _mm_add_ps(_mm_mul_ps(by, top), _mm_mul_ps(ay, bottom)));
+}
+#endif
+
+template <class T>
+void blend4(int channels, const T* data, const Footing& at, float out[4])
+{
+    switch (channels) {
+    case 1: blend4<1>(data, at, out); break;
+    case 2: blend4<2>(data, at, out); break;
+    case 3: blend4<3>(data, at, out); break;
+    default: blend4<4>(data, at, out); break;
+    }
+}
+
+template <class T>
+void nearest(int channels, const T* texel, float out[4])
+{
+    switch (channels) {
+    case 1: texel_rgba<1>(texel, out); break;
+    case 2: texel_rgba<2>(texel, out); break;
+    case 3: texel_rgba<3>(texel, out); break;
+    default: texel_rgba<4>(texel, out); break;
+    }
+}
+
+}  // namespace
+
+void MipMap::sample(const Level& level, float s, float down, float out[4]) const
+{
+    const float x = s * float(level.width), y = down * float(level.height);
+    const std::size_t row = std::size_t(level.width) * m_channels;
     if (!m_filter.linear) {
-        fetch(level, std::min(int(x), level.width - 1), std::min(int(y), level.height - 1), out);
+        const std::size_t at = std::size_t(std::min(int(y), level.height - 1)) * row +
+                               std::size_t(std::min(int(x), level.width - 1)) * m_channels;
+        if (!level.bytes.empty())
+            nearest(m_channels, level.bytes.data() + at, out);
+        else
+            nearest(m_channels, level.floats.data() + at, out);
         return;
     }
     // Texel centres sit at half-integer coordinates.
     const float fx = x - 0.5f, fy = y - 0.5f;
     const float x0f = std::floor(fx), y0f = std::floor(fy);
-    const float ax = fx - x0f, ay = fy - y0f;
-    const int x0 = wrap(int(x0f), level.width), x1 = wrap(int(x0f) + 1, level.width);
-    const int y0 = wrap(int(y0f), level.height), y1 = wrap(int(y0f) + 1, level.height);
-    float a[4], b[4], c[4], d[4];
-    fetch(level, x0, y0, a);
-    fetch(level, x1, y0, b);
-    fetch(level, x0, y1, c);
-    fetch(level, x1, y1, d);
-    for (int k = 0; k < 4; ++k)
-        out[k] = (1 - ay) * ((1 - ax) * a[k] + ax * b[k]) + ay * ((1 - ax) * c[k] + ax * d[k]);
+    const int y0 = wrap_near(int(y0f), level.height), y1 = wrap_near(int(y0f) + 1, level.height);
+    const Footing at{std::size_t(y0) * row, std::size_t(y1) * row,
+                     wrap_near(int(x0f), level.width), wrap_near(int(x0f) + 1, level.width),
+                     fx - x0f, fy - y0f};
+    if (!level.bytes.empty())
+        blend4(m_channels, level.bytes.data(), at, out);
+    else
+        blend4(m_channels, level.floats.data(), at, out);
 }
 
-Texel MipMap::lookup(float s, float t, const TextureFootprint& fp) const
+Texel MipMap::lookup(float s_gl, float t_gl, const TextureFootprint& fp) const
 {
+    // Rows run top to bottom, OpenGL's t bottom to top.
+    const float s = repeat(s_gl), down = repeat(1 - t_gl);
     float v[4];
     const Level& finest = m_levels.front();
     // The footprint's longer axis, in texels of the finest level: its log2 is the level.
     const float w = float(finest.width), h = float(finest.height);
     const float ax = fp.dsdx * w, ay = fp.dtdx * h, bx = fp.dsdy * w, by = fp.dtdy * h;
-    const float extent2 = std::fmax(ax * ax + ay * ay, bx * bx + by * by);
+    const float a2 = ax * ax + ay * ay, b2 = bx * bx + by * by;
+    const float extent2 = a2 > b2 || std::isnan(b2) ? a2 : b2;  // std::fmax, inline
     if (m_levels.size() == 1 || !(extent2 > 1)) {
-        sample(finest, s, t, v);
+        sample(finest, s, down, v);
     } else {
-        const float lod = std::fmin(0.5f * std::log2(extent2), float(m_levels.size() - 1));
+        const float lod = std::min(0.5f * std::log2(extent2), float(m_levels.size() - 1));
         const std::size_t fine = static_cast<std::size_t>(lod);
         const float blend = lod - float(fine);
-        sample(m_levels[fine], s, t, v);
+        sample(m_levels[fine], s, down, v);
         if (blend > 0 && fine + 1 < m_levels.size()) {
             float coarse[4];
-            sample(m_levels[fine + 1], s, t, coarse);
+            sample(m_levels[fine + 1], s, down, coarse);
             for (int k = 0; k < 4; ++k)
                 v[k] += blend * (coarse[k] - v[k]);
         }

@@ -44,6 +44,10 @@ public:
 
     int channels() const { return m_channels; }
     bool has_alpha() const { return m_channels == 2 || m_channels == 4; }
+    /// Whether a lookup at the finest level can give alpha below 1/2 (the cut-out test):
+    /// false when every texel's alpha is at least 128/255 (floats: 0.501), since a blend
+    /// of such texels stays above 1/2 by far more than its rounding.
+    bool can_cut_out() const { return m_can_cut_out; }
     std::size_t levels() const { return m_levels.size(); }
     /// Bytes held by all levels.
     std::uint64_t bytes() const;
@@ -58,14 +62,14 @@ private:
         std::vector<std::uint8_t> bytes;
         std::vector<float> floats;
     };
-    /// The level's values at (s, t), unconverted: 4 values (grey filled out to RGB,
-    /// missing alpha 1).
-    void sample(const Level& level, float s, float t, float out[4]) const;
-    void fetch(const Level& level, int x, int y, float out[4]) const;
+    /// The level's values at s and `down` (both in [0, 1], down from the top row),
+    /// unconverted: 4 values (grey filled out to RGB, missing alpha 1).
+    void sample(const Level& level, float s, float down, float out[4]) const;
 
     std::vector<Level> m_levels;
     int m_channels;
     bool m_srgb;
+    bool m_can_cut_out = false;
     TextureFilter m_filter;
 };
 

@@ -80,6 +80,11 @@ bool TextureSet::has_alpha(int index) const
     return valid(index) && m_impl->entries[static_cast<std::size_t>(index)].map->has_alpha();
 }
 
+bool TextureSet::cuts_out(int index) const
+{
+    return valid(index) && m_impl->entries[static_cast<std::size_t>(index)].map->can_cut_out();
+}
+
 Texel TextureSet::lookup(int index, float s, float t, float width) const
 {
     return lookup(index, s, t, TextureFootprint{width, 0, 0, width});

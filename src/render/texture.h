@@ -56,8 +56,11 @@ public:
     bool valid(int index) const;
     /// E: decal (replaces the diffuse colour) rather than modulate.
     bool decal(int index) const;
-    /// Whether the image has an alpha channel (cut-outs are tested only then).
+    /// Whether the image has an alpha channel.
     bool has_alpha(int index) const;
+    /// Whether some of the image is cut out: alpha below 1/2 at the finest level
+    /// (MipMap::can_cut_out). Hits on an opaque image's surfaces need no alpha test.
+    bool cuts_out(int index) const;
 
     /// The filtered texel at (s, t); `width` is the lookup's footprint in texture units
     /// (0: the finest level). Invalid indices give white, alpha 1.

@@ -120,6 +120,30 @@ TEST(MipMap, GreyAndAlphaFillOutToRgba)
     EXPECT_EQ(three.lookup(0.5f, 0.5f, {}).alpha, 1.0f);
 }
 
+TEST(MipMap, CanCutOutOnlyWhereSomeAlphaIsBelowHalf)
+{
+    auto rgba = [](std::uint8_t a0, std::uint8_t a1) {
+        return MipMap(TexturePixels{2, 1, 4, {9, 9, 9, a0, 9, 9, 9, a1}, {}, true}, {true, true});
+    };
+    EXPECT_FALSE(rgba(255, 128).can_cut_out());
+    EXPECT_TRUE(rgba(255, 127).can_cut_out());
+    EXPECT_TRUE(rgba(0, 255).can_cut_out());
+    auto grey_alpha = [](float a) {
+        return MipMap(TexturePixels{1, 2, 2, {}, {0.3f, 1, 0.3f, a}, false}, {true, true});
+    };
+    EXPECT_FALSE(grey_alpha(0.6f).can_cut_out());
+    EXPECT_TRUE(grey_alpha(0.5f).can_cut_out());  // a blend of 0.5s may round below it
+    EXPECT_TRUE(grey_alpha(std::nanf("")).can_cut_out());
+    EXPECT_FALSE(MipMap(TexturePixels{1, 1, 3, {0, 0, 0}, {}, true}, {}).can_cut_out());
+    // The reason it may say no: every blend of alphas of 128/255 stays at 1/2 or above.
+    TexturePixels half{5, 3, 4, std::vector<std::uint8_t>(5 * 3 * 4, 128), {}, true};
+    MipMap all_128(std::move(half), {true, true});
+    for (int i = 0; i <= 1000; ++i) {
+        const float s = i * 0.001237f - 0.3f, t = i * 0.000711f + 0.2f;
+        EXPECT_GE(all_128.lookup(s, t, {}).alpha, 0.5f);
+    }
+}
+
 TEST(MipMap, RefusesPixelsThatDoNotMatchTheirSize)
 {
     EXPECT_THROW(MipMap(TexturePixels{2, 2, 1, {}, {1, 2, 3}, false}, {}), std::invalid_argument);

@@ -193,6 +193,44 @@ TEST(Texture, AlphaCutOutSilhouetteIsTheMask)
     fs::remove_all(dir);
 }
 
+// An RGBA image whose alpha is at least 128/255 everywhere cuts nothing out, so its
+// surfaces get no alpha test (no filter at all on a flat quad); one texel below 128 is
+// enough to bring the test back, and it cuts out that texel only.
+TEST(Texture, OpaqueAlphaNeedsNoCutOutTest)
+{
+    fs::path dir = temp_dir();
+    const int n = 4;
+    auto image = [&](const char* name, std::uint8_t lowest) {
+        std::vector<std::uint8_t> pixels;
+        for (int i = 0; i < n * n; ++i)
+            for (std::uint8_t c : {200, 100, 50, i == 5 ? lowest : 255})
+                pixels.push_back(c);
+        write_image(dir / name, n, n, 4, pixels);
+        return nearest(dir / name);
+    };
+    TextureSet set({image("opaque.png", 128), image("hole.png", 127)});
+    EXPECT_TRUE(set.has_alpha(0));
+    EXPECT_FALSE(set.cuts_out(0));
+    EXPECT_TRUE(set.cuts_out(1));
+    EXPECT_FALSE(set.cuts_out(7));  // not a texture
+    for (std::int16_t texture : {0, 1}) {
+        geom::Scene s;
+        add_quad(s.geometry, 0, 0, 4, 4, 0, 1, 1, texture);  // uv (0,0)..(1,1), x, y 0..4
+        EmbreeScene accel(s, top_camera(0, 0, 10, 10, 10), &set);
+        EXPECT_EQ(accel.filtered_shapes().empty(), texture == 0);
+        int holes = 0;
+        for (int row = 0; row < n; ++row)
+            for (int col = 0; col < n; ++col) {
+                float x = col + 0.5f, y = n - (row + 0.5f);  // texel (col, row)
+                bool hit = accel.intersect({x, y, 5}, {0, 0, -1}, 0, inf).has_value();
+                holes += !hit;
+                EXPECT_EQ(hit, texture == 0 || row * n + col != 5) << col << ", " << row;
+            }
+        EXPECT_EQ(holes, texture == 0 ? 0 : 1);
+    }
+    fs::remove_all(dir);
+}
+
 // Rendered: a white quad under a white light shows the texture's decoded colours, and
 // the background where it is cut out.
 TEST(Texture, TexturedQuadRendersTheTexture)
