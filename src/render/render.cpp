@@ -202,6 +202,9 @@ struct RenderState {
     /// Camera rays made in float (Camera::generate_rays_f): a pinhole perspective camera
     /// without clipping, and the box filter (whose image points are floats already).
     bool float_rays = camera.single_precision() && filter.box();
+    /// A parallel camera's traced rays made in one vectorised pass (generate_parallel_rays:
+    /// the same bits), for the box filter's float image points.
+    bool parallel_rays = camera.projection() == Camera::Projection::parallel && filter.box();
     bool adaptive = settings.noise_target > 0;
     std::optional<FlatMiss> miss = flat_miss(ctx, settings);
     /// The pixels that may meet the scene (screen_mask); the others take
@@ -307,28 +310,20 @@ void film_pairs(const RenderState& f, const PixelReplicas& replicas, std::uint32
     }
 }
 
-/// Camera ray `ray` as it is traced (out): in single precision, from the near clipping
-/// plane; `tnear`: where that is along the camera's ray.
-void traced_ray(const CameraRay& ray, double& tnear, CameraRayF& out)
-{
-    out.org = Vec3f(ray.org);
-    out.dir = Vec3f(ray.dir);
-    if (ray.tnear > 0)
-        out.org = Vec3f(ray.org + ray.dir * ray.tnear);  // front clipping: start at the plane
-    // Far clipping: geometry beyond the back plane must not show.
-    out.tfar = std::isfinite(ray.tfar) ? static_cast<float>(ray.tfar - ray.tnear) : infinity;
-    tnear = ray.tnear;
-}
-
 /// The camera rays of samples i0 .. i0 + n - 1 of pixel (x, y) (n at most
 /// CameraBatch::size) into b, in passes over the batch: film pairs, image points, camera
 /// rays (in float where RenderState::float_rays; else in double, Camera::generate_rays
-/// without a lens), their traced form.
+/// without a lens), their traced form (for a parallel camera, in the same pass).
 void camera_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uint32_t n,
                     const PixelReplicas& replicas, CameraBatch& b)
 {
     n = std::min(n, CameraBatch::size);
     film_pairs(f, replicas, i0, n, b);
+    if (f.parallel_rays) {  // the image point x + jx in float, as below
+        f.camera.generate_parallel_rays(x, y, std::span(b.jx.data(), n), std::span(b.jy.data(), n),
+                                        std::span(b.tnear.data(), n), std::span(b.rays.data(), n));
+        return;
+    }
     if (f.float_rays) {
         for (std::uint32_t k = 0; k < n; ++k) {
             b.jx[k] += static_cast<float>(x);  // the image point, in float as below
@@ -354,7 +349,7 @@ void camera_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::u
         }
     }
     for (std::uint32_t k = 0; k < n; ++k)
-        traced_ray(b.camera_rays[k], b.tnear[k], b.rays[k]);
+        b.rays[k] = traced_ray(b.camera_rays[k], b.tnear[k]);
 }
 
 /// Sample i (its camera ray `ray`, starting `tnear` along the camera's) added to its
