@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -435,22 +436,49 @@ void add_batch(const RenderState& f, const PixelReplicas& replicas, std::uint32_
     st.radiance = radiance;
 }
 
+/// The radiance sum that take_background_samples made last (in a tile and pass): from
+/// `from`, `count` samples of the background make `to` (bit patterns, so that -0 and 0
+/// differ as they may in a sum).
+struct BackgroundRun {
+    using Bits = std::array<std::uint32_t, 3>;
+    static Bits bits(const Vec3f& v)
+    {
+        return {std::bit_cast<std::uint32_t>(v.x), std::bit_cast<std::uint32_t>(v.y),
+                std::bit_cast<std::uint32_t>(v.z)};
+    }
+    Bits from{}, to{};
+    std::uint32_t count = 0;  // 0: none made yet
+};
+
 /// Samples i0 .. i1 - 1 of a pixel whose camera rays are known to meet nothing
 /// (ScreenMask): each adds what a traced camera ray that missed adds (take_flat_miss),
-/// with neither a sampler nor a ray.
+/// with neither a sampler nor a ray. Without adaptive sampling a pixel's sums are then
+/// its radiance and count only, and the empty pixels of a pass usually all start from
+/// the same sum (0 in the first pass): `last` gives the result of the same additions
+/// made for the pixel before, instead of a chain of as many dependent additions (a
+/// float addition's latency per sample, for most of the samples of a plant's view).
 void take_background_samples(const RenderState& f, std::uint32_t i0, std::uint32_t i1,
-                             PixelState& st)
+                             PixelState& st, BackgroundRun& last)
 {
+    const BackgroundRun::Bits from = BackgroundRun::bits(st.radiance);
+    if (!f.adaptive && i1 - i0 == last.count && from == last.from) {
+        st.radiance = {std::bit_cast<float>(last.to[0]), std::bit_cast<float>(last.to[1]),
+                       std::bit_cast<float>(last.to[2])};
+        st.samples += i1 - i0;
+        return;
+    }
     Vec3f radiance = st.radiance;
     for (std::uint32_t i = i0; i < i1; ++i)
         take_flat_miss(f, *f.miss, i, st, radiance);
     st.radiance = radiance;
+    last = {from, BackgroundRun::bits(radiance), i1 - i0};
 }
 
 /// A tile row's camera batches and pixel hashes (take_row), made once per tile.
 struct RowBatches {
     std::array<CameraBatch, tile_size> batch;
     std::array<std::optional<PixelReplicas>, tile_size> replicas;
+    BackgroundRun background;  // the tile's last take_background_samples
 };
 
 /// Samples i0 .. i1 - 1 of pixel (x, y) in a scene with a ground plane, added to its sums
@@ -491,7 +519,7 @@ std::uint64_t take_row(const RenderState& f, const PixelRect& region, int y, int
             continue;
         if (f.mask && !f.mask->may_hit(region.x + x, region.y + y)) {
             background_only += target - st.samples;
-            take_background_samples(f, st.samples, target, st);
+            take_background_samples(f, st.samples, target, st, row.background);
         } else {
             replicas.emplace(region.x + x, region.y + y, f.settings.seed, f.adaptive);
         }
