@@ -373,6 +373,18 @@ double Camera::farthest_ray_origin() const
     return max_abs(m_origin) + std::sqrt(3.0) * m_aperture_radius;
 }
 
+bool Camera::parallel_rays_in_reach() const
+{
+    if (m_projection != Projection::parallel)
+        return false;
+    // A ray starts at most farthest_ray_origin() from the origin; clipping moves it along
+    // forward() to the front plane's depth from origin(), whose own distance from the
+    // origin is within farthest_ray_origin() too.
+    double front = std::isinf(m_clip_near) ? 0.0 : std::abs(m_clip_near);
+    double reach = 2 * farthest_ray_origin() + front;
+    return reach <= geom::max_ray_start / 2;  // false for NaN
+}
+
 void Camera::check_range(const std::string& what) const
 {
     auto unit = [](const Vec3& v) { return std::abs(geom::length(v) - 1) < 1e-6; };

@@ -143,6 +143,12 @@ public:
     /// image, up to two pixels outside it, starts (before clipping); NaN when some
     /// number of the camera is not finite.
     double farthest_ray_origin() const;
+    /// Whether every ray generate_parallel_rays() makes for points up to two pixels
+    /// outside the image starts within geom::max_ray_start (half of it, for rounding)
+    /// when check_range() passed: a front clipping plane moves a ray's start forward, and
+    /// one far beyond the scene may take it out of Embree's reach (render skips such
+    /// rays). Then EmbreeScene::intersect_coherent need not check each ray.
+    bool parallel_rays_in_reach() const;
     /// Throws Error unless every ray the camera makes is one Embree can take: finite,
     /// a unit frame, a positive pixel size, and ray origins within geom::max_ray_origin.
     /// `what` names where the camera came from in the message.

@@ -206,6 +206,10 @@ struct RenderState {
     /// A parallel camera's traced rays made in one vectorised pass (generate_parallel_rays:
     /// the same bits), for the box filter's float image points.
     bool parallel_rays = camera.projection() == Camera::Projection::parallel && filter.box();
+    /// Camera rays that intersect_coherent need not check one by one: float rays start at
+    /// the eye, which check_range put within reach of Embree; parallel ones where no front
+    /// plane moves them out of it.
+    bool rays_in_reach = float_rays || (parallel_rays && camera.parallel_rays_in_reach());
     bool adaptive = settings.noise_target > 0;
     std::optional<FlatMiss> miss = flat_miss(ctx, settings);
     /// The pixels that may meet the scene (screen_mask); the others take
@@ -414,9 +418,8 @@ void trace_batch(const RenderState& f, int x, int y, std::uint32_t i0, std::uint
                  const PixelReplicas& replicas, CameraBatch& b)
 {
     camera_samples(f, x, y, i0, n, replicas, b);
-    // Float rays start at the eye, which check_range put within reach of Embree.
     f.accel.intersect_coherent(std::span(b.rays.data(), n), std::span(b.hits.data(), n),
-                               f.float_rays);
+                               f.rays_in_reach);
 }
 
 /// The traced batch b (samples i0 .. i0 + n - 1) added to its pixel's sums in order.

@@ -2,6 +2,7 @@
 // Camera framing against hand-computed values from cpfg's rule (CalculateWindow, SetView).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -10,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "geom/scene_limits.h"
 #include "render/camera.h"
 
 namespace cambium::render {
@@ -260,6 +262,38 @@ TEST(Camera, ParallelBatchRaysAreTheTracedDoubleRays)
     EXPECT_EQ(rays[5].org, want.org);
     EXPECT_EQ(rays[5].dir, want.dir);
     EXPECT_EQ(tnear[5], want_tnear);
+}
+
+// A parallel camera's rays are all within Embree's reach unless a front plane far beyond
+// the scene moves their starts out of it; the check holds at the image's corners.
+TEST(Camera, ParallelRaysInReachUnlessAFrontPlaneTakesThemOut)
+{
+    Camera c = Camera::parallel({3e9, -2e9, 1e9}, {0.6, 0, -0.8}, {0, 1, 0}, 1e7, 4e9, 640, 480);
+    c.check_range("test");
+    // The largest coordinate of the starts of the rays through the image's corners
+    // (two pixels outside it).
+    auto reach = [](const Camera& cam) {
+        std::vector<float> xs{-2, 642, -2, 642}, ys{-2, -2, 482, 482};
+        std::vector<double> tnear(4);
+        std::vector<CameraRayF> rays(4);
+        cam.generate_parallel_rays(0, 0, xs, ys, tnear, rays);
+        float most = 0;
+        for (const CameraRayF& r : rays)
+            most = std::max({most, std::abs(r.org.x), std::abs(r.org.y), std::abs(r.org.z)});
+        return double(most);
+    };
+    for (const Camera& near : {c, c.with_clipping(-1e10, 5e10), c.with_clipping(1e11, 2e11)}) {
+        EXPECT_TRUE(near.parallel_rays_in_reach());
+        EXPECT_LE(reach(near), geom::max_ray_start);
+    }
+    // A front plane at 6e11 (0.8 of it along z): the rays start beyond Embree's reach,
+    // though the camera itself passes check_range (its unclipped rays are within it).
+    const Camera far_front = c.with_clipping(6e11, 7e11);
+    far_front.check_range("test");
+    EXPECT_FALSE(far_front.parallel_rays_in_reach());
+    EXPECT_GT(reach(far_front), geom::max_ray_start);
+    EXPECT_FALSE(Camera::perspective({0, 0, 10}, {0, 0, 0}, {0, 1, 0}, 40, 64, 48)
+                     .parallel_rays_in_reach());
 }
 
 // Perspective clipping planes are at depths along the view direction: an oblique ray
