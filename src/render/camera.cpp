@@ -125,6 +125,59 @@ Camera make_parallel(const geom::View& view, const Frame& f, const geom::Bounds3
     return Camera::parallel(centre, f.forward, f.up, pixel_size, back_off, width, height);
 }
 
+// The SIMD clones exist only on x86 (elsewhere the compiler vectorises for what it has):
+// AVX-512 (x86-64-v4, 8 doubles a register), AVX2 and the baseline, picked at load time.
+#if defined(__x86_64__) || defined(__i386__)
+#define CAMBIUM_SIMD_CLONES [[gnu::target_clones("arch=x86-64-v4", "avx2", "default")]]
+#else
+#define CAMBIUM_SIMD_CLONES
+#endif
+
+/// A parallel camera's numbers as generate_ray() and clip() use them, for
+/// parallel_block: the same operands, so the same operations give the same bits.
+struct ParallelFrame {
+    double half_width, half_height, pixel_size;
+    Vec3 origin, right, up, forward;
+    Vec3 back;  // forward * back_off
+    double rate;  // clip(): depth gained per unit of t, dot(forward, forward)
+    double near, far;  // clipping depths (infinite without)
+    Vec3f dir;
+};
+
+constexpr std::size_t parallel_block_size = 16;
+
+/// generate_ray() then traced_ray() for the image points (pixel_x + x[k], pixel_y + y[k])
+/// (summed in float) of a block: the same
+/// double operations in the same order (ISO C++ mode contracts nothing into FMAs), over a
+/// fixed count in separate arrays, which vectorises (camera.cpp is compiled without
+/// trapping math, so that the choices become selects). An unclipped camera's infinite
+/// planes give clip()'s tnear 0 and tfar infinity.
+CAMBIUM_SIMD_CLONES void parallel_block(const ParallelFrame& c, float pixel_x, float pixel_y,
+                                        const float* __restrict x, const float* __restrict y,
+                                        double* __restrict tnear, float* __restrict org_x,
+                                        float* __restrict org_y, float* __restrict org_z,
+                                        float* __restrict tfar)
+{
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < parallel_block_size; ++k) {
+        double sx = (static_cast<double>(pixel_x + x[k]) - c.half_width) * c.pixel_size;
+        double sy = (c.half_height - static_cast<double>(pixel_y + y[k])) * c.pixel_size;
+        double ox = c.origin.x + c.right.x * sx + c.up.x * sy - c.back.x;
+        double oy = c.origin.y + c.right.y * sx + c.up.y * sy - c.back.y;
+        double oz = c.origin.z + c.right.z * sx + c.up.z * sy - c.back.z;
+        double depth = (ox - c.origin.x) * c.forward.x + (oy - c.origin.y) * c.forward.y +
+                       (oz - c.origin.z) * c.forward.z;
+        double tn = std::max(0.0, (c.near - depth) / c.rate);
+        double tf = std::max(0.0, (c.far - depth) / c.rate);
+        tnear[k] = tn;
+        org_x[k] = static_cast<float>(tn > 0 ? ox + c.forward.x * tn : ox);
+        org_y[k] = static_cast<float>(tn > 0 ? oy + c.forward.y * tn : oy);
+        org_z[k] = static_cast<float>(tn > 0 ? oz + c.forward.z * tn : oz);
+        // tf is never NaN (std::max gives 0 for it): finite is below infinity.
+        tfar[k] = tf < inf ? static_cast<float>(tf - tn) : std::numeric_limits<float>::infinity();
+    }
+}
+
 }  // namespace
 
 Camera Camera::parallel(const Vec3& focus, const Vec3& forward, const Vec3& up,
@@ -219,6 +272,44 @@ void Camera::generate_rays_f(std::span<const float> xs, std::span<const float> y
     }
 }
 
+void Camera::generate_parallel_rays(int x, int y, std::span<const float> xs,
+                                    std::span<const float> ys, std::span<double> tnear,
+                                    std::span<CameraRayF> rays) const
+{
+    const std::size_t n = std::min({xs.size(), ys.size(), tnear.size(), rays.size()});
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    const double rate = geom::dot(m_forward, m_forward);
+    const auto fx = static_cast<float>(x), fy = static_cast<float>(y);
+    if (m_projection != Projection::parallel || !(rate > 0)) {  // clip() empties every ray
+        for (std::size_t k = 0; k < n; ++k)
+            rays[k] = traced_ray(generate_ray(fx + xs[k], fy + ys[k]), tnear[k]);
+        return;
+    }
+    const ParallelFrame frame{m_width * 0.5,  m_height * 0.5, m_pixel_size, m_origin,
+                              m_right,        m_up,           m_forward,    m_forward * m_back_off,
+                              rate,           clipped() ? m_clip_near : -inf,
+                              clipped() ? m_clip_far : inf,   Vec3f(m_forward)};
+    constexpr std::size_t block = parallel_block_size;
+    for (std::size_t k0 = 0; k0 < n; k0 += block) {
+        const std::size_t m = std::min(block, n - k0);
+        std::array<float, block> ox, oy, oz, tfar;
+        if (m == block) {  // a whole block (a batch's usual 16 samples): read and write in place
+            parallel_block(frame, fx, fy, xs.data() + k0, ys.data() + k0, tnear.data() + k0,
+                           ox.data(), oy.data(), oz.data(), tfar.data());
+        } else {
+            std::array<float, block> x{}, y{};
+            std::array<double, block> tn;
+            std::copy_n(xs.data() + k0, m, x.data());
+            std::copy_n(ys.data() + k0, m, y.data());
+            parallel_block(frame, fx, fy, x.data(), y.data(), tn.data(), ox.data(), oy.data(),
+                           oz.data(), tfar.data());
+            std::copy_n(tn.data(), m, tnear.data() + k0);
+        }
+        for (std::size_t k = 0; k < m; ++k)
+            rays[k0 + k] = {{ox[k], oy[k], oz[k]}, frame.dir, tfar[k]};
+    }
+}
+
 CameraRay Camera::generate_ray(double x, double y, double lens_u, double lens_v) const
 {
     if (m_aperture_radius <= 0 || m_projection == Projection::parallel)
@@ -280,6 +371,18 @@ double Camera::farthest_ray_origin() const
     if (m_projection == Projection::parallel)
         return max_abs(m_origin) + m_back_off + half_image * m_pixel_size;
     return max_abs(m_origin) + std::sqrt(3.0) * m_aperture_radius;
+}
+
+bool Camera::parallel_rays_in_reach() const
+{
+    if (m_projection != Projection::parallel)
+        return false;
+    // A ray starts at most farthest_ray_origin() from the origin; clipping moves it along
+    // forward() to the front plane's depth from origin(), whose own distance from the
+    // origin is within farthest_ray_origin() too.
+    double front = std::isinf(m_clip_near) ? 0.0 : std::abs(m_clip_near);
+    double reach = 2 * farthest_ray_origin() + front;
+    return reach <= geom::max_ray_start / 2;  // false for NaN
 }
 
 void Camera::check_range(const std::string& what) const

@@ -35,6 +35,21 @@ struct CameraRayF {
     float tfar = 0;
 };
 
+/// Camera ray `ray` as the path tracer traces it: in single precision, from the near
+/// clipping plane (front clipping: org + tnear dir), tfar counted from there (far
+/// clipping: geometry beyond the back plane must not show); `tnear`: where it starts
+/// along the camera's ray.
+inline CameraRayF traced_ray(const CameraRay& ray, double& tnear)
+{
+    CameraRayF out;
+    out.org = Vec3f(ray.tnear > 0 ? ray.org + ray.dir * ray.tnear : ray.org);
+    out.dir = Vec3f(ray.dir);
+    out.tfar = std::isfinite(ray.tfar) ? static_cast<float>(ray.tfar - ray.tnear)
+                                       : std::numeric_limits<float>::infinity();
+    tnear = ray.tnear;
+    return out;
+}
+
 /// A pinhole or orthographic camera in world units. Immutable after make_camera().
 class Camera {
 public:
@@ -82,6 +97,15 @@ public:
     /// sample.
     void generate_rays_f(std::span<const float> xs, std::span<const float> ys,
                          std::span<CameraRayF> rays) const;
+    /// For a parallel camera (cpfg's default view, with or without clipping planes): for
+    /// each k, traced_ray(generate_ray(x + xs[k], y + ys[k]), tnear[k]) into rays[k] (as
+    /// many; the image point summed in float, as the box filter's are), the same bits,
+    /// made in blocks of 16 in separate arrays per component, which vectorise (one ray at
+    /// a time, a camera sample's own time was mostly scalar double arithmetic on 64-byte
+    /// rays). Any other camera's rays are made one at a time, as that says.
+    void generate_parallel_rays(int x, int y, std::span<const float> xs,
+                                std::span<const float> ys, std::span<double> tnear,
+                                std::span<CameraRayF> rays) const;
     /// The same through the lens point given by two uniforms in [0, 1) (a thin lens:
     /// every ray through (x, y) meets the others on the plane in focus). Equals
     /// generate_ray(x, y) for a pinhole camera.
@@ -119,6 +143,12 @@ public:
     /// image, up to two pixels outside it, starts (before clipping); NaN when some
     /// number of the camera is not finite.
     double farthest_ray_origin() const;
+    /// Whether every ray generate_parallel_rays() makes for points up to two pixels
+    /// outside the image starts within geom::max_ray_start (half of it, for rounding)
+    /// when check_range() passed: a front clipping plane moves a ray's start forward, and
+    /// one far beyond the scene may take it out of Embree's reach (render skips such
+    /// rays). Then EmbreeScene::intersect_coherent need not check each ray.
+    bool parallel_rays_in_reach() const;
     /// Throws Error unless every ray the camera makes is one Embree can take: finite,
     /// a unit frame, a positive pixel size, and ray origins within geom::max_ray_origin.
     /// `what` names where the camera came from in the message.

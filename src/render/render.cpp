@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -202,6 +203,13 @@ struct RenderState {
     /// Camera rays made in float (Camera::generate_rays_f): a pinhole perspective camera
     /// without clipping, and the box filter (whose image points are floats already).
     bool float_rays = camera.single_precision() && filter.box();
+    /// A parallel camera's traced rays made in one vectorised pass (generate_parallel_rays:
+    /// the same bits), for the box filter's float image points.
+    bool parallel_rays = camera.projection() == Camera::Projection::parallel && filter.box();
+    /// Camera rays that intersect_coherent need not check one by one: float rays start at
+    /// the eye, which check_range put within reach of Embree; parallel ones where no front
+    /// plane moves them out of it.
+    bool rays_in_reach = float_rays || (parallel_rays && camera.parallel_rays_in_reach());
     bool adaptive = settings.noise_target > 0;
     std::optional<FlatMiss> miss = flat_miss(ctx, settings);
     /// The pixels that may meet the scene (screen_mask); the others take
@@ -307,28 +315,20 @@ void film_pairs(const RenderState& f, const PixelReplicas& replicas, std::uint32
     }
 }
 
-/// Camera ray `ray` as it is traced (out): in single precision, from the near clipping
-/// plane; `tnear`: where that is along the camera's ray.
-void traced_ray(const CameraRay& ray, double& tnear, CameraRayF& out)
-{
-    out.org = Vec3f(ray.org);
-    out.dir = Vec3f(ray.dir);
-    if (ray.tnear > 0)
-        out.org = Vec3f(ray.org + ray.dir * ray.tnear);  // front clipping: start at the plane
-    // Far clipping: geometry beyond the back plane must not show.
-    out.tfar = std::isfinite(ray.tfar) ? static_cast<float>(ray.tfar - ray.tnear) : infinity;
-    tnear = ray.tnear;
-}
-
 /// The camera rays of samples i0 .. i0 + n - 1 of pixel (x, y) (n at most
 /// CameraBatch::size) into b, in passes over the batch: film pairs, image points, camera
 /// rays (in float where RenderState::float_rays; else in double, Camera::generate_rays
-/// without a lens), their traced form.
+/// without a lens), their traced form (for a parallel camera, in the same pass).
 void camera_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uint32_t n,
                     const PixelReplicas& replicas, CameraBatch& b)
 {
     n = std::min(n, CameraBatch::size);
     film_pairs(f, replicas, i0, n, b);
+    if (f.parallel_rays) {  // the image point x + jx in float, as below
+        f.camera.generate_parallel_rays(x, y, std::span(b.jx.data(), n), std::span(b.jy.data(), n),
+                                        std::span(b.tnear.data(), n), std::span(b.rays.data(), n));
+        return;
+    }
     if (f.float_rays) {
         for (std::uint32_t k = 0; k < n; ++k) {
             b.jx[k] += static_cast<float>(x);  // the image point, in float as below
@@ -354,7 +354,7 @@ void camera_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::u
         }
     }
     for (std::uint32_t k = 0; k < n; ++k)
-        traced_ray(b.camera_rays[k], b.tnear[k], b.rays[k]);
+        b.rays[k] = traced_ray(b.camera_rays[k], b.tnear[k]);
 }
 
 /// Sample i (its camera ray `ray`, starting `tnear` along the camera's) added to its
@@ -418,9 +418,8 @@ void trace_batch(const RenderState& f, int x, int y, std::uint32_t i0, std::uint
                  const PixelReplicas& replicas, CameraBatch& b)
 {
     camera_samples(f, x, y, i0, n, replicas, b);
-    // Float rays start at the eye, which check_range put within reach of Embree.
     f.accel.intersect_coherent(std::span(b.rays.data(), n), std::span(b.hits.data(), n),
-                               f.float_rays);
+                               f.rays_in_reach);
 }
 
 /// The traced batch b (samples i0 .. i0 + n - 1) added to its pixel's sums in order.
@@ -440,22 +439,49 @@ void add_batch(const RenderState& f, const PixelReplicas& replicas, std::uint32_
     st.radiance = radiance;
 }
 
+/// The radiance sum that take_background_samples made last (in a tile and pass): from
+/// `from`, `count` samples of the background make `to` (bit patterns, so that -0 and 0
+/// differ as they may in a sum).
+struct BackgroundRun {
+    using Bits = std::array<std::uint32_t, 3>;
+    static Bits bits(const Vec3f& v)
+    {
+        return {std::bit_cast<std::uint32_t>(v.x), std::bit_cast<std::uint32_t>(v.y),
+                std::bit_cast<std::uint32_t>(v.z)};
+    }
+    Bits from{}, to{};
+    std::uint32_t count = 0;  // 0: none made yet
+};
+
 /// Samples i0 .. i1 - 1 of a pixel whose camera rays are known to meet nothing
 /// (ScreenMask): each adds what a traced camera ray that missed adds (take_flat_miss),
-/// with neither a sampler nor a ray.
+/// with neither a sampler nor a ray. Without adaptive sampling a pixel's sums are then
+/// its radiance and count only, and the empty pixels of a pass usually all start from
+/// the same sum (0 in the first pass): `last` gives the result of the same additions
+/// made for the pixel before, instead of a chain of as many dependent additions (a
+/// float addition's latency per sample, for most of the samples of a plant's view).
 void take_background_samples(const RenderState& f, std::uint32_t i0, std::uint32_t i1,
-                             PixelState& st)
+                             PixelState& st, BackgroundRun& last)
 {
+    const BackgroundRun::Bits from = BackgroundRun::bits(st.radiance);
+    if (!f.adaptive && i1 - i0 == last.count && from == last.from) {
+        st.radiance = {std::bit_cast<float>(last.to[0]), std::bit_cast<float>(last.to[1]),
+                       std::bit_cast<float>(last.to[2])};
+        st.samples += i1 - i0;
+        return;
+    }
     Vec3f radiance = st.radiance;
     for (std::uint32_t i = i0; i < i1; ++i)
         take_flat_miss(f, *f.miss, i, st, radiance);
     st.radiance = radiance;
+    last = {from, BackgroundRun::bits(radiance), i1 - i0};
 }
 
 /// A tile row's camera batches and pixel hashes (take_row), made once per tile.
 struct RowBatches {
     std::array<CameraBatch, tile_size> batch;
     std::array<std::optional<PixelReplicas>, tile_size> replicas;
+    BackgroundRun background;  // the tile's last take_background_samples
 };
 
 /// Samples i0 .. i1 - 1 of pixel (x, y) in a scene with a ground plane, added to its sums
@@ -496,7 +522,7 @@ std::uint64_t take_row(const RenderState& f, const PixelRect& region, int y, int
             continue;
         if (f.mask && !f.mask->may_hit(region.x + x, region.y + y)) {
             background_only += target - st.samples;
-            take_background_samples(f, st.samples, target, st);
+            take_background_samples(f, st.samples, target, st, row.background);
         } else {
             replicas.emplace(region.x + x, region.y + y, f.settings.seed, f.adaptive);
         }

@@ -2,10 +2,16 @@
 // Camera framing against hand-computed values from cpfg's rule (CalculateWindow, SetView).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <numbers>
+#include <utility>
 #include <vector>
 
+#include "geom/scene_limits.h"
 #include "render/camera.h"
 
 namespace cambium::render {
@@ -187,6 +193,107 @@ TEST(Camera, SinglePrecisionRaysAreTheDoubleRaysRounded)
     EXPECT_FALSE(c.with_clipping(1, 100).single_precision());
     EXPECT_FALSE(Camera::parallel({0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 0.1, 10, 64, 48)
                      .single_precision());
+}
+
+// A parallel camera's batch rays are traced_ray(generate_ray()) bit for bit: with and
+// without clipping planes, in either frame, for whole blocks of 16 and the rest, and
+// in the four places a front plane can be (behind the rays' start, in front, beyond
+// the back plane) and the back plane behind the start (an empty interval).
+TEST(Camera, ParallelBatchRaysAreTheTracedDoubleRays)
+{
+    geom::View view;
+    view.viewpoint = {3.1, -2.7, 11.3};
+    view.reference_point = {0.4, 1.9, -0.6};
+    view.twist_deg = 17;
+    Camera plain = make_camera(view, box({-2.3, -1.1, -3.7}, {4.9, 6.2, 1.3}), 320, 240);
+    Camera axis = Camera::parallel({0.5, 0.25, 0}, {0, 0, -1}, {0, 1, 0}, 0.013, 9.5, 64, 48);
+    ASSERT_EQ(plain.projection(), Camera::Projection::parallel);
+    constexpr double inf = std::numeric_limits<double>::infinity();
+    std::vector<Camera> cameras;
+    for (const Camera& c : {plain, axis}) {
+        cameras.push_back(c);
+        for (auto [near, far] : std::vector<std::pair<double, double>>{
+                 {-1, 2.5}, {-30, 40}, {-inf, 0.7}, {0.3, inf}, {1.5, 1.2}, {-40, -35}})
+            cameras.push_back(c.with_clipping(near, far));
+    }
+    std::vector<float> xs, ys;
+    for (float x : {0.0f, 0.37f, 63.99f, 160.0f, 271.5f, 319.999f, -2.0f})
+        for (float y : {0.0f, 0.61f, 47.5f, 200.25f, 239.99f, 241.5f}) {
+            xs.push_back(x);
+            ys.push_back(y);
+        }
+    ASSERT_NE(xs.size() % 16, 0u);
+    auto bits = [](float v) { return std::bit_cast<std::uint32_t>(v); };
+    for (std::size_t i = 0; i < cameras.size(); ++i) {
+        const Camera& c = cameras[i];
+        std::vector<CameraRayF> rays(xs.size());
+        std::vector<double> tnear(xs.size(), -1);
+        // The image points of pixel (13, 7): 13 + xs[k] and 7 + ys[k], summed in float.
+        c.generate_parallel_rays(13, 7, xs, ys, tnear, rays);
+        std::size_t clipped_front = 0, empty = 0;
+        for (std::size_t k = 0; k < xs.size(); ++k) {
+            double want_tnear = -1;
+            CameraRayF want = traced_ray(c.generate_ray(13.0f + xs[k], 7.0f + ys[k]), want_tnear);
+            EXPECT_EQ(bits(rays[k].org.x), bits(want.org.x)) << i << " " << k;
+            EXPECT_EQ(bits(rays[k].org.y), bits(want.org.y)) << i << " " << k;
+            EXPECT_EQ(bits(rays[k].org.z), bits(want.org.z)) << i << " " << k;
+            EXPECT_EQ(bits(rays[k].dir.x), bits(want.dir.x)) << i << " " << k;
+            EXPECT_EQ(bits(rays[k].dir.y), bits(want.dir.y)) << i << " " << k;
+            EXPECT_EQ(bits(rays[k].dir.z), bits(want.dir.z)) << i << " " << k;
+            EXPECT_EQ(bits(rays[k].tfar), bits(want.tfar)) << i << " " << k;
+            EXPECT_EQ(std::bit_cast<std::uint64_t>(tnear[k]), std::bit_cast<std::uint64_t>(want_tnear))
+                << i << " " << k;
+            clipped_front += want_tnear > 0;
+            empty += want.tfar <= 0;  // nothing to see: Embree takes no tfar below 0
+        }
+        // The cases are what they say: a front plane in front of the start moves it.
+        bool front = !std::isinf(c.clip_near()) && c.clip_near() > -9;
+        EXPECT_EQ(clipped_front, front ? xs.size() : 0u) << i;
+        EXPECT_EQ(empty, c.clip_far() < -9 || c.clip_far() < c.clip_near() ? xs.size() : 0u) << i;
+    }
+    // Any other camera gets its rays one at a time, the same way.
+    Camera persp = Camera::perspective({12, 14, 19}, {0, 10, 0}, {0, 1, 0}, 50, 320, 240)
+                       .with_clipping(2, 30);
+    std::vector<CameraRayF> rays(xs.size());
+    std::vector<double> tnear(xs.size());
+    persp.generate_parallel_rays(2, 3, xs, ys, tnear, rays);
+    double want_tnear = 0;
+    CameraRayF want = traced_ray(persp.generate_ray(2.0f + xs[5], 3.0f + ys[5]), want_tnear);
+    EXPECT_EQ(rays[5].org, want.org);
+    EXPECT_EQ(rays[5].dir, want.dir);
+    EXPECT_EQ(tnear[5], want_tnear);
+}
+
+// A parallel camera's rays are all within Embree's reach unless a front plane far beyond
+// the scene moves their starts out of it; the check holds at the image's corners.
+TEST(Camera, ParallelRaysInReachUnlessAFrontPlaneTakesThemOut)
+{
+    Camera c = Camera::parallel({3e9, -2e9, 1e9}, {0.6, 0, -0.8}, {0, 1, 0}, 1e7, 4e9, 640, 480);
+    c.check_range("test");
+    // The largest coordinate of the starts of the rays through the image's corners
+    // (two pixels outside it).
+    auto reach = [](const Camera& cam) {
+        std::vector<float> xs{-2, 642, -2, 642}, ys{-2, -2, 482, 482};
+        std::vector<double> tnear(4);
+        std::vector<CameraRayF> rays(4);
+        cam.generate_parallel_rays(0, 0, xs, ys, tnear, rays);
+        float most = 0;
+        for (const CameraRayF& r : rays)
+            most = std::max({most, std::abs(r.org.x), std::abs(r.org.y), std::abs(r.org.z)});
+        return double(most);
+    };
+    for (const Camera& near : {c, c.with_clipping(-1e10, 5e10), c.with_clipping(1e11, 2e11)}) {
+        EXPECT_TRUE(near.parallel_rays_in_reach());
+        EXPECT_LE(reach(near), geom::max_ray_start);
+    }
+    // A front plane at 6e11 (0.8 of it along z): the rays start beyond Embree's reach,
+    // though the camera itself passes check_range (its unclipped rays are within it).
+    const Camera far_front = c.with_clipping(6e11, 7e11);
+    far_front.check_range("test");
+    EXPECT_FALSE(far_front.parallel_rays_in_reach());
+    EXPECT_GT(reach(far_front), geom::max_ray_start);
+    EXPECT_FALSE(Camera::perspective({0, 0, 10}, {0, 0, 0}, {0, 1, 0}, 40, 64, 48)
+                     .parallel_rays_in_reach());
 }
 
 // Perspective clipping planes are at depths along the view direction: an oblique ray

@@ -66,6 +66,27 @@ TEST(RenderLimits, RaysEmbreeWouldAbortOnAreSkippedAndCounted)
     EXPECT_EQ(accel.skipped_rays(), 4u);
 }
 
+// A front clipping plane far beyond the scene moves a parallel view's rays out of
+// Embree's reach: each is skipped and counted, not traced, and shows the background.
+TEST(RenderLimits, ParallelRaysMovedOutOfReachByAFrontPlaneAreSkipped)
+{
+    geom::Scene s = empty_scene({-2, -2, -2}, {2, 2, 2});
+    add_segment(s, {-2, 0, 0}, {2, 0, 0}, 1.0f, 3);
+    s.background = {0.25f, 0.5f, 0.75f};
+    const Camera camera =
+        Camera::parallel({0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 0.5, 10, 8, 8).with_clipping(5e11, 6e11);
+    ASSERT_FALSE(camera.parallel_rays_in_reach());
+    RenderReport report;
+    ::testing::internal::CaptureStderr();
+    Image img = render(s, camera, small(8, 8, 2), &report);
+    ::testing::internal::GetCapturedStderr();
+    EXPECT_GT(report.skipped_rays, 0u);
+    EXPECT_EQ(report.skipped_rays + report.background_only_samples, report.samples);
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x)
+            EXPECT_EQ(img.at(x, y, 3), 0.0f) << x << " " << y;  // nothing met
+}
+
 TEST(RenderLimits, NotFiniteSamplesCountAsBlackAndAreReported)
 {
     geom::Scene s = empty_scene({-2, -2, -2}, {2, 2, 2});
