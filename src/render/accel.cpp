@@ -250,7 +250,9 @@ struct GeometrySource {
 /// What a primitive says about its hit in object space.
 struct LocalSurface {
     Vec3f geometric;     ///< true normal (front side for discs and triangles)
-    Vec3f shading;       ///< interpolated normal (front side), or zero: the geometric one
+    /// Triangles: the vertex normals interpolated (front side), or zero: the geometric
+    /// one. Other shapes have none (zero), and surface_hit() reads it for triangles only.
+    Vec3f shading;
     float radius = 0;
     bool two_sided = false;
     /// Flat shapes: their largest coordinate (object space), a measure of the float error
@@ -1527,11 +1529,10 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
     Vec3f ng(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
     const ShapeKind& shape = kind(part.shape);
     LocalSurface local = local_surface(part, prim, rh.hit.u, rh.hit.v, ng);
-    Vec3f geometric = local.geometric, shading = local.shading;
+    Vec3f geometric = local.geometric;
     float radius = local.radius;
     if (placement) {
         geometric = placement->normals * geometric;
-        shading = placement->normals * shading;
         if (radius != 0)
             radius *= placement->radius_scale();
     }
@@ -1540,7 +1541,15 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
     const bool back = local.two_sided && facing_away;
     if (facing_away)
         geometric = -geometric;
-    shading = unit(back ? -shading : shading);
+    // Only triangles interpolate a shading normal; the other shapes shade by their true one.
+    Vec3f normal = geometric;
+    if (part.shape == Shape::triangle) {
+        Vec3f shading = placement ? placement->normals * local.shading : local.shading;
+        shading = unit(back ? -shading : shading);
+        // A shading normal turned away from the ray (or absent) gives way to the true one.
+        if (dot(shading, dir) < 0)
+            normal = shading;
+    }
 
     HitMaterials materials = materials_at(part, prim, back, style, rh.hit.u);
     const int texture = texture_of(part, prim, style);
@@ -1566,8 +1575,7 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
     return SurfaceHit{
         .t = t,
         .position = position,
-        // A shading normal turned away from the ray (or absent) gives way to the true one.
-        .normal = dot(shading, dir) < 0 ? shading : geometric,
+        .normal = normal,
         .geometric_normal = geometric,
         .geom_id = rh.hit.geomID,
         .prim_id = prim,
