@@ -1567,16 +1567,22 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
         if (radius != 0)
             radius *= placement->radius_scale();
     }
+    // Only triangles interpolate a shading normal; the other shapes shade by their true one.
+    // It is made unit before the side hit is known, beside the true normal, so that their
+    // square roots and divisions overlap (turned to the side after: negation is exact).
+    const bool smooth = part.shape == Shape::triangle;
+    Vec3f shading;
+    if (smooth)
+        shading = unit(placement ? placement->normals * local.shading : local.shading);
     geometric = unit(geometric);
     const bool facing_away = dot(geometric, dir) > 0;
     const bool back = local.two_sided && facing_away;
     if (facing_away)
         geometric = -geometric;
-    // Only triangles interpolate a shading normal; the other shapes shade by their true one.
     Vec3f normal = geometric;
-    if (part.shape == Shape::triangle) {
-        Vec3f shading = placement ? placement->normals * local.shading : local.shading;
-        shading = unit(back ? -shading : shading);
+    if (smooth) {
+        if (back)
+            shading = -shading;
         // A shading normal turned away from the ray (or absent) gives way to the true one.
         if (dot(shading, dir) < 0)
             normal = shading;
