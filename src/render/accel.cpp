@@ -980,20 +980,33 @@ struct HitMaterials {
     float blend = 0;
 };
 
-HitMaterials materials_at(const GeometrySource& part, std::uint32_t prim, bool back,
-                          const InstanceStyle* style, float u)
+/// A primitive's own material entries for both sides (`back` = `front` where the part has
+/// no back materials), before inherit_material is resolved.
+struct MaterialEntries {
+    std::uint16_t front = 0, back = 0;
+};
+
+/// Read apart from materials_at(), before the hit's surface: on a large mesh they miss the
+/// cache, and read first their misses overlap those of the vertices. (Read after, where
+/// the side hit picks the entry, the back one waited for the vertices: the side is known
+/// from them only.)
+MaterialEntries material_entries(const GeometrySource& part, std::uint32_t prim)
 {
     std::uint32_t index = part.attribute_index(prim);
-    std::uint16_t material = at_or(*part.material, index, std::uint16_t{0});
-    if (back && part.back_material)
-        material = at_or(*part.back_material, index, material);
+    std::uint16_t front = at_or(*part.material, index, std::uint16_t{0});
+    return {front, part.back_material ? at_or(*part.back_material, index, front) : front};
+}
+
+HitMaterials materials_at(const GeometrySource& part, std::uint32_t prim, MaterialEntries own,
+                          bool back, const InstanceStyle* style, float u)
+{
     auto resolve = [&](std::uint16_t mat) -> std::uint16_t {
         if (mat != geom::inherit_material)
             return mat;
         return style ? (back ? style->back_material : style->material) : 0;
     };
     HitMaterials m;
-    m.material = resolve(material);
+    m.material = resolve(back ? own.back : own.front);
     const geom::HermiteCurves& c = part.geometry->curves;
     if (part.shape == Shape::curve && prim < c.end_material.size()) {
         std::uint16_t end = resolve(c.end_material[prim]);
@@ -1063,7 +1076,7 @@ void opacity_filter(const RTCFilterFunctionNArguments* args)
                   RTCRayN_dir_z(args->ray, args->N, i));
         LocalSurface local = local_surface(part, c.prim, u, v, ng);
         bool back = local.two_sided && dot(local.geometric, dir) > 0;
-        HitMaterials m = materials_at(part, c.prim, back, p, u);
+        HitMaterials m = materials_at(part, c.prim, material_entries(part, c.prim), back, p, u);
         float opacity = ctx->opacity_of(m.material);
         if (m.blend > 0)
             opacity += (ctx->opacity_of(m.end_material) - opacity) * m.blend;
@@ -1558,6 +1571,7 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
 
     // Embree reports an instanced hit's normal in the prototype's frame.
     Vec3f ng(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+    const MaterialEntries own_materials = material_entries(part, prim);
     const ShapeKind& shape = kind(part.shape);
     LocalSurface local = local_surface(part, prim, rh.hit.u, rh.hit.v, ng);
     Vec3f geometric = local.geometric;
@@ -1588,7 +1602,7 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
             normal = shading;
     }
 
-    HitMaterials materials = materials_at(part, prim, back, style, rh.hit.u);
+    HitMaterials materials = materials_at(part, prim, own_materials, back, style, rh.hit.u);
     const int texture = texture_of(part, prim, style);
     TextureCoords st{0, 0};
     TextureTangents tangents{};
