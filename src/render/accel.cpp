@@ -1417,7 +1417,9 @@ namespace {
 bool traceable(const Vec3f& org, const Vec3f& dir, float tnear, float tfar)
 {
     constexpr auto reach = static_cast<float>(geom::max_ray_start);
-    auto within = [](float v, float limit) { return v >= -limit && v <= limit; };
+    // |v| <= limit, not -limit <= v && v <= limit (the same, NaN included): the compiler
+    // made a branch of each &&.
+    auto within = [](float v, float limit) { return std::fabs(v) <= limit; };
     // & rather than &&: every test is cheap, and one branch predicts better than nine.
     return within(org.x, reach) & within(org.y, reach) & within(org.z, reach) &
            std::isfinite(dir.x) & std::isfinite(dir.y) & std::isfinite(dir.z) & (tnear >= 0) &
