@@ -2,6 +2,7 @@
 // EmbreeScene: hits on round linear curves, pixel radii, empty scenes, spawn offsets.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <utility>
 
@@ -166,6 +167,67 @@ TEST(EmbreeScene, FiltersOnlyRoundShapesOfAnUntexturedScene)
     auto again = accel.intersect({-3, 0, 0}, {1, 0, 0}, 0, inf, cap->prim());
     ASSERT_TRUE(again);
     EXPECT_EQ(again->shape, Shape::cap);
+}
+
+// Only triangles carry vertex normals: a hit on any other shape shades by its true normal,
+// and a triangle's shading normal is its vertex normals interpolated at the hit, unit, on
+// the side hit (surface_hit makes the shading normal for triangles alone).
+TEST(EmbreeScene, OnlyTrianglesShadeByAnInterpolatedNormal)
+{
+    geom::Scene s = empty_scene({-10, -10, -10}, {10, 10, 10});
+    add_segment(s, {-1, 0, 0}, {1, 0, 0}, 0.5f);  // a cone curve with two caps
+    s.geometry.spheres.centres.push_back({0, 3, 0, 1});
+    s.geometry.spheres.material.push_back(1);
+    s.geometry.discs.centres.push_back({0, -3, 0, 1});
+    s.geometry.discs.normals.push_back({0, 0, 1});
+    s.geometry.discs.material.push_back(1);
+    s.geometry.discs.back_material.push_back(1);
+    geom::TriangleMesh& m = s.geometry.mesh;
+    m.positions = {{4, -1, 0}, {8, -1, 0}, {4, 3, 0}};
+    // tilted toward -x, +x and +y: at barycentric (u, v) the sum leans by (2u - 1 + v, v)
+    m.normals = {{-0.6f, 0, 0.8f}, {0.6f, 0, 0.8f}, {0, 0.6f, 0.8f}};
+    m.triangles = {{0, 1, 2}};
+    m.material = {1};
+    m.back_material = {1};
+    EmbreeScene accel(s, unit_camera(s));
+    const Vec3f slant = normalize(Vec3f(0.3f, 0.2f, -1));
+    auto expect_true_normal = [&](Vec3f org, Shape shape) {
+        for (float side : {1.0f, -1.0f}) {
+            Vec3f o(org.x, org.y, org.z * side), d(slant.x, slant.y, slant.z * side);
+            auto hit = accel.intersect(o - d * 10, d, 0, inf);
+            ASSERT_TRUE(hit) << int(shape);
+            EXPECT_EQ(hit->shape, shape);
+            EXPECT_EQ(hit->normal.x, hit->geometric_normal.x) << int(shape);
+            EXPECT_EQ(hit->normal.y, hit->geometric_normal.y) << int(shape);
+            EXPECT_EQ(hit->normal.z, hit->geometric_normal.z) << int(shape);
+            EXPECT_LT(dot(hit->normal, d), 0) << int(shape);
+        }
+    };
+    expect_true_normal({0, 0, 0.4f}, Shape::line);
+    expect_true_normal({0, 3, 0.9f}, Shape::sphere);
+    expect_true_normal({0, -3, 0}, Shape::disc);
+    auto cap = accel.intersect({-5, 0.1f, 0.1f}, {1, 0, 0}, 0, inf);
+    ASSERT_TRUE(cap);
+    EXPECT_EQ(cap->shape, Shape::cap);
+    EXPECT_EQ(cap->normal.x, cap->geometric_normal.x);
+    EXPECT_EQ(cap->normal.x, -1.0f);
+
+    // The triangle at (5, 0): barycentric u = 1/4, v = 1/4 (positions above).
+    for (float side : {1.0f, -1.0f}) {
+        Vec3f d(0, 0, -side);
+        auto hit = accel.intersect(Vec3f(5, 0, 5 * side), d, 0, inf);
+        ASSERT_TRUE(hit);
+        EXPECT_EQ(hit->shape, Shape::triangle);
+        EXPECT_EQ(hit->back, side < 0);
+        Vec3f lean = Vec3f(-0.6f, 0, 0.8f) * 0.5f + Vec3f(0.6f, 0, 0.8f) * 0.25f +
+                     Vec3f(0, 0.6f, 0.8f) * 0.25f;
+        Vec3f expected = normalize(lean) * side;
+        EXPECT_NEAR(hit->normal.x, expected.x, 1e-5f);
+        EXPECT_NEAR(hit->normal.y, expected.y, 1e-5f);
+        EXPECT_NEAR(hit->normal.z, expected.z, 1e-5f);
+        EXPECT_NEAR(hit->geometric_normal.z, side, 1e-6f);
+        EXPECT_GT(std::fabs(hit->normal.x - hit->geometric_normal.x), 0.05f);
+    }
 }
 
 // A straight polyline of short joined segments (neighbour flags) is one convex tube: rays

@@ -5,9 +5,12 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "base/diagnostics.h"
+#include "geom/scene_limits.h"
 #include "render/accel.h"
 #include "render/camera.h"
 #include "test_scenes.h"
@@ -85,6 +88,54 @@ TEST(RenderLimits, ParallelRaysMovedOutOfReachByAFrontPlaneAreSkipped)
     for (int y = 0; y < 8; ++y)
         for (int x = 0; x < 8; ++x)
             EXPECT_EQ(img.at(x, y, 3), 0.0f) << x << " " << y;  // nothing met
+}
+
+// A coherent stream checks its rays as intersect() does, every float of every ray (all of
+// them at once, then one by one where some ray fails): each ray that one float makes
+// untraceable is skipped and counted, and the stream's other rays hit as intersect()'s do.
+TEST(RenderLimits, CoherentStreamsSkipEachRayEmbreeWouldAbortOn)
+{
+    geom::Scene s = empty_scene({-1, -1, -1}, {1, 1, 1});
+    add_segment(s, {-1, 0, 0}, {1, 0, 0}, 0.5f);
+    EmbreeScene accel(s, make_camera(s.view, s.bounds, 16, 16));
+    const float reach = static_cast<float>(geom::max_ray_start);
+    std::vector<CameraRayF> rays;
+    std::uint64_t skipped = 0;
+    for (float far : {100.0f, inf})  // (clipped or not)
+    for (std::size_t n : {std::size_t{16}, std::size_t{5}})
+        for (std::size_t bad = 0; bad < n; ++bad)
+            for (int field = 0; field < 7; ++field)
+                for (float value : {nan_value, inf, -inf, reach, std::nextafter(reach, inf)}) {
+                    rays.clear();
+                    for (std::size_t k = 0; k < n; ++k)
+                        rays.push_back({{-0.9f + 0.1f * float(k), 0.1f, 5}, {0, 0, -1}, far});
+                    CameraRayF& r = rays[bad];
+                    float* floats[7] = {&r.org.x, &r.org.y, &r.org.z, &r.dir.x,
+                                        &r.dir.y, &r.dir.z, &r.tfar};
+                    *floats[field] = value;
+                    // expected: what intersect() makes of each ray
+                    std::vector<std::optional<SurfaceHit>> expected;
+                    for (const CameraRayF& q : rays)
+                        expected.push_back(accel.intersect(q.org, q.dir, 0, q.tfar, {}, true));
+                    const std::uint64_t single = accel.skipped_rays() - skipped;
+                    std::vector<std::optional<SurfaceHit>> hits(n);
+                    accel.intersect_coherent(rays, hits);
+                    const std::uint64_t streamed = accel.skipped_rays() - skipped - single;
+                    skipped = accel.skipped_rays();
+                    EXPECT_EQ(streamed, single) << n << " " << bad << " " << field << " " << value;
+                    // origins beyond reach, directions not finite, a NaN tfar: skipped
+                    bool traceable = field < 3   ? std::fabs(value) <= reach
+                                     : field < 6 ? std::isfinite(value)
+                                                 : !std::isnan(value);
+                    EXPECT_EQ(single, traceable ? 0u : 1u) << field << " " << value;
+                    for (std::size_t k = 0; k < n; ++k) {
+                        ASSERT_EQ(bool(hits[k]), bool(expected[k])) << n << " " << bad << " " << k;
+                        if (hits[k]) {
+                            EXPECT_EQ(hits[k]->t, expected[k]->t);
+                        }
+                    }
+                    EXPECT_TRUE(hits[(bad + 1) % n]);  // the others hit the segment
+                }
 }
 
 TEST(RenderLimits, NotFiniteSamplesCountAsBlackAndAreReported)
