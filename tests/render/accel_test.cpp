@@ -142,17 +142,26 @@ TEST(EmbreeScene, SpawnedRaysDoNotHitTheirOwnSegment)
     EXPECT_LE(rehits, n / 1000) << rehits << " of " << n;
 }
 
-// Filter functions run only on geometries that need one: round shapes (to skip the
-// primitive a ray leaves), pixel-width lines and alpha cut-outs; flat shapes run none.
-TEST(EmbreeScene, FiltersOnlyRoundShapesOfAnUntexturedScene)
+/// A scene of every kind of primitive but triangles, material 1: a cone segment of
+/// `radius` along x from -1 to 1 (a curve with two caps), a unit sphere at y = 3 and a unit
+/// disc at y = -3 facing +z.
+geom::Scene round_and_flat_shapes(float radius)
 {
     geom::Scene s = empty_scene({-10, -10, -10}, {10, 10, 10});
-    add_segment(s, {-1, 0, 0}, {1, 0, 0}, 0.1f);  // a cone curve with two caps
+    add_segment(s, {-1, 0, 0}, {1, 0, 0}, radius);
     s.geometry.spheres.centres.push_back({0, 3, 0, 1});
     s.geometry.spheres.material.push_back(1);
     s.geometry.discs.centres.push_back({0, -3, 0, 1});
     s.geometry.discs.normals.push_back({0, 0, 1});
     s.geometry.discs.material.push_back(1);
+    return s;
+}
+
+// Filter functions run only on geometries that need one: round shapes (to skip the
+// primitive a ray leaves), pixel-width lines and alpha cut-outs; flat shapes run none.
+TEST(EmbreeScene, FiltersOnlyRoundShapesOfAnUntexturedScene)
+{
+    geom::Scene s = round_and_flat_shapes(0.1f);
     geom::TriangleMesh& m = s.geometry.mesh;
     m.positions = {{5, 0, 0}, {6, 0, 0}, {5, 1, 0}};
     m.normals.assign(3, {0, 0, 1});
@@ -174,13 +183,7 @@ TEST(EmbreeScene, FiltersOnlyRoundShapesOfAnUntexturedScene)
 // the side hit (surface_hit makes the shading normal for triangles alone).
 TEST(EmbreeScene, OnlyTrianglesShadeByAnInterpolatedNormal)
 {
-    geom::Scene s = empty_scene({-10, -10, -10}, {10, 10, 10});
-    add_segment(s, {-1, 0, 0}, {1, 0, 0}, 0.5f);  // a cone curve with two caps
-    s.geometry.spheres.centres.push_back({0, 3, 0, 1});
-    s.geometry.spheres.material.push_back(1);
-    s.geometry.discs.centres.push_back({0, -3, 0, 1});
-    s.geometry.discs.normals.push_back({0, 0, 1});
-    s.geometry.discs.material.push_back(1);
+    geom::Scene s = round_and_flat_shapes(0.5f);
     s.geometry.discs.back_material.push_back(1);
     geom::TriangleMesh& m = s.geometry.mesh;
     m.positions = {{4, -1, 0}, {8, -1, 0}, {4, 3, 0}};
