@@ -1599,8 +1599,9 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
                                           const Vec3f& dir) const
 {
     const float t = rh.ray.tfar;
-    // Where Embree found it: along the direction it traced (make_ray).
-    const Vec3f position = org + traced(dir) * t;
+    // Where Embree found it: along the direction it traced (make_ray stored traced(dir),
+    // which Embree leaves as it was: read back, not tilted a second time).
+    const Vec3f position = org + Vec3f(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z) * t;
     const std::uint32_t prim = rh.hit.primID, inst_id = rh.hit.instID[0];
     const std::optional<Placement> placement = this->placement(inst_id);
     const InstanceStyle* style = placement ? &placement->style : nullptr;
