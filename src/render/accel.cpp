@@ -3,6 +3,7 @@
 #include "render/accel.h"
 
 #include <embree3/rtcore.h>
+
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
@@ -29,6 +30,7 @@
 #include "render/line_geometry.h"
 #include "render/pixel_lines.h"
 #include "render/ray_counter.h"
+#include "render/ray_tilt.h"
 #include "render/texture.h"
 #include "render/tube_angle.h"
 
@@ -283,19 +285,6 @@ struct ShapeKind {
     /// rely on their offset alone and run no filter for it.
     bool self_hits;
 };
-
-/// Embree's round Hermite curves are many times slower for a ray with a direction
-/// component exactly zero (9x per sample on the corpus's GeneralizedCylinder, whose every
-/// camera ray, as in cpfg's default parallel view, points down -z). In scenes with such
-/// curves, components below a millionth of the largest are raised to that: a tilt under
-/// 1e-6 rad, far below a pixel. (Other scenes keep their rays exact: pixel-width lines
-/// are drawn to OpenGL's exact pixels.)
-Vec3f off_axis(const Vec3f& d)
-{
-    float least = 1e-6f * largest_coordinate(d);
-    auto raise = [least](float c) { return std::fabs(c) < least ? std::copysign(least, c) : c; };
-    return {raise(d.x), raise(d.y), raise(d.z)};
-}
 
 // ---- Shared by the shapes ------------------------------------------------------------
 
