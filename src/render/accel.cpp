@@ -3,6 +3,7 @@
 #include "render/accel.h"
 
 #include <embree3/rtcore.h>
+
 #if defined(__GLIBC__)
 #include <malloc.h>
 #endif
@@ -29,6 +30,7 @@
 #include "render/line_geometry.h"
 #include "render/pixel_lines.h"
 #include "render/ray_counter.h"
+#include "render/ray_tilt.h"
 #include "render/texture.h"
 #include "render/tube_angle.h"
 
@@ -255,6 +257,10 @@ struct LocalSurface {
 
 using TextureCoords = std::array<float, 2>;
 using TextureTangents = std::array<Vec3f, 2>;
+struct TextureFrame {
+    TextureCoords st;
+    TextureTangents tangents;
+};
 
 /// Everything accel does that depends on the kind of primitive: one entry per Shape in
 /// `shape_kinds`, so a new kind of primitive is added in one place (and a case in
@@ -265,10 +271,11 @@ struct ShapeKind {
     /// Texture coordinates (s, t) of a hit.
     TextureCoords (*texture_coords)(const GeometrySource& part, std::uint32_t prim, float u,
                                     float v, const Vec3f& ng);
-    /// dP/ds and dP/dt in object space at a hit (texture_coords' derivatives); zero where
-    /// a coordinate does not change.
-    TextureTangents (*texture_tangents)(const GeometrySource& part, std::uint32_t prim,
-                                        float u, const Vec3f& ng, float radius);
+    /// A textured hit's (s, t) and its tangents: texture_coords, and dP/ds and dP/dt in
+    /// object space (their derivatives; zero where a coordinate does not change). One call,
+    /// so that what both need (a curve's axis) is found once.
+    TextureFrame (*texture_frame)(const GeometrySource& part, std::uint32_t prim, float u,
+                                  float v, const Vec3f& ng, float radius);
     /// Spawned rays start this far off the surface: per unit of radius, per unit of the
     /// hit's largest coordinate, and absolute (see EmbreeScene::intersect).
     float offset_per_radius, offset_per_scale, offset_absolute;
@@ -278,19 +285,6 @@ struct ShapeKind {
     /// rely on their offset alone and run no filter for it.
     bool self_hits;
 };
-
-/// Embree's round Hermite curves are many times slower for a ray with a direction
-/// component exactly zero (9x per sample on the corpus's GeneralizedCylinder, whose every
-/// camera ray, as in cpfg's default parallel view, points down -z). In scenes with such
-/// curves, components below a millionth of the largest are raised to that: a tilt under
-/// 1e-6 rad, far below a pixel. (Other scenes keep their rays exact: pixel-width lines
-/// are drawn to OpenGL's exact pixels.)
-Vec3f off_axis(const Vec3f& d)
-{
-    float least = 1e-6f * largest_coordinate(d);
-    auto raise = [least](float c) { return std::fabs(c) < least ? std::copysign(least, c) : c; };
-    return {raise(d.x), raise(d.y), raise(d.z)};
-}
 
 // ---- Shared by the shapes ------------------------------------------------------------
 
@@ -363,6 +357,15 @@ TextureCoords no_coords(const GeometrySource&, std::uint32_t, float, float, cons
     return {0, 0};
 }
 
+/// A shape's texture frame from its separate coordinates and tangents (shapes whose two
+/// share no work).
+template <auto coords, auto tangents>
+TextureFrame frame_of(const GeometrySource& part, std::uint32_t prim, float u, float v,
+                      const Vec3f& ng, float radius)
+{
+    return {coords(part, prim, u, v, ng), tangents(part, prim, u, ng, radius)};
+}
+
 // ---- Lines (F, G): cone curves, or round ones for pixel-width lines ------------------
 
 RTCGeometry build_lines(RTCDevice device, const GeometrySource& part)
@@ -405,13 +408,15 @@ TextureCoords line_coords(const GeometrySource& part, std::uint32_t prim, float 
     return {angle_around(vec(part.line_keys[k + 1]) - vec(part.line_keys[k]), ng), t};
 }
 
-TextureTangents line_tangents(const GeometrySource& part, std::uint32_t prim, float,
-                              const Vec3f& ng, float radius)
+/// line_coords and the tube's tangents, from one axis.
+TextureFrame line_frame(const GeometrySource& part, std::uint32_t prim, float u, float,
+                        const Vec3f& ng, float radius)
 {
     const geom::LinearCurves& l = part.geometry->lines;
     std::uint32_t k = l.segments[prim];
-    Vec3f axis = vec(part.line_keys[k + 1]) - vec(part.line_keys[k]);
-    return tube_tangents(axis, ng, radius, line_t(l, k + 1) - line_t(l, k));
+    const float t0 = line_t(l, k), dt = line_t(l, k + 1) - t0;
+    const Vec3f axis = vec(part.line_keys[k + 1]) - vec(part.line_keys[k]);
+    return {{angle_around(axis, ng), t0 + dt * u}, tube_tangents(axis, ng, radius, dt)};
 }
 
 // ---- Caps and joints: the flat free ends and round bends of shaded lines ------------
@@ -520,12 +525,17 @@ TextureCoords curve_coords(const GeometrySource& part, std::uint32_t prim, float
     return {angle_around(hermite_axis(c, k, u), ng), t};
 }
 
-TextureTangents curve_tangents(const GeometrySource& part, std::uint32_t prim, float u,
-                               const Vec3f& ng, float radius)
+/// curve_coords and the tube's tangents, from one evaluation of the axis.
+TextureFrame curve_frame(const GeometrySource& part, std::uint32_t prim, float u, float,
+                         const Vec3f& ng, float radius)
 {
     const geom::HermiteCurves& c = part.geometry->curves;
     std::uint32_t k = c.segments[prim];
-    return tube_tangents(hermite_axis(c, k, u), ng, radius, curve_dv(c, k));
+    const bool keyed = c.v.size() == c.points.size();
+    const float dv = keyed ? c.v[k + 1] - c.v[k] : 0.0f;
+    const Vec3f axis = hermite_axis(c, k, u);
+    return {{angle_around(axis, ng), keyed ? c.v[k] + dv * u : 0.0f},
+            tube_tangents(axis, ng, radius, dv)};
 }
 
 // ---- Spheres (@O) -------------------------------------------------------------------
@@ -669,13 +679,17 @@ TextureTangents triangle_tangents(const GeometrySource& part, std::uint32_t prim
 // largest coordinate or the primitive's (see EmbreeScene::intersect), which clears the
 // error of Embree's hit distance at any angle (physics_test: a plane lit at grazing angles).
 constexpr std::array<ShapeKind, 7> shape_kinds{{
-    /* line */ {build_lines, line_coords, line_tangents, 1e-3f, 1e-6f, 0, true},
-    /* curve */ {build_curves, curve_coords, curve_tangents, 1e-3f, 1e-6f, 0, true},
-    /* sphere */ {build_spheres, sphere_coords, sphere_tangents, 1e-4f, 1e-6f, 0, true},
-    /* disc */ {build_discs, no_coords, no_tangents, 0, 1e-5f, 1e-7f, false},
-    /* triangle */ {build_triangles, triangle_coords, triangle_tangents, 0, 1e-5f, 1e-7f, false},
-    /* cap */ {build_caps, cap_coords, no_tangents, 1e-3f, 1e-5f, 1e-7f, false},
-    /* joint */ {build_joints, joint_coords, no_tangents, 1e-3f, 1e-6f, 0, true},
+    /* line */ {build_lines, line_coords, line_frame, 1e-3f, 1e-6f, 0, true},
+    /* curve */ {build_curves, curve_coords, curve_frame, 1e-3f, 1e-6f, 0, true},
+    /* sphere */ {build_spheres, sphere_coords, frame_of<sphere_coords, sphere_tangents>, 1e-4f,
+                  1e-6f, 0, true},
+    /* disc */ {build_discs, no_coords, frame_of<no_coords, no_tangents>, 0, 1e-5f, 1e-7f, false},
+    /* triangle */ {build_triangles, triangle_coords, frame_of<triangle_coords, triangle_tangents>,
+                    0, 1e-5f, 1e-7f, false},
+    /* cap */ {build_caps, cap_coords, frame_of<cap_coords, no_tangents>, 1e-3f, 1e-5f, 1e-7f,
+               false},
+    /* joint */ {build_joints, joint_coords, frame_of<joint_coords, no_tangents>, 1e-3f, 1e-6f, 0,
+                 true},
 }};
 
 const ShapeKind& kind(Shape s) { return shape_kinds[static_cast<std::size_t>(s)]; }
@@ -1574,8 +1588,9 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
                                           const Vec3f& dir) const
 {
     const float t = rh.ray.tfar;
-    // Where Embree found it: along the direction it traced (make_ray).
-    const Vec3f position = org + traced(dir) * t;
+    // Where Embree found it: along the direction it traced (make_ray stored traced(dir),
+    // which Embree leaves as it was: read back, not tilted a second time).
+    const Vec3f position = org + Vec3f(rh.ray.dir_x, rh.ray.dir_y, rh.ray.dir_z) * t;
     const std::uint32_t prim = rh.hit.primID, inst_id = rh.hit.instID[0];
     const std::optional<Placement> placement = this->placement(inst_id);
     const InstanceStyle* style = placement ? &placement->style : nullptr;
@@ -1619,8 +1634,10 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
     TextureCoords st{0, 0};
     TextureTangents tangents{};
     if (texture != geom::no_texture) {
-        st = shape.texture_coords(part, prim, rh.hit.u, rh.hit.v, ng);
-        tangents = shape.texture_tangents(part, prim, rh.hit.u, ng, local.radius);
+        const TextureFrame frame =
+            shape.texture_frame(part, prim, rh.hit.u, rh.hit.v, ng, local.radius);
+        st = frame.st;
+        tangents = frame.tangents;
         if (placement)
             tangents = {placement->linear * tangents[0], placement->linear * tangents[1]};
     }
