@@ -276,7 +276,11 @@ inline float bsdf_pdf(const BsdfAt& at, const Vec3f& wi)
     return bsdf_detail::pdf_with(at, bsdf_detail::lobe_weights(at.bsdf), wi);
 }
 
-inline BsdfSample bsdf_sample(const BsdfAt& at, float u1, float u2)
+// Always inline: GCC made it a call, whose result came back through memory, and the
+// caller's 8-byte load of weight.x and .y spanned two of its stores (a 16-byte and an
+// 8-byte one), which stalls store forwarding at every vertex; an empty result was zeroed
+// by `rep stos` for a caller that reads only its pdf.
+[[gnu::always_inline]] inline BsdfSample bsdf_sample(const BsdfAt& at, float u1, float u2)
 {
     using namespace bsdf_detail;
     const Bsdf& b = at.bsdf;
@@ -285,10 +289,15 @@ inline BsdfSample bsdf_sample(const BsdfAt& at, float u1, float u2)
         return sample_diffuse(b, n, u1, u2);
     LobeWeights w = lobe_weights(b);
     Vec3f wi;
-    if (u1 < w.reflect) {
-        wi = sample_cosine(n, u1 / w.reflect, u2);
-    } else if (u1 < w.reflect + w.transmit) {
-        wi = sample_cosine(-n, (u1 - w.reflect) / w.transmit, u2);
+    const bool reflect = u1 < w.reflect;
+    if (reflect | (u1 < w.reflect + w.transmit)) {
+        // Either Lambertian lobe, picked by selects, not a branch: on a translucent leaf
+        // which one is a coin flip, a branch mispredicted half the time. The same values
+        // as one branch per lobe: u1 - 0 is u1, and the axis is n or n negated.
+        const float below = reflect ? 0.0f : w.reflect;
+        const float share = reflect ? w.reflect : w.transmit;
+        const float side = reflect ? 1.0f : -1.0f;
+        wi = sample_cosine(n * side, (u1 - below) / share, u2);
     } else if (w.glossy > 0) {
         // min(x, 1) by hand, as std::fmin gives it for every x (NaN too), where std::fmin
         // is a library call.
