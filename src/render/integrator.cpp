@@ -543,7 +543,10 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             if (depth == 0) {
                 result.radiance += beta * seen_by_camera(ctx, dir);
             } else if (!facts.environment_black) {
-                float w = bsdf_hit_weight(bsdf_pdf_prev, lights.pdf_li(dir));
+                // Unless the environment is sampled (then the set holds it), pdf_li() is
+                // 0: asked here without the call, for most bounce rays off a leaf escape.
+                float w = bsdf_hit_weight(bsdf_pdf_prev,
+                                          facts.environment_nee ? lights.pdf_li(dir) : 0.0f);
                 result.radiance += beta * env_radiance(dir) * w;
             }
             break;
