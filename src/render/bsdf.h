@@ -37,6 +37,24 @@ struct BsdfSample {
     float pdf = 0;
 };
 
+/// One BSDF seen along wo at a point with shading normal n: what its evaluations there
+/// share, made once per path vertex, where next-event estimation evaluates the BSDF once
+/// per lit light and sampling once more: the mirror direction of wo and the Phong lobe's
+/// normalisation (a dot product and a division that every call made again). The same
+/// operations as inside each call, so every value is the same to the bit.
+struct BsdfAt {
+    const Bsdf& bsdf;
+    Vec3f n, wo;
+    Vec3f mirror;           ///< wo mirrored about n: the Phong lobe's axis
+    float glossy_f = 0;     ///< (exponent + 2) / (2 pi), the lobe's normalisation in f
+    bool glossy = false;    ///< the Phong lobe is not black
+};
+inline BsdfAt bsdf_at(const Bsdf& bsdf, const Vec3f& n, const Vec3f& wo);
+/// bsdf_eval(), bsdf_pdf() and bsdf_sample() of at.bsdf at at.n and at.wo.
+inline Vec3f bsdf_eval(const BsdfAt& at, const Vec3f& wi);
+inline float bsdf_pdf(const BsdfAt& at, const Vec3f& wi);
+inline BsdfSample bsdf_sample(const BsdfAt& at, float u1, float u2);
+
 /// f(wo, wi); n is the shading normal on wo's side, all vectors unit.
 inline Vec3f bsdf_eval(const Bsdf& bsdf, const Vec3f& n, const Vec3f& wo, const Vec3f& wi);
 /// The solid-angle density bsdf_sample() draws wi with.
@@ -153,25 +171,36 @@ inline float power(float c, float e)
     return static_cast<float>(p);
 }
 
-/// cos^exponent of the angle between wi and the mirror direction (0 behind it).
-inline float phong_term(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3f& wi)
+/// cos^exponent of the angle between wi and the mirror direction `axis` (0 behind it).
+inline float phong_about(const Bsdf& b, const Vec3f& axis, const Vec3f& wi)
 {
-    float c = dot(mirror(wo, n), wi);
+    float c = dot(axis, wi);
     if (c <= 0)
         return 0;
     return b.exponent > 0 ? power(c, b.exponent) : 1.0f;
 }
 
-/// bsdf_pdf() with the lobes' selection probabilities already made.
-inline float pdf_with(const Bsdf& b, const LobeWeights& w, const Vec3f& n, const Vec3f& wo,
-                      const Vec3f& wi)
+/// cos^exponent of the angle between wi and the mirror direction (0 behind it).
+inline float phong_term(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3f& wi)
 {
-    float cos_i = dot(n, wi);
+    return phong_about(b, mirror(wo, n), wi);
+}
+
+/// The Phong lobe's share of the pdf per unit of its term: w.glossy (exponent + 1) / (2 pi).
+inline float glossy_pdf_scale(const Bsdf& b, const LobeWeights& w)
+{
+    return w.glossy * (b.exponent + 1) / (2 * pi);
+}
+
+/// bsdf_pdf() with the lobes' selection probabilities already made.
+inline float pdf_with(const BsdfAt& at, const LobeWeights& w, const Vec3f& wi)
+{
+    float cos_i = dot(at.n, wi);
     if (cos_i < 0)
         return w.transmit * -cos_i * inv_pi;
     float p = w.reflect * cos_i * inv_pi;
     if (w.glossy > 0)
-        p += w.glossy * (b.exponent + 1) / (2 * pi) * phong_term(b, n, wo, wi);
+        p += glossy_pdf_scale(at.bsdf, w) * phong_about(at.bsdf, at.mirror, wi);
     return p;
 }
 
@@ -182,20 +211,20 @@ struct EvalPdf {
     float pdf = 0;
 };
 
-inline EvalPdf eval_pdf_with(const Bsdf& b, const LobeWeights& w, const Vec3f& n,
-                             const Vec3f& wo, const Vec3f& wi)
+inline EvalPdf eval_pdf_with(const BsdfAt& at, const LobeWeights& w, const Vec3f& wi)
 {
-    float cos_i = dot(n, wi);
+    const Bsdf& b = at.bsdf;
+    float cos_i = dot(at.n, wi);
     if (cos_i < 0)
         return {b.transmit * inv_pi, w.transmit * -cos_i * inv_pi};
-    const bool glossy_f = !is_black(b.glossy), glossy_pdf = w.glossy > 0;
-    const float phong = glossy_f || glossy_pdf ? phong_term(b, n, wo, wi) : 0.0f;
+    const bool glossy_pdf = w.glossy > 0;
+    const float phong = at.glossy || glossy_pdf ? phong_about(b, at.mirror, wi) : 0.0f;
     Vec3f f = b.reflect * inv_pi;
-    if (glossy_f)
-        f += b.glossy * ((b.exponent + 2) / (2 * pi) * phong);
+    if (at.glossy)
+        f += b.glossy * (at.glossy_f * phong);
     float p = w.reflect * cos_i * inv_pi;
     if (glossy_pdf)
-        p += w.glossy * (b.exponent + 1) / (2 * pi) * phong;
+        p += glossy_pdf_scale(b, w) * phong;
     return {f, p};
 }
 
@@ -222,48 +251,85 @@ inline BsdfSample sample_diffuse(const Bsdf& b, const Vec3f& n, float u1, float 
 
 }  // namespace bsdf_detail
 
-inline Vec3f bsdf_eval(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3f& wi)
+inline BsdfAt bsdf_at(const Bsdf& b, const Vec3f& n, const Vec3f& wo)
 {
     using namespace bsdf_detail;
-    float cos_i = dot(n, wi);
+    const bool glossy = !is_black(b.glossy);
+    return {b, n, wo, mirror(wo, n), glossy ? (b.exponent + 2) / (2 * pi) : 0.0f, glossy};
+}
+
+inline Vec3f bsdf_eval(const BsdfAt& at, const Vec3f& wi)
+{
+    using namespace bsdf_detail;
+    const Bsdf& b = at.bsdf;
+    float cos_i = dot(at.n, wi);
     if (cos_i < 0)
         return b.transmit * inv_pi;
     Vec3f f = b.reflect * inv_pi;
-    if (!is_black(b.glossy))
-        f += b.glossy * ((b.exponent + 2) / (2 * pi) * phong_term(b, n, wo, wi));
+    if (at.glossy)
+        f += b.glossy * (at.glossy_f * phong_about(b, at.mirror, wi));
     return f;
 }
 
-inline float bsdf_pdf(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3f& wi)
+inline float bsdf_pdf(const BsdfAt& at, const Vec3f& wi)
 {
-    return bsdf_detail::pdf_with(b, bsdf_detail::lobe_weights(b), n, wo, wi);
+    return bsdf_detail::pdf_with(at, bsdf_detail::lobe_weights(at.bsdf), wi);
 }
 
-inline BsdfSample bsdf_sample(const Bsdf& b, const Vec3f& n, const Vec3f& wo, float u1, float u2)
+// Always inline: GCC made it a call, whose result came back through memory, and the
+// caller's 8-byte load of weight.x and .y spanned two of its stores (a 16-byte and an
+// 8-byte one), which stalls store forwarding at every vertex; an empty result was zeroed
+// by `rep stos` for a caller that reads only its pdf.
+[[gnu::always_inline]] inline BsdfSample bsdf_sample(const BsdfAt& at, float u1, float u2)
 {
     using namespace bsdf_detail;
+    const Bsdf& b = at.bsdf;
+    const Vec3f& n = at.n;
     if (diffuse_only(b))
         return sample_diffuse(b, n, u1, u2);
     LobeWeights w = lobe_weights(b);
     Vec3f wi;
-    if (u1 < w.reflect) {
-        wi = sample_cosine(n, u1 / w.reflect, u2);
-    } else if (u1 < w.reflect + w.transmit) {
-        wi = sample_cosine(-n, (u1 - w.reflect) / w.transmit, u2);
+    const bool reflect = u1 < w.reflect;
+    if (reflect | (u1 < w.reflect + w.transmit)) {
+        // Either Lambertian lobe, picked by selects, not a branch: on a translucent leaf
+        // which one is a coin flip, a branch mispredicted half the time. The same values
+        // as one branch per lobe: u1 - 0 is u1, and the axis is n or n negated.
+        const float below = reflect ? 0.0f : w.reflect;
+        const float share = reflect ? w.reflect : w.transmit;
+        const float side = reflect ? 1.0f : -1.0f;
+        wi = sample_cosine(n * side, (u1 - below) / share, u2);
     } else if (w.glossy > 0) {
-        float u = std::fmin((u1 - w.reflect - w.transmit) / w.glossy, 1.0f);
+        // min(x, 1) by hand, as std::fmin gives it for every x (NaN too), where std::fmin
+        // is a library call.
+        const float x = (u1 - w.reflect - w.transmit) / w.glossy;
+        const float u = x < 1 ? x : 1.0f;
         // pdf (n+1)/(2 pi) cos^n about the mirror direction: cos = u^(1/(n+1)).
         float cos_a = std::pow(u, 1 / (b.exponent + 1));
-        wi = around(mirror(wo, n), cos_a, u2);
+        wi = around(at.mirror, cos_a, u2);
         if (dot(n, wi) <= 0)
             return {};  // below the surface: the lobe's lost energy
     } else {
         return {};
     }
-    const EvalPdf e = eval_pdf_with(b, w, n, wo, wi);
+    const EvalPdf e = eval_pdf_with(at, w, wi);
     if (e.pdf <= 0)
         return {};
     return {wi, e.f * (std::fabs(dot(n, wi)) / e.pdf), e.pdf};
+}
+
+inline Vec3f bsdf_eval(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3f& wi)
+{
+    return bsdf_eval(bsdf_at(b, n, wo), wi);
+}
+
+inline float bsdf_pdf(const Bsdf& b, const Vec3f& n, const Vec3f& wo, const Vec3f& wi)
+{
+    return bsdf_pdf(bsdf_at(b, n, wo), wi);
+}
+
+inline BsdfSample bsdf_sample(const Bsdf& b, const Vec3f& n, const Vec3f& wo, float u1, float u2)
+{
+    return bsdf_sample(bsdf_at(b, n, wo), u1, u2);
 }
 
 }  // namespace cambium::render

@@ -171,10 +171,10 @@ private:
     float m_u = 0;
 };
 
+/// A shading vertex: its hit and its BSDF seen along the path (made once per vertex).
 struct Vertex {
     const SurfaceHit& hit;
-    const Bsdf& bsdf;
-    Vec3f wo;
+    const BsdfAt& bsdf;
 };
 
 /// The four uniforms a vertex spends on next-event estimation.
@@ -213,7 +213,7 @@ Vec3f unshadowed(const Vertex& v, const LightLiSample& ls)
     float cos = std::fabs(dot(v.hit.normal, ls.wi));
     if (cos <= 0 || !same_side(v.hit, ls.wi))
         return {};
-    Vec3f f = bsdf_eval(v.bsdf, v.hit.normal, v.wo, ls.wi);
+    Vec3f f = bsdf_eval(v.bsdf, ls.wi);
     if (is_black(f))
         return {};
     return f * ls.li * cos;
@@ -348,7 +348,7 @@ Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, co
         return {};
     float pdf = chosen->probability * ls.pdf;
     float w = ls.delta || last ? 1.0f
-                               : power_heuristic(pdf, bsdf_pdf(v.bsdf, v.hit.normal, v.wo, ls.wi));
+                               : power_heuristic(pdf, bsdf_pdf(v.bsdf, ls.wi));
     return c * (through * w / pdf);
 }
 
@@ -543,7 +543,10 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             if (depth == 0) {
                 result.radiance += beta * seen_by_camera(ctx, dir);
             } else if (!facts.environment_black) {
-                float w = bsdf_hit_weight(bsdf_pdf_prev, lights.pdf_li(dir));
+                // Unless the environment is sampled (then the set holds it), pdf_li() is
+                // 0: asked here without the call, for most bounce rays off a leaf escape.
+                float w = bsdf_hit_weight(bsdf_pdf_prev,
+                                          facts.environment_nee ? lights.pdf_li(dir) : 0.0f);
                 result.radiance += beta * env_radiance(dir) * w;
             }
             break;
@@ -608,7 +611,8 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             Vec3f g = bsdf.glossy * tint;
             bsdf.glossy = {std::fmin(g.x, 1.0f), std::fmin(g.y, 1.0f), std::fmin(g.z, 1.0f)};
         }
-        Vertex vertex{*hit, bsdf, -dir};
+        const BsdfAt at = bsdf_at(bsdf, hit->normal, -dir);
+        Vertex vertex{*hit, at};
         const bool last = depth + 1 == ctx.max_depth;
         result.radiance += beta * sample_ld(ctx, facts, vertex, last, sampler, block);
         if (++depth == ctx.max_depth)
@@ -616,7 +620,7 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
 
         // Continue the path: sample the BSDF, then Russian roulette on the throughput.
         auto [u1, u2] = sampler.get2d(block + sample_dimension::bsdf);
-        BsdfSample bs = bsdf_sample(bsdf, hit->normal, vertex.wo, u1, u2);
+        BsdfSample bs = bsdf_sample(at, u1, u2);
         if (bs.pdf <= 0 || !same_side(*hit, bs.wi))
             break;
         beta *= bs.weight;

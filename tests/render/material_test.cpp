@@ -152,6 +152,58 @@ TEST(Material, SampleWeightAndPdfAreEvalAndPdf)
     EXPECT_GT(glossy, 20);  // the glossy lobe was drawn and checked too
 }
 
+// One BsdfAt, made once for a vertex and then asked about many directions (as the path
+// tracer does), gives f and pdf by the normalized Phong formulas written out here, about
+// a tilted normal (so a wrong mirror direction shows), and its samples pick the lobe's
+// side as u1 says: reflection below w.reflect, transmission up to w.reflect + w.transmit.
+TEST(Material, BsdfAtIsTheFormulasForEveryDirection)
+{
+    const Bsdf b = make_bsdf(coloured_lobes(6.75f));
+    const Vec3f n = normalize(Vec3f(0.3f, -0.2f, 0.9f));
+    const Vec3f wo = normalize(Vec3f(-0.5f, 0.1f, 0.6f));
+    const BsdfAt at = bsdf_at(b, n, wo);
+    const double r = (b.reflect.x + b.reflect.y + b.reflect.z) / 3.0,
+                 t = (b.transmit.x + b.transmit.y + b.transmit.z) / 3.0,
+                 g = (b.glossy.x + b.glossy.y + b.glossy.z) / 3.0, sum = r + t + g;
+    const double e = b.exponent;
+    const Vec3f axis = n * (2 * dot(n, wo)) - wo;
+    int below = 0, lobed = 0;
+    for (int i = 0; i < 4000; ++i) {
+        Sampler s(static_cast<std::uint32_t>(i), 3, 0, 17);
+        const float z = 1 - 2 * s.next(), phi = 2 * pi * s.next();
+        const float rad = std::sqrt(std::fmax(0.0f, 1 - z * z));
+        const Vec3f wi(rad * std::cos(phi), rad * std::sin(phi), z);
+        const double cos_i = dot(n, wi), c = std::fmax(0.0, double(dot(axis, wi)));
+        const double phong = c > 0 ? std::pow(c, e) : 0;
+        lobed += c > 0.5;
+        below += cos_i < 0;
+        const double want_f = cos_i < 0 ? b.transmit.y / pi
+                                        : b.reflect.y / pi + b.glossy.y * (e + 2) / (2 * pi) * phong;
+        const double want_pdf = cos_i < 0 ? t / sum * -cos_i / pi
+                                          : r / sum * cos_i / pi + g / sum * (e + 1) / (2 * pi) * phong;
+        ASSERT_NEAR(bsdf_eval(at, wi).y, want_f, 1e-5 * want_f + 1e-7) << i;
+        ASSERT_NEAR(bsdf_pdf(at, wi), want_pdf, 1e-5 * want_pdf + 1e-7) << i;
+        // The same to the bit as the calls that make their own BsdfAt.
+        ASSERT_EQ(bsdf_eval(at, wi).x, bsdf_eval(b, n, wo, wi).x) << i;
+        ASSERT_EQ(bsdf_pdf(at, wi), bsdf_pdf(b, n, wo, wi)) << i;
+    }
+    EXPECT_GT(below, 1000);
+    EXPECT_GT(lobed, 100);
+    for (int i = 0; i < 1000; ++i) {
+        const float u1 = (static_cast<float>(i) + 0.5f) / 1000;
+        const float u2 = static_cast<float>((i * 7919) % 1000) / 1000;
+        const BsdfSample bs = bsdf_sample(at, u1, u2);
+        if (u1 < r / sum - 1e-6) {
+            ASSERT_GT(dot(n, bs.wi), 0) << u1;
+        } else if (u1 > r / sum + 1e-6 && u1 < (r + t) / sum - 1e-6) {
+            ASSERT_LT(dot(n, bs.wi), 0) << u1;
+        }
+        if (!(bs.pdf > 0))
+            continue;
+        ASSERT_NEAR(bs.pdf, bsdf_pdf(at, bs.wi), 1e-6f * bs.pdf) << u1;
+    }
+}
+
 // Sampling agrees with quadrature of eval for every lobe mixture: pdf and eval match.
 TEST(Material, SamplingMatchesQuadrature)
 {
