@@ -25,6 +25,7 @@
 
 #include "base/diagnostics.h"
 #include "geom/scene_limits.h"
+#include "render/simd_clones.h"
 
 namespace cambium::render {
 
@@ -124,14 +125,6 @@ Camera make_parallel(const geom::View& view, const Frame& f, const geom::Bounds3
     double back_off = geom::length(all.extent()) + geom::length(all.center() - centre) + 1.0;
     return Camera::parallel(centre, f.forward, f.up, pixel_size, back_off, width, height);
 }
-
-// The SIMD clones exist only on x86 (elsewhere the compiler vectorises for what it has):
-// AVX-512 (x86-64-v4, 8 doubles a register), AVX2 and the baseline, picked at load time.
-#if defined(__x86_64__) || defined(__i386__)
-#define CAMBIUM_SIMD_CLONES [[gnu::target_clones("arch=x86-64-v4", "avx2", "default")]]
-#else
-#define CAMBIUM_SIMD_CLONES
-#endif
 
 /// A parallel camera's numbers as generate_ray() and clip() use them, for
 /// parallel_block: the same operands, so the same operations give the same bits.

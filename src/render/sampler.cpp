@@ -5,19 +5,11 @@
 #include <algorithm>
 #include <array>
 
+#include "render/simd_clones.h"
+
 namespace cambium::render {
 
 namespace {
-
-// The SIMD clones exist only on x86 (elsewhere the compiler vectorises for what it has).
-// x86-64-v4 is AVX-512 with its byte and word instructions (AVX512BW), which the byte
-// swap that GCC finds in reverse_bits_shifts needs at 16 lanes; "avx512f" alone would
-// not vectorise the block at that width.
-#if defined(__x86_64__) || defined(__i386__)
-#define CAMBIUM_SIMD_CLONES [[gnu::target_clones("arch=x86-64-v4", "avx2", "default")]]
-#else
-#define CAMBIUM_SIMD_CLONES
-#endif
 
 /// The pair values of samples first .. first + 15 (sobol_pairs). Plain integer arithmetic
 /// over a fixed count, which vectorises: GCC builds one version for AVX-512 (the block's
