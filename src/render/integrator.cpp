@@ -352,16 +352,6 @@ Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, co
     return c * (through * w / pdf);
 }
 
-/// A direction about the unit normal n drawn with density cos / pi (Malley's method).
-Vec3f cosine_direction(const Vec3f& n, float u1, float u2)
-{
-    float r = std::sqrt(u1), phi = 2 * std::numbers::pi_v<float> * u2;
-    Vec3f t, b;
-    make_basis(n, t, b);
-    return normalize(t * (r * std::cos(phi)) + b * (r * std::sin(phi)) +
-                     n * std::sqrt(std::fmax(0.0f, 1 - u1)));
-}
-
 /// A shadow catcher's point (Cycles' idea): the light a white Lambertian surface there
 /// reflects with the plant in the way and without it, from the same samples: one light
 /// chosen by power (lights, emissive primitives, a non-uniform environment; full weight,
@@ -397,7 +387,7 @@ void catch_shadow(const PathContext& ctx, const PathContext::SceneFlags& facts,
     }
     if (!facts.environment_black && !facts.environment_nee) {
         // f cos / pdf = (1 / pi) cos / (cos / pi) = 1
-        Vec3f wi = cosine_direction(hit.normal, c1, c2);
+        Vec3f wi = bsdf_detail::sample_cosine(hit.normal, c1, c2);  // as a Lambertian BSDF draws
         add(wi, escaped_radiance(ctx, wi), infinity);
     }
 }
@@ -543,10 +533,7 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             if (depth == 0) {
                 result.radiance += beta * seen_by_camera(ctx, dir);
             } else if (!facts.environment_black) {
-                // Unless the environment is sampled (then the set holds it), pdf_li() is
-                // 0: asked here without the call, for most bounce rays off a leaf escape.
-                float w = bsdf_hit_weight(bsdf_pdf_prev,
-                                          facts.environment_nee ? lights.pdf_li(dir) : 0.0f);
+                float w = bsdf_hit_weight(bsdf_pdf_prev, lights.pdf_li(dir));
                 result.radiance += beta * env_radiance(dir) * w;
             }
             break;

@@ -237,9 +237,4 @@ float LightSet::pdf_li(const Vec3f& p, const SurfaceHit& hit) const
     return m_area ? m_area_probability * m_area->pdf(p, hit) : 0.0f;
 }
 
-float LightSet::pdf_li(const Vec3f& wi) const
-{
-    return m_environment ? m_environment_probability * m_environment->pdf(wi) : 0.0f;
-}
-
 }  // namespace cambium::render

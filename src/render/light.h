@@ -117,8 +117,12 @@ public:
     /// point `hit` seen from p; 0 when it is not a sampled area light.
     float pdf_li(const Vec3f& p, const SurfaceHit& hit) const;
     /// The density (choice included) with which sampling the set finds the environment
-    /// along wi; 0 when the environment is not sampled.
-    float pdf_li(const Vec3f& wi) const;
+    /// along wi; 0 when the environment is not sampled. Inline: most bounce rays off a
+    /// leaf escape and ask, and most sets hold no environment.
+    float pdf_li(const Vec3f& wi) const
+    {
+        return m_environment ? m_environment_probability * m_environment->pdf(wi) : 0.0f;
+    }
 
 private:
     struct Entry {
