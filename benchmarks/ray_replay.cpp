@@ -326,38 +326,57 @@ double seconds_since(Clock::time_point t)
     return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-/// Raw rtcIntersect1 (or rtcOccluded1) over the recorded rays, in parallel; returns seconds.
-double replay(RTCScene scene, const RayLog& log, bool occlusion, std::uint64_t& hits)
+/// A recorded ray as Embree takes it for intersection: no hit yet.
+RTCRayHit unhit(const RTCRay& ray)
 {
-    const std::vector<RTCRay>& rays = log.rays;
+    RTCRayHit rh;
+    rh.ray = ray;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    return rh;
+}
+
+/// body(i, context) for i in [0, n), in parallel (grains of `grain`) on the caller's arena,
+/// each task with the float modes the render's threads trace with (render/float_mode.h)
+/// and its own replay context (`flags`); body returns the hits it found, summed into
+/// `hits`. Returns the wall seconds.
+template <class Body>
+double replay_in_parallel(std::size_t n, std::size_t grain, RTCIntersectContextFlags flags,
+                          std::uint64_t& hits, const Body& body)
+{
     std::atomic<std::uint64_t> hit_count{0};
     auto t0 = Clock::now();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), 1024),
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, grain),
                       [&](const tbb::blocked_range<std::size_t>& r) {
-        // The modes the render's threads trace with (render/float_mode.h).
         render::DenormalsFlushed flushed;
         ReplayContext c;
+        c.context.flags = flags;
         std::uint64_t local = 0;
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            if (!log.skips.empty())
-                c.skip = log.skips[i];
-            if (occlusion) {
-                RTCRay ray = rays[i];
-                embree().occluded(scene, &c.context, &ray);
-                local += ray.tfar < 0 ? 1 : 0;
-                continue;
-            }
-            RTCRayHit rh;
-            rh.ray = rays[i];
-            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-            embree().intersect(scene, &c.context, &rh);
-            local += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
-        }
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+            local += body(i, c);
         hit_count += local;
     });
     hits = hit_count;
     return seconds_since(t0);
+}
+
+/// Raw rtcIntersect1 (or rtcOccluded1) over the recorded rays, in parallel; returns seconds.
+double replay(RTCScene scene, const RayLog& log, bool occlusion, std::uint64_t& hits)
+{
+    const std::vector<RTCRay>& rays = log.rays;
+    return replay_in_parallel(rays.size(), 1024, RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT, hits,
+                              [&](std::size_t i, ReplayContext& c) -> std::uint64_t {
+        if (!log.skips.empty())
+            c.skip = log.skips[i];
+        if (occlusion) {
+            RTCRay ray = rays[i];
+            embree().occluded(scene, &c.context, &ray);
+            return ray.tfar < 0 ? 1 : 0;
+        }
+        RTCRayHit rh = unhit(rays[i]);
+        embree().intersect(scene, &c.context, &rh);
+        return rh.hit.geomID != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
+    });
 }
 
 /// Raw rtcIntersect1M over the recorded streams (each as the path tracer traced it, with
@@ -368,32 +387,21 @@ double replay_streams(RTCScene scene, const std::vector<RTCRay>& rays, std::uint
     for (std::size_t i = 0; i < rays.size(); i += std::max<unsigned>(rays[i].id, 1))
         if (rays[i].id > 0 && i + rays[i].id <= rays.size())
             starts.push_back(i);
-    std::atomic<std::uint64_t> hit_count{0};
-    auto t0 = Clock::now();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, starts.size(), 64),
-                      [&](const tbb::blocked_range<std::size_t>& r) {
-        render::DenormalsFlushed flushed;
-        ReplayContext c;
-        c.context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-        std::array<RTCRayHit, RayLog::chunk> batch;
-        std::uint64_t local = 0;
-        for (std::size_t b = r.begin(); b != r.end(); ++b) {
-            const std::size_t first = starts[b];
-            const unsigned m = rays[first].id;
-            for (unsigned k = 0; k < m; ++k) {
-                batch[k].ray = rays[first + k];
-                batch[k].ray.id = 0;
-                batch[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
-                batch[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-            }
-            embree().intersect_stream(scene, &c.context, batch.data(), m, sizeof(RTCRayHit));
-            for (unsigned k = 0; k < m; ++k)
-                local += batch[k].hit.geomID != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
+    return replay_in_parallel(starts.size(), 64, RTC_INTERSECT_CONTEXT_FLAG_COHERENT, hits,
+                              [&](std::size_t b, ReplayContext& c) -> std::uint64_t {
+        thread_local std::array<RTCRayHit, RayLog::chunk> batch;  // a stream fits its chunk
+        const std::size_t first = starts[b];
+        const unsigned m = rays[first].id;
+        for (unsigned k = 0; k < m; ++k) {
+            batch[k] = unhit(rays[first + k]);
+            batch[k].ray.id = 0;
         }
-        hit_count += local;
+        embree().intersect_stream(scene, &c.context, batch.data(), m, sizeof(RTCRayHit));
+        std::uint64_t found = 0;
+        for (unsigned k = 0; k < m; ++k)
+            found += batch[k].hit.geomID != RTC_INVALID_GEOMETRY_ID ? 1 : 0;
+        return found;
     });
-    hits = hit_count;
-    return seconds_since(t0);
 }
 
 }  // namespace
