@@ -42,7 +42,9 @@
 // count) and their hashes (`ray_hashes`: singles, streams, shadow rays; equal at any
 // thread count), what was recorded (`one_in`: one run of rays in k) and replayed,
 // `trace_s` / `trace_cpu_s` (the timed render: first Embree call of the pixel loop to the
-// end of the pass), `recording_trace_cpu_s` (the recording render's, with the interposer's
+// end of the pass; `trace_window_s`: that span on the steady clock, CLOCK_MONOTONIC, for
+// cutting a `perf record -k CLOCK_MONOTONIC` profile to it with benchmarks/embree_share.py),
+// `recording_trace_cpu_s` (the recording render's, with the interposer's
 // work), `raw_embree_cpu_s` (raw Embree's CPU seconds for the same numbers of rays of
 // each kind; `raw_embree_first_round_cpu_s` at the first replay round's rates alone),
 // `path_tracer_rays_per_s`, `raw_embree_rays_per_s` (wall) and
@@ -430,6 +432,7 @@ void report_raw_embree(const std::string& plant, const Settings& s,
                 "\"timed_render\":\"the second of two identical renders, not recorded\","
                 "\"same_render\":%s,\"renderer_rays\":%llu,"
                 "\"trace_s\":%.3f,\"trace_cpu_s\":%.3f,\"recording_trace_cpu_s\":%.3f,"
+                "\"trace_window_s\":[%.6f,%.6f],"
                 "\"raw_embree_cpu_s\":%.3f,\"raw_embree_first_round_cpu_s\":%.3f,"
                 "\"path_tracer_rays_per_s\":%.0f,\"raw_embree_rays_per_s\":%.0f,"
                 "\"path_tracer_fraction_of_raw\":%.3f,"
@@ -448,7 +451,8 @@ void report_raw_embree(const std::string& plant, const Settings& s,
                 raw.intersect_first_cpu_s, raw.stream_first_cpu_s, raw.occluded_first_cpu_s,
                 m.same_render ? "true" : "false",
                 static_cast<unsigned long long>(m.timed.rays), t.trace_s, t.trace_cpu_s,
-                t.recording_trace_cpu_s, t.raw_mix_cpu_s(), t.raw_mix_first_round_cpu_s(),
+                t.recording_trace_cpu_s, t.trace_window_s[0], t.trace_window_s[1],
+                t.raw_mix_cpu_s(), t.raw_mix_first_round_cpu_s(),
                 t.trace_s > 0 ? double(t.rays()) / t.trace_s : 0.0, t.raw_rays_per_s(),
                 t.path_tracer_fraction_of_raw(), t.path_tracer_fraction_of_raw_cpu());
     std::fflush(stdout);

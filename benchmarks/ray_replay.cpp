@@ -508,6 +508,10 @@ void Recorder::stop_timed()
     if (timed_started) {
         m_trace.trace_s = std::chrono::duration<double>(end - timed_first_call).count();
         m_trace.trace_cpu_s = end_cpu - timed_first_call_cpu;
+        auto seconds = [](Clock::time_point t) {
+            return std::chrono::duration<double>(t.time_since_epoch()).count();
+        };
+        m_trace.trace_window_s = {seconds(timed_first_call), seconds(end)};
     }
 }
 

@@ -176,6 +176,10 @@ struct TraceFigures {
     /// ray_hash summed over the recording render's rays of each kind.
     std::uint64_t singles_hash = 0, occlusions_hash = 0, streams_hash = 0;
     double trace_s = 0, trace_cpu_s = 0;  ///< the timed render: first Embree call to its end
+    /// The same span on the steady clock (CLOCK_MONOTONIC on Linux), in seconds: the window
+    /// of a profile taken with `perf record -k CLOCK_MONOTONIC` that is the timed trace
+    /// (benchmarks/embree_share.py).
+    std::array<double, 2> trace_window_s{};
     /// Whether the timed render's calls went straight to Embree's own entry points from
     /// its first call to its end.
     bool timed_forwarded = false;

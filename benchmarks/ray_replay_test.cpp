@@ -3,6 +3,8 @@
 // without the interposer counting or recording them, at any thread count.
 #include "ray_replay.h"
 
+#include <ctime>
+
 #include <gtest/gtest.h>
 
 #include "test_scenes.h"
@@ -71,6 +73,27 @@ TEST(RayReplay, TimedRenderTracesTheRecordedRaysAndCountsNone)
     EXPECT_GT(f.raw_mix_cpu_s(), 0);
     EXPECT_GT(f.raw_mix_first_round_cpu_s(), 0);
     EXPECT_GT(f.path_tracer_fraction_of_raw_cpu(), 0);
+}
+
+/// The seconds on CLOCK_MONOTONIC, the clock `perf record -k CLOCK_MONOTONIC` stamps
+/// samples with.
+double monotonic_seconds()
+{
+    timespec t{};
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+TEST(RayReplay, TraceWindowIsTheTimedTraceOnTheMonotonicClock)
+{
+    const double before = monotonic_seconds();
+    const TraceFigures f = measure_lattice(2).trace;
+    const double after = monotonic_seconds();
+    // A profile cut to this window holds the timed trace and nothing outside the run.
+    EXPECT_LE(before, f.trace_window_s[0]);
+    EXPECT_LT(f.trace_window_s[0], f.trace_window_s[1]);
+    EXPECT_LE(f.trace_window_s[1], after);
+    EXPECT_NEAR(f.trace_window_s[1] - f.trace_window_s[0], f.trace_s, 1e-6);
 }
 
 TEST(RayReplay, AfterAMeasurementTheEntryPointsCountNothing)

@@ -72,6 +72,10 @@ def main():
                         help="turn the camera by this many radians about its right and up "
                              "axes: camera rays without exactly zero components (Embree's "
                              "round curves are very slow on those; Cambium nudges them)")
+    parser.add_argument("--render-only", type=int, metavar="SPP",
+                        help="after the sync, render once at SPP and print its times only "
+                             "(no reference, no noise): a window to profile Cycles' render "
+                             "in, e.g. its share of time inside Embree under perf")
     args = parser.parse_args(argv)
 
     plant = os.path.splitext(os.path.basename(args.scene))[0]
@@ -92,6 +96,15 @@ def main():
         ("-no-mesh-lights" if args.no_mesh_lights else "")
     scratch = os.path.join(args.cache, f"{plant}-{size}-run.exr")
     sync = timed_render(scratch, 1, 0)
+    if args.render_only:
+        start = time.clock_gettime(time.CLOCK_MONOTONIC)
+        w, c = timed_render(scratch, args.render_only, 0)
+        end = time.clock_gettime(time.CLOCK_MONOTONIC)
+        print(json.dumps({"plant": plant, "renderer": "cycles", "image": size,
+                          "threads": args.threads, "spp": args.render_only,
+                          "seconds": round(w, 3), "cpu_seconds": round(c, 3),
+                          "sync_s": round(sync[0], 3), "window_s": [start, end]}), flush=True)
+        return
 
     reference_file = os.path.join(args.cache, f"{plant}-{size}-{args.reference_spp}.exr")
     reference_seconds = None
