@@ -432,6 +432,28 @@ TextureFootprint texture_footprint(const SurfaceHit& hit, const Vec3f& dir, floa
     return {dsdx, dtdx, dsdy, dtdy};
 }
 
+bool footprint_within_texel(const SurfaceHit& hit, const Vec3f& dir, float width, float texels)
+{
+    if (!(texels > 0))
+        return true;
+    // texture_footprint's axes are the pixel's ellipse (`width` and width / cos across,
+    // cos clamped as there) taken to (s, t) by the pseudo-inverse of J = (dpds dpdt). In
+    // exact arithmetic an axis m gives |(ds, dt)|^2 <= |m|^2 / lambda_min(J^T J), and
+    // lambda_min >= det / (a + c) (the larger eigenvalue is below the trace), so the
+    // lookup's extent^2 in texels is at most texels^2 width^2 (a + c) / (cos^2 det). A
+    // well-conditioned frame (det > 1/100 of a c, which a tube's orthogonal tangents
+    // meet with det = a c) keeps texture_footprint's float error near 1e-5 of that bound
+    // (its divisions by det); asking for a quarter of one texel^2 covers it many times.
+    const Vec3f &dpds = hit.dpds, &dpdt = hit.dpdt;
+    const float a = dot(dpds, dpds), b = dot(dpds, dpdt), c = dot(dpdt, dpdt);
+    const float ac = a * c, det = ac - b * b;
+    const float cos_abs = std::fabs(dot(dir, hit.geometric_normal));
+    const float cos = cos_abs > 0.02f ? cos_abs : 0.02f;
+    const float reach = texels * width;
+    return ac > 1e-30f && det > 0.01f * ac &&
+           4 * (reach * reach) * (a + c) <= (cos * cos) * det;
+}
+
 void prepare_path_context(PathContext& ctx)
 {
     const Environment* env = ctx.environment;
@@ -550,10 +572,14 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         auto textured_diffuse = [&] {
             if (!ctx.textures || hit->texture == geom::no_texture)
                 return material.diffuse;
+            // Most hits see less than a texel (GeneralizedCylinder's almost all): then the
+            // finest level is taken for sure, and the footprint is not made.
+            const float width = ctx.camera_cone.width + ctx.camera_cone.spread * travelled;
+            const bool finest = footprint_within_texel(
+                *hit, dir, width, ctx.textures->footprint_texels(hit->texture));
             return ctx.textures->apply(
                 hit->texture, material.diffuse, hit->u, hit->v,
-                texture_footprint(*hit, dir,
-                                  ctx.camera_cone.width + ctx.camera_cone.spread * travelled));
+                finest ? TextureFootprint{} : texture_footprint(*hit, dir, width));
         };
         std::optional<Vec3f> diffuse_seen;  // looked up once per vertex at most
         if (first && depth == 0 && passes == 0) {

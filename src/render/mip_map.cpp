@@ -118,6 +118,8 @@ MipMap::MipMap(TexturePixels pixels, TextureFilter filter)
                                    coarse.width, coarse.height);
         m_levels.push_back(std::move(coarse));
     }
+    if (m_levels.size() > 1)
+        m_footprint_texels = float(std::max(m_levels.front().width, m_levels.front().height));
 }
 
 std::uint64_t MipMap::bytes() const

@@ -85,6 +85,12 @@ bool TextureSet::cuts_out(int index) const
     return valid(index) && m_impl->entries[static_cast<std::size_t>(index)].map->can_cut_out();
 }
 
+float TextureSet::footprint_texels(int index) const
+{
+    return valid(index) ? m_impl->entries[static_cast<std::size_t>(index)].map->footprint_texels()
+                        : 0.0f;
+}
+
 Texel TextureSet::lookup(int index, float s, float t, float width) const
 {
     return lookup(index, s, t, TextureFootprint{width, 0, 0, width});

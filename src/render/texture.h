@@ -62,6 +62,11 @@ public:
     /// (MipMap::can_cut_out). Hits on an opaque image's surfaces need no alpha test.
     bool cuts_out(int index) const;
 
+    /// The longer side of the texture's finest level in texels, where its lookups choose
+    /// a MIP level by their footprint; 0 where no footprint matters (one level, or not a
+    /// valid index): what footprint_within_texel() (integrator.h) compares with.
+    float footprint_texels(int index) const;
+
     /// The filtered texel at (s, t); `width` is the lookup's footprint in texture units
     /// (0: the finest level). Invalid indices give white, alpha 1.
     Texel lookup(int index, float s, float t, float width = 0) const;
