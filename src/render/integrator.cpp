@@ -595,9 +595,11 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             const float width = ctx.camera_cone.width + ctx.camera_cone.spread * travelled;
             const bool finest = footprint_within_texel(
                 *hit, dir, width, ctx.textures->footprint_texels(hit->texture));
-            return ctx.textures->apply(
-                hit->texture, material.diffuse, hit->u, hit->v,
-                finest ? TextureFootprint{} : texture_footprint(*hit, dir, width));
+            TextureSet::Rgbx seen;
+            ctx.textures->apply(hit->texture, material.diffuse, hit->u, hit->v,
+                                finest ? TextureFootprint{} : texture_footprint(*hit, dir, width),
+                                seen);
+            return seen.rgb();
         };
         std::optional<Vec3f> diffuse_seen;  // looked up once per vertex at most
         if (first && depth == 0 && passes == 0) {

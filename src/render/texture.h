@@ -77,6 +77,17 @@ public:
     Vec3f apply(int index, const Vec3f& diffuse, float s, float t,
                 const TextureFootprint& footprint = {}) const;
 
+    /// A colour written whole: R, G, B and a fourth value of no meaning.
+    struct alignas(16) Rgbx {
+        float v[4];
+        Vec3f rgb() const { return {v[0], v[1], v[2]}; }
+    };
+    /// apply() into `out`, written with one 16-byte store: a Vec3f returned by value comes
+    /// back in two registers, which the path tracer stored apart and read back as one
+    /// 8-byte load across both (a stalled store forward at every textured vertex).
+    void apply(int index, const Vec3f& diffuse, float s, float t,
+               const TextureFootprint& footprint, Rgbx& out) const;
+
 private:
     struct Impl;
     std::unique_ptr<Impl> m_impl;
