@@ -17,6 +17,10 @@
 #include <string>
 #include <utility>
 
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
+
 namespace cambium::render {
 
 namespace {
@@ -40,9 +44,23 @@ const SurfaceMaterial& material_at(const PathContext& ctx, std::uint16_t m)
 /// cpfg's window GL_MODULATE multiplies the whole lit colour, ambient and specular too.
 Vec3f texture_tint(const SurfaceMaterial& m, const Vec3f& diffuse_seen)
 {
+#if defined(__SSE2__)
+    // The three divisions as one (a division lane by lane is the same IEEE division, so
+    // the same values), where three in a row delayed every textured vertex: a lane whose
+    // plain value is not above 0 takes 1, its quotient (inf or NaN) dropped.
+    const __m128 seen = _mm_setr_ps(diffuse_seen.x, diffuse_seen.y, diffuse_seen.z, 1.0f);
+    const __m128 plain = _mm_setr_ps(m.diffuse.x, m.diffuse.y, m.diffuse.z, 1.0f);
+    const __m128 positive = _mm_cmpgt_ps(plain, _mm_setzero_ps());
+    const __m128 ratio = _mm_or_ps(_mm_and_ps(positive, _mm_div_ps(seen, plain)),
+                                   _mm_andnot_ps(positive, _mm_set1_ps(1.0f)));
+    alignas(16) float out[4];
+    _mm_store_ps(out, ratio);
+    return {out[0], out[1], out[2]};
+#else
     auto ratio = [](float seen, float plain) { return plain > 0 ? seen / plain : 1.0f; };
     return {ratio(diffuse_seen.x, m.diffuse.x), ratio(diffuse_seen.y, m.diffuse.y),
             ratio(diffuse_seen.z, m.diffuse.z)};
+#endif
 }
 
 /// The power heuristic (beta = 2) for a sample drawn with pdf a against one of pdf b.
@@ -432,6 +450,28 @@ TextureFootprint texture_footprint(const SurfaceHit& hit, const Vec3f& dir, floa
     return {dsdx, dtdx, dsdy, dtdy};
 }
 
+bool footprint_within_texel(const SurfaceHit& hit, const Vec3f& dir, float width, float texels)
+{
+    if (!(texels > 0))
+        return true;
+    // texture_footprint's axes are the pixel's ellipse (`width` and width / cos across,
+    // cos clamped as there) taken to (s, t) by the pseudo-inverse of J = (dpds dpdt). In
+    // exact arithmetic an axis m gives |(ds, dt)|^2 <= |m|^2 / lambda_min(J^T J), and
+    // lambda_min >= det / (a + c) (the larger eigenvalue is below the trace), so the
+    // lookup's extent^2 in texels is at most texels^2 width^2 (a + c) / (cos^2 det). A
+    // well-conditioned frame (det > 1/100 of a c, which a tube's orthogonal tangents
+    // meet with det = a c) keeps texture_footprint's float error near 1e-5 of that bound
+    // (its divisions by det); asking for a quarter of one texel^2 covers it many times.
+    const Vec3f &dpds = hit.dpds, &dpdt = hit.dpdt;
+    const float a = dot(dpds, dpds), b = dot(dpds, dpdt), c = dot(dpdt, dpdt);
+    const float ac = a * c, det = ac - b * b;
+    const float cos_abs = std::fabs(dot(dir, hit.geometric_normal));
+    const float cos = cos_abs > 0.02f ? cos_abs : 0.02f;
+    const float reach = texels * width;
+    return ac > 1e-30f && det > 0.01f * ac &&
+           4 * (reach * reach) * (a + c) <= (cos * cos) * det;
+}
+
 void prepare_path_context(PathContext& ctx)
 {
     const Environment* env = ctx.environment;
@@ -550,10 +590,16 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         auto textured_diffuse = [&] {
             if (!ctx.textures || hit->texture == geom::no_texture)
                 return material.diffuse;
-            return ctx.textures->apply(
-                hit->texture, material.diffuse, hit->u, hit->v,
-                texture_footprint(*hit, dir,
-                                  ctx.camera_cone.width + ctx.camera_cone.spread * travelled));
+            // Most hits see less than a texel (GeneralizedCylinder's almost all): then the
+            // finest level is taken for sure, and the footprint is not made.
+            const float width = ctx.camera_cone.width + ctx.camera_cone.spread * travelled;
+            const bool finest = footprint_within_texel(
+                *hit, dir, width, ctx.textures->footprint_texels(hit->texture));
+            TextureSet::Rgbx seen;
+            ctx.textures->apply(hit->texture, material.diffuse, hit->u, hit->v,
+                                finest ? TextureFootprint{} : texture_footprint(*hit, dir, width),
+                                seen);
+            return seen.rgb();
         };
         std::optional<Vec3f> diffuse_seen;  // looked up once per vertex at most
         if (first && depth == 0 && passes == 0) {
@@ -595,8 +641,11 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         }
         Bsdf bsdf = make_bsdf(material, diffuse);
         if (textured) {  // the highlight takes the texture's colour, as in cpfg's window
-            Vec3f g = bsdf.glossy * tint;
-            bsdf.glossy = {std::fmin(g.x, 1.0f), std::fmin(g.y, 1.0f), std::fmin(g.z, 1.0f)};
+            // min(x, 1) by hand, as std::fmin gives it for every x (NaN: 1), where
+            // std::fmin is a library call (three at every textured vertex).
+            const Vec3f g = bsdf.glossy * tint;
+            auto at_most_1 = [](float x) { return x < 1 ? x : 1.0f; };
+            bsdf.glossy = {at_most_1(g.x), at_most_1(g.y), at_most_1(g.z)};
         }
         const BsdfAt at = bsdf_at(bsdf, hit->normal, -dir);
         Vertex vertex{*hit, at};

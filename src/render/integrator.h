@@ -92,6 +92,14 @@ void prepare_path_context(PathContext& ctx);
 /// through the hit's dpds and dpdt (least squares).
 TextureFootprint texture_footprint(const SurfaceHit& hit, const Vec3f& dir, float width);
 
+/// Whether texture_footprint(hit, dir, width) is surely under one texel of a texture whose
+/// finest level's longer side is `texels` (TextureSet::footprint_texels; 0: no MIP levels,
+/// always true), so that the lookup takes the finest level whatever the footprint: then
+/// a zero footprint gives the same texel, and the footprint need not be made. A bound on
+/// its longest axis from the tangents' Gram matrix alone, with a factor 2 to spare for
+/// rounding; false where that cannot show it (a sliver of a tangent frame, NaN).
+bool footprint_within_texel(const SurfaceHit& hit, const Vec3f& dir, float width, float texels);
+
 /// The radiance of one path and whether its camera ray hit geometry.
 struct PathResult {
     Vec3f radiance;

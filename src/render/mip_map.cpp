@@ -64,14 +64,21 @@ std::vector<T> reduce(const std::vector<T>& fine, int width, int height, int cha
     return coarse;
 }
 
-/// srgb_to_linear at i / srgb_steps for i in [0, srgb_steps], and the last value again
-/// (decode_srgb reads one past its index). Filled before main: no guard on each lookup.
+/// srgb_to_linear at i / srgb_steps, and the step to the next entry (0 after the last:
+/// decode_srgb reads entry srgb_steps too). One 8-byte load a channel; the step is the
+/// same float subtraction decode_srgb made at every lookup. Filled before main: no guard
+/// on each lookup.
 constexpr int srgb_steps = 1024;
-const std::array<float, srgb_steps + 2> srgb_table = [] {
-    std::array<float, srgb_steps + 2> t{};
+struct SrgbEntry {
+    float value, step;
+};
+const std::array<SrgbEntry, srgb_steps + 1> srgb_table = [] {
+    std::array<float, srgb_steps + 1> v{};
     for (int i = 0; i <= srgb_steps; ++i)
-        t[i] = srgb_to_linear(float(i) / srgb_steps);
-    t[srgb_steps + 1] = t[srgb_steps];
+        v[i] = srgb_to_linear(float(i) / srgb_steps);
+    std::array<SrgbEntry, srgb_steps + 1> t{};
+    for (int i = 0; i <= srgb_steps; ++i)
+        t[i] = {v[i], (i < srgb_steps ? v[i + 1] : v[i]) - v[i]};
     return t;
 }();
 
@@ -83,7 +90,8 @@ float decode_srgb(float v)
     // std::fmin and std::fmax are library calls here; NaN -> 0 as with them.
     const float x = (v > 0 ? (v < 1 ? v : 1.0f) : 0.0f) * srgb_steps;
     const int i = static_cast<int>(x);
-    return srgb_table[i] + (x - float(i)) * (srgb_table[i + 1] - srgb_table[i]);
+    const SrgbEntry& e = srgb_table[i];
+    return e.value + (x - float(i)) * e.step;
 }
 
 }  // namespace
@@ -118,6 +126,8 @@ MipMap::MipMap(TexturePixels pixels, TextureFilter filter)
                                    coarse.width, coarse.height);
         m_levels.push_back(std::move(coarse));
     }
+    if (m_levels.size() > 1)
+        m_footprint_texels = float(std::max(m_levels.front().width, m_levels.front().height));
 }
 
 std::uint64_t MipMap::bytes() const

@@ -49,6 +49,9 @@ public:
     /// of such texels stays above 1/2 by far more than its rounding.
     bool can_cut_out() const { return m_can_cut_out; }
     std::size_t levels() const { return m_levels.size(); }
+    /// The finest level's longer side in texels, where lookup() chooses a level by the
+    /// footprint; 0 where it has only the one level (any footprint gives the finest).
+    float footprint_texels() const { return m_footprint_texels; }
     /// Bytes held by all levels.
     std::uint64_t bytes() const;
 
@@ -70,6 +73,7 @@ private:
     int m_channels;
     bool m_srgb;
     bool m_can_cut_out = false;
+    float m_footprint_texels = 0;
     TextureFilter m_filter;
 };
 

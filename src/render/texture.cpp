@@ -10,6 +10,10 @@
 #include "render/image_codec.h"
 #include "render/mip_map.h"
 
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
+
 namespace cambium::render {
 
 namespace {
@@ -85,6 +89,12 @@ bool TextureSet::cuts_out(int index) const
     return valid(index) && m_impl->entries[static_cast<std::size_t>(index)].map->can_cut_out();
 }
 
+float TextureSet::footprint_texels(int index) const
+{
+    return valid(index) ? m_impl->entries[static_cast<std::size_t>(index)].map->footprint_texels()
+                        : 0.0f;
+}
+
 Texel TextureSet::lookup(int index, float s, float t, float width) const
 {
     return lookup(index, s, t, TextureFootprint{width, 0, 0, width});
@@ -99,11 +109,25 @@ Texel TextureSet::lookup(int index, float s, float t, const TextureFootprint& fp
 Vec3f TextureSet::apply(int index, const Vec3f& diffuse, float s, float t,
                         const TextureFootprint& footprint) const
 {
-    if (!valid(index))
-        return diffuse;
-    const Entry& entry = m_impl->entries[static_cast<std::size_t>(index)];
-    Texel texel = entry.map->lookup(s, t, footprint);
-    return entry.decal ? texel.colour : diffuse * texel.colour;
+    Rgbx out;
+    apply(index, diffuse, s, t, footprint, out);
+    return out.rgb();
+}
+
+void TextureSet::apply(int index, const Vec3f& diffuse, float s, float t,
+                       const TextureFootprint& footprint, Rgbx& out) const
+{
+    Vec3f c = diffuse;
+    if (valid(index)) {
+        const Entry& entry = m_impl->entries[static_cast<std::size_t>(index)];
+        const Texel texel = entry.map->lookup(s, t, footprint);
+        c = entry.decal ? texel.colour : diffuse * texel.colour;
+    }
+#if defined(__SSE2__)
+    _mm_store_ps(out.v, _mm_setr_ps(c.x, c.y, c.z, 0.0f));
+#else
+    out = {{c.x, c.y, c.z, 0.0f}};
+#endif
 }
 
 }  // namespace cambium::render

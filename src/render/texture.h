@@ -62,6 +62,11 @@ public:
     /// (MipMap::can_cut_out). Hits on an opaque image's surfaces need no alpha test.
     bool cuts_out(int index) const;
 
+    /// The longer side of the texture's finest level in texels, where its lookups choose
+    /// a MIP level by their footprint; 0 where no footprint matters (one level, or not a
+    /// valid index): what footprint_within_texel() (integrator.h) compares with.
+    float footprint_texels(int index) const;
+
     /// The filtered texel at (s, t); `width` is the lookup's footprint in texture units
     /// (0: the finest level). Invalid indices give white, alpha 1.
     Texel lookup(int index, float s, float t, float width = 0) const;
@@ -71,6 +76,17 @@ public:
     /// The diffuse albedo after texture `index` at (s, t): modulated or replaced.
     Vec3f apply(int index, const Vec3f& diffuse, float s, float t,
                 const TextureFootprint& footprint = {}) const;
+
+    /// A colour written whole: R, G, B and a fourth value of no meaning.
+    struct alignas(16) Rgbx {
+        float v[4];
+        Vec3f rgb() const { return {v[0], v[1], v[2]}; }
+    };
+    /// apply() into `out`, written with one 16-byte store: a Vec3f returned by value comes
+    /// back in two registers, which the path tracer stored apart and read back as one
+    /// 8-byte load across both (a stalled store forward at every textured vertex).
+    void apply(int index, const Vec3f& diffuse, float s, float t,
+               const TextureFootprint& footprint, Rgbx& out) const;
 
 private:
     struct Impl;

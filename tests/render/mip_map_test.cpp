@@ -5,9 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 #include <stdexcept>
 
 #include "render/color.h"
+#include "render/integrator.h"
 #include "render/mip_map.h"
 
 namespace cambium::render {
@@ -150,6 +152,77 @@ TEST(MipMap, RefusesPixelsThatDoNotMatchTheirSize)
     EXPECT_THROW(MipMap(TexturePixels{1, 1, 5, {}, {1, 2, 3, 4, 5}, false}, {}),
                  std::invalid_argument);
     EXPECT_THROW(MipMap(TexturePixels{0, 1, 1, {}, {}, false}, {}), std::invalid_argument);
+}
+
+TEST(MipMap, FootprintTexelsIsTheFinestLevelsLongerSideWhereLevelsAreChosen)
+{
+    EXPECT_EQ(MipMap(grey(5, 3, [](int, int) { return 0.0f; }), {true, true}).footprint_texels(),
+              5.0f);
+    EXPECT_EQ(MipMap(grey(3, 8, [](int, int) { return 0.0f; }), {true, true}).footprint_texels(),
+              8.0f);
+    // One level: no footprint changes a lookup.
+    EXPECT_EQ(MipMap(grey(4, 4, [](int, int) { return 0.0f; }), {true, false}).footprint_texels(),
+              0.0f);
+    EXPECT_EQ(MipMap(grey(1, 1, [](int, int) { return 0.0f; }), {true, true}).footprint_texels(),
+              0.0f);
+}
+
+// footprint_within_texel (integrator.h) is a bound: where it says a footprint is under one
+// texel, the lookup through the whole footprint takes the finest level alone, bit for bit
+// the lookup without one. A checkerboard of single texels makes every coarser level grey,
+// so any blend toward level 1 shows. Tangent frames of every shape (down to slivers) and
+// scale, views down to grazing, widths from far under a texel to several texels.
+TEST(MipMap, FootprintWithinTexelNeverHidesACoarserLevel)
+{
+    MipMap map(grey(64, 32, [](int x, int y) { return float((x + y) & 1); }), {true, true});
+    ASSERT_EQ(map.footprint_texels(), 64.0f);
+    std::mt19937 rng(16);
+    std::uniform_real_distribution<float> u(-1, 1), unit(0, 1);
+    int within = 0, beyond = 0, coarser = 0;
+    for (int i = 0; i < 200000; ++i) {
+        SurfaceHit hit;
+        hit.geometric_normal = normalize(Vec3f(u(rng), u(rng), u(rng)));
+        Vec3f e0, e1;
+        make_basis(hit.geometric_normal, e0, e1);
+        const float phi = 3.2f * unit(rng), gap = 3.1f * unit(rng) + 0.001f;
+        const float scale_s = std::pow(10.0f, 3 * u(rng)), scale_t = std::pow(10.0f, 3 * u(rng));
+        hit.dpds = (e0 * std::cos(phi) + e1 * std::sin(phi)) * scale_s;
+        hit.dpdt = (e0 * std::cos(phi + gap) + e1 * std::sin(phi + gap)) * scale_t;
+        const Vec3f dir = normalize(Vec3f(u(rng), u(rng), u(rng)));
+        const float width = std::pow(10.0f, 1.5f * u(rng) - 0.5f) *
+                            std::min(scale_s, scale_t) / map.footprint_texels();
+        const float s = unit(rng), t = unit(rng);
+        const float zero = map.lookup(s, t, {}).colour.x;
+        const float full = map.lookup(s, t, texture_footprint(hit, dir, width)).colour.x;
+        coarser += full != zero;
+        if (footprint_within_texel(hit, dir, width, map.footprint_texels())) {
+            ++within;
+            ASSERT_EQ(full, zero) << "frame " << i;
+        } else {
+            beyond += full == zero;
+        }
+    }
+    // Both answers are common, and the bound lets most footprints under a texel through.
+    EXPECT_GT(within, 40000);
+    EXPECT_GT(coarser, 40000);
+    EXPECT_LT(beyond, within);
+}
+
+TEST(MipMap, FootprintWithinTexelWithoutLevelsOrWithNaN)
+{
+    SurfaceHit hit;
+    hit.geometric_normal = {0, 0, 1};
+    hit.dpds = {1, 0, 0};
+    hit.dpdt = {0, 1, 0};
+    const Vec3f down{0, 0, -1};
+    EXPECT_TRUE(footprint_within_texel(hit, down, 1e-3f, 100));
+    EXPECT_FALSE(footprint_within_texel(hit, down, 1e-2f, 100));  // one texel exactly
+    EXPECT_TRUE(footprint_within_texel(hit, down, 1e6f, 0));      // no levels to choose
+    EXPECT_FALSE(footprint_within_texel(hit, down, std::nanf(""), 100));
+    hit.dpdt = {1, 1e-3f, 0};  // a sliver: no bound from it
+    EXPECT_FALSE(footprint_within_texel(hit, down, 1e-9f, 100));
+    hit.dpdt = {};  // t constant
+    EXPECT_FALSE(footprint_within_texel(hit, down, 1e-9f, 100));
 }
 
 }  // namespace
