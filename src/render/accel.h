@@ -122,6 +122,11 @@ public:
     /// passed, and the check per ray is left out.
     void intersect_coherent(std::span<const CameraRayF> rays,
                             std::span<std::optional<SurfaceHit>> hits, bool checked = false) const;
+    /// The same for the first n of `rays` (rays.ray(k) for k < n; n at most
+    /// ParallelRays::capacity), read by component: the stream is filled from their arrays,
+    /// with one direction for all.
+    void intersect_coherent(const ParallelRays& rays, std::size_t n,
+                            std::span<std::optional<SurfaceHit>> hits, bool checked = false) const;
     /// Whether anything but `skip` blocks org + t dir for t in [tnear, tfar].
     bool occluded(const Vec3f& org, const Vec3f& dir, float tnear, float tfar,
                   PrimId skip = {}) const;

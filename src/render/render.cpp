@@ -288,9 +288,9 @@ Sampler sampler_of(const RenderState& f, const PixelReplicas& replicas, std::uin
                    f.settings.sampler);
 }
 
-/// A batch of camera samples traced together (trace_batch): made once per tile, in
-/// RowBatches, not per pixel (its members' initialisers cost a visible share of the
-/// pixel loop).
+/// A batch of camera samples traced together (trace_batch): made once per thread, in
+/// RowBatches, not per pixel or tile (its members' initialisers cost a visible share of
+/// the pixel loop).
 struct CameraBatch {
     static constexpr std::uint32_t size = EmbreeScene::max_coherent_rays;
     std::array<float, size> jx, jy;  // film pairs, then (float rays) image points
@@ -300,8 +300,16 @@ struct CameraBatch {
     /// starts along the camera's ray.
     std::array<double, size> tnear;
     std::array<CameraRayF, size> rays;
+    ParallelRays parallel;  // the traced rays instead, where RenderState::parallel_rays
     std::array<std::optional<SurfaceHit>, size> hits;
+
+    /// The traced camera ray of sample k.
+    CameraRayF ray(const RenderState& f, std::uint32_t k) const
+    {
+        return f.parallel_rays ? parallel.ray(k) : rays[k];
+    }
 };
+static_assert(CameraBatch::size <= ParallelRays::capacity);
 
 /// The film pairs of samples i0 .. i0 + n - 1 of a pixel (n at most CameraBatch::size),
 /// into jx and jy: the values of sampler_of(f, replicas, i).get2d(film), made per replica
@@ -348,7 +356,7 @@ void camera_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::u
     film_pairs(f, replicas, i0, n, b);
     if (f.parallel_rays) {  // the image point x + jx in float, as below
         f.camera.generate_parallel_rays(x, y, std::span(b.jx.data(), n), std::span(b.jy.data(), n),
-                                        std::span(b.tnear.data(), n), std::span(b.rays.data(), n));
+                                        std::span(b.tnear.data(), n), b.parallel);
         return;
     }
     if (f.float_rays) {
@@ -442,8 +450,11 @@ void trace_batch(const RenderState& f, int x, int y, std::uint32_t i0, std::uint
                  const PixelReplicas& replicas, CameraBatch& b)
 {
     camera_samples(f, x, y, i0, n, replicas, b);
-    f.accel.intersect_coherent(std::span(b.rays.data(), n), std::span(b.hits.data(), n),
-                               f.rays_in_reach);
+    if (f.parallel_rays)  // (the stream filled from the rays' arrays)
+        f.accel.intersect_coherent(b.parallel, n, std::span(b.hits.data(), n), f.rays_in_reach);
+    else
+        f.accel.intersect_coherent(std::span(b.rays.data(), n), std::span(b.hits.data(), n),
+                                   f.rays_in_reach);
 }
 
 /// The traced batch b (samples i0 .. i0 + n - 1) added to its pixel's sums in order.
@@ -457,7 +468,7 @@ void add_batch(const RenderState& f, const PixelReplicas& replicas, std::uint32_
             continue;
         }
         st.radiance = radiance;
-        take_sample(f, replicas, b.tnear[k], b.rays[k], i0 + k, st, ex, &b.hits[k]);
+        take_sample(f, replicas, b.tnear[k], b.ray(f, k), i0 + k, st, ex, &b.hits[k]);
         radiance = st.radiance;
     }
     st.radiance = radiance;
@@ -518,7 +529,7 @@ void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uin
         std::uint32_t n = std::min(CameraBatch::size, i1 - start);
         camera_samples(f, x, y, start, n, replicas, b);
         for (std::uint32_t k = 0; k < n; ++k)
-            take_sample(f, replicas, b.tnear[k], b.rays[k], start + k, st, ex);
+            take_sample(f, replicas, b.tnear[k], b.ray(f, k), start + k, st, ex);
     }
 }
 
