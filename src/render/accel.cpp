@@ -884,9 +884,9 @@ struct EmbreeScene::Impl : HitResolver {
                PrimId skip, bool coherent) const;
     /// Traces rh[0 .. traced - 1] as one stream of coherent rays and makes the hit of
     /// rh[k] in hits[slot(k)] (reset where it met nothing), for the ray that ray_at(slot(k))
-    /// gives (EmbreeScene::intersect_coherent).
+    /// gives (EmbreeScene::intersect_coherent). Returns the hits' bits (bit slot(k)).
     template <typename Slot, typename RayAt>
-    void trace_stream(std::span<RTCRayHit> rh, std::size_t traced, Slot slot, RayAt ray_at,
+    std::uint32_t trace_stream(std::span<RTCRayHit> rh, std::size_t traced, Slot slot, RayAt ray_at,
                       std::span<std::optional<SurfaceHit>> hits) const;
     mutable std::atomic<std::uint64_t> skipped_rays{0};
     RayCounter rays;
@@ -1546,11 +1546,13 @@ bool EmbreeScene::Impl::trace(RTCRayHit& rh, const Vec3f& org, const Vec3f& dir,
 }
 
 template <typename Slot, typename RayAt>
-void EmbreeScene::Impl::trace_stream(std::span<RTCRayHit> rh, std::size_t traced, Slot slot,
-                                     RayAt ray_at, std::span<std::optional<SurfaceHit>> hits) const
+std::uint32_t EmbreeScene::Impl::trace_stream(std::span<RTCRayHit> rh, std::size_t traced,
+                                              Slot slot, RayAt ray_at,
+                                              std::span<std::optional<SurfaceHit>> hits) const
 {
+    static_assert(max_coherent_rays <= 32);
     if (traced == 0)
-        return;
+        return 0;
     SkipContext context = make_context({}, true);
     // A stream of coherent rays: Embree gathers it into SIMD packets.
     rtcIntersect1M(scene, &context.context, rh.data(), static_cast<unsigned>(traced),
@@ -1560,20 +1562,23 @@ void EmbreeScene::Impl::trace_stream(std::span<RTCRayHit> rh, std::size_t traced
     for (std::size_t k = 0; k < traced; ++k)
         if (placed_instance(rh[k].hit.instID[0]) && rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID)
             __builtin_prefetch(instance(rh[k].hit.instID[0]));
+    std::uint32_t hit_bits = 0;
     for (std::size_t k = 0; k < traced; ++k) {
         const std::size_t i = slot(k);
         if (rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID) {
             const CameraRayF r = ray_at(i);
             surface_hit(rh[k], r.org, r.dir, hits[i]);
+            hit_bits |= std::uint32_t{1} << i;
         } else {
             hits[i].reset();
         }
     }
+    return hit_bits;
 }
 
-void EmbreeScene::intersect_coherent(std::span<const CameraRayF> rays,
-                                     std::span<std::optional<SurfaceHit>> hits,
-                                     bool checked) const
+std::uint32_t EmbreeScene::intersect_coherent(std::span<const CameraRayF> rays,
+                                              std::span<std::optional<SurfaceHit>> hits,
+                                              bool checked) const
 {
     const Impl& m = *m_impl;
     std::array<RTCRayHit, max_coherent_rays> rh;
@@ -1596,14 +1601,14 @@ void EmbreeScene::intersect_coherent(std::span<const CameraRayF> rays,
         rh[traced].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         index[traced++] = static_cast<std::uint32_t>(i);
     }
-    m.trace_stream(
+    return m.trace_stream(
         rh, traced, [&](std::size_t k) { return all_traceable ? k : std::size_t(index[k]); },
         [&](std::size_t i) -> const CameraRayF& { return rays[i]; }, hits);
 }
 
-void EmbreeScene::intersect_coherent(const ParallelRays& rays, std::size_t n,
-                                     std::span<std::optional<SurfaceHit>> hits,
-                                     bool checked) const
+std::uint32_t EmbreeScene::intersect_coherent(const ParallelRays& rays, std::size_t n,
+                                              std::span<std::optional<SurfaceHit>> hits,
+                                              bool checked) const
 {
     const Impl& m = *m_impl;
     std::array<RTCRayHit, max_coherent_rays> rh;
@@ -1618,10 +1623,9 @@ void EmbreeScene::intersect_coherent(const ParallelRays& rays, std::size_t n,
             rh[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
             rh[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         }
-        m.trace_stream(
+        return m.trace_stream(
             rh, n, [](std::size_t k) { return k; },
             [&](std::size_t i) { return rays.ray(i); }, hits);
-        return;
     }
     std::array<std::uint32_t, max_coherent_rays> index;  // rh[k] is rays.ray(index[k])
     std::size_t traced = 0;
@@ -1637,7 +1641,7 @@ void EmbreeScene::intersect_coherent(const ParallelRays& rays, std::size_t n,
         rh[traced].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         index[traced++] = static_cast<std::uint32_t>(i);
     }
-    m.trace_stream(
+    return m.trace_stream(
         rh, traced, [&](std::size_t k) { return std::size_t(index[k]); },
         [&](std::size_t i) { return rays.ray(i); }, hits);
 }

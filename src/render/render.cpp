@@ -20,6 +20,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdint>
 #include <ctime>
 #include <limits>
 #include <memory>
@@ -302,6 +303,9 @@ struct CameraBatch {
     std::array<CameraRayF, size> rays;
     ParallelRays parallel;  // the traced rays instead, where RenderState::parallel_rays
     std::array<std::optional<SurfaceHit>, size> hits;
+    /// Bit k set where hits[k] has a value (intersect_coherent's), so that add_batch
+    /// reads only the hits there are (each flag lies in its own hit's cache line).
+    std::uint32_t hit_bits = 0;
 
     /// The traced camera ray of sample k.
     CameraRayF ray(const RenderState& f, std::uint32_t k) const
@@ -451,10 +455,11 @@ void trace_batch(const RenderState& f, int x, int y, std::uint32_t i0, std::uint
 {
     camera_samples(f, x, y, i0, n, replicas, b);
     if (f.parallel_rays)  // (the stream filled from the rays' arrays)
-        f.accel.intersect_coherent(b.parallel, n, std::span(b.hits.data(), n), f.rays_in_reach);
+        b.hit_bits = f.accel.intersect_coherent(b.parallel, n, std::span(b.hits.data(), n),
+                                                f.rays_in_reach);
     else
-        f.accel.intersect_coherent(std::span(b.rays.data(), n), std::span(b.hits.data(), n),
-                                   f.rays_in_reach);
+        b.hit_bits = f.accel.intersect_coherent(std::span(b.rays.data(), n),
+                                                std::span(b.hits.data(), n), f.rays_in_reach);
 }
 
 /// The traced batch b (samples i0 .. i0 + n - 1) added to its pixel's sums in order.
@@ -463,7 +468,7 @@ void add_batch(const RenderState& f, const PixelReplicas& replicas, std::uint32_
 {
     Vec3f radiance = st.radiance;
     for (std::uint32_t k = 0; k < n; ++k) {
-        if (f.miss && !b.hits[k]) {
+        if (f.miss && !(b.hit_bits >> k & 1u)) {
             take_flat_miss(f, *f.miss, i0 + k, st, ex, radiance);
             continue;
         }
@@ -531,6 +536,19 @@ void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uin
         for (std::uint32_t k = 0; k < n; ++k)
             take_sample(f, replicas, b.tnear[k], b.ray(f, k), start + k, st, ex);
     }
+}
+
+/// Asks for the sums of pixels x0 .. x1 - 1 of row y of `film` (w wide) ahead of take_row:
+/// a tile's rows lie an image row apart, a pattern the processor's prefetcher does not
+/// follow, and the first look at each row's sums waited on memory.
+void prefetch_row(const Film& film, int y, int x0, int x1, int w)
+{
+    constexpr std::uintptr_t line = 64;
+    const auto* first = &film.px[std::size_t(y) * std::size_t(w) + std::size_t(x0)];
+    const auto from = reinterpret_cast<std::uintptr_t>(first) & ~(line - 1);
+    const auto to = reinterpret_cast<std::uintptr_t>(first + (x1 - x0));
+    for (std::uintptr_t p = from; p < to; p += line)
+        __builtin_prefetch(reinterpret_cast<const void*>(p));
 }
 
 /// The samples take_row took, and how many of them were of pixels the screen mask skips.
@@ -1035,8 +1053,12 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                     RowSamples tile;
                     row->background = {};  // (a pure function of the view's miss, so per tile)
                     const int x1 = std::min(x0 + tile_size, w);
+                    const int y1 = std::min(y0 + tile_size, h);
+                    prefetch_row(film, y0, x0, x1, w);
                     // Checked every row, so even passes of thousands of samples stop soon.
-                    for (int y = y0; y < std::min(y0 + tile_size, h) && !should_stop(); ++y) {
+                    for (int y = y0; y < y1 && !should_stop(); ++y) {
+                        if (y + 1 < y1)
+                            prefetch_row(film, y + 1, x0, x1, w);
                         RowSamples taken = take_row(state, region, y, x0, x1, target, film, w, *row);
                         tile.taken += taken.taken;
                         tile.background_only += taken.background_only;
