@@ -140,17 +140,17 @@ struct ParallelFrame {
 
 constexpr std::size_t parallel_block_size = 16;
 
-/// generate_ray() then traced_ray() for the image points (pixel_x + x[k], pixel_y + y[k])
-/// (summed in float) of a block: the same
-/// double operations in the same order (ISO C++ mode contracts nothing into FMAs), over a
-/// fixed count in separate arrays, which vectorises (camera.cpp is compiled without
-/// trapping math, so that the choices become selects). An unclipped camera's infinite
-/// planes give clip()'s tnear 0 and tfar infinity.
-CAMBIUM_SIMD_CLONES void parallel_block(const ParallelFrame& c, float pixel_x, float pixel_y,
-                                        const float* __restrict x, const float* __restrict y,
-                                        double* __restrict tnear, float* __restrict org_x,
-                                        float* __restrict org_y, float* __restrict org_z,
-                                        float* __restrict tfar)
+/// parallel_block's loop; `unit_rate`: c.rate is 1, and dividing by 1 changes nothing, so
+/// the divisions (a block's slowest instructions) are left out: the same bits.
+template <bool unit_rate>
+[[gnu::always_inline]] inline void parallel_block_of(const ParallelFrame& c, float pixel_x,
+                                                     float pixel_y, const float* __restrict x,
+                                                     const float* __restrict y,
+                                                     double* __restrict tnear,
+                                                     float* __restrict org_x,
+                                                     float* __restrict org_y,
+                                                     float* __restrict org_z,
+                                                     float* __restrict tfar)
 {
     constexpr double inf = std::numeric_limits<double>::infinity();
     for (std::size_t k = 0; k < parallel_block_size; ++k) {
@@ -161,8 +161,8 @@ CAMBIUM_SIMD_CLONES void parallel_block(const ParallelFrame& c, float pixel_x, f
         double oz = c.origin.z + c.right.z * sx + c.up.z * sy - c.back.z;
         double depth = (ox - c.origin.x) * c.forward.x + (oy - c.origin.y) * c.forward.y +
                        (oz - c.origin.z) * c.forward.z;
-        double tn = std::max(0.0, (c.near - depth) / c.rate);
-        double tf = std::max(0.0, (c.far - depth) / c.rate);
+        double tn = std::max(0.0, unit_rate ? c.near - depth : (c.near - depth) / c.rate);
+        double tf = std::max(0.0, unit_rate ? c.far - depth : (c.far - depth) / c.rate);
         tnear[k] = tn;
         org_x[k] = static_cast<float>(tn > 0 ? ox + c.forward.x * tn : ox);
         org_y[k] = static_cast<float>(tn > 0 ? oy + c.forward.y * tn : oy);
@@ -170,6 +170,25 @@ CAMBIUM_SIMD_CLONES void parallel_block(const ParallelFrame& c, float pixel_x, f
         // tf is never NaN (std::max gives 0 for it): finite is below infinity.
         tfar[k] = tf < inf ? static_cast<float>(tf - tn) : std::numeric_limits<float>::infinity();
     }
+}
+
+/// generate_ray() then traced_ray() for the image points (pixel_x + x[k], pixel_y + y[k])
+/// (summed in float) of a block: the same
+/// double operations in the same order (ISO C++ mode contracts nothing into FMAs), over a
+/// fixed count in separate arrays, which vectorises (camera.cpp is compiled without
+/// trapping math, so that the choices become selects). An unclipped camera's infinite
+/// planes give clip()'s tnear 0 and tfar infinity. A view along an axis (most of cpfg's)
+/// has a forward() whose squared length, clip()'s rate, is exactly 1.
+CAMBIUM_SIMD_CLONES void parallel_block(const ParallelFrame& c, float pixel_x, float pixel_y,
+                                        const float* __restrict x, const float* __restrict y,
+                                        double* __restrict tnear, float* __restrict org_x,
+                                        float* __restrict org_y, float* __restrict org_z,
+                                        float* __restrict tfar)
+{
+    if (c.rate == 1)
+        parallel_block_of<true>(c, pixel_x, pixel_y, x, y, tnear, org_x, org_y, org_z, tfar);
+    else
+        parallel_block_of<false>(c, pixel_x, pixel_y, x, y, tnear, org_x, org_y, org_z, tfar);
 }
 
 }  // namespace
