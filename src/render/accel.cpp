@@ -882,6 +882,12 @@ struct EmbreeScene::Impl : HitResolver {
     /// whether it hit something, reported in rh.
     bool trace(RTCRayHit& rh, const Vec3f& org, const Vec3f& dir, float tnear, float tfar,
                PrimId skip, bool coherent) const;
+    /// Traces rh[0 .. traced - 1] as one stream of coherent rays and makes the hit of
+    /// rh[k] in hits[slot(k)] (reset where it met nothing), for the ray that ray_at(slot(k))
+    /// gives (EmbreeScene::intersect_coherent). Returns the hits' bits (bit slot(k)).
+    template <typename Slot, typename RayAt>
+    std::uint32_t trace_stream(std::span<RTCRayHit> rh, std::size_t traced, Slot slot, RayAt ray_at,
+                      std::span<std::optional<SurfaceHit>> hits) const;
     mutable std::atomic<std::uint64_t> skipped_rays{0};
     RayCounter rays;
     double build_seconds = 0;
@@ -1539,9 +1545,40 @@ bool EmbreeScene::Impl::trace(RTCRayHit& rh, const Vec3f& org, const Vec3f& dir,
     return rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
 }
 
-void EmbreeScene::intersect_coherent(std::span<const CameraRayF> rays,
-                                     std::span<std::optional<SurfaceHit>> hits,
-                                     bool checked) const
+template <typename Slot, typename RayAt>
+std::uint32_t EmbreeScene::Impl::trace_stream(std::span<RTCRayHit> rh, std::size_t traced,
+                                              Slot slot, RayAt ray_at,
+                                              std::span<std::optional<SurfaceHit>> hits) const
+{
+    static_assert(max_coherent_rays <= 32);
+    if (traced == 0)
+        return 0;
+    SkipContext context = make_context({}, true);
+    // A stream of coherent rays: Embree gathers it into SIMD packets.
+    rtcIntersect1M(scene, &context.context, rh.data(), static_cast<unsigned>(traced),
+                   sizeof(RTCRayHit));
+    // The instance records of the stream's instanced hits, asked for together: their
+    // cache misses overlap instead of stalling each hit's conversion in turn.
+    for (std::size_t k = 0; k < traced; ++k)
+        if (placed_instance(rh[k].hit.instID[0]) && rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID)
+            __builtin_prefetch(instance(rh[k].hit.instID[0]));
+    std::uint32_t hit_bits = 0;
+    for (std::size_t k = 0; k < traced; ++k) {
+        const std::size_t i = slot(k);
+        if (rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID) {
+            const CameraRayF r = ray_at(i);
+            surface_hit(rh[k], r.org, r.dir, hits[i]);
+            hit_bits |= std::uint32_t{1} << i;
+        } else {
+            hits[i].reset();
+        }
+    }
+    return hit_bits;
+}
+
+std::uint32_t EmbreeScene::intersect_coherent(std::span<const CameraRayF> rays,
+                                              std::span<std::optional<SurfaceHit>> hits,
+                                              bool checked) const
 {
     const Impl& m = *m_impl;
     std::array<RTCRayHit, max_coherent_rays> rh;
@@ -1564,24 +1601,49 @@ void EmbreeScene::intersect_coherent(std::span<const CameraRayF> rays,
         rh[traced].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         index[traced++] = static_cast<std::uint32_t>(i);
     }
-    if (traced == 0)
-        return;
-    SkipContext context = make_context({}, true);
-    // A stream of coherent rays: Embree gathers it into SIMD packets.
-    rtcIntersect1M(m.scene, &context.context, rh.data(), static_cast<unsigned>(traced),
-                   sizeof(RTCRayHit));
-    // The instance records of the stream's instanced hits, asked for together: their
-    // cache misses overlap instead of stalling each hit's conversion in turn.
-    for (std::size_t k = 0; k < traced; ++k)
-        if (m.placed_instance(rh[k].hit.instID[0]) && rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID)
-            __builtin_prefetch(m.instance(rh[k].hit.instID[0]));
-    for (std::size_t k = 0; k < traced; ++k) {
-        std::size_t i = all_traceable ? k : index[k];
-        if (rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID)
-            m.surface_hit(rh[k], rays[i].org, rays[i].dir, hits[i]);
-        else
-            hits[i].reset();
+    return m.trace_stream(
+        rh, traced, [&](std::size_t k) { return all_traceable ? k : std::size_t(index[k]); },
+        [&](std::size_t i) -> const CameraRayF& { return rays[i]; }, hits);
+}
+
+std::uint32_t EmbreeScene::intersect_coherent(const ParallelRays& rays, std::size_t n,
+                                              std::span<std::optional<SurfaceHit>> hits,
+                                              bool checked) const
+{
+    const Impl& m = *m_impl;
+    std::array<RTCRayHit, max_coherent_rays> rh;
+    static_assert(ParallelRays::capacity <= max_coherent_rays);
+    n = std::min({n, hits.size(), ParallelRays::capacity});
+    m.rays.add(n);
+    const Vec3f dir = m.traced(rays.dir);  // (tilted once for all)
+    if (checked) {  // rh[k] is rays.ray(k): the common case, without an index
+        for (std::size_t k = 0; k < n; ++k) {
+            rh[k].ray = make_ray({rays.org_x[k], rays.org_y[k], rays.org_z[k]}, dir, 0,
+                                 rays.tfar[k]);
+            rh[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            rh[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        }
+        return m.trace_stream(
+            rh, n, [](std::size_t k) { return k; },
+            [&](std::size_t i) { return rays.ray(i); }, hits);
     }
+    std::array<std::uint32_t, max_coherent_rays> index;  // rh[k] is rays.ray(index[k])
+    std::size_t traced = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const CameraRayF r = rays.ray(i);
+        if (!traceable(r.org, r.dir, 0, r.tfar)) {
+            ++m.skipped_rays;
+            hits[i].reset();
+            continue;
+        }
+        rh[traced].ray = make_ray(r.org, dir, 0, r.tfar);
+        rh[traced].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        rh[traced].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        index[traced++] = static_cast<std::uint32_t>(i);
+    }
+    return m.trace_stream(
+        rh, traced, [&](std::size_t k) { return std::size_t(index[k]); },
+        [&](std::size_t i) { return rays.ray(i); }, hits);
 }
 
 SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,

@@ -119,9 +119,17 @@ public:
     /// (a pixel's samples). The same hits as intersect() gives. `checked`: the caller
     /// vouches that every ray is one intersect() would trace (finite, starting within
     /// geom::max_ray_start), as Camera::generate_rays_f's are once Camera::check_range
-    /// passed, and the check per ray is left out.
-    void intersect_coherent(std::span<const CameraRayF> rays,
-                            std::span<std::optional<SurfaceHit>> hits, bool checked = false) const;
+    /// passed, and the check per ray is left out. Returns a bit per ray, set where it hit
+    /// (bit k: hits[k] has a value), so that a caller need not read every hit.
+    std::uint32_t intersect_coherent(std::span<const CameraRayF> rays,
+                                     std::span<std::optional<SurfaceHit>> hits,
+                                     bool checked = false) const;
+    /// The same for the first n of `rays` (rays.ray(k) for k < n; n at most
+    /// ParallelRays::capacity), read by component: the stream is filled from their arrays,
+    /// with one direction for all.
+    std::uint32_t intersect_coherent(const ParallelRays& rays, std::size_t n,
+                                     std::span<std::optional<SurfaceHit>> hits,
+                                     bool checked = false) const;
     /// Whether anything but `skip` blocks org + t dir for t in [tnear, tfar].
     bool occluded(const Vec3f& org, const Vec3f& dir, float tnear, float tfar,
                   PrimId skip = {}) const;

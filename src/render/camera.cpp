@@ -21,6 +21,7 @@
 #include <cstdio>
 #include <limits>
 #include <numbers>
+#include <stdexcept>
 #include <utility>
 
 #include "base/diagnostics.h"
@@ -139,17 +140,17 @@ struct ParallelFrame {
 
 constexpr std::size_t parallel_block_size = 16;
 
-/// generate_ray() then traced_ray() for the image points (pixel_x + x[k], pixel_y + y[k])
-/// (summed in float) of a block: the same
-/// double operations in the same order (ISO C++ mode contracts nothing into FMAs), over a
-/// fixed count in separate arrays, which vectorises (camera.cpp is compiled without
-/// trapping math, so that the choices become selects). An unclipped camera's infinite
-/// planes give clip()'s tnear 0 and tfar infinity.
-CAMBIUM_SIMD_CLONES void parallel_block(const ParallelFrame& c, float pixel_x, float pixel_y,
-                                        const float* __restrict x, const float* __restrict y,
-                                        double* __restrict tnear, float* __restrict org_x,
-                                        float* __restrict org_y, float* __restrict org_z,
-                                        float* __restrict tfar)
+/// parallel_block's loop; `unit_rate`: c.rate is 1, and dividing by 1 changes nothing, so
+/// the divisions (a block's slowest instructions) are left out: the same bits.
+template <bool unit_rate>
+[[gnu::always_inline]] inline void parallel_block_of(const ParallelFrame& c, float pixel_x,
+                                                     float pixel_y, const float* __restrict x,
+                                                     const float* __restrict y,
+                                                     double* __restrict tnear,
+                                                     float* __restrict org_x,
+                                                     float* __restrict org_y,
+                                                     float* __restrict org_z,
+                                                     float* __restrict tfar)
 {
     constexpr double inf = std::numeric_limits<double>::infinity();
     for (std::size_t k = 0; k < parallel_block_size; ++k) {
@@ -160,8 +161,8 @@ CAMBIUM_SIMD_CLONES void parallel_block(const ParallelFrame& c, float pixel_x, f
         double oz = c.origin.z + c.right.z * sx + c.up.z * sy - c.back.z;
         double depth = (ox - c.origin.x) * c.forward.x + (oy - c.origin.y) * c.forward.y +
                        (oz - c.origin.z) * c.forward.z;
-        double tn = std::max(0.0, (c.near - depth) / c.rate);
-        double tf = std::max(0.0, (c.far - depth) / c.rate);
+        double tn = std::max(0.0, unit_rate ? c.near - depth : (c.near - depth) / c.rate);
+        double tf = std::max(0.0, unit_rate ? c.far - depth : (c.far - depth) / c.rate);
         tnear[k] = tn;
         org_x[k] = static_cast<float>(tn > 0 ? ox + c.forward.x * tn : ox);
         org_y[k] = static_cast<float>(tn > 0 ? oy + c.forward.y * tn : oy);
@@ -169,6 +170,25 @@ CAMBIUM_SIMD_CLONES void parallel_block(const ParallelFrame& c, float pixel_x, f
         // tf is never NaN (std::max gives 0 for it): finite is below infinity.
         tfar[k] = tf < inf ? static_cast<float>(tf - tn) : std::numeric_limits<float>::infinity();
     }
+}
+
+/// generate_ray() then traced_ray() for the image points (pixel_x + x[k], pixel_y + y[k])
+/// (summed in float) of a block: the same
+/// double operations in the same order (ISO C++ mode contracts nothing into FMAs), over a
+/// fixed count in separate arrays, which vectorises (camera.cpp is compiled without
+/// trapping math, so that the choices become selects). An unclipped camera's infinite
+/// planes give clip()'s tnear 0 and tfar infinity. A view along an axis (most of cpfg's)
+/// has a forward() whose squared length, clip()'s rate, is exactly 1.
+CAMBIUM_SIMD_CLONES void parallel_block(const ParallelFrame& c, float pixel_x, float pixel_y,
+                                        const float* __restrict x, const float* __restrict y,
+                                        double* __restrict tnear, float* __restrict org_x,
+                                        float* __restrict org_y, float* __restrict org_z,
+                                        float* __restrict tfar)
+{
+    if (c.rate == 1)
+        parallel_block_of<true>(c, pixel_x, pixel_y, x, y, tnear, org_x, org_y, org_z, tfar);
+    else
+        parallel_block_of<false>(c, pixel_x, pixel_y, x, y, tnear, org_x, org_y, org_z, tfar);
 }
 
 }  // namespace
@@ -270,37 +290,63 @@ void Camera::generate_parallel_rays(int x, int y, std::span<const float> xs,
                                     std::span<CameraRayF> rays) const
 {
     const std::size_t n = std::min({xs.size(), ys.size(), tnear.size(), rays.size()});
+    if (m_projection != Projection::parallel) {  // one at a time
+        const auto fx = static_cast<float>(x), fy = static_cast<float>(y);
+        for (std::size_t k = 0; k < n; ++k)
+            rays[k] = traced_ray(generate_ray(fx + xs[k], fy + ys[k]), tnear[k]);
+        return;
+    }
+    constexpr std::size_t block = ParallelRays::capacity;
+    ParallelRays made;
+    for (std::size_t k0 = 0; k0 < n; k0 += block) {
+        const std::size_t m = std::min(block, n - k0);
+        generate_parallel_rays(x, y, xs.subspan(k0, m), ys.subspan(k0, m), tnear.subspan(k0, m),
+                               made);
+        for (std::size_t k = 0; k < m; ++k)
+            rays[k0 + k] = made.ray(k);
+    }
+}
+
+void Camera::generate_parallel_rays(int x, int y, std::span<const float> xs,
+                                    std::span<const float> ys, std::span<double> tnear,
+                                    ParallelRays& rays) const
+{
+    static_assert(ParallelRays::capacity == parallel_block_size);
+    const std::size_t n = std::min({xs.size(), ys.size(), tnear.size(), ParallelRays::capacity});
     constexpr double inf = std::numeric_limits<double>::infinity();
     const double rate = geom::dot(m_forward, m_forward);
     const auto fx = static_cast<float>(x), fy = static_cast<float>(y);
-    if (m_projection != Projection::parallel || !(rate > 0)) {  // clip() empties every ray
-        for (std::size_t k = 0; k < n; ++k)
-            rays[k] = traced_ray(generate_ray(fx + xs[k], fy + ys[k]), tnear[k]);
+    if (m_projection != Projection::parallel)
+        throw std::logic_error("Camera::generate_parallel_rays: the camera is not parallel");
+    if (!(rate > 0)) {  // clip() empties every ray; each runs along forward()
+        rays.dir = Vec3f(m_forward);
+        for (std::size_t k = 0; k < n; ++k) {
+            CameraRayF r = traced_ray(generate_ray(fx + xs[k], fy + ys[k]), tnear[k]);
+            rays.org_x[k] = r.org.x;
+            rays.org_y[k] = r.org.y;
+            rays.org_z[k] = r.org.z;
+            rays.tfar[k] = r.tfar;
+            rays.dir = r.dir;
+        }
         return;
     }
     const ParallelFrame frame{m_width * 0.5,  m_height * 0.5, m_pixel_size, m_origin,
                               m_right,        m_up,           m_forward,    m_forward * m_back_off,
                               rate,           clipped() ? m_clip_near : -inf,
                               clipped() ? m_clip_far : inf,   Vec3f(m_forward)};
-    constexpr std::size_t block = parallel_block_size;
-    for (std::size_t k0 = 0; k0 < n; k0 += block) {
-        const std::size_t m = std::min(block, n - k0);
-        std::array<float, block> ox, oy, oz, tfar;
-        if (m == block) {  // a whole block (a batch's usual 16 samples): read and write in place
-            parallel_block(frame, fx, fy, xs.data() + k0, ys.data() + k0, tnear.data() + k0,
-                           ox.data(), oy.data(), oz.data(), tfar.data());
-        } else {
-            std::array<float, block> x{}, y{};
-            std::array<double, block> tn;
-            std::copy_n(xs.data() + k0, m, x.data());
-            std::copy_n(ys.data() + k0, m, y.data());
-            parallel_block(frame, fx, fy, x.data(), y.data(), tn.data(), ox.data(), oy.data(),
-                           oz.data(), tfar.data());
-            std::copy_n(tn.data(), m, tnear.data() + k0);
-        }
-        for (std::size_t k = 0; k < m; ++k)
-            rays[k0 + k] = {{ox[k], oy[k], oz[k]}, frame.dir, tfar[k]};
+    rays.dir = frame.dir;
+    if (n == parallel_block_size) {  // a whole block (a batch's usual 16 samples): in place
+        parallel_block(frame, fx, fy, xs.data(), ys.data(), tnear.data(), rays.org_x.data(),
+                       rays.org_y.data(), rays.org_z.data(), rays.tfar.data());
+        return;
     }
+    std::array<float, parallel_block_size> px{}, py{};
+    std::array<double, parallel_block_size> tn;
+    std::copy_n(xs.data(), n, px.data());
+    std::copy_n(ys.data(), n, py.data());
+    parallel_block(frame, fx, fy, px.data(), py.data(), tn.data(), rays.org_x.data(),
+                   rays.org_y.data(), rays.org_z.data(), rays.tfar.data());
+    std::copy_n(tn.data(), n, tnear.data());
 }
 
 CameraRay Camera::generate_ray(double x, double y, double lens_u, double lens_v) const

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <span>
@@ -33,6 +34,18 @@ struct CameraRay {
 struct CameraRayF {
     Vec3f org, dir;
     float tfar = 0;
+};
+
+/// Camera rays along one direction (a parallel camera's), at most `capacity`, in separate
+/// arrays per component, as SIMD code makes them and a coherent stream is filled from them
+/// (Camera::generate_parallel_rays, EmbreeScene::intersect_coherent): ray k starts at
+/// (org_x[k], org_y[k], org_z[k]) and runs along `dir` for t < tfar[k].
+struct ParallelRays {
+    static constexpr std::size_t capacity = 16;
+    std::array<float, capacity> org_x, org_y, org_z, tfar;
+    Vec3f dir;
+
+    CameraRayF ray(std::size_t k) const { return {{org_x[k], org_y[k], org_z[k]}, dir, tfar[k]}; }
 };
 
 /// Camera ray `ray` as the path tracer traces it: in single precision, from the near
@@ -106,6 +119,12 @@ public:
     void generate_parallel_rays(int x, int y, std::span<const float> xs,
                                 std::span<const float> ys, std::span<double> tnear,
                                 std::span<CameraRayF> rays) const;
+    /// The same rays for a parallel camera (only), at most ParallelRays::capacity, by
+    /// component: rays.ray(k) is the rays[k] above. Written as they are made, without
+    /// gathering each ray's floats into a CameraRayF.
+    void generate_parallel_rays(int x, int y, std::span<const float> xs,
+                                std::span<const float> ys, std::span<double> tnear,
+                                ParallelRays& rays) const;
     /// The same through the lens point given by two uniforms in [0, 1) (a thin lens:
     /// every ray through (x, y) meets the others on the plane in focus). Equals
     /// generate_ray(x, y) for a pinhole camera.

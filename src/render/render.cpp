@@ -8,6 +8,7 @@
 #include "render/render.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -19,6 +20,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdint>
 #include <ctime>
 #include <limits>
 #include <memory>
@@ -153,17 +155,38 @@ private:
     std::vector<double> m_cdf;
 };
 
-/// A pixel's running sums.
+/// A pixel's running sums that every render keeps: small (24 bytes), because every pass
+/// reads and writes them for every pixel, most of them the background's, so a tile row's
+/// sums share a few cache lines (with the other sums beside them, 104 bytes a pixel,
+/// reading them was most of the pixel loop's cache misses).
 struct PixelState {
-    Vec3f radiance, albedo, normal;
+    Vec3f radiance;
+    std::uint32_t samples = 0, hits = 0;
+    bool done = false;  // adaptive sampling: converged
+};
+
+/// A pixel's sums that only some renders keep (Film::extras): the albedo, normal and depth
+/// layers, adaptive sampling's luminance sums, the shadow catcher's light.
+struct PixelExtras {
+    Vec3f albedo, normal;
+    float depth = infinity;
     /// Luminance sums of the two independent replicas (even and odd samples), for the
     /// adaptive error estimate (relative_error).
     std::array<double, 2> replica_luminance{};
     double luminance_sq = 0;
-    double lit_with = 0, lit_without = 0;    // shadow-catcher samples' light (PathResult)
-    float depth = infinity;
-    std::uint32_t samples = 0, hits = 0, caught = 0;  // caught: met the shadow catcher
-    bool done = false;  // adaptive sampling: converged
+    double lit_with = 0, lit_without = 0;  // shadow-catcher samples' light (PathResult)
+    std::uint32_t caught = 0;              // samples that met the shadow catcher
+};
+
+/// The sampled pixels' sums, row by row.
+struct Film {
+    std::vector<PixelState> px;
+    /// Beside px, where the render has AOVs, adaptive sampling or a shadow catcher (the
+    /// only renders whose samples add to them); else empty.
+    std::vector<PixelExtras> extras;
+
+    Film(std::size_t pixels, bool with_extras) : px(pixels), extras(with_extras ? pixels : 0) {}
+    PixelExtras* extra(std::size_t i) { return extras.empty() ? nullptr : &extras[i]; }
 };
 
 float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
@@ -266,9 +289,9 @@ Sampler sampler_of(const RenderState& f, const PixelReplicas& replicas, std::uin
                    f.settings.sampler);
 }
 
-/// A batch of camera samples traced together (trace_batch): made once per tile, in
-/// RowBatches, not per pixel (its members' initialisers cost a visible share of the
-/// pixel loop).
+/// A batch of camera samples traced together (trace_batch): made once per thread, in
+/// RowBatches, not per pixel or tile (its members' initialisers cost a visible share of
+/// the pixel loop).
 struct CameraBatch {
     static constexpr std::uint32_t size = EmbreeScene::max_coherent_rays;
     std::array<float, size> jx, jy;  // film pairs, then (float rays) image points
@@ -278,8 +301,19 @@ struct CameraBatch {
     /// starts along the camera's ray.
     std::array<double, size> tnear;
     std::array<CameraRayF, size> rays;
+    ParallelRays parallel;  // the traced rays instead, where RenderState::parallel_rays
     std::array<std::optional<SurfaceHit>, size> hits;
+    /// Bit k set where hits[k] has a value (intersect_coherent's), so that add_batch
+    /// reads only the hits there are (each flag lies in its own hit's cache line).
+    std::uint32_t hit_bits = 0;
+
+    /// The traced camera ray of sample k.
+    CameraRayF ray(const RenderState& f, std::uint32_t k) const
+    {
+        return f.parallel_rays ? parallel.ray(k) : rays[k];
+    }
 };
+static_assert(CameraBatch::size <= ParallelRays::capacity);
 
 /// The film pairs of samples i0 .. i0 + n - 1 of a pixel (n at most CameraBatch::size),
 /// into jx and jy: the values of sampler_of(f, replicas, i).get2d(film), made per replica
@@ -326,7 +360,7 @@ void camera_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::u
     film_pairs(f, replicas, i0, n, b);
     if (f.parallel_rays) {  // the image point x + jx in float, as below
         f.camera.generate_parallel_rays(x, y, std::span(b.jx.data(), n), std::span(b.jy.data(), n),
-                                        std::span(b.tnear.data(), n), std::span(b.rays.data(), n));
+                                        std::span(b.tnear.data(), n), b.parallel);
         return;
     }
     if (f.float_rays) {
@@ -358,10 +392,10 @@ void camera_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::u
 }
 
 /// Sample i (its camera ray `ray`, starting `tnear` along the camera's) added to its
-/// pixel's sums; `camera_hit`: its camera ray's first hit when already traced (null:
-/// trace_path traces it).
+/// pixel's sums (`ex`: its extra sums, null where the render keeps none); `camera_hit`:
+/// its camera ray's first hit when already traced (null: trace_path traces it).
 void take_sample(const RenderState& f, const PixelReplicas& replicas, double tnear,
-                 const CameraRayF& ray, std::uint32_t i, PixelState& st,
+                 const CameraRayF& ray, std::uint32_t i, PixelState& st, PixelExtras* ex,
                  const std::optional<SurfaceHit>* camera_hit = nullptr)
 {
     const RenderSettings& s = f.settings;
@@ -370,10 +404,10 @@ void take_sample(const RenderState& f, const PixelReplicas& replicas, double tne
                        ? camera_miss(f.ctx, ray.dir)
                        : trace_path(f.ctx, ray.org, ray.dir, sampler_of(f, replicas, i), ray.tfar,
                                     s.aovs ? &first : nullptr, camera_hit);
-    if (first.hit) {
-        st.albedo += first.albedo;
-        st.normal += first.normal;
-        st.depth = std::min(st.depth, static_cast<float>(first.t + tnear));
+    if (first.hit) {  // (asked for with AOVs only, which keep extras)
+        ex->albedo += first.albedo;
+        ex->normal += first.normal;
+        ex->depth = std::min(ex->depth, static_cast<float>(first.t + tnear));
     }
     if ((s.transparent_background || s.ground.shadow_catcher) && !r.hit)
         r.radiance = Vec3f();
@@ -386,29 +420,31 @@ void take_sample(const RenderState& f, const PixelReplicas& replicas, double tne
     st.radiance += r.radiance;
     st.hits += r.hit ? 1 : 0;
     st.samples += 1;
-    st.caught += r.catcher ? 1 : 0;
-    st.lit_with += r.lit_with;
-    st.lit_without += r.lit_without;
+    if (!ex)
+        return;  // no shadow catcher (so no catcher's light), no adaptive sampling
+    ex->caught += r.catcher ? 1 : 0;
+    ex->lit_with += r.lit_with;
+    ex->lit_without += r.lit_without;
     if (!f.adaptive)
         return;  // only adaptive sampling reads the luminance sums (relative_error_squared)
     // Adaptive sampling watches a shadow catcher's light estimate (its colour is 0).
     double l = r.catcher ? r.lit_with : luminance(r.radiance);
-    st.replica_luminance[i & 1u] += l;
-    st.luminance_sq += l * l;
+    ex->replica_luminance[i & 1u] += l;
+    ex->luminance_sq += l * l;
 }
 
 /// take_sample for sample i whose camera ray met nothing, with a FlatMiss: the same sums,
 /// the radiance's in `radiance` (the pixel's, held where the compiler can keep it in
 /// registers across a batch's misses; the same additions in the same order).
 void take_flat_miss(const RenderState& f, const FlatMiss& miss, std::uint32_t i, PixelState& st,
-                    Vec3f& radiance)
+                    PixelExtras* ex, Vec3f& radiance)
 {
     radiance += miss.radiance;
     st.samples += 1;
     if (!f.adaptive)
         return;
-    st.replica_luminance[i & 1u] += miss.luminance;
-    st.luminance_sq += miss.luminance * miss.luminance;
+    ex->replica_luminance[i & 1u] += miss.luminance;
+    ex->luminance_sq += miss.luminance * miss.luminance;
 }
 
 /// Camera samples i0 .. i0 + n - 1 of pixel (x, y) (n at most CameraBatch::size) made
@@ -418,22 +454,26 @@ void trace_batch(const RenderState& f, int x, int y, std::uint32_t i0, std::uint
                  const PixelReplicas& replicas, CameraBatch& b)
 {
     camera_samples(f, x, y, i0, n, replicas, b);
-    f.accel.intersect_coherent(std::span(b.rays.data(), n), std::span(b.hits.data(), n),
-                               f.rays_in_reach);
+    if (f.parallel_rays)  // (the stream filled from the rays' arrays)
+        b.hit_bits = f.accel.intersect_coherent(b.parallel, n, std::span(b.hits.data(), n),
+                                                f.rays_in_reach);
+    else
+        b.hit_bits = f.accel.intersect_coherent(std::span(b.rays.data(), n),
+                                                std::span(b.hits.data(), n), f.rays_in_reach);
 }
 
 /// The traced batch b (samples i0 .. i0 + n - 1) added to its pixel's sums in order.
 void add_batch(const RenderState& f, const PixelReplicas& replicas, std::uint32_t i0,
-               std::uint32_t n, PixelState& st, const CameraBatch& b)
+               std::uint32_t n, PixelState& st, PixelExtras* ex, const CameraBatch& b)
 {
     Vec3f radiance = st.radiance;
     for (std::uint32_t k = 0; k < n; ++k) {
-        if (f.miss && !b.hits[k]) {
-            take_flat_miss(f, *f.miss, i0 + k, st, radiance);
+        if (f.miss && !(b.hit_bits >> k & 1u)) {
+            take_flat_miss(f, *f.miss, i0 + k, st, ex, radiance);
             continue;
         }
         st.radiance = radiance;
-        take_sample(f, replicas, b.tnear[k], b.rays[k], i0 + k, st, &b.hits[k]);
+        take_sample(f, replicas, b.tnear[k], b.ray(f, k), i0 + k, st, ex, &b.hits[k]);
         radiance = st.radiance;
     }
     st.radiance = radiance;
@@ -461,7 +501,7 @@ struct BackgroundRun {
 /// made for the pixel before, instead of a chain of as many dependent additions (a
 /// float addition's latency per sample, for most of the samples of a plant's view).
 void take_background_samples(const RenderState& f, std::uint32_t i0, std::uint32_t i1,
-                             PixelState& st, BackgroundRun& last)
+                             PixelState& st, PixelExtras* ex, BackgroundRun& last)
 {
     const BackgroundRun::Bits from = BackgroundRun::bits(st.radiance);
     if (!f.adaptive && i1 - i0 == last.count && from == last.from) {
@@ -472,7 +512,7 @@ void take_background_samples(const RenderState& f, std::uint32_t i0, std::uint32
     }
     Vec3f radiance = st.radiance;
     for (std::uint32_t i = i0; i < i1; ++i)
-        take_flat_miss(f, *f.miss, i, st, radiance);
+        take_flat_miss(f, *f.miss, i, st, ex, radiance);
     st.radiance = radiance;
     last = {from, BackgroundRun::bits(radiance), i1 - i0};
 }
@@ -488,68 +528,95 @@ struct RowBatches {
 /// in order: camera rays meet the ground beside the Embree scene, so each path traces
 /// its own.
 void take_samples(const RenderState& f, int x, int y, std::uint32_t i0, std::uint32_t i1,
-                  PixelState& st, CameraBatch& b, const PixelReplicas& replicas)
+                  PixelState& st, PixelExtras* ex, CameraBatch& b, const PixelReplicas& replicas)
 {
     for (std::uint32_t start = i0; start < i1; start += CameraBatch::size) {
         std::uint32_t n = std::min(CameraBatch::size, i1 - start);
         camera_samples(f, x, y, start, n, replicas, b);
         for (std::uint32_t k = 0; k < n; ++k)
-            take_sample(f, replicas, b.tnear[k], b.rays[k], start + k, st);
+            take_sample(f, replicas, b.tnear[k], b.ray(f, k), start + k, st, ex);
     }
 }
 
-/// Row y of a tile (pixels x0 .. x1 - 1 of `pixels`, w wide): each pixel's samples up to
+/// Asks for the sums of pixels x0 .. x1 - 1 of row y of `film` (w wide) ahead of take_row:
+/// a tile's rows lie an image row apart, a pattern the processor's prefetcher does not
+/// follow, and the first look at each row's sums waited on memory.
+void prefetch_row(const Film& film, int y, int x0, int x1, int w)
+{
+    constexpr std::uintptr_t line = 64;
+    const auto* first = &film.px[std::size_t(y) * std::size_t(w) + std::size_t(x0)];
+    const auto from = reinterpret_cast<std::uintptr_t>(first) & ~(line - 1);
+    const auto to = reinterpret_cast<std::uintptr_t>(first + (x1 - x0));
+    for (std::uintptr_t p = from; p < to; p += line)
+        __builtin_prefetch(reinterpret_cast<const void*>(p));
+}
+
+/// The samples take_row took, and how many of them were of pixels the screen mask skips.
+struct RowSamples {
+    std::uint64_t taken = 0, background_only = 0;
+};
+
+/// Row y of a tile (pixels x0 .. x1 - 1 of `film`, w wide): each pixel's samples up to
 /// `target`, in rounds of a batch per pixel. A round traces every pixel's batch before it
 /// adds any to the sums, so the row's camera streams meet Embree back to back (its nodes
 /// stay in cache) instead of between the paths of the hits (and the hits' paths follow
 /// each other too); each pixel's sums take the same samples in the same order. (Rounds
 /// over one row measured as fast as over two and faster than over four or a whole tile.)
-/// Pixels the screen mask skips take their background samples at once; returns how many.
-std::uint64_t take_row(const RenderState& f, const PixelRect& region, int y, int x0, int x1,
-                       std::uint32_t target, std::vector<PixelState>& pixels, int w,
-                       RowBatches& row)
+/// Pixels the screen mask skips take their background samples at once.
+RowSamples take_row(const RenderState& f, const PixelRect& region, int y, int x0, int x1,
+                    std::uint32_t target, Film& film, int w, RowBatches& row)
 {
-    std::uint64_t background_only = 0;
-    auto pixel = [&](int x) -> PixelState& { return pixels[std::size_t(y) * w + x]; };
-    auto batch_size = [&](const PixelState& st) {
-        return std::min(CameraBatch::size, target - st.samples);
-    };
+    RowSamples taken;
+    const std::size_t first = std::size_t(y) * std::size_t(w);  // the row's index in film
+    // The row's pixels whose camera rays are traced, as offsets from x0, in order.
+    std::array<std::uint8_t, tile_size> traced;
+    std::size_t count = 0;
     for (int x = x0; x < x1; ++x) {
-        auto& replicas = row.replicas[std::size_t(x - x0)];
-        replicas.reset();
-        PixelState& st = pixel(x);
+        PixelState& st = film.px[first + std::size_t(x)];
         if (st.done || st.samples >= target)
             continue;
+        taken.taken += target - st.samples;
         if (f.mask && !f.mask->may_hit(region.x + x, region.y + y)) {
-            background_only += target - st.samples;
-            take_background_samples(f, st.samples, target, st, row.background);
+            taken.background_only += target - st.samples;
+            take_background_samples(f, st.samples, target, st, film.extra(first + std::size_t(x)),
+                                    row.background);
         } else {
-            replicas.emplace(region.x + x, region.y + y, f.settings.seed, f.adaptive);
+            row.replicas[std::size_t(x - x0)].emplace(region.x + x, region.y + y, f.settings.seed,
+                                                      f.adaptive);
+            traced[count++] = static_cast<std::uint8_t>(x - x0);
         }
     }
+    auto pixel = [&](std::size_t k) -> PixelState& { return film.px[first + std::size_t(x0) + k]; };
+    auto extra = [&](std::size_t k) { return film.extra(first + std::size_t(x0) + k); };
     if (f.ctx.ground) {  // no streams: each path traces its own camera ray
-        for (int x = x0; x < x1; ++x)
-            if (const auto& replicas = row.replicas[std::size_t(x - x0)])
-                take_samples(f, region.x + x, region.y + y, pixel(x).samples, target, pixel(x),
-                             row.batch[0], *replicas);
-        return background_only;
+        for (std::size_t j = 0; j < count; ++j) {
+            const std::size_t k = traced[j];
+            take_samples(f, region.x + x0 + int(k), region.y + y, pixel(k).samples, target,
+                         pixel(k), extra(k), row.batch[0], *row.replicas[k]);
+        }
+        return taken;
     }
-    for (bool more = true; more;) {
+    for (bool more = count > 0; more;) {
         more = false;
-        for (int x = x0; x < x1; ++x)
-            if (row.replicas[std::size_t(x - x0)] && pixel(x).samples < target)
-                trace_batch(f, region.x + x, region.y + y, pixel(x).samples, batch_size(pixel(x)),
-                            *row.replicas[std::size_t(x - x0)], row.batch[std::size_t(x - x0)]);
-        for (int x = x0; x < x1; ++x) {
-            PixelState& st = pixel(x);
-            if (!row.replicas[std::size_t(x - x0)] || st.samples >= target)
+        for (std::size_t j = 0; j < count; ++j) {
+            const std::size_t k = traced[j];
+            const PixelState& st = pixel(k);
+            if (st.samples < target)
+                trace_batch(f, region.x + x0 + int(k), region.y + y, st.samples,
+                            std::min(CameraBatch::size, target - st.samples), *row.replicas[k],
+                            row.batch[k]);
+        }
+        for (std::size_t j = 0; j < count; ++j) {
+            const std::size_t k = traced[j];
+            PixelState& st = pixel(k);
+            if (st.samples >= target)
                 continue;
-            add_batch(f, *row.replicas[std::size_t(x - x0)], st.samples, batch_size(st), st,
-                      row.batch[std::size_t(x - x0)]);
+            add_batch(f, *row.replicas[k], st.samples, std::min(CameraBatch::size, target - st.samples),
+                      st, extra(k), row.batch[k]);
             more |= st.samples < target;
         }
     }
-    return background_only;
+    return taken;
 }
 
 /// The pixels whose camera rays may meet the scene, for a view where a camera ray that
@@ -591,14 +658,14 @@ std::vector<int> pass_targets(const RenderSettings& s)
 /// stratification gain of 1/sqrt(n), more than nets achieve on an edge). From a few
 /// samples the replicas often agree exactly on an edge (each net's coverage count is an
 /// integer): an estimate of zero, which without the floor would stop the pixel at once.
-double relative_error_squared(const PixelState& st)
+double relative_error_squared(const PixelState& st, const PixelExtras& ex)
 {
     if (st.samples < std::uint32_t(min_adaptive_samples))
         return std::numeric_limits<double>::infinity();
     double n = st.samples, n_even = (st.samples + 1) / 2, n_odd = st.samples / 2;
-    double sum = st.replica_luminance[0] + st.replica_luminance[1], mean = sum / n;
-    double replica_error = (st.replica_luminance[0] / n_even - st.replica_luminance[1] / n_odd) / 2;
-    double variance = std::max(0.0, (st.luminance_sq - sum * mean) / (n - 1));
+    double sum = ex.replica_luminance[0] + ex.replica_luminance[1], mean = sum / n;
+    double replica_error = (ex.replica_luminance[0] / n_even - ex.replica_luminance[1] / n_odd) / 2;
+    double variance = std::max(0.0, (ex.luminance_sq - sum * mean) / (n - 1));
     double error_sq = std::max(replica_error * replica_error, variance / (n * n));
     return error_sq / std::max(mean * mean, 1e-4);
 }
@@ -607,11 +674,12 @@ double relative_error_squared(const PixelState& st)
 /// rectangle, w x h: its edges are the image's or lie in the crop's margin). A pixel's
 /// replica estimate has one degree of freedom; pooled over the neighbourhood (the mean of
 /// the squared errors) it has nine, so a lucky pair of replicas rarely stops a pixel early.
-void mark_converged(std::vector<PixelState>& px, int w, int h, double target)
+void mark_converged(Film& film, int w, int h, double target)
 {
+    std::vector<PixelState>& px = film.px;
     std::vector<double> err(px.size());
     for (std::size_t i = 0; i < px.size(); ++i)
-        err[i] = relative_error_squared(px[i]);
+        err[i] = relative_error_squared(px[i], film.extras[i]);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             double pooled = 0;
@@ -628,19 +696,20 @@ void mark_converged(std::vector<PixelState>& px, int w, int h, double target)
 /// A shadow catcher's share of a pixel's coverage, in samples: its samples that met the
 /// catcher (those with light) times the fraction of the light the plant takes away, as a
 /// ratio of the sums (Cycles' catcher): 0 where nothing is in the way.
-float shadow_coverage(const PixelState& st)
+float shadow_coverage(const PixelExtras& ex)
 {
-    if (!(st.lit_without > 0) || st.lit_with >= st.lit_without)
+    if (!(ex.lit_without > 0) || ex.lit_with >= ex.lit_without)
         return 0;
-    float missing = static_cast<float>(1 - st.lit_with / st.lit_without);
-    return missing * static_cast<float>(st.caught);
+    float missing = static_cast<float>(1 - ex.lit_with / ex.lit_without);
+    return missing * static_cast<float>(ex.caught);
 }
 
-/// The image of the sums so far over `out`, from the sums over `sampled` (which holds it).
-Image resolve(const std::vector<PixelState>& px, const PixelRect& sampled, const PixelRect& out,
+/// The image of the sums so far over `out`, from the sums over `sampled` (which holds it),
+/// row by row (each output row is a run of a sampled row).
+Image resolve(const Film& film, const PixelRect& sampled, const PixelRect& out,
               const RenderSettings& s)
 {
-    const std::size_t count = std::size_t(out.width) * out.height;
+    const std::size_t width = std::size_t(out.width), count = width * std::size_t(out.height);
     Image img{out.width, out.height, std::vector<float>(count * 4)};
     img.transparent = s.transparent_background || s.ground.shadow_catcher;
     if (s.aovs) {
@@ -648,26 +717,31 @@ Image resolve(const std::vector<PixelState>& px, const PixelRect& sampled, const
         img.normal.assign(count * 3, 0.0f);
         img.depth.assign(count, infinity);
     }
-    for (std::size_t i = 0; i < count; ++i) {
-        int x = out.x - sampled.x + int(i % std::size_t(out.width));
-        int y = out.y - sampled.y + int(i / std::size_t(out.width));
-        const PixelState& st = px[std::size_t(y) * std::size_t(sampled.width) + std::size_t(x)];
-        if (st.samples == 0)
-            continue;
-        float inv = 1.0f / static_cast<float>(st.samples);
-        img.rgba[i * 4 + 0] = st.radiance.x * inv;
-        img.rgba[i * 4 + 1] = st.radiance.y * inv;
-        img.rgba[i * 4 + 2] = st.radiance.z * inv;
-        img.rgba[i * 4 + 3] = (static_cast<float>(st.hits) + shadow_coverage(st)) * inv;
-        if (s.aovs) {
-            Vec3f a = st.albedo * inv, n = st.normal * inv;
-            img.albedo[i * 3 + 0] = a.x;
-            img.albedo[i * 3 + 1] = a.y;
-            img.albedo[i * 3 + 2] = a.z;
-            img.normal[i * 3 + 0] = n.x;
-            img.normal[i * 3 + 1] = n.y;
-            img.normal[i * 3 + 2] = n.z;
-            img.depth[i] = st.depth;
+    const bool extras = !film.extras.empty();  // (without them no pixel has a catcher's light)
+    for (std::size_t row = 0; row < std::size_t(out.height); ++row) {
+        const std::size_t from = (std::size_t(out.y - sampled.y) + row) * std::size_t(sampled.width) +
+                                 std::size_t(out.x - sampled.x);
+        for (std::size_t x = 0, i = row * width; x < width; ++x, ++i) {
+            const PixelState& st = film.px[from + x];
+            if (st.samples == 0)
+                continue;
+            float inv = 1.0f / static_cast<float>(st.samples);
+            float coverage = extras ? shadow_coverage(film.extras[from + x]) : 0.0f;
+            img.rgba[i * 4 + 0] = st.radiance.x * inv;
+            img.rgba[i * 4 + 1] = st.radiance.y * inv;
+            img.rgba[i * 4 + 2] = st.radiance.z * inv;
+            img.rgba[i * 4 + 3] = (static_cast<float>(st.hits) + coverage) * inv;
+            if (s.aovs) {
+                const PixelExtras& ex = film.extras[from + x];
+                Vec3f a = ex.albedo * inv, n = ex.normal * inv;
+                img.albedo[i * 3 + 0] = a.x;
+                img.albedo[i * 3 + 1] = a.y;
+                img.albedo[i * 3 + 2] = a.z;
+                img.normal[i * 3 + 0] = n.x;
+                img.normal[i * 3 + 1] = n.y;
+                img.normal[i * 3 + 2] = n.z;
+                img.depth[i] = ex.depth;
+            }
         }
     }
     return img;
@@ -903,13 +977,18 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
              (settings.backdrop == RenderSettings::Backdrop::view &&
               camera.projection() == Camera::Projection::perspective));
         ctx.camera_cone = camera_cone(camera);
-        std::vector<PixelState> pixels(std::size_t(w) * h);
         RenderReport rep;
         RenderState state{ctx, *accel, camera, settings,
                     FilterTable(settings.filter, settings.filter_radius),
                     camera.aperture_radius() > 0 &&
                         camera.projection() == Camera::Projection::perspective,
                     &nonfinite};
+        Film film(std::size_t(w) * h,
+                  settings.aovs || state.adaptive || (ctx.ground && ctx.ground->shadow_catcher));
+        std::vector<PixelState>& pixels = film.px;
+        // Each thread's camera batches, made on its first tile (not once per tile: their
+        // members' initialisers, ~60 kB of stores a tile, were a tenth of the pixel loop).
+        tbb::enumerable_thread_specific<std::unique_ptr<RowBatches>> thread_rows;
 
         const ScreenMask mask = screen_mask(scene, state);
         state.mask = &mask;
@@ -964,24 +1043,30 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
             // Each tile writes only its own pixels; no exception leaves a task.
             tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1),
                               [&](const tbb::blocked_range<int>& r) {
+                // Taken from the thread's slot while in use: a task this one waits on inside
+                // (nested parallelism) may run another tile on this thread, with its own.
+                std::unique_ptr<RowBatches> row = std::move(thread_rows.local());
+                if (!row)
+                    row = std::make_unique_for_overwrite<RowBatches>();  // no zero fill
                 for (int t = r.begin(); t != r.end(); ++t) {
                     int x0 = (t % tiles_x) * tile_size, y0 = (t / tiles_x) * tile_size;
-                    std::uint64_t taken = 0, background_only = 0;
-                    auto row = std::make_unique_for_overwrite<RowBatches>();  // no zero fill
+                    RowSamples tile;
+                    row->background = {};  // (a pure function of the view's miss, so per tile)
                     const int x1 = std::min(x0 + tile_size, w);
+                    const int y1 = std::min(y0 + tile_size, h);
+                    prefetch_row(film, y0, x0, x1, w);
                     // Checked every row, so even passes of thousands of samples stop soon.
-                    for (int y = y0; y < std::min(y0 + tile_size, h) && !should_stop(); ++y) {
-                        for (int x = x0; x < x1; ++x) {
-                            const PixelState& st = pixels[std::size_t(y) * w + x];
-                            if (st.done || st.samples >= target)
-                                continue;
-                            taken += target - st.samples;
-                        }
-                        background_only += take_row(state, region, y, x0, x1, target, pixels, w, *row);
+                    for (int y = y0; y < y1 && !should_stop(); ++y) {
+                        if (y + 1 < y1)
+                            prefetch_row(film, y + 1, x0, x1, w);
+                        RowSamples taken = take_row(state, region, y, x0, x1, target, film, w, *row);
+                        tile.taken += taken.taken;
+                        tile.background_only += taken.background_only;
                     }
-                    progress.add(taken);
-                    background_samples.fetch_add(background_only, std::memory_order_relaxed);
+                    progress.add(tile.taken);
+                    background_samples.fetch_add(tile.background_only, std::memory_order_relaxed);
                 }
+                thread_rows.local() = std::move(row);
             });
             if (stop)
                 break;
@@ -989,9 +1074,9 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
             last_pass_samples = pass_samples;
             rep.passes += 1;
             if (settings.noise_target > 0)
-                mark_converged(pixels, w, h, settings.noise_target);
+                mark_converged(film, w, h, settings.noise_target);
             if (settings.on_pass)
-                settings.on_pass(resolve(pixels, region, out_rect, settings));
+                settings.on_pass(resolve(film, region, out_rect, settings));
         }
         progress.finish();
         rep.cancelled = cancelled;
@@ -1015,7 +1100,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                  " ray(s) not finite or starting too far from the origin were skipped");
         for (const PixelState& st : pixels)
             rep.samples += st.samples;
-        Image image = resolve(pixels, region, out_rect, settings);
+        Image image = resolve(film, region, out_rect, settings);
         // Labels over the image, as cpfg's window draws them (on the crop's pixels).
         draw_labels(image, scene, camera, *accel,
                     LabelCanvas{out_rect.x, out_rect.y, settings.width, settings.height});

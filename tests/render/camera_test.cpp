@@ -196,7 +196,8 @@ TEST(Camera, SinglePrecisionRaysAreTheDoubleRaysRounded)
 }
 
 // A parallel camera's batch rays are traced_ray(generate_ray()) bit for bit: with and
-// without clipping planes, in either frame, for whole blocks of 16 and the rest, and
+// without clipping planes, in each frame (along an axis, twisted, one whose unit forward
+// squares to just below 1), for whole blocks of 16 and the rest, and
 // in the four places a front plane can be (behind the rays' start, in front, beyond
 // the back plane) and the back plane behind the start (an empty interval).
 TEST(Camera, ParallelBatchRaysAreTheTracedDoubleRays)
@@ -207,10 +208,18 @@ TEST(Camera, ParallelBatchRaysAreTheTracedDoubleRays)
     view.twist_deg = 17;
     Camera plain = make_camera(view, box({-2.3, -1.1, -3.7}, {4.9, 6.2, 1.3}), 320, 240);
     Camera axis = Camera::parallel({0.5, 0.25, 0}, {0, 0, -1}, {0, 1, 0}, 0.013, 9.5, 64, 48);
+    // A view direction whose unit vector's squared length rounds to just below 1, which
+    // the blocks divide by (where it is exactly 1 they need not).
+    geom::View skewed = view;
+    skewed.viewpoint = {-0.1, 0.07, 1.3};
+    skewed.reference_point = {0, 0, 0};
+    Camera skew = make_camera(skewed, box({-2.3, -1.1, -3.7}, {4.9, 6.2, 1.3}), 320, 240);
     ASSERT_EQ(plain.projection(), Camera::Projection::parallel);
+    ASSERT_NE(geom::dot(skew.forward(), skew.forward()), 1.0);
+    ASSERT_EQ(geom::dot(axis.forward(), axis.forward()), 1.0);
     constexpr double inf = std::numeric_limits<double>::infinity();
     std::vector<Camera> cameras;
-    for (const Camera& c : {plain, axis}) {
+    for (const Camera& c : {plain, axis, skew}) {
         cameras.push_back(c);
         for (auto [near, far] : std::vector<std::pair<double, double>>{
                  {-1, 2.5}, {-30, 40}, {-inf, 0.7}, {0.3, inf}, {1.5, 1.2}, {-40, -35}})
