@@ -20,6 +20,7 @@
 #include <mutex>
 #include <new>
 #include <numbers>
+#include <optional>
 #include <span>
 #include <string>
 #include <tuple>
@@ -215,6 +216,12 @@ T at_or(const std::vector<T>& v, std::size_t i, T fallback)
 
 struct HitResolver;
 
+/// A primitive's own material entries for both sides (`back` = `front` where the part has
+/// no back materials), before inherit_material is resolved.
+struct MaterialEntries {
+    std::uint16_t front = 0, back = 0;
+};
+
 /// One Embree geometry's source primitives and where their attributes live.
 struct GeometrySource {
     Shape shape = Shape::line;
@@ -232,6 +239,10 @@ struct GeometrySource {
     bool own_textures = false;
     /// Caps and joints: the line segment each belongs to (their attributes are its).
     const std::vector<std::uint32_t>* segment = nullptr;
+    /// Every primitive's material entries are `uniform` (found at build time), so a hit
+    /// reads none: Lilac's 247 k petal triangles have one material, whose two entries
+    /// per triangle were two more cache misses a hit (beside the vertices').
+    std::optional<MaterialEntries> uniform{};
     /// The filters its Embree geometry runs on each candidate hit (none: no filter at all):
     /// the primitive a ray leaves, the pixels a pixel-width line covers, alpha cut-outs.
     bool skips_self = false, pixel_line = false, cut_out = false;
@@ -1003,21 +1014,52 @@ struct HitMaterials {
     float blend = 0;
 };
 
-/// A primitive's own material entries for both sides (`back` = `front` where the part has
-/// no back materials), before inherit_material is resolved.
-struct MaterialEntries {
-    std::uint16_t front = 0, back = 0;
-};
-
 /// Read apart from materials_at(), before the hit's surface: on a large mesh they miss the
 /// cache, and read first their misses overlap those of the vertices. (Read after, where
 /// the side hit picks the entry, the back one waited for the vertices: the side is known
 /// from them only.)
 MaterialEntries material_entries(const GeometrySource& part, std::uint32_t prim)
 {
+    if (part.uniform)
+        return *part.uniform;
     std::uint32_t index = part.attribute_index(prim);
     std::uint16_t front = at_or(*part.material, index, std::uint16_t{0});
     return {front, part.back_material ? at_or(*part.back_material, index, front) : front};
+}
+
+/// How many primitives the part's Embree geometry holds.
+std::size_t primitive_count(const GeometrySource& part)
+{
+    const geom::Geometry& g = *part.geometry;
+    if (part.segment)  // caps and joints: one per entry
+        return part.segment->size();
+    switch (part.shape) {
+    case Shape::line: return g.lines.segment_count();
+    case Shape::curve: return g.curves.segment_count();
+    case Shape::sphere: return g.spheres.size();
+    case Shape::disc: return g.discs.size();
+    case Shape::triangle: return g.mesh.size();
+    case Shape::cap:
+    case Shape::joint: break;  // (always with a segment)
+    }
+    return 0;
+}
+
+/// The material entries every primitive of the part has, if they are all the same (none:
+/// they differ, or the part is empty). Found by asking material_entries() of each, so a
+/// hit that takes them from here gets what it would have read.
+std::optional<MaterialEntries> uniform_materials(const GeometrySource& part)
+{
+    const std::size_t n = primitive_count(part);
+    if (n == 0)
+        return std::nullopt;
+    const MaterialEntries first = material_entries(part, 0);
+    for (std::size_t prim = 1; prim < n; ++prim) {
+        MaterialEntries e = material_entries(part, static_cast<std::uint32_t>(prim));
+        if (e.front != first.front || e.back != first.back)
+            return std::nullopt;
+    }
+    return first;
 }
 
 HitMaterials materials_at(const GeometrySource& part, std::uint32_t prim, MaterialEntries own,
@@ -1205,6 +1247,7 @@ void EmbreeScene::Impl::attach(RTCScene s, GeometrySource part,
     part.pixel_line = part.shape == Shape::line && part.unlit;
     part.cut_out = textures && (alpha || part.pixel_line);
     part.own_textures = part.texture && any_texture(*part.texture);
+    part.uniform = uniform_materials(part);
     parts.push_back(part);
     rtcSetGeometryUserData(g, &parts.back());
     if (part.skips_self || part.pixel_line || part.cut_out) {
