@@ -222,6 +222,19 @@ struct MaterialEntries {
     std::uint16_t front = 0, back = 0;
 };
 
+/// What a hit on a triangle of a large mesh reads of it, in one cache line (56 of its 64
+/// bytes): the true normal turned to the front and the extent, as triangle_surface()
+/// makes them from the vertices, the three vertex normals and the material entries. Read
+/// through the triangle's vertex indices instead, each hit waited for two cache misses,
+/// one after the other (the indices, then the vertices), beside those of the entries.
+struct alignas(64) TriangleRecord {
+    Vec3f face;
+    float extent = 0;
+    std::array<Vec3f, 3> normals;
+    MaterialEntries materials;
+};
+static_assert(sizeof(TriangleRecord) == 64);
+
 /// One Embree geometry's source primitives and where their attributes live.
 struct GeometrySource {
     Shape shape = Shape::line;
@@ -243,6 +256,8 @@ struct GeometrySource {
     /// reads none: Lilac's 247 k petal triangles have one material, whose two entries
     /// per triangle were two more cache misses a hit (beside the vertices').
     std::optional<MaterialEntries> uniform{};
+    /// Triangles of a large mesh: one record each (triangle_records()), else null.
+    const TriangleRecord* records = nullptr;
     /// The filters its Embree geometry runs on each candidate hit (none: no filter at all):
     /// the primitive a ray leaves, the pixels a pixel-width line covers, alpha cut-outs.
     bool skips_self = false, pixel_line = false, cut_out = false;
@@ -636,6 +651,11 @@ RTCGeometry build_triangles(RTCDevice device, const GeometrySource& part)
                                                             std::uint32_t prim, float u, float v,
                                                             const Vec3f&)
 {
+    if (part.records) {
+        const TriangleRecord& r = part.records[prim];
+        return {r.face, r.normals[0] * (1 - u - v) + r.normals[1] * u + r.normals[2] * v, 0,
+                true, r.extent};
+    }
     const geom::TriangleMesh& m = part.geometry->mesh;
     const auto& tri = m.triangles[prim];
     Vec3f p0 = vec(m.positions[tri[0]]), p1 = vec(m.positions[tri[1]]),
@@ -862,6 +882,8 @@ struct EmbreeScene::Impl : HitResolver {
     std::vector<RTCScene> prototype_scenes;
     std::vector<RTCScene> line_end_rtc_scenes;  ///< the scene's own caps and joints (HitResolver)
     std::deque<GeometrySource> parts;  ///< stable addresses (Embree user data)
+    /// The records of large meshes' triangles (GeometrySource::records), one vector each.
+    std::deque<std::vector<TriangleRecord>> triangle_records;
     std::deque<LineEnds> line_ends;  ///< caps and joints of shaded lines (stable addresses)
     std::vector<Key> world_keys;  ///< line keys with pixel radii converted (else empty)
     /// Pixel-width lines of prototypes, placed by every instance in world space with
@@ -1022,6 +1044,8 @@ MaterialEntries material_entries(const GeometrySource& part, std::uint32_t prim)
 {
     if (part.uniform)
         return *part.uniform;
+    if (part.records)
+        return part.records[prim].materials;
     std::uint32_t index = part.attribute_index(prim);
     std::uint16_t front = at_or(*part.material, index, std::uint16_t{0});
     return {front, part.back_material ? at_or(*part.back_material, index, front) : front};
@@ -1236,6 +1260,35 @@ std::size_t bytes_shared_with_embree(const GeometrySource& part)
 
 }  // namespace
 
+/// Whether the part's triangles get records: a mesh whose indices and vertices outgrow a
+/// core's cache (2 MiB: 64 Ki triangles hold about that much), so that hits on it miss,
+/// up to the number of triangles geom::flatten_small_instances places at most (records
+/// cost 64 B a triangle, as much as Embree's BVH of them: 32 MiB at most per mesh).
+/// Smaller meshes, prototypes shared by many instances among them, stay in cache.
+bool wants_records(const GeometrySource& part)
+{
+    constexpr std::size_t records_from = std::size_t{1} << 16, records_up_to = std::size_t{1} << 19;
+    const std::size_t n = part.shape == Shape::triangle ? part.geometry->mesh.size() : 0;
+    return n >= records_from && n <= records_up_to;
+}
+
+/// One record per triangle of the part, made by the functions a hit without them calls,
+/// so that a hit reading them gets the same numbers.
+std::vector<TriangleRecord> make_records(const GeometrySource& part)
+{
+    const geom::TriangleMesh& m = part.geometry->mesh;
+    std::vector<TriangleRecord> records(m.size());
+    for (std::uint32_t i = 0; i < records.size(); ++i) {
+        const auto& tri = m.triangles[i];
+        const LocalSurface l = triangle_surface(part, i, 0, 0, Vec3f());
+        records[i].face = l.geometric;
+        records[i].extent = l.extent;
+        records[i].normals = {vec(m.normals[tri[0]]), vec(m.normals[tri[1]]), vec(m.normals[tri[2]])};
+        records[i].materials = material_entries(part, i);
+    }
+    return records;
+}
+
 void EmbreeScene::Impl::attach(RTCScene s, GeometrySource part,
                                std::vector<const GeometrySource*>& ids, bool alpha)
 {
@@ -1248,6 +1301,8 @@ void EmbreeScene::Impl::attach(RTCScene s, GeometrySource part,
     part.cut_out = textures && (alpha || part.pixel_line);
     part.own_textures = part.texture && any_texture(*part.texture);
     part.uniform = uniform_materials(part);
+    if (wants_records(part))
+        part.records = triangle_records.emplace_back(make_records(part)).data();
     parts.push_back(part);
     rtcSetGeometryUserData(g, &parts.back());
     if (part.skips_self || part.pixel_line || part.cut_out) {
@@ -1466,6 +1521,8 @@ std::uint64_t EmbreeScene::own_bytes() const
     const Impl& m = *m_impl;
     std::size_t bytes = capacity_bytes(m.world_keys) + m.styles.size() * sizeof(InstanceStyle) +
                         m.parts.size() * sizeof(GeometrySource);
+    for (const std::vector<TriangleRecord>& r : m.triangle_records)
+        bytes += capacity_bytes(r);
     for (const LineEnds& e : m.line_ends)
         bytes += capacity_bytes(e.caps) + capacity_bytes(e.cap_normals) +
                  capacity_bytes(e.cap_segment) + capacity_bytes(e.cap_at_end) +
