@@ -1260,11 +1260,13 @@ std::size_t bytes_shared_with_embree(const GeometrySource& part)
 
 }  // namespace
 
-/// Whether the part's triangles get records: a mesh whose indices and vertices outgrow a
-/// core's cache (2 MiB: 64 Ki triangles hold about that much), so that hits on it miss,
-/// up to the number of triangles geom::flatten_small_instances places at most (records
-/// cost 64 B a triangle, as much as Embree's BVH of them: 32 MiB at most per mesh).
-/// Smaller meshes, prototypes shared by many instances among them, stay in cache.
+/// Whether the part's triangles get records: a mesh of the scene's own geometry (a plant,
+/// with its small instances drawn in place) whose indices and vertices outgrow a core's
+/// cache (2 MiB: 64 Ki triangles hold about that much), so that hits on it miss, up to the
+/// number of triangles geom::flatten_small_instances places at most. Records cost 64 B a
+/// triangle, about what Embree's BVH of them costs (32 MiB at most): prototypes do without
+/// them, since scenes of many plants have many large ones (a field of lilac variants) and
+/// the memory they save by instancing must stay saved (docs/architecture.md).
 bool wants_records(const GeometrySource& part)
 {
     constexpr std::size_t records_from = std::size_t{1} << 16, records_up_to = std::size_t{1} << 19;
@@ -1301,7 +1303,7 @@ void EmbreeScene::Impl::attach(RTCScene s, GeometrySource part,
     part.cut_out = textures && (alpha || part.pixel_line);
     part.own_textures = part.texture && any_texture(*part.texture);
     part.uniform = uniform_materials(part);
-    if (wants_records(part))
+    if (s == scene && wants_records(part))
         part.records = triangle_records.emplace_back(make_records(part)).data();
     parts.push_back(part);
     rtcSetGeometryUserData(g, &parts.back());

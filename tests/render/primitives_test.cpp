@@ -367,6 +367,15 @@ TEST(Primitives, LargeMeshesShadeAsSmallOnes)
         EXPECT_GT(hits, 1000);
         EXPECT_GT(backs, 100);
         EXPECT_LT(backs, hits - 100);
+        // The same mesh as a prototype gets none: scenes of many plants keep their memory.
+        geom::Scene placed;
+        placed.prototypes.push_back(geom::Prototype{"", large.geometry});
+        placed.instances.push_back(geom::Instance{});
+        EmbreeScene c(placed, any_camera());
+        EXPECT_LT(c.own_bytes(), 64 * large.geometry.mesh.size());
+        auto hc = c.intersect({105.1f, -37.8f, 20}, {0, 0, -1}, 0, 30);
+        ASSERT_TRUE(hc);
+        EXPECT_EQ(hc->material, uniform ? 3 : 2 + int(hc->prim_id) % 5);
     }
 }
 
