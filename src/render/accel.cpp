@@ -252,15 +252,15 @@ struct GeometrySource {
     bool own_textures = false;
     /// Caps and joints: the line segment each belongs to (their attributes are its).
     const std::vector<std::uint32_t>* segment = nullptr;
+    /// The filters its Embree geometry runs on each candidate hit (none: no filter at all):
+    /// the primitive a ray leaves, the pixels a pixel-width line covers, alpha cut-outs.
+    bool skips_self = false, pixel_line = false, cut_out = false;
     /// Every primitive's material entries are `uniform` (found at build time), so a hit
     /// reads none: Lilac's 247 k petal triangles have one material, whose two entries
     /// per triangle were two more cache misses a hit (beside the vertices').
     std::optional<MaterialEntries> uniform{};
     /// Triangles of a large mesh: one record each (triangle_records()), else null.
     const TriangleRecord* records = nullptr;
-    /// The filters its Embree geometry runs on each candidate hit (none: no filter at all):
-    /// the primitive a ray leaves, the pixels a pixel-width line covers, alpha cut-outs.
-    bool skips_self = false, pixel_line = false, cut_out = false;
 
     std::uint32_t attribute_index(std::uint32_t prim) const
     {
