@@ -259,7 +259,8 @@ struct GeometrySource {
     /// reads none: Lilac's 247 k petal triangles have one material, whose two entries
     /// per triangle were two more cache misses a hit (beside the vertices').
     std::optional<MaterialEntries> uniform{};
-    /// Triangles of a large mesh: one record each (triangle_records()), else null.
+    /// Triangles of a large mesh of the scene's own: one record each (wants_records(),
+    /// make_records()), else null.
     const TriangleRecord* records = nullptr;
 
     std::uint32_t attribute_index(std::uint32_t prim) const
