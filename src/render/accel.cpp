@@ -20,6 +20,7 @@
 #include <mutex>
 #include <new>
 #include <numbers>
+#include <optional>
 #include <span>
 #include <string>
 #include <tuple>
@@ -215,6 +216,25 @@ T at_or(const std::vector<T>& v, std::size_t i, T fallback)
 
 struct HitResolver;
 
+/// A primitive's own material entries for both sides (`back` = `front` where the part has
+/// no back materials), before inherit_material is resolved.
+struct MaterialEntries {
+    std::uint16_t front = 0, back = 0;
+};
+
+/// What a hit on a triangle of a large mesh reads of it, in one cache line (56 of its 64
+/// bytes): the true normal turned to the front and the extent, as triangle_surface()
+/// makes them from the vertices, the three vertex normals and the material entries. Read
+/// through the triangle's vertex indices instead, each hit waited for two cache misses,
+/// one after the other (the indices, then the vertices), beside those of the entries.
+struct alignas(64) TriangleRecord {
+    Vec3f face;
+    float extent = 0;
+    std::array<Vec3f, 3> normals;
+    MaterialEntries materials;
+};
+static_assert(sizeof(TriangleRecord) == 64);
+
 /// One Embree geometry's source primitives and where their attributes live.
 struct GeometrySource {
     Shape shape = Shape::line;
@@ -235,6 +255,13 @@ struct GeometrySource {
     /// The filters its Embree geometry runs on each candidate hit (none: no filter at all):
     /// the primitive a ray leaves, the pixels a pixel-width line covers, alpha cut-outs.
     bool skips_self = false, pixel_line = false, cut_out = false;
+    /// Every primitive's material entries are `uniform` (found at build time), so a hit
+    /// reads none: Lilac's 247 k petal triangles have one material, whose two entries
+    /// per triangle were two more cache misses a hit (beside the vertices').
+    std::optional<MaterialEntries> uniform{};
+    /// Triangles of a large mesh of the scene's own: one record each (wants_records(),
+    /// make_records()), else null.
+    const TriangleRecord* records = nullptr;
 
     std::uint32_t attribute_index(std::uint32_t prim) const
     {
@@ -625,6 +652,11 @@ RTCGeometry build_triangles(RTCDevice device, const GeometrySource& part)
                                                             std::uint32_t prim, float u, float v,
                                                             const Vec3f&)
 {
+    if (part.records) {
+        const TriangleRecord& r = part.records[prim];
+        return {r.face, r.normals[0] * (1 - u - v) + r.normals[1] * u + r.normals[2] * v, 0,
+                true, r.extent};
+    }
     const geom::TriangleMesh& m = part.geometry->mesh;
     const auto& tri = m.triangles[prim];
     Vec3f p0 = vec(m.positions[tri[0]]), p1 = vec(m.positions[tri[1]]),
@@ -851,6 +883,8 @@ struct EmbreeScene::Impl : HitResolver {
     std::vector<RTCScene> prototype_scenes;
     std::vector<RTCScene> line_end_rtc_scenes;  ///< the scene's own caps and joints (HitResolver)
     std::deque<GeometrySource> parts;  ///< stable addresses (Embree user data)
+    /// The records of large meshes' triangles (GeometrySource::records), one vector each.
+    std::deque<std::vector<TriangleRecord>> triangle_records;
     std::deque<LineEnds> line_ends;  ///< caps and joints of shaded lines (stable addresses)
     std::vector<Key> world_keys;  ///< line keys with pixel radii converted (else empty)
     /// Pixel-width lines of prototypes, placed by every instance in world space with
@@ -1009,21 +1043,54 @@ struct HitMaterials {
     float blend = 0;
 };
 
-/// A primitive's own material entries for both sides (`back` = `front` where the part has
-/// no back materials), before inherit_material is resolved.
-struct MaterialEntries {
-    std::uint16_t front = 0, back = 0;
-};
-
 /// Read apart from materials_at(), before the hit's surface: on a large mesh they miss the
 /// cache, and read first their misses overlap those of the vertices. (Read after, where
 /// the side hit picks the entry, the back one waited for the vertices: the side is known
 /// from them only.)
 MaterialEntries material_entries(const GeometrySource& part, std::uint32_t prim)
 {
+    if (part.uniform)
+        return *part.uniform;
+    if (part.records)
+        return part.records[prim].materials;
     std::uint32_t index = part.attribute_index(prim);
     std::uint16_t front = at_or(*part.material, index, std::uint16_t{0});
     return {front, part.back_material ? at_or(*part.back_material, index, front) : front};
+}
+
+/// How many primitives the part's Embree geometry holds.
+std::size_t primitive_count(const GeometrySource& part)
+{
+    const geom::Geometry& g = *part.geometry;
+    if (part.segment)  // caps and joints: one per entry
+        return part.segment->size();
+    switch (part.shape) {
+    case Shape::line: return g.lines.segment_count();
+    case Shape::curve: return g.curves.segment_count();
+    case Shape::sphere: return g.spheres.size();
+    case Shape::disc: return g.discs.size();
+    case Shape::triangle: return g.mesh.size();
+    case Shape::cap:
+    case Shape::joint: break;  // (always with a segment)
+    }
+    return 0;
+}
+
+/// The material entries every primitive of the part has, if they are all the same (none:
+/// they differ, or the part is empty). Found by asking material_entries() of each, so a
+/// hit that takes them from here gets what it would have read.
+std::optional<MaterialEntries> uniform_materials(const GeometrySource& part)
+{
+    const std::size_t n = primitive_count(part);
+    if (n == 0)
+        return std::nullopt;
+    const MaterialEntries first = material_entries(part, 0);
+    for (std::size_t prim = 1; prim < n; ++prim) {
+        MaterialEntries e = material_entries(part, static_cast<std::uint32_t>(prim));
+        if (e.front != first.front || e.back != first.back)
+            return std::nullopt;
+    }
+    return first;
 }
 
 HitMaterials materials_at(const GeometrySource& part, std::uint32_t prim, MaterialEntries own,
@@ -1164,6 +1231,23 @@ void geometry_filter(const RTCFilterFunctionNArguments* args)
         alpha_filter(args);
 }
 
+/// The context filter of single rays in a scene with triangle records: asks for the record
+/// of each candidate hit on a mesh that has them, so that its cache miss runs while Embree
+/// traverses on (a hit's conversion, which starts when Embree returns, waited for it).
+/// Accepts every hit. Set by trace() only: a context filter is paid only by the rays whose
+/// hits are converted (as the meshes' geometry filter, it made every traversal of the
+/// scene 2-3% dearer, raw Embree's replay too); camera streams meet the same few
+/// triangles, already in cache.
+void prefetch_records(const RTCFilterFunctionNArguments* args)
+{
+    const auto* part = static_cast<const GeometrySource*>(args->geometryUserPtr);
+    if (!part->records)
+        return;
+    for (unsigned i = 0; i < args->N; ++i)
+        if (args->valid[i] != 0)
+            __builtin_prefetch(&part->records[RTCHitN_primID(args->hit, args->N, i)]);
+}
+
 namespace {
 
 /// The bytes of `v` if Embree reads it in place (padded for its loads), else 0.
@@ -1200,6 +1284,37 @@ std::size_t bytes_shared_with_embree(const GeometrySource& part)
 
 }  // namespace
 
+/// Whether the part's triangles get records: a mesh of the scene's own geometry (a plant,
+/// with its small instances drawn in place) whose indices and vertices outgrow a core's
+/// cache (2 MiB: 64 Ki triangles hold about that much), so that hits on it miss, up to the
+/// number of triangles geom::flatten_small_instances places at most. Records cost 64 B a
+/// triangle, about what Embree's BVH of them costs (32 MiB at most): prototypes do without
+/// them, since scenes of many plants have many large ones (a field of lilac variants) and
+/// the memory they save by instancing must stay saved (docs/architecture.md).
+bool wants_records(const GeometrySource& part)
+{
+    constexpr std::size_t records_from = std::size_t{1} << 16, records_up_to = std::size_t{1} << 19;
+    const std::size_t n = part.shape == Shape::triangle ? part.geometry->mesh.size() : 0;
+    return n >= records_from && n <= records_up_to;
+}
+
+/// One record per triangle of the part, made by the functions a hit without them calls,
+/// so that a hit reading them gets the same numbers.
+std::vector<TriangleRecord> make_records(const GeometrySource& part)
+{
+    const geom::TriangleMesh& m = part.geometry->mesh;
+    std::vector<TriangleRecord> records(m.size());
+    for (std::uint32_t i = 0; i < records.size(); ++i) {
+        const auto& tri = m.triangles[i];
+        const LocalSurface l = triangle_surface(part, i, 0, 0, Vec3f());
+        records[i].face = l.geometric;
+        records[i].extent = l.extent;
+        records[i].normals = {vec(m.normals[tri[0]]), vec(m.normals[tri[1]]), vec(m.normals[tri[2]])};
+        records[i].materials = material_entries(part, i);
+    }
+    return records;
+}
+
 void EmbreeScene::Impl::attach(RTCScene s, GeometrySource part,
                                std::vector<const GeometrySource*>& ids, bool alpha)
 {
@@ -1211,6 +1326,9 @@ void EmbreeScene::Impl::attach(RTCScene s, GeometrySource part,
     part.pixel_line = part.shape == Shape::line && part.unlit;
     part.cut_out = textures && (alpha || part.pixel_line);
     part.own_textures = part.texture && any_texture(*part.texture);
+    part.uniform = uniform_materials(part);
+    if (s == scene && wants_records(part))
+        part.records = triangle_records.emplace_back(make_records(part)).data();
     parts.push_back(part);
     rtcSetGeometryUserData(g, &parts.back());
     if (part.skips_self || part.pixel_line || part.cut_out) {
@@ -1429,6 +1547,8 @@ std::uint64_t EmbreeScene::own_bytes() const
     const Impl& m = *m_impl;
     std::size_t bytes = capacity_bytes(m.world_keys) + m.styles.size() * sizeof(InstanceStyle) +
                         m.parts.size() * sizeof(GeometrySource);
+    for (const std::vector<TriangleRecord>& r : m.triangle_records)
+        bytes += capacity_bytes(r);
     for (const LineEnds& e : m.line_ends)
         bytes += capacity_bytes(e.caps) + capacity_bytes(e.cap_normals) +
                  capacity_bytes(e.cap_segment) + capacity_bytes(e.cap_at_end) +
@@ -1538,6 +1658,8 @@ bool EmbreeScene::Impl::trace(RTCRayHit& rh, const Vec3f& org, const Vec3f& dir,
         return false;
     }
     SkipContext context = make_context(skip, coherent);
+    if (!triangle_records.empty())
+        context.context.filter = &prefetch_records;
     rh.ray = make_ray(org, traced(dir), tnear, tfar);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;

@@ -298,6 +298,87 @@ TEST(Primitives, FittedMeshesAndInstancesShadeAsBefore)
     EXPECT_LT(own->geometric_normal.y, -0.4f);  // z' = z + y / 2: the normal ~ (0, -0.5, 1)
 }
 
+// A large mesh's hits read one record per triangle, made when the scene is built, and a
+// part whose primitives share their materials reads none per hit: the hits must be the
+// ones the triangle's vertices and entries give. A patch of triangles (tilted vertex normals, some
+// wound against them, away from the origin) is shot alone, a small mesh read through its
+// indices, and again inside a mesh of 2^16 more triangles far off, with one material for
+// every triangle and with materials that differ.
+TEST(Primitives, LargeMeshesShadeAsSmallOnes)
+{
+    constexpr int cells = 12;
+    auto add_patch = [&](geom::Geometry& g, bool uniform) {
+        for (int i = 0; i < cells; ++i)
+            for (int j = 0; j < cells; ++j) {
+                float x = 100.3f + 1.1f * i, y = -40.7f + 0.9f * j, z = 0.37f * float((i * j) % 3);
+                geom::Float3 p0{x, y, z}, p1{x + 1.1f, y, z + 0.2f}, p2{x, y + 0.9f, z - 0.1f};
+                geom::Float3 n0{0.3f * float(i % 3), -0.2f, 1}, n1{-0.4f, 0.1f * float(j % 4), 1},
+                    n2{0.05f, 0.5f, 0.9f};
+                int k = i * cells + j;
+                if (k % 7 == 3)
+                    std::swap(p1, p2);  // wound against its vertex normals
+                auto front = static_cast<std::uint16_t>(uniform ? 3 : 2 + k % 5);
+                auto back = static_cast<std::uint16_t>(uniform ? 4 : 10 + k % 3);
+                add_triangle(g, {{p0, p1, p2}}, {n0, n1, n2}, {{{0, 0}, {1, 0}, {0, 1}}}, front,
+                             back);
+            }
+    };
+    for (bool uniform : {true, false}) {
+        geom::Scene small, large;
+        add_patch(small.geometry, uniform);
+        add_patch(large.geometry, uniform);
+        geom::Float3 n{0, 0, 1};
+        for (int k = 0; k < (1 << 16); ++k) {  // far below the patch
+            auto x = float(k % 256), y = float(k / 256);
+            add_triangle(large.geometry, {{{x, y, -500}, {x + 1, y, -500}, {x, y + 1, -500}}},
+                         {n, n, n}, {{{0, 0}, {1, 0}, {0, 1}}}, uniform ? 3 : 20, uniform ? 4 : 21);
+        }
+        EmbreeScene a(small, any_camera()), b(large, any_camera());
+        // The records are the renderer's own bytes (64 a triangle).
+        EXPECT_GE(b.own_bytes(), a.own_bytes() + 64 * large.geometry.mesh.size());
+        int hits = 0, backs = 0;
+        for (float dz : {-1.0f, 1.0f})
+            for (float x = 99.95f; x < 100.3f + 1.1f * cells; x += 0.25f)
+                for (float y = -41.1f; y < -40.7f + 0.9f * cells; y += 0.25f) {
+                    Vec3f org(x, y, -20 * dz), dir(0.02f, -0.03f, dz);
+                    auto ha = a.intersect(org, dir, 0, 30);
+                    auto hb = b.intersect(org, dir, 0, 30);
+                    ASSERT_EQ(bool(ha), bool(hb)) << x << " " << y;
+                    if (!ha)
+                        continue;
+                    ++hits;
+                    backs += ha->back;
+                    auto same = [](const Vec3f& p, const Vec3f& q) {
+                        return p.x == q.x && p.y == q.y && p.z == q.z;
+                    };
+                    EXPECT_EQ(ha->t, hb->t);
+                    EXPECT_TRUE(same(ha->position, hb->position));
+                    EXPECT_TRUE(same(ha->normal, hb->normal));
+                    EXPECT_TRUE(same(ha->geometric_normal, hb->geometric_normal));
+                    EXPECT_EQ(ha->material, hb->material);
+                    EXPECT_EQ(ha->back, hb->back);
+                    EXPECT_EQ(ha->spawn_offset, hb->spawn_offset);
+                    EXPECT_EQ(ha->prim_id, hb->prim_id);
+                    // The entry of the side hit, as add_patch gave it.
+                    int k = int(ha->prim_id);
+                    int expected = uniform ? (ha->back ? 4 : 3) : (ha->back ? 10 + k % 3 : 2 + k % 5);
+                    EXPECT_EQ(ha->material, expected);
+                }
+        EXPECT_GT(hits, 1000);
+        EXPECT_GT(backs, 100);
+        EXPECT_LT(backs, hits - 100);
+        // The same mesh as a prototype gets none: scenes of many plants keep their memory.
+        geom::Scene placed;
+        placed.prototypes.push_back(geom::Prototype{"", large.geometry});
+        placed.instances.push_back(geom::Instance{});
+        EmbreeScene c(placed, any_camera());
+        EXPECT_LT(c.own_bytes(), 64 * large.geometry.mesh.size());
+        auto hc = c.intersect({105.1f, -37.8f, 20}, {0, 0, -1}, 0, 30);
+        ASSERT_TRUE(hc);
+        EXPECT_EQ(hc->material, uniform ? 3 : 2 + int(hc->prim_id) % 5);
+    }
+}
+
 // An instance costs Cambium nothing beside what Embree keeps: 200 instances of a
 // prototype leave the renderer's own bytes where one instance does. Embree's instance
 // objects, which its memory monitor does not report (about 300 B each), are seen on the heap.
