@@ -1627,6 +1627,14 @@ RTCRay make_ray(const Vec3f& org, const Vec3f& dir, float tnear, float tfar)
     return r;
 }
 
+/// rh made ready to trace: its ray make_ray(...), its hit none yet (as Embree asks).
+void set_query(RTCRayHit& rh, const Vec3f& org, const Vec3f& dir, float tnear, float tfar)
+{
+    rh.ray = make_ray(org, dir, tnear, tfar);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
 }  // namespace
 
 std::optional<SurfaceHit> EmbreeScene::intersect(const Vec3f& org, const Vec3f& dir, float tnear,
@@ -1660,9 +1668,7 @@ bool EmbreeScene::Impl::trace(RTCRayHit& rh, const Vec3f& org, const Vec3f& dir,
     SkipContext context = make_context(skip, coherent);
     if (!triangle_records.empty())
         context.context.filter = &prefetch_records;
-    rh.ray = make_ray(org, traced(dir), tnear, tfar);
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    set_query(rh, org, traced(dir), tnear, tfar);
     rtcIntersect1(scene, &context.context, &rh);
     return rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
 }
@@ -1718,9 +1724,7 @@ std::uint32_t EmbreeScene::intersect_coherent(std::span<const CameraRayF> rays,
             hits[i].reset();
             continue;
         }
-        rh[traced].ray = make_ray(r.org, m.traced(r.dir), 0, r.tfar);
-        rh[traced].hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh[traced].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        set_query(rh[traced], r.org, m.traced(r.dir), 0, r.tfar);
         index[traced++] = static_cast<std::uint32_t>(i);
     }
     return m.trace_stream(
@@ -1732,40 +1736,22 @@ std::uint32_t EmbreeScene::intersect_coherent(const ParallelRays& rays, std::siz
                                               std::span<std::optional<SurfaceHit>> hits,
                                               bool checked) const
 {
+    n = std::min({n, hits.size(), ParallelRays::capacity});
+    if (!checked) {  // (rare: rays that may be out of reach) each ray is checked as a CameraRayF
+        std::array<CameraRayF, ParallelRays::capacity> each;
+        for (std::size_t k = 0; k < n; ++k)
+            each[k] = rays.ray(k);
+        return intersect_coherent(std::span(each.data(), n), hits, false);
+    }
     const Impl& m = *m_impl;
     std::array<RTCRayHit, max_coherent_rays> rh;
     static_assert(ParallelRays::capacity <= max_coherent_rays);
-    n = std::min({n, hits.size(), ParallelRays::capacity});
     m.rays.add(n);
     const Vec3f dir = m.traced(rays.dir);  // (tilted once for all)
-    if (checked) {  // rh[k] is rays.ray(k): the common case, without an index
-        for (std::size_t k = 0; k < n; ++k) {
-            rh[k].ray = make_ray({rays.org_x[k], rays.org_y[k], rays.org_z[k]}, dir, 0,
-                                 rays.tfar[k]);
-            rh[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
-            rh[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        }
-        return m.trace_stream(
-            rh, n, [](std::size_t k) { return k; },
-            [&](std::size_t i) { return rays.ray(i); }, hits);
-    }
-    std::array<std::uint32_t, max_coherent_rays> index;  // rh[k] is rays.ray(index[k])
-    std::size_t traced = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-        const CameraRayF r = rays.ray(i);
-        if (!traceable(r.org, r.dir, 0, r.tfar)) {
-            ++m.skipped_rays;
-            hits[i].reset();
-            continue;
-        }
-        rh[traced].ray = make_ray(r.org, dir, 0, r.tfar);
-        rh[traced].hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh[traced].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        index[traced++] = static_cast<std::uint32_t>(i);
-    }
+    for (std::size_t k = 0; k < n; ++k)  // rh[k] is rays.ray(k), without an index
+        set_query(rh[k], {rays.org_x[k], rays.org_y[k], rays.org_z[k]}, dir, 0, rays.tfar[k]);
     return m.trace_stream(
-        rh, traced, [&](std::size_t k) { return std::size_t(index[k]); },
-        [&](std::size_t i) { return rays.ray(i); }, hits);
+        rh, n, [](std::size_t k) { return k; }, [&](std::size_t i) { return rays.ray(i); }, hits);
 }
 
 SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
