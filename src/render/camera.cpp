@@ -287,28 +287,6 @@ void Camera::generate_rays_f(std::span<const float> xs, std::span<const float> y
 
 void Camera::generate_parallel_rays(int x, int y, std::span<const float> xs,
                                     std::span<const float> ys, std::span<double> tnear,
-                                    std::span<CameraRayF> rays) const
-{
-    const std::size_t n = std::min({xs.size(), ys.size(), tnear.size(), rays.size()});
-    if (m_projection != Projection::parallel) {  // one at a time
-        const auto fx = static_cast<float>(x), fy = static_cast<float>(y);
-        for (std::size_t k = 0; k < n; ++k)
-            rays[k] = traced_ray(generate_ray(fx + xs[k], fy + ys[k]), tnear[k]);
-        return;
-    }
-    constexpr std::size_t block = ParallelRays::capacity;
-    ParallelRays made;
-    for (std::size_t k0 = 0; k0 < n; k0 += block) {
-        const std::size_t m = std::min(block, n - k0);
-        generate_parallel_rays(x, y, xs.subspan(k0, m), ys.subspan(k0, m), tnear.subspan(k0, m),
-                               made);
-        for (std::size_t k = 0; k < m; ++k)
-            rays[k0 + k] = made.ray(k);
-    }
-}
-
-void Camera::generate_parallel_rays(int x, int y, std::span<const float> xs,
-                                    std::span<const float> ys, std::span<double> tnear,
                                     ParallelRays& rays) const
 {
     static_assert(ParallelRays::capacity == parallel_block_size);

@@ -110,18 +110,13 @@ public:
     /// sample.
     void generate_rays_f(std::span<const float> xs, std::span<const float> ys,
                          std::span<CameraRayF> rays) const;
-    /// For a parallel camera (cpfg's default view, with or without clipping planes): for
-    /// each k, traced_ray(generate_ray(x + xs[k], y + ys[k]), tnear[k]) into rays[k] (as
-    /// many; the image point summed in float, as the box filter's are), the same bits,
-    /// made in blocks of 16 in separate arrays per component, which vectorise (one ray at
-    /// a time, a camera sample's own time was mostly scalar double arithmetic on 64-byte
-    /// rays). Any other camera's rays are made one at a time, as that says.
-    void generate_parallel_rays(int x, int y, std::span<const float> xs,
-                                std::span<const float> ys, std::span<double> tnear,
-                                std::span<CameraRayF> rays) const;
-    /// The same rays for a parallel camera (only), at most ParallelRays::capacity, by
-    /// component: rays.ray(k) is the rays[k] above. Written as they are made, without
-    /// gathering each ray's floats into a CameraRayF.
+    /// For a parallel camera (cpfg's default view, with or without clipping planes; any
+    /// other throws std::logic_error): for each k < min(size, ParallelRays::capacity),
+    /// traced_ray(generate_ray(x + xs[k], y + ys[k]), tnear[k]) as rays.ray(k) (the image
+    /// point summed in float, as the box filter's are), the same bits, made as a block in
+    /// separate arrays per component, which vectorise (one ray at a time, a camera
+    /// sample's own time was mostly scalar double arithmetic on 64-byte rays), and
+    /// written as they are made, without gathering each ray's floats into a CameraRayF.
     void generate_parallel_rays(int x, int y, std::span<const float> xs,
                                 std::span<const float> ys, std::span<double> tnear,
                                 ParallelRays& rays) const;
