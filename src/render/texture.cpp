@@ -106,14 +106,6 @@ Texel TextureSet::lookup(int index, float s, float t, const TextureFootprint& fp
                         : Texel{};
 }
 
-Vec3f TextureSet::apply(int index, const Vec3f& diffuse, float s, float t,
-                        const TextureFootprint& footprint) const
-{
-    Rgbx out;
-    apply(index, diffuse, s, t, footprint, out);
-    return out.rgb();
-}
-
 void TextureSet::apply(int index, const Vec3f& diffuse, float s, float t,
                        const TextureFootprint& footprint, Rgbx& out) const
 {

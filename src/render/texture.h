@@ -73,18 +73,16 @@ public:
     /// The same filtered over an anisotropic footprint (mipmapped textures only).
     Texel lookup(int index, float s, float t, const TextureFootprint& footprint) const;
 
-    /// The diffuse albedo after texture `index` at (s, t): modulated or replaced.
-    Vec3f apply(int index, const Vec3f& diffuse, float s, float t,
-                const TextureFootprint& footprint = {}) const;
-
     /// A colour written whole: R, G, B and a fourth value of no meaning.
     struct alignas(16) Rgbx {
         float v[4];
         Vec3f rgb() const { return {v[0], v[1], v[2]}; }
     };
-    /// apply() into `out`, written with one 16-byte store: a Vec3f returned by value comes
-    /// back in two registers, which the path tracer stored apart and read back as one
-    /// 8-byte load across both (a stalled store forward at every textured vertex).
+    /// The diffuse albedo after texture `index` at (s, t) (`diffuse` itself for an
+    /// invalid index): modulated or replaced. Written into `out` with one 16-byte store: a
+    /// Vec3f returned by value comes back in two registers, which the path tracer stored
+    /// apart and read back as one 8-byte load across both (a stalled store forward at
+    /// every textured vertex).
     void apply(int index, const Vec3f& diffuse, float s, float t,
                const TextureFootprint& footprint, Rgbx& out) const;
 

@@ -101,12 +101,17 @@ TEST(Texture, ModulateAndDecal)
     geom::TextureDef modulate = nearest(dir / "q.png"), decal = modulate;
     decal.decal = true;
     TextureSet set({modulate, decal});
-    Vec3f grey = set.apply(0, Vec3f(0.5f), 0.75f, 0.25f);
+    auto apply = [&](int index, float s, float t) {
+        TextureSet::Rgbx seen;
+        set.apply(index, Vec3f(0.5f), s, t, TextureFootprint{}, seen);
+        return seen.rgb();
+    };
+    Vec3f grey = apply(0, 0.75f, 0.25f);
     float g = srgb_to_linear(128 / 255.0f);
     EXPECT_NEAR(grey.x, 0.5f * g, 1e-4f);
-    Vec3f replaced = set.apply(1, Vec3f(0.5f), 0.75f, 0.25f);
+    Vec3f replaced = apply(1, 0.75f, 0.25f);
     EXPECT_NEAR(replaced.x, g, 1e-4f);
-    EXPECT_EQ(set.apply(geom::no_texture, Vec3f(0.5f), 0, 0), Vec3f(0.5f));
+    EXPECT_EQ(apply(geom::no_texture, 0, 0), Vec3f(0.5f));
     fs::remove_all(dir);
 }
 
