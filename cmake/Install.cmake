@@ -12,13 +12,13 @@ include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
 set(CAMBIUM_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/cambium)
-foreach(layer base lsys geom render app)
+foreach(layer base lsys geom env render app)
   set_target_properties(cambium_${layer} PROPERTIES EXPORT_NAME ${layer})
 endforeach()
 # The static libraries name the warning flags' target in their link interface.
 set_target_properties(cambium_warnings PROPERTIES EXPORT_NAME warnings)
 
-install(TARGETS cambium cambium_base cambium_lsys cambium_geom cambium_render cambium_app
+install(TARGETS cambium cambium_base cambium_lsys cambium_geom cambium_env cambium_render cambium_app
                 cambium_warnings
   EXPORT cambiumTargets
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}

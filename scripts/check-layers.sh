@@ -4,6 +4,7 @@
 #   base    the standard library (and POSIX headers) only
 #   lsys    + base
 #   geom    + lsys; never Embree, TBB, OpenImageIO or render
+#   env     + geom (open L-systems' environments); never Embree, TBB, OpenImageIO or render
 #   render  + geom/scene.h, geom/scene_limits.h and geom/vec.h (the Scene contract), Embree, TBB,
 #           FreeType and fontconfig (labels)
 #   imageio what render may + render + OpenImageIO (libcambium_imageio.so: the only OpenImageIO user)
@@ -20,6 +21,7 @@ BEGIN {
     project["base"] = "^base/"
     project["lsys"] = "^(base|lsys)/"
     project["geom"] = "^(base|lsys|geom)/"
+    project["env"] = "^(base|lsys|geom|env)/"
     project["render"] = "^(base|render)/|^geom/(scene|scene_limits|vec)\\.h$"
     project["imageio"] = "^(base|render|imageio)/|^geom/(scene|scene_limits|vec)\\.h$"
     project["app"] = "."
@@ -29,6 +31,7 @@ BEGIN {
     rule["base"] = "the standard library only"
     rule["lsys"] = "the standard library and base only"
     rule["geom"] = "the standard library, base and lsys only"
+    rule["env"] = "the standard library, base, lsys and geom only"
     rule["render"] = "base, geom/scene.h, geom/scene_limits.h, geom/vec.h, Embree, TBB, FreeType and fontconfig only"
     rule["imageio"] = "base, render, the Scene contract, TBB and OpenImageIO only"
     rule["app"] = "anything"

@@ -1,0 +1,99 @@
+// SPDX-License-Identifier: Apache-2.0
+// Open L-systems (manual chapter 7): what the environmental step sends for each ?E
+// module, what comes back, and the environments that answer it.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "base/diagnostics.h"
+
+namespace cambium::env {
+
+/// One turtle vector as a `.e` format string sent it: the values an environmental
+/// program reads back (sscanf "%f %f %f" after the format's literal prefix), and how
+/// many it read (0 when the `.e` file does not ask for this vector).
+struct SentVector {
+    std::array<float, 3> values{};
+    int count = 0;
+};
+
+/// A module as sent: its name ("?E", "F", "@Gs") and its parameters as cpfg's "%g"
+/// text reads back (six significant digits).
+struct SentModule {
+    std::string symbol;
+    std::vector<float> params;
+};
+
+/// One communication module's message (manual 7.4.3), every number already quantised as
+/// cpfg's text protocol quantises it, so a built-in computes from what a program would read.
+struct Query {
+    std::uint64_t address = 0;            ///< cpfg's address: bytes from the pass's first ?E
+    SentModule module;                    ///< the ?E itself
+    std::optional<SentModule> following;  ///< the next module (`following module: yes`)
+    SentVector position, heading, left, up;
+    SentVector line_width, scale_factor;  ///< one value each
+    std::vector<std::string> geometry;    ///< `interpreted modules:` polygons, as text lines
+};
+
+/// A reply: the ?E at `address` gets each given parameter; nullopt (an empty field)
+/// leaves that parameter unchanged. Values are quantised through "%g" by the caller.
+struct Reply {
+    std::uint64_t address = 0;
+    std::vector<std::optional<float>> params;
+};
+
+/// An 8-bit RGB image, rows top to bottom (what a built-in reads from an image file).
+struct RgbImage {
+    int width = 0, height = 0;
+    std::vector<std::uint8_t> rgb;  ///< width * height * 3
+};
+
+/// What an environment may use beside its own arguments.
+struct Context {
+    /// The model's folder: programs run there and relative file names are read there.
+    std::filesystem::path folder;
+    /// Files outside `folder` may be read (--allow-file-access).
+    bool allow_file_access = false;
+    /// Reads an image file (SGI .rgb, Targa, PNG, ...); throws cambium::Error naming it.
+    std::function<RgbImage(const std::filesystem::path&)> read_image;
+};
+
+/// An environmental process: cpfg's external program or one of Cambium's built-ins.
+/// It keeps its state from pass to pass, as a program started once for the run does.
+class Environment {
+public:
+    virtual ~Environment() = default;
+    /// One environmental pass: every ?E of the string, in string order; `step` is the
+    /// step counter cpfg sends at the pass's end (0 for the axiom's pass). Replies may
+    /// come in any order; a reply to an address that was not sent is ignored.
+    virtual std::vector<Reply> pass(const std::vector<Query>& queries, int step) = 0;
+};
+
+/// One `keyword: value` line of a built-in's specification file (vlab's `.spec` files).
+struct SpecLine {
+    std::string keyword;  ///< the text before the first ':', as written (case kept)
+    std::string value;    ///< the text after it, leading blanks removed
+    FileLoc loc;          ///< the line (column of the value)
+};
+
+/// The `keyword: value` lines of a specification file named by a built-in's argument,
+/// relative to the model folder and confined to it unless file access is allowed. Lines
+/// without ':' are returned with an empty value. Errors name the file.
+std::vector<SpecLine> read_spec_file(const std::filesystem::path& file, const Context& context);
+
+/// The file an argument names, relative to the model folder; Error when it lies outside
+/// the folder and file access is not allowed, or when it is not a regular file.
+std::filesystem::path model_file(const std::string& name, const Context& context);
+
+/// Warns about a keyword a program would ignore: "<program>: <file>:<line>: unknown
+/// keyword 'x' ignored".
+void warn_unknown_keyword(const std::string& program, const SpecLine& line);
+
+}  // namespace cambium::env
