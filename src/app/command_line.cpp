@@ -62,7 +62,7 @@ const std::map<std::string, CpfgOption>& cpfg_options()
         {"-v", {0, [](Options& o, auto&) { o.verbosity = Verbosity::warnings; }}},
         {"-V", {0, [](Options& o, auto&) { o.verbosity = Verbosity::verbose; }}},
         {"-homo", {0, [](Options& o, auto&) { o.homomorphism_in_string = true; }}},
-        {"-e", {1, [](Options& o, auto&) { o.environment_requested = true; }}},
+        {"-e", {1, [](Options& o, auto& a) { o.environment_file = a[0]; }}},
         {"-P", {1, [](Options& o, auto& a) { o.preprocessor = a[0]; }}},
         {"-w", {2, [](Options& o, auto& a) { set_image_size(o, a[0], a[1]); }}},
         {"-str", {1, [](Options& o, auto& a) { o.string_text = a[0]; }}},

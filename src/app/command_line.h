@@ -65,7 +65,7 @@ struct Options {
     std::uint64_t max_memory_bytes = default_max_memory_bytes();
     std::optional<int> steps;                  ///< --steps: derivation steps instead of the file's
     Verbosity verbosity = Verbosity::normal;
-    bool environment_requested = false;        ///< -e: no environment program is connected
+    std::optional<std::filesystem::path> environment_file;  ///< -e file.e (manual 7.4.1)
     bool allow_system_calls = false;           ///< @S runs commands only with this
     bool allow_file_access = false;            ///< fopen outside the model's folder
 

@@ -306,8 +306,6 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
     for (const auto& out : images)
         if (!is_video(out))
             render::check_output_format(out);  // fail before the work, not after
-    if (options.environment_requested)
-        warn("-e: no environmental program is connected; ?E modules keep their parameters");
     if (options.assemble)
         return assemble(options, images, say);
     // With --mpi, rank 0 alone writes files.

@@ -11,6 +11,7 @@
 #include "base/confinement.h"
 #include "base/diagnostics.h"
 #include "base/subprocess.h"
+#include "env/environmental_step.h"
 #include "geom/background_scene.h"
 #include "geom/flatten.h"
 #include "geom/function.h"
@@ -20,6 +21,7 @@
 #include "geom/scene_limits.h"
 #include "geom/wireframe.h"
 #include "lsys/program.h"
+#include "render/image_codec.h"
 
 namespace cambium::app {
 namespace {
@@ -78,6 +80,58 @@ void run_system_call(const std::string& command, const std::filesystem::path& fo
         throw Error("@S: cannot run /bin/sh: " + r.messages);
     else if (r.exit_code != 0)
         warn("@S(\"" + command + "\") ended with status " + std::to_string(r.exit_code));
+}
+
+/// An image a built-in environment reads (clover's light map), as 8-bit RGB rows from
+/// the top, through the image module.
+env::RgbImage read_environment_image(const std::filesystem::path& file, std::uint64_t max_memory_bytes)
+{
+    std::string why;
+    std::optional<render::TexturePixels> pixels =
+        render::image_codec().read_texture(file, max_memory_bytes, why);
+    if (!pixels)
+        throw Error(FileLoc{file.string()}, "cannot read the environment's image: " + why);
+    env::RgbImage image;
+    image.width = pixels->width;
+    image.height = pixels->height;
+    const std::size_t n = static_cast<std::size_t>(pixels->width) * static_cast<std::size_t>(pixels->height);
+    const int c = pixels->channels;
+    image.rgb.resize(n * 3);
+    for (std::size_t i = 0; i < n; ++i)
+        for (int k = 0; k < 3; ++k) {
+            const std::size_t from = i * static_cast<std::size_t>(c) + static_cast<std::size_t>(std::min(k, c - 1));
+            image.rgb[i * 3 + static_cast<std::size_t>(k)] =
+                pixels->bytes.empty()
+                    ? static_cast<std::uint8_t>(std::lround(std::clamp(pixels->floats[from], 0.0f, 1.0f) * 255))
+                    : pixels->bytes[from];
+        }
+    return image;
+}
+
+/// Connects the `-e` file's environment to the derivation (manual 7): the environmental
+/// step runs where the query pass runs, on the same string.
+void connect_environment(const Options& options, lsys::LoadOptions& load,
+                         const std::shared_ptr<QueryContext>& queries)
+{
+    if (!options.environment_file)
+        return;
+    env::CommSpec spec = env::read_comm_spec(*options.environment_file);
+    env::Context context;
+    context.folder = model_folder(options);
+    context.allow_file_access = options.allow_file_access;
+    context.read_image = [limit = options.max_memory_bytes](const std::filesystem::path& f) {
+        return read_environment_image(f, limit);
+    };
+    env::Connection connection = env::connect(spec, context);
+    if (!options.quiet)
+        std::fprintf(stderr, "environment: %s\n", connection.description.c_str());
+    load.environment = [queries, spec = std::move(spec), connection = std::move(connection)] {
+        auto step = std::make_shared<env::EnvironmentalStep>(spec, connection);
+        return [queries, step](lsys::ModuleString& string, int n) {
+            if (queries->symbols)
+                step->run(string, *queries->symbols, *queries->view, n);
+        };
+    };
 }
 
 }  // namespace
@@ -148,6 +202,7 @@ Model load_model(const Options& options)
         if (queries->symbols)
             geom::answer_queries(string, *queries->symbols, *queries->view);
     };
+    connect_environment(options, load, queries);
     // Fragmentation (manual 5.1.9): the turtles saved at `%(par)` before each step are
     // the model's, for drawing `%(par, index)`; each derivation run starts them afresh.
     auto fragments = std::make_shared<std::vector<geom::Turtle>>();

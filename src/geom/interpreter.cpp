@@ -165,6 +165,9 @@ public:
     /// Records the answers of query modules (?P ?H ?L ?U) while interpreting.
     void collect_queries(std::vector<QueryAnswer>* answers) { m_answers = answers; }
 
+    /// Records the turtle at each communication module ?E while interpreting.
+    void collect_communication(std::vector<TurtleAtModule>* turtles) { m_communication = turtles; }
+
     Scene take() { return std::move(m_scene); }
 
 private:
@@ -551,6 +554,12 @@ private:
         case TurtleOp::QueryHeading: answer_query(p, m_turtle.heading); break;
         case TurtleOp::QueryLeft: answer_query(p, m_turtle.left); break;
         case TurtleOp::QueryUp: answer_query(p, m_turtle.up); break;
+        case TurtleOp::Communicate:
+            if (m_communication)
+                m_communication->push_back({m_module_index, m_turtle.position, m_turtle.heading,
+                                            m_turtle.left, m_turtle.up, m_turtle.line_width,
+                                            m_turtle.scale});
+            break;
         case TurtleOp::CylinderStart: at_command(); m_cylinders.start(m_turtle); break;
         case TurtleOp::CylinderPoint: at_command(); m_cylinders.control_point(m_turtle, p); break;
         case TurtleOp::CylinderEnd: at_command(); m_cylinders.end(m_turtle, p); break;
@@ -1077,6 +1086,7 @@ private:
     std::vector<std::vector<PolygonCorner>> m_polygons;  ///< cpfg's polygon stack
     std::vector<double> m_sub_scales;                    ///< cpfg's sub-L-system scale stack
     std::vector<QueryAnswer>* m_answers = nullptr;
+    std::vector<TurtleAtModule>* m_communication = nullptr;
     std::vector<Turtle>* m_fresh_turtles = nullptr;           ///< the fragment pass's
     std::vector<std::uint32_t>* m_fragment_starts = nullptr;  ///< ... and their modules
     std::size_t m_fresh_limit = 0;
@@ -1162,6 +1172,17 @@ std::vector<QueryAnswer> collect_query_answers(const lsys::ModuleString& string,
     interpreter.collect_queries(&answers);
     interpreter.run(string, symbols);
     return answers;
+}
+
+std::vector<TurtleAtModule> collect_communication_turtles(const lsys::ModuleString& string,
+                                                          const lsys::SymbolTable& symbols,
+                                                          const ViewFile& view)
+{
+    std::vector<TurtleAtModule> turtles;
+    Interpreter interpreter(view, InterpretOptions{});
+    interpreter.collect_communication(&turtles);
+    interpreter.run(string, symbols);
+    return turtles;
 }
 
 }  // namespace cambium::geom

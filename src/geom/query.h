@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "geom/vec.h"
 #include "geom/view_file.h"
 #include "lsys/module_string.h"
 
@@ -29,5 +30,19 @@ struct QueryAnswer {
 std::vector<QueryAnswer> collect_query_answers(const lsys::ModuleString& string,
                                                const lsys::SymbolTable& symbols,
                                                const ViewFile& view);
+
+/// The turtle at one communication module `?E` (manual 7.1): what the environmental step
+/// may send with it.
+struct TurtleAtModule {
+    std::size_t module;  ///< index in the string
+    Vec3 position, heading, left, up;
+    double line_width = 1;
+    double scale = 1;
+};
+
+/// The turtle at every `?E` module, in string order (defined in interpreter.cpp).
+std::vector<TurtleAtModule> collect_communication_turtles(const lsys::ModuleString& string,
+                                                          const lsys::SymbolTable& symbols,
+                                                          const ViewFile& view);
 
 }  // namespace cambium::geom

@@ -97,8 +97,9 @@ Deriver::Deriver(const Program& program, DeriveLimits limits)
     };
     m_runtime.warning = &m_warning;
     m_query_symbol.assign(symbols.size(), 0);
-    // (and `%`, whose one-parameter modules the fragment pass maps back the same way)
-    for (const char* name : {"?P", "?H", "?L", "?U", "%"})
+    // (and `%`, whose one-parameter modules the fragment pass maps back the same way, and
+    // the communication modules ?E, whose answers the environmental step maps back)
+    for (const char* name : {"?P", "?H", "?L", "?U", "?E", "%"})
         if (int id = symbols.find(name); id >= 0)
             m_query_symbol[static_cast<std::size_t>(id)] = 1;
     try {

@@ -77,11 +77,11 @@ LSystem::LSystem(std::unique_ptr<Program> program, LoadOptions options)
         m_has_queries |= uses_symbol(*m_program, symbols.find(name));
     for (const auto& ls : m_program->lsystems)
         m_has_homomorphism |= !ls.homomorphism.productions.empty();
-    // cpfg's ?E talks to an environmental program (out of scope): say so once
-    if (uses_symbol(*m_program, symbols.find("?E")))
+    m_has_communication = uses_symbol(*m_program, symbols.find("?E"));
+    if (m_has_communication && !m_options.environment)
         warn(FileLoc{m_program->file_name, 0, 0},
-             "the L-system uses ?E communication modules, but no environment is connected; "
-             "they stay in the string with their parameters unchanged");
+             "the L-system uses ?E communication modules, but no environment is connected "
+             "(-e file.e); they stay in the string with their parameters unchanged");
 }
 LSystem::LSystem(LSystem&&) noexcept = default;
 LSystem& LSystem::operator=(LSystem&&) noexcept = default;
@@ -175,6 +175,8 @@ Derivation LSystem::start() const
 Derivation::Derivation(const LSystem& lsystem, std::unique_ptr<Deriver> deriver)
     : m_lsystem(&lsystem), m_deriver(std::move(deriver))
 {
+    if (lsystem.m_has_communication && lsystem.m_options.environment)
+        m_environment = lsystem.m_options.environment();
 }
 Derivation::Derivation(Derivation&&) noexcept = default;
 Derivation& Derivation::operator=(Derivation&&) noexcept = default;
@@ -199,6 +201,8 @@ void Derivation::advance(int steps)
         // interpreting the string before each step, not after the last one
         if (m_lsystem->m_has_queries && options.query)
             m_lsystem->run_query(*m_deriver);
+        if (m_environment)
+            m_lsystem->run_environment(*m_deriver, m_environment);
         if (m_deriver->has_cut_symbol())
             m_saved_turtles += m_lsystem->run_fragment_pass(*m_deriver, m_saved_turtles);
         m_deriver->step();
@@ -230,34 +234,43 @@ bool Derivation::stopped() const { return m_deriver->stop_requested(); }
 bool Derivation::stop_runs_end() const { return m_deriver->stop_runs_end(); }
 ModuleString Derivation::take_string() { return m_deriver->take_string(); }
 
-void LSystem::run_query(Deriver& deriver) const
+void LSystem::run_query(Deriver& deriver) const { turtle_pass(deriver, m_options.query); }
+
+void LSystem::run_environment(Deriver& deriver,
+                              const std::function<void(ModuleString&, int)>& pass) const
+{
+    const int step = deriver.steps_done();
+    turtle_pass(deriver, [&](ModuleString& s) { pass(s, step); });
+}
+
+void LSystem::turtle_pass(Deriver& deriver, const std::function<void(ModuleString&)>& pass) const
 {
     ModuleString& s = deriver.mutable_string();
     auto changed_count = [&] {
         return Error(FileLoc{m_program->file_name, 0, 0},
-                     "internal: the query pass changed the number of parameters");
+                     "internal: a turtle pass changed the number of parameters");
     };
     if (!m_has_homomorphism && m_program->split_commands.empty()) {
-        m_options.query(s);
+        pass(s);
         return;
     }
     if (!m_has_homomorphism) {
         // '@' has no parameters, so the joined string holds the same values in the same order
         ModuleString joined = join_at_commands(s);
-        m_options.query(joined);
+        pass(joined);
         if (joined.param_total() != s.param_total())
             throw changed_count();
         std::copy_n(joined.param_data(), joined.param_total(), s.mutable_params().data());
         return;
     }
-    // cpfg answers queries while interpreting the string with the homomorphism applied,
-    // with the derivation's own variables
+    // cpfg interprets the string with the homomorphism applied, with the derivation's own
+    // variables; the modules the homomorphism keeps in place take their values back
     ModuleString expanded;
     std::vector<ParamLink> links;
     deriver.apply_homomorphism(s, expanded, &links);
     ModuleString joined = joined_at_commands(std::move(expanded));
     std::size_t total = joined.param_total();
-    m_options.query(joined);
+    pass(joined);
     if (joined.param_total() != total)
         throw changed_count();
     float* params = s.mutable_params().data();

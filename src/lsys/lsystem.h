@@ -44,6 +44,16 @@ struct LoadOptions {
     /// interpretation_string() would join them), and may change parameter values only,
     /// not modules or parameter counts.
     std::function<void(ModuleString&)> query;
+    /// The environmental step of an open L-system (manual 7, from the app's environment).
+    /// Each derivation run calls `environment()` once, when it starts, for a pass of its
+    /// own (an environment keeps state from pass to pass, as cpfg's program does, and two
+    /// runs must not share it). The run calls that pass, when the program has
+    /// communication modules ?E, before every derivation step (after `query`, at the same
+    /// points), with the string as the turtle reads it (as `query` gets it) and cpfg's
+    /// step counter (0 for the axiom's pass). It may change parameter values only; those
+    /// of the ?E modules the homomorphism leaves in place go back into the derived string,
+    /// the others (made by the homomorphism) are dropped.
+    std::function<std::function<void(ModuleString&, int step)>()> environment;
     /// Fragmentation's turtle pass (manual 5.1.9 `%(par)`), from geom. Called before every
     /// step whose string holds a one-parameter `%` (after `query`), with the string as the
     /// turtle reads it (as `query` gets it) and the index of the first turtle this pass
@@ -114,6 +124,7 @@ private:
     bool m_finished = false;
     bool m_track_lineage = false;
     std::uint32_t m_saved_turtles = 0;  ///< by fragment starts in this run (manual 5.1.9)
+    std::function<void(ModuleString&, int step)> m_environment;  ///< this run's (manual 7)
     std::vector<std::uint32_t> m_lineage;
 };
 
@@ -179,6 +190,11 @@ private:
     friend class Derivation;
     explicit LSystem(std::unique_ptr<Program> program, LoadOptions options);
     void run_query(Deriver& deriver) const;
+    void run_environment(Deriver& deriver, const std::function<void(ModuleString&, int)>& pass) const;
+    /// Calls `pass` on the string as the turtle reads it (homomorphism applied,
+    /// @-commands joined), then copies the parameters of the query and communication
+    /// modules that string keeps in place back into the derived string.
+    void turtle_pass(Deriver& deriver, const std::function<void(ModuleString&)>& pass) const;
     /// Marks the fragment starts of the deriver's string for its next step; returns the
     /// turtles saved (numbered from `first_turtle`).
     std::uint32_t run_fragment_pass(Deriver& deriver, std::uint32_t first_turtle) const;
@@ -192,6 +208,7 @@ private:
     /// Globals and arrays after the last derive(), for interpretation_string()
     mutable std::shared_ptr<Runtime> m_last_runtime;
     bool m_has_queries = false;
+    bool m_has_communication = false;
     bool m_has_homomorphism = false;
 };
 

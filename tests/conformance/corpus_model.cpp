@@ -60,6 +60,8 @@ app::Options model_options(const CorpusModel& model)
     absolute(o.view);
     if (o.animation)
         absolute(*o.animation);
+    if (o.environment_file)
+        absolute(*o.environment_file);
     for (auto& f : o.colour_files)
         absolute(f.file);
     o.quiet = true;

@@ -1,0 +1,158 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "env/comm_spec.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+#include "geom/text_input.h"
+
+namespace cambium::env {
+namespace {
+
+/// Longest format accepted: far beyond any real one, and a bound on what it prints.
+constexpr std::size_t max_format_length = 200;
+
+/// Checks that `text` holds only literal text, "%%" and floating-point conversions
+/// ([flags][width][.precision] f e E g G a A), at most `most` of them; a model file's
+/// format is never handed to printf otherwise.
+TurtleFormat checked_format(const std::string& text, int most, const FileLoc& loc)
+{
+    if (text.size() > max_format_length)
+        throw Error(loc, "format longer than " + std::to_string(max_format_length) + " characters");
+    TurtleFormat f{text, 0};
+    for (std::size_t i = 0; i < text.size(); ++i) {
+        if (text[i] != '%')
+            continue;
+        const std::size_t start = i++;
+        if (i < text.size() && text[i] == '%')
+            continue;
+        while (i < text.size() && std::string_view("-+ #0").find(text[i]) != std::string_view::npos)
+            ++i;
+        auto digits = [&] {
+            std::size_t n = 0;
+            for (; i < text.size() && std::isdigit(static_cast<unsigned char>(text[i])); ++i)
+                ++n;
+            return n;
+        };
+        std::size_t width = digits(), precision = 0;
+        if (i < text.size() && text[i] == '.') {
+            ++i;
+            precision = digits();
+        }
+        FileLoc at{loc.file, loc.line, loc.column + static_cast<int>(start)};
+        if (width > 2 || precision > 2)
+            throw Error(at, "a field width or precision of more than two digits");
+        if (i >= text.size() || std::string_view("feEgGaA").find(text[i]) == std::string_view::npos)
+            throw Error(at, "a turtle field's format may only convert numbers (%f %e %g %a)");
+        if (++f.conversions > most)
+            throw Error(at, "more conversions than the field has values (" + std::to_string(most) + ")");
+    }
+    return f;
+}
+
+bool yes(const std::string& value) { return value.rfind("yes", 0) == 0 || value.rfind("on", 0) == 0; }
+
+}  // namespace
+
+float through_g(float value)
+{
+    char text[64];
+    std::snprintf(text, sizeof text, "%g", static_cast<double>(value));
+    return static_cast<float>(std::atof(text));
+}
+
+int send_through_format(const TurtleFormat& format, const double* values, int count, float* out)
+{
+    char text[max_format_length * 2 + 4 * 400];
+    double v[3] = {0, 0, 0};
+    for (int k = 0; k < count && k < 3; ++k)
+        v[k] = values[k];
+    // the format was checked: only %f %e %g %a conversions, at most `count` of them
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wformat-nonliteral"
+    std::snprintf(text, sizeof text, format.format.c_str(), v[0], v[1], v[2]);
+#pragma GCC diagnostic pop
+    const std::size_t prefix = std::min(format.format.find('%'), format.format.size());
+    const char* body = std::string_view(text).size() >= prefix ? text + prefix : text;
+    float read[3] = {0, 0, 0};
+    int n = std::sscanf(body, "%f %f %f", &read[0], &read[1], &read[2]);
+    n = std::max(0, std::min(n, count));
+    for (int k = 0; k < n; ++k)
+        out[k] = read[k];
+    return n;
+}
+
+CommSpec read_comm_spec(const std::filesystem::path& file)
+{
+    CommSpec spec;
+    spec.file = file;
+    const std::string text = geom::read_text_file(file, "communication specification file");
+    std::istringstream in(text);
+    int number = 0;
+    for (std::string line; std::getline(in, line);) {
+        ++number;
+        if (!line.empty() && line.back() == '\r')
+            line.pop_back();
+        if (line.find_first_not_of(" \t") == std::string::npos)
+            continue;
+        const std::size_t colon = line.find(':');
+        const FileLoc loc{file.string(), number, 1};
+        if (colon == std::string::npos)
+            throw Error(loc, "expected 'command: value', found '" + line + "'");
+        const std::string name = geom::normalize_command_name(line.substr(0, colon));
+        // a format keeps its blanks; other values lose the leading ones
+        const std::string raw = line.substr(colon + 1);
+        const std::size_t first = std::min(raw.size(), raw.find_first_not_of(" \t"));
+        const std::string value = raw.substr(first);
+        const FileLoc at{file.string(), number, static_cast<int>(colon + 2 + first)};
+        const FileLoc raw_at{file.string(), number, static_cast<int>(colon + 2)};
+        if (name == "executable") {
+            std::istringstream words(value);
+            for (std::string w; words >> w;) {
+                if (w == "-e" && !spec.executable.empty()) {
+                    words >> w;  // cpfg's own `-e file`, which it adds when missing
+                    continue;
+                }
+                spec.executable.push_back(w);
+            }
+            spec.executable_loc = at;
+        } else if (name == "communication type") {
+            std::istringstream words(value);
+            words >> spec.communication_type;
+            if (spec.communication_type != "pipes" && spec.communication_type != "sockets" &&
+                spec.communication_type != "memory" && spec.communication_type != "files")
+                throw Error(at, "communication type: expected pipes, sockets, memory or files, found '" +
+                                    value + "'");
+        } else if (name == "following module") {
+            spec.following_module = yes(value);
+        } else if (name == "verbose") {
+            spec.verbose = yes(value);
+        } else if (name == "interpreted modules") {
+            std::istringstream words(value);
+            for (std::string w; std::getline(words, w, ',');) {
+                std::size_t a = w.find_first_not_of(" \t"), b = w.find_last_not_of(" \t");
+                if (a != std::string::npos)
+                    spec.interpreted_modules.push_back(w.substr(a, b - a + 1));
+            }
+        } else if (name == "turtle position" || name == "turtle heading" || name == "turtle left" ||
+                   name == "turtle up") {
+            TurtleFormat f = checked_format(raw, 3, raw_at);
+            (name == "turtle position" ? spec.position
+             : name == "turtle heading" ? spec.heading
+             : name == "turtle left"    ? spec.left
+                                        : spec.up) = f;
+        } else if (name == "turtle line width" || name == "turtle scale factor") {
+            TurtleFormat f = checked_format(raw, 1, raw_at);
+            (name == "turtle line width" ? spec.line_width : spec.scale_factor) = f;
+        } else {
+            throw Error(loc, "unknown command '" + line.substr(0, colon) +
+                                 "' in a communication specification file (manual 7.4.1)");
+        }
+    }
+    if (spec.executable.empty())
+        throw Error(FileLoc{file.string()}, "no 'executable:' line names the environmental program");
+    return spec;
+}
+
+}  // namespace cambium::env

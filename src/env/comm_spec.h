@@ -1,0 +1,47 @@
+// SPDX-License-Identifier: Apache-2.0
+// The communication specification file (`.e`, manual 7.4.1): which program answers the
+// ?E modules and what the plant sends it.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "base/diagnostics.h"
+
+namespace cambium::env {
+
+/// A printf format for one turtle field (`turtle position:P:%.4f %.4f %.0f`): literal
+/// text and at most `most` floating-point conversions (checked when read).
+struct TurtleFormat {
+    std::string format;
+    int conversions = 0;
+};
+
+struct CommSpec {
+    std::filesystem::path file;            ///< the .e file, for messages
+    std::vector<std::string> executable;   ///< program and its arguments, `-e file` removed
+    FileLoc executable_loc;
+    std::string communication_type = "pipes";  ///< pipes, sockets, memory or files
+    bool following_module = true;          ///< cpfg's default, whatever the manual says
+    std::optional<TurtleFormat> position, heading, left, up, line_width, scale_factor;
+    /// `interpreted modules:`: "all" or names with optional parameter counts, as written.
+    std::vector<std::string> interpreted_modules;
+    bool verbose = false;
+};
+
+/// Reads a `.e` file. Errors name the file, line and column: unknown commands, a format
+/// with a conversion other than %f %e %g %a (or more of them than the field has values),
+/// a missing `executable:`.
+CommSpec read_comm_spec(const std::filesystem::path& file);
+
+/// `format` applied to the field's values as cpfg prints it, then read back as an
+/// environmental program reads it: the format's literal prefix skipped, then
+/// sscanf("%f %f %f"). Returns the values read and their count.
+int send_through_format(const TurtleFormat& format, const double* values, int count, float* out);
+
+/// A number as the protocol carries parameters: printed with "%g", read back with atof.
+float through_g(float value);
+
+}  // namespace cambium::env

@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: Apache-2.0
+// The environmental step (manual 7.1): a turtle pass over the string that sends every
+// ?E module to the environment and writes the answers back into their parameters.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "env/comm_spec.h"
+#include "env/environment.h"
+#include "geom/view_file.h"
+#include "lsys/module_string.h"
+
+namespace cambium::env {
+
+/// The environment a `.e` file names, made anew for each derivation run.
+struct Connection {
+    std::function<std::unique_ptr<Environment>()> make;
+    std::string description;  ///< "honda81 (built in)": for the line that says which
+};
+
+/// Connects a `.e` file: Cambium's built-in of the executable's name (honda81,
+/// ecosystem, chiba, clover), made once here so that its specification file's errors
+/// come before any work. Any other program is an Error naming it and the file.
+Connection connect(const CommSpec& spec, const Context& context);
+
+/// One derivation run's environmental steps, with the run's own environment.
+class EnvironmentalStep {
+public:
+    EnvironmentalStep(CommSpec spec, Connection connection);
+
+    /// One pass over `string` (as the turtle reads it) at cpfg's step counter `step`. A
+    /// string without ?E sends nothing.
+    void run(lsys::ModuleString& string, const lsys::SymbolTable& symbols,
+             const geom::ViewFile& view, int step);
+
+    /// Passes that sent something, and the ?E modules sent, since construction.
+    std::size_t passes() const { return m_passes; }
+    std::size_t queries() const { return m_queries; }
+
+private:
+    std::vector<Query> queries_of(const lsys::ModuleString& string, const lsys::SymbolTable& symbols,
+                                  const geom::ViewFile& view, int communication,
+                                  std::vector<std::size_t>& modules) const;
+
+    CommSpec m_spec;
+    Connection m_connection;
+    std::unique_ptr<Environment> m_environment;
+    std::size_t m_passes = 0, m_queries = 0;
+};
+
+}  // namespace cambium::env
