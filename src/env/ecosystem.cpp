@@ -5,6 +5,7 @@
 // parameter is a vigor that ranks before size, groups are not used, and a circle
 // dominated earlier in string order no longer dominates. Single precision, as the program.
 #include <algorithm>
+#include <cmath>
 
 #include "env/builtins.h"
 #include "env/spatial_grid.h"

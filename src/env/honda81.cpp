@@ -2,6 +2,8 @@
 // vlab's honda81: a query is blocked (?E(0)) when another query of its group with at
 // least its vigor lies within the radius, free (?E(1)) otherwise. The program computes
 // in single precision; so does this, for the same answers at the boundary.
+#include <cmath>
+
 #include "env/builtins.h"
 #include "env/spatial_grid.h"
 #include "env/spec_values.h"

@@ -85,7 +85,7 @@ TEST(CommSpec, ValuesTravelAsTheFormatPrintsThem)
     EXPECT_EQ(send_through_format(two, v, 3, out), 2);
     // 4 significant digits
     TurtleFormat g{"%.4g %.4g %.4g", 3};
-    const double w[3] = {12.3456, 0.000123456, 98765};
+    const double w[3] = {12.3456, 0.000123456, 98766};
     send_through_format(g, w, 3, out);
     EXPECT_EQ(out[0], 12.35f);
     EXPECT_EQ(out[1], 0.0001235f);
