@@ -67,6 +67,7 @@ Options plant_options(const Options& options, const ScenePlant& plant)
     o.view = plant.model.view;
     o.colour_files = plant.model.colour_files;
     o.colour_block = plant.model.colour_block;
+    o.environment_file = plant.model.environment_file;
     o.lsystem_seed = plant.seed;
     o.homomorphism_in_string = false;
     o.string_text.reset();

@@ -250,6 +250,8 @@ Options model_options(const Node& n, const fs::path& folder, bool allow_file_acc
         model.colour_files.push_back(c);
     }
     model.colour_block = parsed->colour_block;
+    if (parsed->environment_file)
+        model.environment_file = in_folder(*parsed->environment_file);
     return model;
 }
 

@@ -616,17 +616,17 @@ TEST(Command, ViewFileCameraOutOfRangeIsAnErrorAtItsColumn)
 TEST(Command, QuietMeansNoWarnings)
 {
     fs::path dir = scratch("quiet");
-    write(dir / "p.l", "lsystem: 1\nderivation length: 0\naxiom: F\nendlsystem\n");
+    // ?E without -e: the L-system warns that no environment answers
+    write(dir / "p.l", "lsystem: 1\nderivation length: 0\naxiom: F?E(1)\nendlsystem\n");
     write(dir / "p.v", "line style: cylinder\n");
-    write(dir / "p.e", "\n");
-    std::string args = "-w 16 12 --spp 1 -e " + (dir / "p.e").string() + " -o " +
-                       (dir / "p.png").string() + " " + (dir / "p.l").string() + " " +
-                       (dir / "p.v").string();
+    std::string args = "-w 16 12 --spp 1 -o " + (dir / "p.png").string() + " " +
+                       (dir / "p.l").string() + " " + (dir / "p.v").string();
     Result loud = run(args);
     EXPECT_EQ(loud.status, 0) << loud.output;
-    std::size_t first = loud.output.find("warning: -e:");
+    std::size_t first = loud.output.find("no environment is connected");
     EXPECT_NE(first, std::string::npos) << loud.output;
-    EXPECT_EQ(loud.output.find("warning: -e:", first + 1), std::string::npos) << loud.output;
+    EXPECT_EQ(loud.output.find("no environment is connected", first + 1), std::string::npos)
+        << loud.output;
     Result quiet = run("-q " + args);
     EXPECT_EQ(quiet.status, 0) << quiet.output;
     EXPECT_EQ(quiet.output, "");
