@@ -140,7 +140,11 @@ void Deriver::start()
     in_block("the axiom");
     for (const auto& m : main.axiom)
         append_evaluated(m, m_string);
-    decompose();
+    // The axiom is not decomposed: manual 5.1.8 decomposes "after each simulation step",
+    // so the first step rewrites the axiom as written (Ring, Lilac). A bad depth is
+    // still reported here, before any step.
+    if (!main.decomposition.productions.empty())
+        decomposition_depth();
 }
 
 bool Deriver::is_query(int symbol) const
@@ -284,12 +288,7 @@ void Deriver::decompose()
     const ProductionSet& set = m_program.lsystems.front().decomposition;
     if (set.productions.empty())
         return;
-    in_block("the decomposition's 'maximum depth:'");
-    int depth = set.max_depth
-                    ? static_cast<int>(setting(*set.max_depth, set.max_depth_loc,
-                                               "the decomposition's maximum depth", 0,
-                                               max_depth_setting))
-                    : 1;
+    int depth = decomposition_depth();
     std::size_t applied = 0;
     for (int pass = 0; pass < depth; ++pass) {
         index(m_string, m_indexed);
@@ -315,6 +314,16 @@ void Deriver::decompose()
         m_runtime = saved;
         m_stochastic = saved_random;
     }
+}
+
+int Deriver::decomposition_depth()
+{
+    const ProductionSet& set = m_program.lsystems.front().decomposition;
+    in_block("the decomposition's 'maximum depth:'");
+    return set.max_depth ? static_cast<int>(setting(*set.max_depth, set.max_depth_loc,
+                                                    "the decomposition's maximum depth", 0,
+                                                    max_depth_setting))
+                         : 1;
 }
 
 void Deriver::compose_lineage(bool first)

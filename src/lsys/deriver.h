@@ -205,6 +205,8 @@ private:
     void produce(const Production& p, ModuleString& dst);
     void append_evaluated(const ModuleTemplate& m, ModuleString& dst);
     void decompose();
+    /// the decomposition's `maximum depth:` (1 without one), range-checked
+    int decomposition_depth();
     void check_size(const ModuleString& s) const;
     [[noreturn]] void out_of_memory(std::size_t bytes, const ModuleString& building) const;
     /// std::bad_alloc within the budget: the system refused the memory

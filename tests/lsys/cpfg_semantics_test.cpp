@@ -155,12 +155,13 @@ endlsystem
 // the '[' that opens a lateral branch, its first I, then '=' skips to that branch's ']'
 // (past a nested branch and modules consider: leaves out), so I(0,0,0) sums 1 + 2 + 4
 // and nothing from the nested branches; no other I is followed by a whole
-// [I=][I=]I pattern. The string comes from decomposing the axiom (A, then B inside it),
-// which cpfg does before the first step; the first step makes the sum.
+// [I=][I=]I pattern. The axiom is decomposed only after the first step (manual 5.1.8),
+// so the second step is the first to see the I modules and make the sum: a pipe-model
+// sum lags the decomposition by a step, as in cpfg's Lilac (the stem's 552, not 618).
 TEST(CpfgSemantics, PipeModelSumsTheFirstWidthOfEachBranch)
 {
     const char* src = R"(lsystem: 1
-derivation length: 1
+derivation length: 2
 consider: I[]
 axiom: A
 I(o,i,w) > [I(o1,i1,w1)=][I(o2,i2,w2)=]I(o3,i3,w3) --> I(o,i,w1+w2+w3)
@@ -170,7 +171,8 @@ A --> I(0,0,0)[I(1,0,1)B][I(2,0,2)C]I(3,0,4)
 B --> I(5,0,10)[I(6,0,20)]
 endlsystem
 )";
-    EXPECT_EQ(derive_text(src, 0), "I(0,0,0)[I(1,0,1)I(5,0,10)[I(6,0,20)]][I(2,0,2)C]I(3,0,4)");
+    EXPECT_EQ(derive_text(src, 0), "A");
+    EXPECT_EQ(derive_text(src, 1), "I(0,0,0)[I(1,0,1)I(5,0,10)[I(6,0,20)]][I(2,0,2)C]I(3,0,4)");
     EXPECT_EQ(derive_text(src), "I(0,0,7)[I(1,0,1)I(5,0,10)[I(6,0,20)]][I(2,0,2)C]I(3,0,4)");
 }
 

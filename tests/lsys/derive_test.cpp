@@ -216,6 +216,45 @@ endlsystem
     EXPECT_EQ(derive_text(src), "xx");
 }
 
+// Manual 5.1.8: decomposition replaces modules "after each simulation step, before the
+// string is interpreted", so the axiom is not decomposed: the first step's productions
+// see X(3), and only its decomposition gives A B B (cpfg's Ring: A and 31 B).
+TEST(DeriveDecomposition, AxiomIsDecomposedOnlyAfterTheFirstStep)
+{
+    const char* src = R"(lsystem: 1
+derivation length: 2
+axiom: X(3)
+A < B --> A
+A --> B
+decomposition
+maximum depth: 10
+X(n) : n > 1 --> X(n-1)B
+X(n) : n == 1 --> A
+endlsystem
+)";
+    EXPECT_EQ(derive_text(src, 0), "X(3)");
+    EXPECT_EQ(derive_text(src, 1), "ABB");
+    EXPECT_EQ(derive_text(src, 2), "BAB");
+}
+
+// The same in a ring L-system, whose first module's left context is the last one
+TEST(DeriveDecomposition, RingAxiomIsDecomposedOnlyAfterTheFirstStep)
+{
+    const char* src = R"(lsystem: 1
+ring lsystem
+derivation length: 1
+axiom: X(4)
+A < B --> A
+A --> B
+decomposition
+maximum depth: 10
+X(n) : n > 1 --> X(n-1)B
+X(n) : n == 1 --> A
+endlsystem
+)";
+    EXPECT_EQ(derive_text(src), "ABBB");
+}
+
 TEST(DeriveCut, PercentRemovesRestOfBranch)
 {
     const char* src = "lsystem: 1\nderivation length: 1\naxiom: A[B%CD[E]F]G\nendlsystem\n";
