@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 
 #include "env_fixture.h"
@@ -50,6 +51,10 @@ TEST(Chiba, WithoutAreasTheChordThroughABallDecidesThePower)
     auto answers = first_params(env->pass({query_at(1, {0, 0, 0}, {1}), query_at(2, {0, 3, 0}, {1})}, 0));
     EXPECT_EQ(answers.at(1), 0.25f);
     EXPECT_EQ(answers.at(2), 1.0f);
+    // from inside an overlapping ball only the chord ahead counts: 1.5 of the diameter 2
+    auto inside = chiba("chord_inside", overhead + "transmittance: 0.25\n");
+    answers = first_params(inside->pass({query_at(1, {0, 0, 0}, {1}), query_at(2, {0, 0.5f, 0}, {1})}, 0));
+    EXPECT_NEAR(answers.at(1), std::pow(0.25, 0.75), 1e-6);
 }
 
 TEST(Chiba, TransmittanceOneShadesNothing)
@@ -68,6 +73,20 @@ TEST(Chiba, APartlyCoveringBallShadesByTheOverlapOfTheDiscs)
     auto env = chiba("lens", overhead + "transmittance: 0.5\nestimate intersection area: on\n");
     auto answers = first_params(env->pass({query_at(1, {0, 0, 0}, {1}), query_at(2, {1, 3, 0}, {1})}, 0));
     const double lens = 2 * std::numbers::pi / 3 - std::sqrt(3.0) / 2;
+    EXPECT_NEAR(answers.at(1), 1 - 0.5 * lens / std::numbers::pi, 1e-6);
+}
+
+TEST(Chiba, EstimatedAreasReachBallsBesideTheRay)
+{
+    // a small ball whose disc overlaps the receiving disc without touching the ray: area
+    // estimation widens each ball's voxels by the largest radius, so the walk finds it
+    auto env = chiba("beside", "grid size: 8x8x8\ntransmittance: 0.5\nestimate intersection area: on\n"
+                               "source direction: 0 1 0 1\n");
+    auto answers = first_params(env->pass({query_at(1, {0, 0, 0}, {1}), query_at(2, {1.1f, 5, 0}, {0.2f})}, 0));
+    // the lens of circles of radii 1 and 0.2, 1.1 apart
+    const double r1 = 1, r2 = 0.2, d = 1.1;
+    const double x1 = (r1 * r1 + d * d - r2 * r2) / (2 * d), x2 = (r2 * r2 + d * d - r1 * r1) / (2 * d);
+    const double lens = r1 * r1 * std::acos(x1 / r1) + r2 * r2 * std::acos(x2 / r2) - std::sqrt(r2 * r2 - x2 * x2) * d;
     EXPECT_NEAR(answers.at(1), 1 - 0.5 * lens / std::numbers::pi, 1e-6);
 }
 
@@ -100,15 +119,16 @@ TEST(Chiba, FourParametersAlsoGetTheBrightestDirection)
 
 TEST(Chiba, NoPositiveRadiusTakesTheSpecifiedOneAndTwoParametersAreIgnored)
 {
-    // ?E(0) balls of the spec's radius 1 cover each other fully; the ?E with two
-    // parameters between them is no ball (it would shade the lowest one a second time)
+    // the ?E(0) ball has the spec's radius 1, so the ball of radius 0.5 above covers a
+    // quarter of its disc: 1 - (1 - t) / 4; the ?E with two parameters between them is
+    // no ball (it would cover the lowest one fully, a second factor t)
     auto env = chiba("radius", overhead + "radius: 1\ntransmittance: 0.5\nestimate intersection area: on\n");
     auto replies = env->pass({query_at(1, {0, 0, 0}, {0}), query_at(2, {0, 1.5f, 0}, {1, 1}),
-                              query_at(3, {0, 3, 0}, {-2})},
+                              query_at(3, {0, 3, 0}, {0.5f})},
                              0);
     auto answers = first_params(replies);
     EXPECT_EQ(answers.size(), 2u);
-    EXPECT_EQ(answers.at(1), 0.5f);
+    EXPECT_EQ(answers.at(1), 0.875f);
     EXPECT_EQ(answers.at(3), 1.0f);
 }
 
@@ -156,6 +176,26 @@ TEST(Chiba, AnUnlitSkyBelowLeavesTheZenithBrightest)
     EXPECT_NEAR(*replies[0].params[1], 0.0f, 1e-6);
     EXPECT_NEAR(*replies[0].params[2], 1.0f, 1e-6);
     EXPECT_NEAR(*replies[0].params[3], 0.0f, 1e-6);
+}
+
+TEST(Chiba, ThreeSpheresAnswerAsTheProgramDid)
+{
+    // the corpus model 10-light-three-spheres: balls of radius 0.9 one apart up the y
+    // axis, one source; cpfg with vlab's chiba wrote these answers (printed with %g)
+    auto env = chiba("three_spheres", "grid size: 32x32x32\nverbose: off\ntransmittance: 0.0\n"
+                                      "lower to upper ratio: 0.0\nnumber of samples: 128\n"
+                                      "estimate intersection area: on\nsource direction:    50 100  0   4\n");
+    auto answers = first_params(env->pass({query_at(0, {0, 0, 0}, {0.9f}), query_at(10, {0, 1, 0}, {0.9f}),
+                                           query_at(20, {0, 2, 0}, {0.9f})},
+                                          0));
+    auto g = [](float v) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%g", v);
+        return std::string(text);
+    };
+    EXPECT_EQ(g(answers.at(0)), "0.189579");
+    EXPECT_EQ(g(answers.at(10)), "0.313054");
+    EXPECT_EQ(g(answers.at(20)), "1");
 }
 
 TEST(Chiba, BadOrOversizedValuesAreErrorsNamingTheLine)
