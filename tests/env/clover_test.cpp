@@ -3,6 +3,8 @@
 // answers follow from what vlab's program computes (docs/environment.md).
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "env_fixture.h"
 
 namespace cambium::env {
@@ -74,6 +76,24 @@ TEST(Clover, TheImageSpansTheGridFromItsBottomRow)
             EXPECT_EQ(*r.params[1], 0.5f);  // red 64 / 128
         }
     }
+}
+
+TEST(Clover, TheCorpusModelsQueryReadsThePixelTheProgramRead)
+{
+    // 13-clover: a 1024 grid over a 256 image, from (-50, -50) over 100; the query at
+    // (20, 25) is cell (716, 768), pixel (178, 191) counted from the bottom: in that
+    // model's light.rgb, green 159 there (cpfg answered 0.623529) and 47 at row 191 from
+    // the top
+    RgbImage image{256, 256, std::vector<std::uint8_t>(256 * 256 * 3, 0)};
+    image.rgb[((255 - 191) * 256 + 178) * 3 + 1] = 159;
+    image.rgb[(191 * 256 + 178) * 3 + 1] = 47;
+    auto env = clover("corpus", "grid position: -50 -50\ngrid range: 100x100view.pnl\ngrid size: 1024x1024\n"
+                                "input image: light.rgb\nverbose: off\ntransmittance: 0.01\n",
+                      image);
+    const float answer = first_params(env->pass({query_at(3, {20, 25, 0}, {0})}, 0)).at(3);
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", answer);
+    EXPECT_STREQ(text, "0.623529");
 }
 
 TEST(Clover, PixelsAreTakenByTruncation)
