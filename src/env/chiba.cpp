@@ -44,6 +44,7 @@ struct Settings {
 
 constexpr long max_samples = 8L << 14;       // the sphere's subdivision level 8
 constexpr long max_voxels = 256L * 256 * 256;
+constexpr long max_listed = 1L << 30;     // balls listed in voxels, over all voxels
 constexpr std::size_t max_sources = 100;     // the program ignores the sources after these
 
 /// The program's normalisation: the length from a float sum of squares, left as it is
@@ -257,6 +258,36 @@ private:
         return (z * n[1] + y) * n[0] + x;
     }
 
+    /// The voxels (first and last on each axis, clamped to the grid) that may lie within
+    /// a ball's reach: one beyond those its box touches, as the program takes them; empty
+    /// when the box is not a number.
+    struct VoxelBox {
+        std::array<std::int64_t, 3> lo{}, hi{};
+        double count() const
+        {
+            double n = 1;
+            for (int c = 0; c < 3; ++c)
+                n *= static_cast<double>(std::max<std::int64_t>(0, hi[c] - lo[c] + 1));
+            return n;
+        }
+    };
+    VoxelBox voxel_box(const Ball& b) const
+    {
+        const auto& n = m_s.grid_size;
+        const float beam = m_max_radius * m_s.beam_radius;
+        VoxelBox box;
+        for (int c = 0; c < 3; ++c) {
+            const float size = static_cast<float>(n[c]);
+            const double first = std::floor((b.pos[c] - b.radius - beam - m_origin[c]) / m_extent[c] * size) - 1;
+            const double last = 1 + std::floor((b.pos[c] + b.radius + beam - m_origin[c]) / m_extent[c] * size);
+            if (!(first == first) || !(last == last))
+                return VoxelBox{{0, 0, 0}, {-1, -1, -1}};
+            box.lo[c] = static_cast<std::int64_t>(std::clamp(first, 0.0, static_cast<double>(n[c])));
+            box.hi[c] = static_cast<std::int64_t>(std::clamp(last, -1.0, static_cast<double>(n[c] - 1)));
+        }
+        return box;
+    }
+
     /// Calls visit(cell) for each voxel whose centre lies within a ball's reach (its
     /// radius, the widest beam and half a voxel diagonal).
     template <class Visit>
@@ -264,16 +295,9 @@ private:
     {
         const auto& n = m_s.grid_size;
         const float beam = m_max_radius * m_s.beam_radius;
-        std::array<std::int64_t, 3> lo{}, hi{};
-        for (int c = 0; c < 3; ++c) {
-            const float size = static_cast<float>(n[c]);
-            const double first = std::floor((b.pos[c] - b.radius - beam - m_origin[c]) / m_extent[c] * size) - 1;
-            const double last = 1 + std::floor((b.pos[c] + b.radius + beam - m_origin[c]) / m_extent[c] * size);
-            if (!(first == first) || !(last == last))
-                return;
-            lo[c] = static_cast<std::int64_t>(std::clamp(first, 0.0, static_cast<double>(n[c])));
-            hi[c] = static_cast<std::int64_t>(std::clamp(last, -1.0, static_cast<double>(n[c] - 1)));
-        }
+        const VoxelBox box = voxel_box(b);
+        const auto& lo = box.lo;
+        const auto& hi = box.hi;
         const float reach = b.radius + beam + half_diagonal;
         for (std::int64_t z = lo[2]; z <= hi[2]; ++z) {
             const float cz = centre(z, 2);
@@ -307,6 +331,15 @@ private:
             half += side * side;
         }
         half = static_cast<float>(0.5 * std::sqrt(static_cast<double>(half)));
+        // the lists hold at most the voxels of the balls' boxes: refuse what would not fit
+        double listed = 0;
+        for (const Ball& b : m_balls)
+            listed += voxel_box(b).count();
+        if (listed > static_cast<double>(max_listed))
+            throw Error("chiba: " + std::to_string(m_balls.size()) +
+                        " leaf balls would reach more than 2^30 voxels of the " + std::to_string(n[0]) + "x" +
+                        std::to_string(n[1]) + "x" + std::to_string(n[2]) +
+                        " grid; a coarser grid size in the specification file lowers this");
         m_first.assign(cells + 1, 0);
         for (const Ball& b : m_balls)
             for_each_voxel(b, half, [&](std::int64_t cell) { ++m_first[static_cast<std::size_t>(cell) + 1]; });
@@ -477,7 +510,7 @@ std::unique_ptr<Environment> make_chiba(const std::vector<std::string>& args, co
                                               line.value + "'");
                 s.grid_size[c] = static_cast<int>(sizes[c]);
             }
-            if (static_cast<long>(s.grid_size[0]) * s.grid_size[1] * s.grid_size[2] > max_voxels)
+            if (static_cast<double>(s.grid_size[0]) * s.grid_size[1] * s.grid_size[2] > max_voxels)
                 throw Error(line.loc, "chiba: grid size: at most 256x256x256 voxels, found '" + line.value + "'");
         } else if (k == "lower to upper ratio") {
             s.lower_to_upper = static_cast<float>(number_value(line));

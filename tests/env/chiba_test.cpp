@@ -212,5 +212,15 @@ TEST(Chiba, BadOrOversizedValuesAreErrorsNamingTheLine)
     }
 }
 
+TEST(Chiba, BallsReachingTooManyVoxelsAreAnError)
+{
+    // 100 balls at one place each reach all 256^3 voxels: over 2^30 list entries
+    auto env = chiba("listed", "grid size: 256x256x256\n");
+    std::vector<Query> queries;
+    for (std::uint64_t i = 0; i < 100; ++i)
+        queries.push_back(query_at(i, {0, 0, 0}, {1}));
+    EXPECT_THROW(env->pass(queries, 0), Error);
+}
+
 }  // namespace
 }  // namespace cambium::env
