@@ -44,8 +44,8 @@ struct Settings {
 
 constexpr long max_samples = 8L << 14;       // the sphere's subdivision level 8
 constexpr long max_voxels = 256L * 256 * 256;
-constexpr long max_listed = 1L << 30;     // balls listed in voxels, over all voxels
-constexpr std::size_t max_sources = 100;     // the program ignores the sources after these
+constexpr long max_listed = 1L << 30;        // balls listed in voxels, over all voxels
+constexpr std::size_t max_sources = 100;    // the program ignores the sources after these
 
 /// The program's normalisation: the length from a float sum of squares, left as it is
 /// when zero.
