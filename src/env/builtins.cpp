@@ -18,6 +18,8 @@ std::unique_ptr<Environment> make_builtin(const std::string& program,
     static constexpr Entry builtins[] = {
         {"honda81", make_honda81},
         {"ecosystem", make_ecosystem},
+        {"chiba", make_chiba},
+        {"clover", make_clover},
     };
     const std::string name = std::filesystem::path(program).filename().string();
     for (const Entry& e : builtins)
