@@ -666,6 +666,7 @@ int derive_frames_with_lineage(const Model& model,
     lsys::Derivation derivation = model.lsystem.start();
     if (lineage)
         derivation.track_lineage();
+    derivation.go_on_after_stop_one();
     for (std::size_t i = 0; i < frames.size(); ++i) {
         derivation.advance(frames[i].derive_steps);
         // cpfg runs the End block once the last frame is reached, or on stop()
@@ -674,7 +675,7 @@ int derive_frames_with_lineage(const Model& model,
             derivation.finish();
         on_frame(frames[i], derivation.string(), derivation.lineage());
         if (derivation.stopped())
-            break;  // stop() ends the animation (manual 5.1)
+            break;  // stop(n), n != 1, ends the animation (manual 5.1)
     }
     return derivation.steps_done();
 }

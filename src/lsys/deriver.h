@@ -69,6 +69,8 @@ public:
     /// ... with an argument other than 1: the End block runs even though the derivation
     /// stopped early
     bool stop_runs_end() const { return m_runtime.stop_runs_end; }
+    /// Forgets a stop() so that the next step() goes on (animate mode's stop(1)).
+    void clear_stop() { m_runtime.stop_requested = m_runtime.stop_runs_end = false; }
     void step();
     void finish();
     /// The fragment starts of the current string, in string order, for the next step()

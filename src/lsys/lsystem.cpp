@@ -214,6 +214,8 @@ void Derivation::advance(int steps)
         }
         if (options.on_step)
             options.on_step(m_deriver->steps_done(), m_deriver->string());
+        if (m_go_on_after_stop_one && m_deriver->stop_requested() && !m_deriver->stop_runs_end())
+            m_deriver->clear_stop();
     }
     m_lsystem->m_last_runtime = std::make_shared<Runtime>(m_deriver->runtime());
 }
@@ -232,6 +234,7 @@ int Derivation::steps_done() const { return m_deriver->steps_done(); }
 int Derivation::derivation_length() const { return m_deriver->derivation_length(); }
 bool Derivation::stopped() const { return m_deriver->stop_requested(); }
 bool Derivation::stop_runs_end() const { return m_deriver->stop_runs_end(); }
+void Derivation::go_on_after_stop_one() { m_go_on_after_stop_one = true; }
 ModuleString Derivation::take_string() { return m_deriver->take_string(); }
 
 void LSystem::run_query(Deriver& deriver) const { turtle_pass(deriver, m_options.query); }

@@ -107,6 +107,10 @@ public:
     bool stopped() const;
     /// ... with an argument other than 1: the End block runs anyway (cpfg).
     bool stop_runs_end() const;
+    /// Animate mode: from now on stop(1) does not end an advance(), as in cpfg's animate
+    /// mode, where it only draws the string and the simulation goes on (manual 5.1);
+    /// stop(n) with n other than 1 still ends it.
+    void go_on_after_stop_one();
     /// Moves the string out; the Derivation is spent afterwards.
     ModuleString take_string();
     /// Records lineage from the next advance() on (Deriver::track_lineage).
@@ -123,6 +127,7 @@ private:
     std::unique_ptr<Deriver> m_deriver;
     bool m_finished = false;
     bool m_track_lineage = false;
+    bool m_go_on_after_stop_one = false;
     std::uint32_t m_saved_turtles = 0;  ///< by fragment starts in this run (manual 5.1.9)
     std::function<void(ModuleString&, int step)> m_environment;  ///< this run's (manual 7)
     std::vector<std::uint32_t> m_lineage;

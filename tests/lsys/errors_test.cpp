@@ -272,6 +272,26 @@ TEST(Stop, StopWithoutArgumentAndStopOneAlsoEndTheDerivation)
     EXPECT_EQ(derive_text(counting("if (n == 2) { stop(1); }")), derive_text(counting(""), 2));
 }
 
+TEST(Stop, InAnimateModeStopOneOnlyDrawsAndTheDerivationGoesOn)
+{
+    // cpfg's animate mode: stop(1) draws the string and the simulation continues, stop(0)
+    // ends it (manual 5.1); an advance past a stop(1) reaches all its steps
+    LSystem one = LSystem::from_source(counting("if (n == 2) { stop(1); }"), "stop.l");
+    Derivation animated = one.start();
+    animated.go_on_after_stop_one();
+    animated.advance(4);
+    EXPECT_EQ(animated.steps_done(), 4);
+    EXPECT_FALSE(animated.stopped());
+    EXPECT_EQ(to_text(animated.string(), one.symbols()), derive_text(counting(""), 4));
+
+    LSystem zero = LSystem::from_source(counting("if (n == 2) { stop(0); }"), "stop.l");
+    Derivation ended = zero.start();
+    ended.go_on_after_stop_one();
+    ended.advance(4);
+    EXPECT_EQ(ended.steps_done(), 2);
+    EXPECT_TRUE(ended.stopped());
+}
+
 /// A model that calls stop(`argument`) in step 2 of 5 and whose End block sets a
 /// global that the homomorphism shows.
 std::string end_block_after_stop(const std::string& argument)
