@@ -490,3 +490,40 @@ TEST(SceneAssembly, InstancedFieldRendersAsTheSamePlantsInline)
     render::Image other = render::render(app::assemble_scene(moved, app::Options{}), settings);
     EXPECT_GT(mean_difference(other, drawn_inline), 1e-3);
 }
+
+namespace {
+
+/// Drawn segments of every prototype and of the scene's own geometry.
+std::size_t segments(const geom::Scene& scene)
+{
+    std::size_t n = scene.geometry.lines.segments.size();
+    for (const geom::Prototype& p : scene.prototypes)
+        n += p.geometry.lines.segments.size();
+    return n;
+}
+
+}  // namespace
+
+TEST(SceneAssembly, OpenLSystemPlantsTalkToTheirEnvironment)
+{
+    // the manual's L-system 3 with honda81: two ends meet after two steps and stop
+    SceneFolder f("open");
+    f.write("m/p.l", "lsystem: 1\nderivation length: 3\naxiom: ?E(1)\n"
+                     "?E(c) : c == 1 --> [+F/(180)?E(1)]F?E(1)\nendlsystem\n");
+    f.write("m/p.v", "angle increment: 60\nline style: cylinder\ninitial line width: 0.1\n");
+    f.write("m/p.e", "executable: honda81 density.spec\nturtle position:P:%.4f %.4f %.0f\n");
+    f.write("m/density.spec", "radius: 0.01\n3d case: on\n");
+    auto drawn = [&](const std::string& command) {
+        app::SceneFile s = app::read_scene_file(
+            f.scene(R"({"plants": [{"model": "m", "command": ")" + command + R"(", "placements": [{}]}]})"),
+            app::Options{});
+        Diagnostics quiet(Diagnostics::Output::quiet);
+        ScopedDiagnostics scope(quiet);
+        app::Options options;
+        options.quiet = true;
+        return segments(app::assemble_scene(s, options, app::AssemblyOptions{}, nullptr));
+    };
+    const std::size_t open = drawn("cpfg -e p.e p.l p.v"), closed = drawn("cpfg p.l p.v");
+    EXPECT_EQ(closed, 14u);  // 2 + 4 + 8: every end branches
+    EXPECT_EQ(open, 10u);    // the two blocked ends of step 2 do not
+}
