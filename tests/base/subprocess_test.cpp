@@ -185,5 +185,36 @@ TEST(Coprocess, DestructionKillsItsWholeGroup)
     EXPECT_TRUE(dies_soon(background));
 }
 
+volatile sig_atomic_t g_stray_interrupts = 0;
+extern "C" void note_stray_interrupt(int)
+{
+    g_stray_interrupts = g_stray_interrupts + 1;
+}
+
+// Ctrl-C during a wait: the program's group is killed and Interrupted thrown. The program
+// sends SIGINT until it is killed, so one lands inside the wait; the test's own handler
+// takes any that arrive outside it.
+TEST(Coprocess, InterruptWhileWaitingKillsItAndThrows)
+{
+    struct sigaction stray {}, saved{};
+    stray.sa_handler = note_stray_interrupt;
+    sigemptyset(&stray.sa_mask);
+    ::sigaction(SIGINT, &stray, &saved);
+    pid_t pid = 0;
+    try {
+        Coprocess c({"sh", "-c", "read go; while kill -INT $PPID; do :; done"}, ".", {});
+        pid = c.pid();
+        EXPECT_EQ(c.write_some("go\n"), 3);
+        for (int i = 0; i < 100; ++i)
+            c.wait(false, true, std::chrono::milliseconds(100));
+        FAIL() << "expected Interrupted";
+    } catch (const Interrupted& e) {
+        EXPECT_EQ(e.signal(), SIGINT);
+    }
+    ::sigaction(SIGINT, &saved, nullptr);
+    ASSERT_GT(pid, 0);
+    EXPECT_NE(::kill(pid, 0), 0);  // killed and reaped
+}
+
 }  // namespace
 }  // namespace cambium
