@@ -150,6 +150,8 @@ TEST(ExternalProgram, FailuresNameTheProgramAndWhatHappened)
                           Case{"flood", "wrote more than 1048576 bytes at step 0"},
                           Case{"long", "wrote a line longer than 65536 bytes"},
                           Case{"garbage", "answered 'hello, plant' at step 0"},
+                          Case{"twice", "answered more often than the 3 ?E modules sent at step 0"},
+                          Case{"deaf", "stopped reading its input at step 0"},
                           Case{"mute", "did not send its start-up byte within 1 s"},
                           Case{"bad-start", "sent 88 instead of its start-up byte 1"}}) {
         Model m = model(c.mode, c.mode);

@@ -10,6 +10,10 @@
 //   die       exits with status 3 at the first query   flood  blank lines, endlessly
 //   long      one line without end    garbage  a line that is no answer
 //   mute      never sends the start-up byte   bad-start  sends 'X' for it
+//   deaf      closes its input before the start-up byte, then waits
+//   twice     answers each query twice
+#include <unistd.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -39,6 +43,8 @@ void answer(const std::string& mode, const Pending& p)
 {
     if (mode == "echo")
         std::printf("%lu E(%g)\n", p.address, double(p.x));
+    else if (mode == "twice")
+        std::printf("%lu E(1)\n%lu E(2)\n", p.address, p.address);
     else if (mode == "unknown")
         std::printf("%lu E(7)\n", p.address + 1000000);
     else if (mode == "empty") {
@@ -62,8 +68,13 @@ int main(int argc, char** argv)
         }
         return 0;
     }
+    if (mode == "deaf")
+        std::fclose(stdin);
     std::fputc(mode == "bad-start" ? 'X' : 1, stdout);
     std::fflush(stdout);
+    if (mode == "deaf")
+        for (;;)
+            ::pause();
     if (mode == "echo") {
         std::ofstream started("started.txt");
         for (int i = 1; i < argc; ++i)
