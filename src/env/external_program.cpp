@@ -187,6 +187,15 @@ void write_private_file(const fs::path& path, const std::string& text)
         throw Error("cannot write '" + path.string() + "': " + std::strerror(errno));
 }
 
+/// An Error's text without its "error: " prefix, to be wrapped in another.
+std::string message_of(const Error& e)
+{
+    std::string text = e.what();
+    if (text.rfind("error: ", 0) == 0)
+        text.erase(0, 7);
+    return text;
+}
+
 bool is_real_directory(const fs::path& folder)
 {
     std::error_code ec;
@@ -209,7 +218,7 @@ public:
         } catch (const Interrupted&) {
             throw;
         } catch (const Error& e) {
-            throw Error(spec.executable_loc, std::string(e.what()) + " (the environmental program of " +
+            throw Error(spec.executable_loc, message_of(e) + " (the environmental program of " +
                                                  spec.file.string() + ")");
         }
         start();
@@ -451,7 +460,7 @@ private:
             write_private_file(base.string() + ".from", m_received_log);
         } catch (const Error& e) {
             if (strict)
-                throw error(std::string("message log: ") + e.what());
+                throw error("message log: " + message_of(e));
         }
     }
 
