@@ -4,6 +4,7 @@
 #include "env/external_program.h"
 
 #include <fcntl.h>
+#include <stdlib.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -18,6 +19,7 @@
 #include <string_view>
 
 #include "base/subprocess.h"
+#include "geom/text_input.h"
 
 namespace cambium::env {
 namespace {
@@ -202,12 +204,70 @@ bool is_real_directory(const fs::path& folder)
     return fs::symlink_status(folder, ec).type() == fs::file_type::directory;
 }
 
+/// A private copy of a `.e` file whose `communication type:` says pipes: vlab's library
+/// takes the type from the file it is given, so a files, memory or sockets `.e` makes it
+/// speak pipes this way. The folder and copy are removed on destruction.
+class PipesCopy {
+public:
+    explicit PipesCopy(const CommSpec& spec)
+    {
+        std::string text = geom::read_text_file(spec.file, "communication specification file");
+        std::string out;
+        std::size_t begin = 0;
+        while (begin < text.size()) {
+            std::size_t end = text.find('\n', begin);
+            end = end == std::string::npos ? text.size() : end + 1;
+            const std::string_view line(text.data() + begin, end - begin);
+            const std::size_t colon = line.find(':');
+            if (colon != std::string_view::npos &&
+                geom::normalize_command_name(line.substr(0, colon)) == "communication type") {
+                out += "communication type: pipes";
+                if (spec.queries_per_chunk > 0) {
+                    out += ' ';
+                    out += std::to_string(spec.queries_per_chunk);
+                }
+                out += '\n';
+            } else {
+                out.append(line);
+            }
+            begin = end;
+        }
+        std::string folder = (fs::temp_directory_path() / "cambium-env-XXXXXX").string();
+        if (::mkdtemp(folder.data()) == nullptr)
+            throw Error("cannot create a private folder for a copy of " + spec.file.string() + ": " +
+                        std::strerror(errno));
+        m_folder = folder;
+        m_file = m_folder / spec.file.filename();
+        try {
+            write_private_file(m_file, out);
+        } catch (...) {
+            remove();
+            throw;
+        }
+    }
+    ~PipesCopy() { remove(); }
+    PipesCopy(const PipesCopy&) = delete;
+    PipesCopy& operator=(const PipesCopy&) = delete;
+    const fs::path& file() const { return m_file; }
+
+private:
+    void remove()
+    {
+        std::error_code ec;
+        fs::remove_all(m_folder, ec);
+    }
+    fs::path m_folder, m_file;
+};
+
 class ExternalProgram final : public Environment {
 public:
     ExternalProgram(const CommSpec& spec, const Context& context, const ExternalLimits& limits)
         : m_spec(spec), m_limits(limits), m_name(spec.executable.front())
     {
-        std::vector<std::string> argv{spec.executable.front(), "-e", spec_argument(spec, context)};
+        if (spec.communication_type != "pipes")
+            m_copy = std::make_unique<PipesCopy>(spec);
+        std::vector<std::string> argv{spec.executable.front(), "-e",
+                                      m_copy ? m_copy->file().string() : spec_argument(spec, context)};
         argv.insert(argv.end(), spec.executable.begin() + 1, spec.executable.end());
         if (argv.size() > 3 && argv.back() == "&")
             argv.pop_back();  // cpfg drops a trailing '&' (its system() background)
@@ -497,6 +557,7 @@ private:
     CommSpec m_spec;
     ExternalLimits m_limits;
     std::string m_name;
+    std::unique_ptr<PipesCopy> m_copy;  ///< declared before m_process: removed after it ends
     std::unique_ptr<Coprocess> m_process;
     std::string m_input;  ///< read and not yet taken (a partial line)
     std::string m_sent_log, m_received_log;
@@ -512,11 +573,6 @@ std::unique_ptr<Environment> make_external_program(const CommSpec& spec, const C
 {
     if (spec.executable.empty())
         throw Error(FileLoc{spec.file.string()}, "no 'executable:' line names the environmental program");
-    if (spec.communication_type != "pipes")
-        throw Error(spec.executable_loc,
-                    "communication type '" + spec.communication_type + "' in " + spec.file.string() +
-                        ": Cambium talks to environmental programs through pipes only (vlab's library "
-                        "reads the type from the .e file, so write 'communication type: pipes')");
     if (!spec.interpreted_modules.empty())
         throw Error(spec.executable_loc, "'interpreted modules:' in " + spec.file.string() +
                                              ": Cambium does not send the modules' polygons to a program");

@@ -161,11 +161,28 @@ TEST(ExternalProgram, FailuresNameTheProgramAndWhatHappened)
     }
 }
 
+TEST(ExternalProgram, OtherCommunicationTypesSpeakPipesThroughAPrivateCopy)
+{
+    Model m = model("files", "echo", "communication type: files 3\nverbose: off\n");
+    fs::path copy;
+    {
+        auto env = make_external_program(m.spec, m.context, quick());
+        EXPECT_EQ(testing::first_params(env->pass(queries(7), 0)).size(), 7u);  // chunks of 3
+        std::istringstream started(read_file(m.context.folder / "started.txt"));
+        std::string e;
+        started >> e >> copy;
+        EXPECT_EQ(e, "-e");
+        EXPECT_EQ(copy.filename(), "plant.e");
+        EXPECT_NE(copy.parent_path(), m.context.folder);
+    }
+    const std::string seen = read_file(m.context.folder / "e-file.txt");
+    EXPECT_NE(seen.find("communication type: pipes 3\nverbose: off\n"), std::string::npos) << seen;
+    EXPECT_NE(seen.find("turtle position:P:%g %g %g\n"), std::string::npos) << seen;
+    EXPECT_FALSE(fs::exists(copy.parent_path()));
+}
+
 TEST(ExternalProgram, RefusesWhatItCannotSpeak)
 {
-    Model files = model("files", "echo", "communication type: files\n");
-    EXPECT_NE(error_of([&] { make_external_program(files.spec, files.context, quick()); }).find("pipes only"),
-              std::string::npos);
     Model polygons = model("polygons", "echo", "interpreted modules: all\n");
     EXPECT_NE(error_of([&] { make_external_program(polygons.spec, polygons.context, quick()); })
                   .find("interpreted modules"),

@@ -3,8 +3,9 @@
 // program built with vlab's communication library speaks it, written from the protocol.
 // Usage: test_program -e FILE.e MODE. It answers the queries of each chunk at the chunk's
 // end, or, in `echo`, at once. Modes:
-//   echo      ?E(x) with the turtle's x; writes started.txt (its arguments) and, at the
-//             goodbye, goodbye.txt (the steps it saw) in its working folder
+//   echo      ?E(x) with the turtle's x; writes started.txt (its arguments), e-file.txt
+//             (the .e it was given) and, at the goodbye, goodbye.txt (the steps it saw)
+//             in its working folder
 //   nothing   no answers    empty  empty fields (parameters unchanged)
 //   unknown   answers to addresses never sent    hang  reads but never answers
 //   die       exits with status 3 at the first query   flood  blank lines, endlessly
@@ -79,6 +80,7 @@ int main(int argc, char** argv)
         std::ofstream started("started.txt");
         for (int i = 1; i < argc; ++i)
             started << argv[i] << (i + 1 < argc ? " " : "\n");
+        std::ofstream("e-file.txt") << std::ifstream(argv[2]).rdbuf();
     }
     const int turtle = turtle_lines(argv[2]);
     std::vector<Pending> pending;
