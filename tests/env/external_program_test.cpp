@@ -127,6 +127,14 @@ TEST(ExternalProgram, ManyQueriesTravelInChunksAndInOne)
     }
 }
 
+TEST(ExternalProgram, AnswersAfterTheLastChunkMayComeInChunks)
+{
+    Model m = model("later", "later");
+    const auto x = testing::first_params(make_external_program(m.spec, m.context, quick())->pass(queries(250), 1));
+    ASSERT_EQ(x.size(), 250u);
+    EXPECT_EQ(x.at(3 * 249), 249.5f);
+}
+
 TEST(ExternalProgram, AHangingProgramEndsAtTheTimeLimit)
 {
     Model m = model("hang", "hang");

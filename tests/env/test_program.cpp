@@ -13,6 +13,7 @@
 //   mute      never sends the start-up byte   bad-start  sends 'X' for it
 //   deaf      closes its input before the start-up byte, then waits
 //   twice     answers each query twice
+//   later     ?E(x) after the pass's last chunk, in chunks of 100 as the library writes
 #include <unistd.h>
 
 #include <cstdio>
@@ -42,7 +43,7 @@ int turtle_lines(const char* file)
 
 void answer(const std::string& mode, const Pending& p)
 {
-    if (mode == "echo")
+    if (mode == "echo" || mode == "later")
         std::printf("%lu E(%g)\n", p.address, double(p.x));
     else if (mode == "twice")
         std::printf("%lu E(1)\n%lu E(2)\n", p.address, p.address);
@@ -98,10 +99,17 @@ int main(int argc, char** argv)
                     std::ofstream("goodbye.txt") << steps;
                 return 0;
             }
-            if (mode == "hang")
+            if (mode == "hang" || (mode == "later" && !(flag & 4))) {
+                if (mode == "later")
+                    std::printf("Control: 5\n");  // nothing yet for this chunk
+                std::fflush(stdout);
                 continue;
-            for (const Pending& p : pending)
-                answer(mode, p);
+            }
+            for (std::size_t k = 0; k < pending.size(); ++k) {
+                if (mode == "later" && k > 0 && k % 100 == 0)
+                    std::printf("Control: 1\n");  // the library's own chunks of 100 answers
+                answer(mode, pending[k]);
+            }
             pending.clear();
             if (flag & 4)
                 steps += std::to_string(step) + "\n";
