@@ -511,7 +511,8 @@ std::string Coprocess::end_description(std::chrono::milliseconds grace)
     for (;;) {
         siginfo_t info{};
         // WNOWAIT leaves the zombie, so the group id stays ours until kill()
-        if (::waitid(P_PID, id_t(m_pid), &info, WEXITED | WNOHANG | WNOWAIT) == 0 && info.si_pid == m_pid) {
+        if (::waitid(P_PID, id_t(m_pid), &info, WEXITED | WNOHANG | WNOWAIT) == 0 &&
+            info.si_pid == m_pid) {
             if (info.si_code == CLD_EXITED)
                 return "exited with status " + std::to_string(info.si_status);
             return "was killed by signal " + std::to_string(info.si_status) + " (" +

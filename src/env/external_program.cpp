@@ -93,10 +93,7 @@ struct Line {
     std::string why;  ///< for garbage
 };
 
-bool separator(char c)
-{
-    return c == ' ' || c == ',' || c == ';' || c == ':';
-}
+bool separator(char c) { return c == ' ' || c == ',' || c == ';' || c == ':'; }
 
 /// Reads a line as cpfg's master reads it: `Control: flag`, or an address (digits, after
 /// any of " ,;:") and then, anywhere after it, `E` with an optional parameter list where
@@ -117,8 +114,7 @@ Line parse_line(std::string_view text)
         return line;
     }
     std::size_t i = 0;
-    while (i < text.size() && separator(text[i]))
-        ++i;
+    while (i < text.size() && separator(text[i])) ++i;
     if (i == text.size()) {
         line.kind = Line::Kind::blank;
         return line;
@@ -234,8 +230,8 @@ public:
         }
         std::string folder = (fs::temp_directory_path() / "cambium-env-XXXXXX").string();
         if (::mkdtemp(folder.data()) == nullptr)
-            throw Error("cannot create a private folder for a copy of " + spec.file.string() + ": " +
-                        std::strerror(errno));
+            throw Error("cannot create a private folder for a copy of " + spec.file.string() +
+                        ": " + std::strerror(errno));
         m_folder = folder;
         m_file = m_folder / spec.file.filename();
         try {
@@ -266,8 +262,9 @@ public:
     {
         if (spec.communication_type != "pipes")
             m_copy = std::make_unique<PipesCopy>(spec);
-        std::vector<std::string> argv{spec.executable.front(), "-e",
-                                      m_copy ? m_copy->file().string() : spec_argument(spec, context)};
+        std::vector<std::string> argv{
+            spec.executable.front(), "-e",
+            m_copy ? m_copy->file().string() : spec_argument(spec, context)};
         argv.insert(argv.end(), spec.executable.begin() + 1, spec.executable.end());
         if (argv.size() > 3 && argv.back() == "&")
             argv.pop_back();  // cpfg drops a trailing '&' (its system() background)
@@ -291,7 +288,8 @@ public:
                 goodbye();
             } catch (const Interrupted& e) {
                 m_process->kill();
-                std::raise(e.signal());  // handlers are restored: the signal ends cambium as it would
+                std::raise(
+                    e.signal());  // handlers are restored: the signal ends cambium as it would
             } catch (...) {
             }
         }
@@ -310,19 +308,20 @@ public:
         m_sent_log.clear();
         m_received_log.clear();
         try {
-            const std::size_t chunk = m_spec.queries_per_chunk > 0 ? std::size_t(m_spec.queries_per_chunk)
-                                                                   : default_queries_per_chunk;
+            const std::size_t chunk = m_spec.queries_per_chunk > 0
+                                          ? std::size_t(m_spec.queries_per_chunk)
+                                          : default_queries_per_chunk;
             const auto deadline = Clock::now() + seconds(m_limits.seconds_per_pass);
             std::string message;
             for (std::size_t begin = 0; begin < queries.size(); begin += chunk) {
                 const std::size_t end = std::min(queries.size(), begin + chunk);
                 const bool last = end == queries.size();
                 message.clear();
-                for (std::size_t k = begin; k < end; ++k)
-                    append_query(message, queries[k], m_spec);
+                for (std::size_t k = begin; k < end; ++k) append_query(message, queries[k], m_spec);
                 const int flag = (begin == 0 ? first_chunk : 0) | (last ? last_chunk : 0);
                 // a chunk that is not the last carries step 0, as in cpfg
-                message += "Control: " + std::to_string(flag) + " " + std::to_string(last ? step : 0) + "\n";
+                message += "Control: " + std::to_string(flag) + " " +
+                           std::to_string(last ? step : 0) + "\n";
                 exchange(message, deadline, replies, queries.size());
             }
         } catch (...) {
@@ -337,7 +336,8 @@ public:
 private:
     static Clock::duration seconds(double s)
     {
-        return std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(s > 0 ? s : 1e9));
+        return std::chrono::duration_cast<Clock::duration>(
+            std::chrono::duration<double>(s > 0 ? s : 1e9));
     }
 
     /// The `.e` file as the program is told it: relative to the model folder when inside it.
@@ -345,8 +345,10 @@ private:
     {
         std::error_code ec;
         const fs::path file = fs::absolute(spec.file, ec);
-        const fs::path folder = fs::absolute(context.folder.empty() ? fs::path(".") : context.folder, ec);
-        const fs::path relative = file.lexically_normal().lexically_relative(folder.lexically_normal());
+        const fs::path folder =
+            fs::absolute(context.folder.empty() ? fs::path(".") : context.folder, ec);
+        const fs::path relative =
+            file.lexically_normal().lexically_relative(folder.lexically_normal());
         if (!relative.empty() && *relative.begin() != "..")
             return relative.string();
         return file.string();
@@ -354,7 +356,8 @@ private:
 
     Error error(const std::string& what) const
     {
-        return Error("environmental program '" + m_name + "' (" + m_spec.file.string() + "): " + what);
+        return Error("environmental program '" + m_name + "' (" + m_spec.file.string() +
+                     "): " + what);
     }
 
     /// The program's end for a message: how it exited, when it has.
@@ -370,7 +373,10 @@ private:
         m_process->kill();
     }
 
-    std::string step_text() const { return m_step < 0 ? std::string("at its start") : "at step " + std::to_string(m_step); }
+    std::string step_text() const
+    {
+        return m_step < 0 ? std::string("at its start") : "at step " + std::to_string(m_step);
+    }
 
     /// Reads what the program wrote into m_input (a bounded amount, so lines are taken
     /// between reads), within the line and pass limits.
@@ -383,15 +389,16 @@ private:
                 return;
             if (n == 0) {
                 const std::string how = end_of_program();
-                throw error("closed its output " + step_text() + (how.empty() ? " (it is still running)" : how));
+                throw error("closed its output " + step_text() +
+                            (how.empty() ? " (it is still running)" : how));
             }
             m_pass_bytes += std::size_t(n);
             m_input.append(buffer.data(), std::size_t(n));
             if (!m_limits.message_folder.empty())
                 m_received_log.append(buffer.data(), std::size_t(n));
             if (m_limits.max_pass_bytes > 0 && m_pass_bytes > m_limits.max_pass_bytes)
-                throw error("wrote more than " + std::to_string(m_limits.max_pass_bytes) + " bytes " +
-                            step_text() + " (the limit of one pass)");
+                throw error("wrote more than " + std::to_string(m_limits.max_pass_bytes) +
+                            " bytes " + step_text() + " (the limit of one pass)");
             const std::size_t last = m_input.rfind('\n');
             check_line_length(m_input.size() - (last == std::string::npos ? 0 : last + 1));
         }
@@ -400,8 +407,8 @@ private:
     void check_line_length(std::size_t length) const
     {
         if (m_limits.max_line_bytes > 0 && length > m_limits.max_line_bytes)
-            throw error("wrote a line longer than " + std::to_string(m_limits.max_line_bytes) + " bytes " +
-                        step_text());
+            throw error("wrote a line longer than " + std::to_string(m_limits.max_line_bytes) +
+                        " bytes " + step_text());
     }
 
     /// Waits until the program wrote its start-up byte (1), as vlab's library sends it.
@@ -411,7 +418,8 @@ private:
         const auto deadline = Clock::now() + seconds(m_limits.seconds_per_pass);
         try {
             while (m_input.empty()) {
-                const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+                const auto left =
+                    std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
                 if (left.count() <= 0)
                     throw error("did not send its start-up byte within " +
                                 printf_double("%g", m_limits.seconds_per_pass) +
@@ -420,8 +428,11 @@ private:
                     read_available();
             }
             if (m_input.front() != '\x01')
-                throw error("sent " + printf_double("%g", double(static_cast<unsigned char>(m_input.front()))) +
-                            " instead of its start-up byte 1 (is it built with vlab's communication library?)");
+                throw error(
+                    "sent " +
+                    printf_double("%g", double(static_cast<unsigned char>(m_input.front()))) +
+                    " instead of its start-up byte 1 (is it built with vlab's communication "
+                    "library?)");
             m_input.erase(0, 1);
         } catch (...) {
             fail();
@@ -431,8 +442,8 @@ private:
 
     /// Sends one chunk and reads the answers up to the program's `Control:` line with the
     /// last-chunk flag, reading while writing so an immediate answer cannot block both.
-    void exchange(const std::string& message, Clock::time_point deadline, std::vector<Reply>& replies,
-                  std::size_t most)
+    void exchange(const std::string& message, Clock::time_point deadline,
+                  std::vector<Reply>& replies, std::size_t most)
     {
         if (!m_limits.message_folder.empty())
             m_sent_log += message;
@@ -440,13 +451,16 @@ private:
         for (;;) {
             if (take_lines(replies, most, written == message.size()))
                 return;
-            const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+            const auto left =
+                std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
             if (left.count() <= 0)
-                throw error("did not answer within " + printf_double("%g", m_limits.seconds_per_pass) + " s " +
-                            step_text() + (written < message.size() ? " (it stopped reading its input)" : ""));
+                throw error("did not answer within " +
+                            printf_double("%g", m_limits.seconds_per_pass) + " s " + step_text() +
+                            (written < message.size() ? " (it stopped reading its input)" : ""));
             const Coprocess::Ready ready = m_process->wait(written < message.size(), true, left);
             if (ready.input) {
-                const std::ptrdiff_t w = m_process->write_some(std::string_view(message).substr(written));
+                const std::ptrdiff_t w =
+                    m_process->write_some(std::string_view(message).substr(written));
                 if (w < 0)
                     throw error("stopped reading its input " + step_text() + end_of_program());
                 written += std::size_t(w);
@@ -461,7 +475,8 @@ private:
     {
         std::size_t begin = 0;
         bool ended = false;
-        for (std::size_t newline; !ended && (newline = m_input.find('\n', begin)) != std::string::npos;
+        for (std::size_t newline;
+             !ended && (newline = m_input.find('\n', begin)) != std::string::npos;
              begin = newline + 1) {
             std::string_view text(m_input.data() + begin, newline - begin);
             check_line_length(text.size());
@@ -469,23 +484,24 @@ private:
                 text.remove_suffix(1);
             Line line = parse_line(text);
             switch (line.kind) {
-            case Line::Kind::blank:
-                break;
-            case Line::Kind::garbage:
-                throw error("answered '" + printable(text) + "' " + step_text() + ": " + line.why);
-            case Line::Kind::control:
-                if (line.flag & last_chunk) {
-                    if (!all_written)
-                        throw error("ended its answers before reading the whole message " + step_text());
-                    ended = true;
-                }
-                break;
-            case Line::Kind::answer:
-                if (replies.size() >= most)
-                    throw error("answered more often than the " + std::to_string(most) + " ?E modules sent " +
-                                step_text());
-                replies.push_back(std::move(line.reply));
-                break;
+                case Line::Kind::blank: break;
+                case Line::Kind::garbage:
+                    throw error("answered '" + printable(text) + "' " + step_text() + ": " +
+                                line.why);
+                case Line::Kind::control:
+                    if (line.flag & last_chunk) {
+                        if (!all_written)
+                            throw error("ended its answers before reading the whole message " +
+                                        step_text());
+                        ended = true;
+                    }
+                    break;
+                case Line::Kind::answer:
+                    if (replies.size() >= most)
+                        throw error("answered more often than the " + std::to_string(most) +
+                                    " ?E modules sent " + step_text());
+                    replies.push_back(std::move(line.reply));
+                    break;
             }
         }
         m_input.erase(0, begin);  // what follows the end stays for the next pass, as in cpfg
@@ -496,7 +512,9 @@ private:
     {
         std::string out;
         for (char c : text.substr(0, 80))
-            out += (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) >= 127) ? '?' : c;
+            out += (static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) >= 127)
+                       ? '?'
+                       : c;
         if (text.size() > 80)
             out += "...";
         return out;
@@ -532,12 +550,14 @@ private:
         std::size_t written = 0, read = 0;
         std::array<char, 4096> buffer;
         for (;;) {
-            const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
+            const auto left =
+                std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now());
             if (left.count() <= 0)
                 return;
             const Coprocess::Ready ready = m_process->wait(written < message.size(), true, left);
             if (ready.input) {
-                const std::ptrdiff_t w = m_process->write_some(std::string_view(message).substr(written));
+                const std::ptrdiff_t w =
+                    m_process->write_some(std::string_view(message).substr(written));
                 if (w < 0)
                     return;
                 written += std::size_t(w);
@@ -572,10 +592,12 @@ std::unique_ptr<Environment> make_external_program(const CommSpec& spec, const C
                                                    const ExternalLimits& limits)
 {
     if (spec.executable.empty())
-        throw Error(FileLoc{spec.file.string()}, "no 'executable:' line names the environmental program");
+        throw Error(FileLoc{spec.file.string()},
+                    "no 'executable:' line names the environmental program");
     if (!spec.interpreted_modules.empty())
-        throw Error(spec.executable_loc, "'interpreted modules:' in " + spec.file.string() +
-                                             ": Cambium does not send the modules' polygons to a program");
+        throw Error(spec.executable_loc,
+                    "'interpreted modules:' in " + spec.file.string() +
+                        ": Cambium does not send the modules' polygons to a program");
     if (!limits.message_folder.empty() && !is_real_directory(limits.message_folder))
         throw Error("message folder '" + limits.message_folder.string() + "' is not a directory");
     return std::make_unique<ExternalProgram>(spec, context, limits);
@@ -586,9 +608,11 @@ void prepare_message_folder(const fs::path& folder)
     if (::mkdir(folder.c_str(), 0700) == 0)
         return;
     if (errno != EEXIST)
-        throw Error("cannot create the message folder '" + folder.string() + "': " + std::strerror(errno));
+        throw Error("cannot create the message folder '" + folder.string() +
+                    "': " + std::strerror(errno));
     if (!is_real_directory(folder))
-        throw Error("the message folder '" + folder.string() + "' exists and is not a directory (or is a link)");
+        throw Error("the message folder '" + folder.string() +
+                    "' exists and is not a directory (or is a link)");
     std::error_code ec;
     if (!fs::is_empty(folder, ec) || ec)
         throw Error("the message folder '" + folder.string() + "' exists and is not empty");

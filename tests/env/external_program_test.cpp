@@ -27,11 +27,12 @@ struct Model {
 Model model(const std::string& test, const std::string& mode, const std::string& extra = "")
 {
     Model m;
-    m.context = testing::model_with("ext_" + test, "plant.e",
-                                    std::string("executable: ") + CAMBIUM_TEST_PROGRAM + " " + mode +
-                                        "\n"
-                                        "turtle position:P:%g %g %g\n" +
-                                        extra);
+    m.context =
+        testing::model_with("ext_" + test, "plant.e",
+                            std::string("executable: ") + CAMBIUM_TEST_PROGRAM + " " + mode +
+                                "\n"
+                                "turtle position:P:%g %g %g\n" +
+                                extra);
     m.spec = read_comm_spec(m.context.folder / "plant.e");
     return m;
 }
@@ -96,17 +97,20 @@ TEST(ExternalProgram, EchoAnswersEveryQueryAndSaysGoodbye)
 TEST(ExternalProgram, NoAnswersEmptyFieldsAndUnknownAddresses)
 {
     Model nothing = model("nothing", "nothing");
-    EXPECT_TRUE(make_external_program(nothing.spec, nothing.context, quick())->pass(queries(4), 0).empty());
+    EXPECT_TRUE(
+        make_external_program(nothing.spec, nothing.context, quick())->pass(queries(4), 0).empty());
 
     Model empty = model("empty", "empty");
-    const auto replies = make_external_program(empty.spec, empty.context, quick())->pass(queries(2, 3), 0);
+    const auto replies =
+        make_external_program(empty.spec, empty.context, quick())->pass(queries(2, 3), 0);
     ASSERT_EQ(replies.size(), 2u);
     EXPECT_EQ(replies[1].address, 3u);
     ASSERT_EQ(replies[1].params.size(), 3u);
     EXPECT_FALSE(replies[1].params[0] || replies[1].params[1] || replies[1].params[2]);
 
     Model unknown = model("unknown", "unknown");
-    const auto strays = make_external_program(unknown.spec, unknown.context, quick())->pass(queries(2), 0);
+    const auto strays =
+        make_external_program(unknown.spec, unknown.context, quick())->pass(queries(2), 0);
     ASSERT_EQ(strays.size(), 2u);
     EXPECT_EQ(strays[0].address, 1000000u);  // passed on: the environmental step ignores it
 }
@@ -130,7 +134,8 @@ TEST(ExternalProgram, ManyQueriesTravelInChunksAndInOne)
 TEST(ExternalProgram, AnswersAfterTheLastChunkMayComeInChunks)
 {
     Model m = model("later", "later");
-    const auto x = testing::first_params(make_external_program(m.spec, m.context, quick())->pass(queries(250), 1));
+    const auto x = testing::first_params(
+        make_external_program(m.spec, m.context, quick())->pass(queries(250), 1));
     ASSERT_EQ(x.size(), 250u);
     EXPECT_EQ(x.at(3 * 249), 249.5f);
 }
@@ -163,7 +168,8 @@ TEST(ExternalProgram, FailuresNameTheProgramAndWhatHappened)
                           Case{"mute", "did not send its start-up byte within 1 s"},
                           Case{"bad-start", "sent 88 instead of its start-up byte 1"}}) {
         Model m = model(c.mode, c.mode);
-        const std::string e = error_of([&] { make_external_program(m.spec, m.context, small)->pass(queries(3), 0); });
+        const std::string e =
+            error_of([&] { make_external_program(m.spec, m.context, small)->pass(queries(3), 0); });
         EXPECT_NE(e.find(c.expected), std::string::npos) << c.mode << ": " << e;
         EXPECT_NE(e.find("plant.e"), std::string::npos) << e;
     }
@@ -192,12 +198,15 @@ TEST(ExternalProgram, OtherCommunicationTypesSpeakPipesThroughAPrivateCopy)
 TEST(ExternalProgram, RefusesWhatItCannotSpeak)
 {
     Model polygons = model("polygons", "echo", "interpreted modules: all\n");
-    EXPECT_NE(error_of([&] { make_external_program(polygons.spec, polygons.context, quick()); })
-                  .find("interpreted modules"),
+    EXPECT_NE(error_of([&] {
+                  make_external_program(polygons.spec, polygons.context, quick());
+              }).find("interpreted modules"),
               std::string::npos);
     Model missing = model("missing", "echo");
     missing.spec.executable = {"./no-such-environment"};
-    EXPECT_NE(error_of([&] { make_external_program(missing.spec, missing.context, quick()); }).find("cannot start"),
+    EXPECT_NE(error_of([&] {
+                  make_external_program(missing.spec, missing.context, quick());
+              }).find("cannot start"),
               std::string::npos);
 }
 
@@ -233,7 +242,8 @@ TEST(ExternalProgram, WritesEachPassToTheMessageFolder)
     EXPECT_NE(error_of([&] { prepare_message_folder(limits.message_folder); }).find("not empty"),
               std::string::npos);
     fs::create_directory_symlink(m.context.folder, m.context.folder / "link");
-    EXPECT_NE(error_of([&] { prepare_message_folder(m.context.folder / "link"); }).find("link"), std::string::npos);
+    EXPECT_NE(error_of([&] { prepare_message_folder(m.context.folder / "link"); }).find("link"),
+              std::string::npos);
 }
 
 }  // namespace

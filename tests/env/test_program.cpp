@@ -36,8 +36,7 @@ int turtle_lines(const char* file)
 {
     std::ifstream in(file);
     int n = 0;
-    for (std::string line; std::getline(in, line);)
-        n += line.rfind("turtle", 0) == 0;
+    for (std::string line; std::getline(in, line);) n += line.rfind("turtle", 0) == 0;
     return n;
 }
 
@@ -51,8 +50,7 @@ void answer(const std::string& mode, const Pending& p)
         std::printf("%lu E(7)\n", p.address + 1000000);
     else if (mode == "empty") {
         std::printf("%lu E(", p.address);
-        for (std::size_t k = 1; k < p.params; ++k)
-            std::printf(",");
+        for (std::size_t k = 1; k < p.params; ++k) std::printf(",");
         std::printf(")\n");
     } else if (mode == "garbage")
         std::printf("hello, plant\n");
@@ -75,12 +73,10 @@ int main(int argc, char** argv)
     std::fputc(mode == "bad-start" ? 'X' : 1, stdout);
     std::fflush(stdout);
     if (mode == "deaf")
-        for (;;)
-            ::pause();
+        for (;;) ::pause();
     if (mode == "echo") {
         std::ofstream started("started.txt");
-        for (int i = 1; i < argc; ++i)
-            started << argv[i] << (i + 1 < argc ? " " : "\n");
+        for (int i = 1; i < argc; ++i) started << argv[i] << (i + 1 < argc ? " " : "\n");
         std::ofstream("e-file.txt") << std::ifstream(argv[2]).rdbuf();
     }
     const int turtle = turtle_lines(argv[2]);
@@ -120,17 +116,14 @@ int main(int argc, char** argv)
         if (mode == "die")
             return 3;
         if (mode == "flood")
-            for (;;)
-                std::fputs("\n\n\n\n\n\n\n\n", stdout);
+            for (;;) std::fputs("\n\n\n\n\n\n\n\n", stdout);
         if (mode == "long")
-            for (;;)
-                std::fputs("xxxxxxxx", stdout);
+            for (;;) std::fputs("xxxxxxxx", stdout);
         Pending p{std::strtoul(line, nullptr, 10), 0, 0};
         const char* e = std::strchr(line, 'E');
         if (e && e[1] == '(') {
             p.params = 1;
-            for (const char* c = e + 2; *c && *c != ')'; ++c)
-                p.params += *c == ',';
+            for (const char* c = e + 2; *c && *c != ')'; ++c) p.params += *c == ',';
         }
         for (int k = 0; k < turtle; ++k) {
             char field[1024];
