@@ -163,10 +163,13 @@ Line parse_line(std::string_view text)
     return line;
 }
 
-/// A file in a message folder, created for this pass only (never through a link).
-void write_private_file(const fs::path& path, const std::string& text)
+/// A file in a message folder, created for this pass only (never through a link); false
+/// when the name is taken.
+bool write_private_file(const fs::path& path, const std::string& text)
 {
     const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0600);
+    if (fd < 0 && errno == EEXIST)
+        return false;
     if (fd < 0)
         throw Error("cannot create '" + path.string() + "': " + std::strerror(errno));
     std::size_t done = 0;
@@ -183,6 +186,7 @@ void write_private_file(const fs::path& path, const std::string& text)
     }
     if (::close(fd) != 0)
         throw Error("cannot write '" + path.string() + "': " + std::strerror(errno));
+    return true;
 }
 
 /// An Error's text without its "error: " prefix, to be wrapped in another.
@@ -235,7 +239,8 @@ public:
         m_folder = folder;
         m_file = m_folder / spec.file.filename();
         try {
-            write_private_file(m_file, out);
+            if (!write_private_file(m_file, out))
+                throw Error("'" + m_file.string() + "' exists");
         } catch (...) {
             remove();
             throw;
@@ -528,14 +533,16 @@ private:
         try {
             char name[32];
             std::snprintf(name, sizeof name, "step%03d", m_step);
-            fs::path base = m_limits.message_folder / name;
             // a step seen again (another run, the same step) gets a number of its own
-            for (int k = 2; fs::exists(fs::path(base.string() + ".to")) ||
-                            fs::exists(fs::path(base.string() + ".from"));
-                 ++k)
-                base = m_limits.message_folder / (std::string(name) + "-" + std::to_string(k));
-            write_private_file(base.string() + ".to", m_sent_log);
-            write_private_file(base.string() + ".from", m_received_log);
+            for (int k = 1;; ++k) {
+                const std::string base =
+                    (m_limits.message_folder / name).string() + (k > 1 ? "-" + std::to_string(k) : "");
+                if (!write_private_file(base + ".to", m_sent_log))
+                    continue;
+                if (!write_private_file(base + ".from", m_received_log))
+                    throw Error("'" + base + ".from' exists");
+                break;
+            }
         } catch (const Error& e) {
             if (strict)
                 throw error("message log: " + message_of(e));
