@@ -74,7 +74,7 @@ void append_query(std::string& out, const Query& q, const CommSpec& spec)
     out += std::to_string(q.address);
     out += ' ';
     append_module(out, q.module, true);
-    if (q.following)
+    if (q.following && spec.following_module)
         append_module(out, *q.following, false);
     out += '\n';
     append_turtle(out, spec.position, q.position);
