@@ -5,12 +5,14 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <pthread.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <chrono>
@@ -82,44 +84,58 @@ Pipe make_pipe()
     return {Fd(fds[0]), Fd(fds[1])};
 }
 
-/// While alive: SIGINT/SIGTERM/SIGHUP are noted (not fatal) and SIGPIPE is ignored (a
-/// helper that stops reading its input must not kill cambium). Restored on destruction.
+/// While any is alive: SIGINT/SIGTERM/SIGHUP are noted (not fatal) and SIGPIPE is
+/// ignored (a helper that stops reading its input must not kill cambium). The first
+/// installs the handlers, the last restores them, so scopes may overlap across threads.
 class SignalScope {
 public:
     SignalScope()
     {
+        std::lock_guard lock(mutex());
+        if (s_users++ > 0)
+            return;
         Pipe p = make_pipe();
         ::fcntl(p.read.get(), F_SETFL, O_NONBLOCK);
         ::fcntl(p.write.get(), F_SETFL, O_NONBLOCK);
-        m_pipe = std::move(p);
-        g_signal_pipe[0] = m_pipe.read.get();
-        g_signal_pipe[1] = m_pipe.write.get();
+        s_pipe = std::move(p);
+        g_signal_pipe[0] = s_pipe.read.get();
+        g_signal_pipe[1] = s_pipe.write.get();
         g_signal = 0;
         struct sigaction note {};
         note.sa_handler = note_signal;
         sigemptyset(&note.sa_mask);
         for (std::size_t i = 0; i < forwarded_signals.size(); ++i)
-            ::sigaction(forwarded_signals[i], &note, &m_saved[i]);
+            ::sigaction(forwarded_signals[i], &note, &s_saved[i]);
         struct sigaction ignore {};
         ignore.sa_handler = SIG_IGN;
         sigemptyset(&ignore.sa_mask);
-        ::sigaction(SIGPIPE, &ignore, &m_saved_pipe);
+        ::sigaction(SIGPIPE, &ignore, &s_saved_pipe);
     }
     ~SignalScope()
     {
+        std::lock_guard lock(mutex());
+        if (--s_users > 0)
+            return;
         for (std::size_t i = 0; i < forwarded_signals.size(); ++i)
-            ::sigaction(forwarded_signals[i], &m_saved[i], nullptr);
-        ::sigaction(SIGPIPE, &m_saved_pipe, nullptr);
+            ::sigaction(forwarded_signals[i], &s_saved[i], nullptr);
+        ::sigaction(SIGPIPE, &s_saved_pipe, nullptr);
         g_signal_pipe[0] = g_signal_pipe[1] = -1;
+        s_pipe = Pipe{};
     }
     SignalScope(const SignalScope&) = delete;
     SignalScope& operator=(const SignalScope&) = delete;
-    int fd() const { return m_pipe.read.get(); }
+    int fd() const { return g_signal_pipe[0]; }
 
 private:
-    Pipe m_pipe;
-    std::array<struct sigaction, forwarded_signals.size()> m_saved{};
-    struct sigaction m_saved_pipe {};
+    static std::mutex& mutex()
+    {
+        static std::mutex m;
+        return m;
+    }
+    static inline int s_users = 0;
+    static inline Pipe s_pipe;
+    static inline std::array<struct sigaction, forwarded_signals.size()> s_saved{};
+    static inline struct sigaction s_saved_pipe {};
 };
 
 /// The started child: its whole process group is killed and the child reaped on
@@ -350,6 +366,162 @@ ProcessResult run_process(const std::vector<std::string>& argv, const std::files
         result.exit_code = WEXITSTATUS(status);
     }
     return result;
+}
+
+Coprocess::Coprocess(const std::vector<std::string>& argv, const std::filesystem::path& folder,
+                     const ProcessLimits& limits)
+{
+    if (argv.empty() || argv[0].empty())
+        throw Error("no program to run");
+    std::vector<char*> args;
+    for (const std::string& a : argv)
+        args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    const std::string where = folder.empty() ? std::string(".") : folder.string();
+    Pipe in_pipe = make_pipe(), out_pipe = make_pipe(), report = make_pipe();
+    const pid_t parent = ::getpid();
+    const pid_t pid = ::fork();
+    if (pid < 0)
+        throw Error("cannot start " + argv[0] + ": " + std::strerror(errno));
+    if (pid == 0)
+        exec_child(args.data(), where.c_str(), in_pipe.read.get(), out_pipe.write.get(), -1,
+                   report.write.get(), parent, limits);
+    ::setpgid(pid, pid);  // also here: no race with a kill before the child's own call
+    m_pid = pid;
+    in_pipe.read.reset();
+    out_pipe.write.reset();
+    report.write.reset();
+    int exec_error = 0;
+    ssize_t got;
+    do
+        got = ::read(report.read.get(), &exec_error, sizeof exec_error);
+    while (got < 0 && errno == EINTR);
+    if (got == sizeof exec_error) {
+        kill();
+        throw Error("cannot start " + argv[0] + ": " + std::strerror(exec_error));
+    }
+    ::fcntl(in_pipe.write.get(), F_SETFL, O_NONBLOCK);
+    ::fcntl(out_pipe.read.get(), F_SETFL, O_NONBLOCK);
+    m_input = in_pipe.write.release();
+    m_output = out_pipe.read.release();
+}
+
+Coprocess::~Coprocess()
+{
+    kill();
+}
+
+void Coprocess::close_input()
+{
+    if (m_input >= 0)
+        ::close(m_input);
+    m_input = -1;
+}
+
+void Coprocess::kill()
+{
+    close_input();
+    if (m_output >= 0)
+        ::close(m_output);
+    m_output = -1;
+    if (m_reaped || m_pid < 0)
+        return;
+    ::kill(-m_pid, SIGKILL);
+    int status = 0;
+    for (;;) {
+        pid_t r = ::waitpid(m_pid, &status, 0);
+        if (r == m_pid || (r < 0 && errno != EINTR))
+            break;
+    }
+    m_reaped = true;
+}
+
+Coprocess::Ready Coprocess::wait(bool writing, bool reading, std::chrono::milliseconds timeout)
+{
+    SignalScope signals;
+    std::array<pollfd, 3> polled{};
+    nfds_t n = 0;
+    polled[n++] = {signals.fd(), POLLIN, 0};
+    if (writing && m_input >= 0)
+        polled[n++] = {m_input, POLLOUT, 0};
+    if (reading && m_output >= 0)
+        polled[n++] = {m_output, POLLIN, 0};
+    const int ms = int(std::clamp<long long>(timeout.count(), 0, 1 << 30));
+    if (g_signal == 0 && ::poll(polled.data(), n, ms) < 0 && errno != EINTR)
+        throw Error(std::string("cannot wait for a helper program: ") + std::strerror(errno));
+    if (g_signal != 0) {
+        const int signal = g_signal;
+        kill();
+        throw Interrupted(signal);
+    }
+    Ready ready;
+    for (nfds_t i = 1; i < n; ++i) {
+        if (polled[i].revents == 0)
+            continue;
+        if (polled[i].fd == m_input)
+            ready.input = true;
+        else
+            ready.output = true;
+    }
+    return ready;
+}
+
+std::ptrdiff_t Coprocess::write_some(std::string_view bytes)
+{
+    if (m_input < 0)
+        return -1;
+    // SIGPIPE is blocked for this write and a pending one discarded: EPIPE tells the same
+    sigset_t pipe_signal, saved;
+    sigemptyset(&pipe_signal);
+    sigaddset(&pipe_signal, SIGPIPE);
+    ::pthread_sigmask(SIG_BLOCK, &pipe_signal, &saved);
+    ssize_t w;
+    do
+        w = ::write(m_input, bytes.data(), bytes.size());
+    while (w < 0 && errno == EINTR);
+    const int error = errno;
+    if (w < 0 && error == EPIPE) {
+        const timespec zero{};
+        ::sigtimedwait(&pipe_signal, nullptr, &zero);
+    }
+    ::pthread_sigmask(SIG_SETMASK, &saved, nullptr);
+    if (w >= 0)
+        return w;
+    return error == EAGAIN || error == EWOULDBLOCK ? 0 : -1;
+}
+
+std::ptrdiff_t Coprocess::read_some(char* buffer, std::size_t size)
+{
+    if (m_output < 0)
+        return 0;
+    ssize_t r;
+    do
+        r = ::read(m_output, buffer, size);
+    while (r < 0 && errno == EINTR);
+    if (r >= 0)
+        return r;
+    return errno == EAGAIN || errno == EWOULDBLOCK ? -1 : 0;
+}
+
+std::string Coprocess::end_description(std::chrono::milliseconds grace)
+{
+    if (m_reaped)
+        return "was stopped";
+    const auto deadline = Clock::now() + grace;
+    for (;;) {
+        siginfo_t info{};
+        // WNOWAIT leaves the zombie, so the group id stays ours until kill()
+        if (::waitid(P_PID, id_t(m_pid), &info, WEXITED | WNOHANG | WNOWAIT) == 0 &&
+            info.si_pid == m_pid) {
+            if (info.si_code == CLD_EXITED)
+                return "exited with status " + std::to_string(info.si_status);
+            return "was killed by signal " + std::to_string(info.si_status) + " (" +
+                   ::strsignal(info.si_status) + ")";
+        }
+        if (Clock::now() >= deadline)
+            return "is still running";
+        ::poll(nullptr, 0, 5);
+    }
 }
 
 }  // namespace cambium

@@ -3,6 +3,9 @@
 // bounded in time, output and memory, and never outliving an interrupted cambium.
 #pragma once
 
+#include <sys/types.h>
+
+#include <chrono>
 #include <cstddef>
 #include <filesystem>
 #include <optional>
@@ -63,5 +66,47 @@ private:
 /// Interrupted; other failures are reported in the result.
 ProcessResult run_process(const std::vector<std::string>& argv, const std::filesystem::path& folder,
                           const ProcessIo& io, const ProcessLimits& limits);
+
+/// A helper program that runs beside cambium for a long time and talks to it through
+/// two pipes (its standard input and output; standard error stays cambium's). Started
+/// as run_process starts one: no shell, in `folder`, in a process group of its own,
+/// dying with cambium. The whole group is killed and the program reaped on destruction.
+class Coprocess {
+public:
+    /// Starts `argv` (argv[0] found through PATH); Error naming it when it cannot start.
+    /// Only `limits.max_memory_bytes` applies: the caller bounds time and output.
+    Coprocess(const std::vector<std::string>& argv, const std::filesystem::path& folder,
+              const ProcessLimits& limits);
+    ~Coprocess();
+    Coprocess(const Coprocess&) = delete;
+    Coprocess& operator=(const Coprocess&) = delete;
+
+    /// What poll found: its input takes bytes, its output has bytes (or ended).
+    struct Ready {
+        bool input = false, output = false;
+    };
+    /// Waits at most `timeout` for its input to take bytes (`writing`) or its output to
+    /// have some (`reading`). When SIGINT, SIGTERM or SIGHUP arrives meanwhile, the
+    /// program's group is killed and Interrupted thrown.
+    Ready wait(bool writing, bool reading, std::chrono::milliseconds timeout);
+    /// Writes what its input takes now: the bytes written, 0 when the pipe is full, -1
+    /// when the program no longer reads (never SIGPIPE).
+    std::ptrdiff_t write_some(std::string_view bytes);
+    /// Reads what its output has now: the bytes read, 0 at its end, -1 when none yet.
+    std::ptrdiff_t read_some(char* buffer, std::size_t size);
+    /// Closes its standard input (the program reads end of file).
+    void close_input();
+    /// How it ended ("exited with status 3", "was killed by signal 11 (Segmentation
+    /// fault)"), waiting at most `grace` for it; "is still running" otherwise.
+    std::string end_description(std::chrono::milliseconds grace);
+    /// Kills its group and reaps it. Idempotent.
+    void kill();
+    pid_t pid() const { return m_pid; }
+
+private:
+    pid_t m_pid = -1;
+    int m_input = -1, m_output = -1;
+    bool m_reaped = false;
+};
 
 }  // namespace cambium

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "env/comm_spec.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
@@ -124,6 +125,9 @@ CommSpec read_comm_spec(const std::filesystem::path& file)
                 spec.communication_type != "memory" && spec.communication_type != "files")
                 throw Error(at, "communication type: expected pipes, sockets, memory or files, found '" +
                                     value + "'");
+            std::string count;
+            if (words >> count)
+                spec.queries_per_chunk = std::max(0, std::atoi(count.c_str()));
         } else if (name == "following module") {
             spec.following_module = yes(value);
         } else if (name == "verbose") {

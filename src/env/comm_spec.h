@@ -24,6 +24,9 @@ struct CommSpec {
     std::vector<std::string> executable;   ///< program and its arguments, `-e file` removed
     FileLoc executable_loc;
     std::string communication_type = "pipes";  ///< pipes, sockets, memory or files
+    /// The number after the type (`pipes 500`): ?E modules per chunk of a pass; 0 when
+    /// absent or not positive (cpfg then sends 100 per chunk through pipes).
+    int queries_per_chunk = 0;
     bool following_module = true;          ///< cpfg's default, whatever the manual says
     std::optional<TurtleFormat> position, heading, left, up, line_width, scale_factor;
     /// `interpreted modules:`: "all" or names with optional parameter counts, as written.

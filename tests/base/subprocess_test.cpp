@@ -9,6 +9,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -127,6 +128,92 @@ TEST(Subprocess, InterruptKillsTheHelperAndThrows)
     struct sigaction now {};
     ::sigaction(SIGINT, nullptr, &now);
     EXPECT_EQ(now.sa_handler, SIG_DFL);
+}
+
+/// Reads from `c` until `want` bytes or its end, waiting at most 10 s in all.
+std::string read_from(Coprocess& c, std::size_t want)
+{
+    std::string got;
+    auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    char buffer[256];
+    while (got.size() < want && std::chrono::steady_clock::now() < deadline) {
+        if (!c.wait(false, true, std::chrono::milliseconds(1000)).output)
+            continue;
+        std::ptrdiff_t n = c.read_some(buffer, sizeof buffer);
+        if (n == 0)
+            break;
+        if (n > 0)
+            got.append(buffer, std::size_t(n));
+    }
+    return got;
+}
+
+TEST(Coprocess, TalksThroughTwoPipesInTheFolderGiven)
+{
+    fs::path dir = scratch("coprocess");
+    Coprocess c({"sh", "-c", "pwd; while read line; do echo \"got $line\"; done; exit 4"}, dir, {});
+    const std::string folder = fs::canonical(dir).string() + "\n";
+    EXPECT_EQ(read_from(c, folder.size()), folder);
+    ASSERT_TRUE(c.wait(true, false, std::chrono::milliseconds(10000)).input);
+    EXPECT_EQ(c.write_some("a b\n"), 4);
+    EXPECT_EQ(read_from(c, 8), "got a b\n");
+    c.close_input();
+    EXPECT_EQ(read_from(c, 1), "");  // its end: the loop read end of file
+    EXPECT_EQ(c.end_description(std::chrono::milliseconds(10000)), "exited with status 4");
+}
+
+TEST(Coprocess, AProgramThatStopsReadingIsNoSigpipe)
+{
+    Coprocess c({"sh", "-c", "exec 0<&-; echo closed"}, ".", {});
+    EXPECT_EQ(read_from(c, 7), "closed\n");
+    EXPECT_EQ(read_from(c, 1), "");
+    EXPECT_EQ(c.write_some("more\n"), -1);
+    EXPECT_THROW(Coprocess({"no-such-program-anywhere"}, ".", {}), Error);
+}
+
+TEST(Coprocess, DestructionKillsItsWholeGroup)
+{
+    pid_t background = 0;
+    {
+        Coprocess c({"sh", "-c", "sleep 60 & echo $!; wait"}, ".", {});
+        std::string line;
+        for (std::string more; line.find('\n') == std::string::npos && !(more = read_from(c, 1)).empty();)
+            line += more;
+        std::istringstream(line) >> background;
+        ASSERT_GT(background, 0);
+    }
+    EXPECT_TRUE(dies_soon(background));
+}
+
+volatile sig_atomic_t g_stray_interrupts = 0;
+extern "C" void note_stray_interrupt(int)
+{
+    g_stray_interrupts = g_stray_interrupts + 1;
+}
+
+// Ctrl-C during a wait: the program's group is killed and Interrupted thrown. The program
+// sends SIGINT until it is killed, so one lands inside the wait; the test's own handler
+// takes any that arrive outside it.
+TEST(Coprocess, InterruptWhileWaitingKillsItAndThrows)
+{
+    struct sigaction stray {}, saved{};
+    stray.sa_handler = note_stray_interrupt;
+    sigemptyset(&stray.sa_mask);
+    ::sigaction(SIGINT, &stray, &saved);
+    pid_t pid = 0;
+    try {
+        Coprocess c({"sh", "-c", "read go; while kill -INT $PPID; do :; done"}, ".", {});
+        pid = c.pid();
+        EXPECT_EQ(c.write_some("go\n"), 3);
+        for (int i = 0; i < 100; ++i)
+            c.wait(false, true, std::chrono::milliseconds(100));
+        FAIL() << "expected Interrupted";
+    } catch (const Interrupted& e) {
+        EXPECT_EQ(e.signal(), SIGINT);
+    }
+    ::sigaction(SIGINT, &saved, nullptr);
+    ASSERT_GT(pid, 0);
+    EXPECT_NE(::kill(pid, 0), 0);  // killed and reaped
 }
 
 }  // namespace

@@ -14,6 +14,15 @@ CommSpec spec_of(const std::string& test, const std::string& text)
     return read_comm_spec(c.folder / "plant.e");
 }
 
+TEST(CommSpec, ReadsTheChunkSizeAfterTheType)
+{
+    EXPECT_EQ(spec_of("chunk", "executable: x\ncommunication type: pipes 500\n").queries_per_chunk,
+              500);
+    EXPECT_EQ(spec_of("chunk0", "executable: x\ncommunication type: pipes -3\n").queries_per_chunk,
+              0);
+    EXPECT_EQ(spec_of("chunk1", "executable: x\ncommunication type: pipes\n").queries_per_chunk, 0);
+}
+
 TEST(CommSpec, ReadsEveryDocumentedCommand)
 {
     CommSpec s = spec_of("all", "executable: honda81 -e plant.e density.spec\n"
