@@ -279,6 +279,12 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
         ->check(CLI::Range(-3600.0f, 3600.0f));
     cli.add_flag("--allow-system-calls", options.allow_system_calls,
                  "Run the commands of @S modules (never done by default)");
+    cli.add_flag("--allow-environment-program", options.allow_environment_program,
+                 "Let the -e file start the environmental program it names, when it is not "
+                 "one of the built-in environments (never done by default)");
+    cli.add_option("--environment-messages", options.environment_messages,
+                   "Write each environmental pass's messages to and from an external "
+                   "program into DIR (created; an existing one must be empty)");
     cli.add_flag("--allow-file-access", options.allow_file_access,
                  "Let the L-system's fopen read and write files outside the model's folder, "
                  "its #include and the background scenes' read files there, and the view "

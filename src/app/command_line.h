@@ -67,6 +67,10 @@ struct Options {
     Verbosity verbosity = Verbosity::normal;
     std::optional<std::filesystem::path> environment_file;  ///< -e file.e (manual 7.4.1)
     bool allow_system_calls = false;           ///< @S runs commands only with this
+    /// --allow-environment-program: a `.e` file may start the program it names (manual 7.4)
+    bool allow_environment_program = false;
+    /// --environment-messages DIR: each pass's messages to and from a program, as text
+    std::optional<std::filesystem::path> environment_messages;
     bool allow_file_access = false;            ///< fopen outside the model's folder
 
     // Outputs besides images (cpfg options, file names may be format strings)

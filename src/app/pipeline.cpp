@@ -122,7 +122,13 @@ void connect_environment(const Options& options, lsys::LoadOptions& load,
     context.read_image = [limit = options.max_memory_bytes](const std::filesystem::path& f) {
         return read_environment_image(f, limit);
     };
-    env::Connection connection = env::connect(spec, context);
+    env::ProgramPermission programs;
+    programs.allowed = options.allow_environment_program;
+    if (options.environment_messages) {
+        env::prepare_message_folder(*options.environment_messages);
+        programs.limits.message_folder = std::filesystem::absolute(*options.environment_messages);
+    }
+    env::Connection connection = env::connect(spec, context, programs);
     if (!options.quiet)
         std::fprintf(stderr, "environment: %s\n", connection.description.c_str());
     load.environment = [queries, spec = std::move(spec), connection = std::move(connection)] {

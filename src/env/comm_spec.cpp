@@ -125,9 +125,11 @@ CommSpec read_comm_spec(const std::filesystem::path& file)
                 spec.communication_type != "memory" && spec.communication_type != "files")
                 throw Error(at, "communication type: expected pipes, sockets, memory or files, found '" +
                                     value + "'");
+            // the chunk size, as atoi reads it; past a million it only costs memory
             std::string count;
             if (words >> count)
-                spec.queries_per_chunk = std::max(0, std::atoi(count.c_str()));
+                spec.queries_per_chunk = static_cast<int>(
+                    std::clamp(std::strtol(count.c_str(), nullptr, 10), 0L, 1'000'000L));
         } else if (name == "following module") {
             spec.following_module = yes(value);
         } else if (name == "verbose") {

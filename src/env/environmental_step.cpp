@@ -41,18 +41,27 @@ SentVector sent_scalar(const std::optional<TurtleFormat>& format, double v)
 
 }  // namespace
 
-Connection connect(const CommSpec& spec, const Context& context)
+Connection connect(const CommSpec& spec, const Context& context, const ProgramPermission& programs)
 {
     const std::string& program = spec.executable.front();
     const std::vector<std::string> args(spec.executable.begin() + 1, spec.executable.end());
-    if (!make_builtin(program, args, context))
+    const std::string name = std::filesystem::path(program).filename().string();
+    Connection c;
+    if (make_builtin(program, args, context)) {
+        c.make = [program, args, context] { return make_builtin(program, args, context); };
+        c.description = name + " (built in: no program is started)";
+        return c;
+    }
+    if (!programs.allowed)
         throw Error(spec.executable_loc,
                     "the environmental program '" + program +
                         "' is not one of Cambium's built-in environments (honda81, ecosystem, "
-                        "chiba, clover), and Cambium does not start external environmental programs");
-    Connection c;
-    c.make = [program, args, context] { return make_builtin(program, args, context); };
-    c.description = std::filesystem::path(program).filename().string() + " (built in: no program is started)";
+                        "chiba, clover); a model file starts a program only with "
+                        "--allow-environment-program");
+    c.make = [spec, context, limits = programs.limits] {
+        return make_external_program(spec, context, limits);
+    };
+    c.description = program + " (an external program, started in " + context.folder.string() + ")";
     return c;
 }
 

@@ -9,6 +9,7 @@
 
 #include "env/comm_spec.h"
 #include "env/environment.h"
+#include "env/external_program.h"
 #include "geom/view_file.h"
 #include "lsys/module_string.h"
 
@@ -20,10 +21,19 @@ struct Connection {
     std::string description;  ///< "honda81 (built in)": for the line that says which
 };
 
+/// Whether, and how, a `.e` file may start a program of its own.
+struct ProgramPermission {
+    bool allowed = false;  ///< --allow-environment-program
+    ExternalLimits limits;
+};
+
 /// Connects a `.e` file: Cambium's built-in of the executable's name (honda81,
 /// ecosystem, chiba, clover), made once here so that its specification file's errors
-/// come before any work. Any other program is an Error naming it and the file.
-Connection connect(const CommSpec& spec, const Context& context);
+/// come before any work; any other program runs as an external program when the
+/// permission allows it (each derivation run starts its own), else it is an Error
+/// naming the program, the `.e` line and the option.
+Connection connect(const CommSpec& spec, const Context& context,
+                   const ProgramPermission& programs = {});
 
 /// One derivation run's environmental steps, with the run's own environment.
 class EnvironmentalStep {

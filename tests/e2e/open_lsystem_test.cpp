@@ -78,6 +78,7 @@ TEST(OpenLSystem, AProgramThatIsNotBuiltInIsRefusedBeforeAnyWork)
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("plant.e:1:13"), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find("obcheck"), std::string::npos);
+        EXPECT_NE(std::string(e.what()).find("--allow-environment-program"), std::string::npos);
     }
 }
 
