@@ -306,7 +306,7 @@ void add_ground(geom::Scene& out, const SceneGround& ground, const SceneLimits& 
         // counter-clockwise seen from above: the front faces +y
         mesh.triangles = {{0, 2, 1}, {0, 3, 2}};
     } else {
-        mesh = read_obj_mesh(*ground.mesh, limits.max_mesh_triangles);
+        mesh = read_obj_mesh(*ground.mesh, limits);
     }
     geom::Bounds3 extent;
     for (const geom::Float3& p : mesh.positions)
