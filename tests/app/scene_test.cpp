@@ -440,7 +440,8 @@ TEST(SceneAssembly, EachDistinctVariantIsDerivedOnce)
     const std::string m = R"("model": "m", "command": "cpfg p.l p.v", )";
     const std::string three = R"("placements": [{}, {"translate": [2, 0, 0]}, {"translate": [4, 0, 0]}])";
     // two entries of one model and steps: one load, one derivation, six plants
-    auto [r1, instances1] = report_of("{" + m + "\"steps\": 2, " + three + "}, {" + m +
+    // (the second's command differs in spaces only)
+    auto [r1, instances1] = report_of("{" + m + "\"steps\": 2, " + three + "}, {\"model\": \"m\", " +
                                       "\"command\": \"cpfg  p.l   p.v\", \"steps\": 2, " + three + "}");
     EXPECT_EQ(r1.models_loaded, 1u);
     EXPECT_EQ(r1.derivations, 1u);
@@ -542,6 +543,34 @@ TEST(SceneAssembly, CameraUpIsHonoured)
     EXPECT_NEAR(up.x, std::sqrt(0.5), 1e-6);
     EXPECT_NEAR(up.y, std::sqrt(0.5), 1e-6);
     EXPECT_NEAR(up.z, 0, 1e-6);
+}
+
+// Placements times the organs each one composes are counted against the memory budget
+// before any instance is made (the scene file bounds the placements alone).
+TEST(SceneAssembly, PlacementsTimesOrgansAreWithinTheMemoryBudget)
+{
+    SceneFolder f("organs_budget");
+    f.tiny_model("m");
+    app::SceneFile s = app::read_scene_file(
+        f.scene(with_plant(R"("steps": 3, "placements": {"scatter": {"rectangle": [0, 0, 100, 100], "count": 1000}})")),
+        app::Options{});
+    // 1000 plants with 3 flowers each: 4000 instances of about 150 B, 600 kB
+    app::Options budget;
+    budget.max_memory_bytes = 400'000;
+    try {
+        app::assemble_scene(s, budget, {app::OrganPlacement::compose, false});
+        ADD_FAILURE() << "4000 instances passed a budget of 400 kB";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("field.json: plants: the placements with their organs (-o>) need about"),
+                  std::string::npos)
+            << e.what();
+    }
+    budget.max_memory_bytes = 800'000;
+    EXPECT_EQ(app::assemble_scene(s, budget, {app::OrganPlacement::compose, false}).instances.size(),
+              4000u);
+    // drawn inline, every copy's primitives count (7 a plant: 100 B each)
+    budget.max_memory_bytes = 400'000;
+    EXPECT_THROW(app::assemble_scene(s, budget, {app::OrganPlacement::compose, true}), Error);
 }
 
 TEST(SceneAssembly, InstancedFieldRendersAsTheSamePlantsInline)
