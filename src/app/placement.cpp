@@ -102,13 +102,12 @@ public:
     double extent() const
     {
         double most = 0;
+        auto widen = [&](double v) { most = std::max(most, std::abs(v)); };
         if (!m_mesh)
-            for (double v : m_spec.rectangle)
-                most = std::max(most, std::abs(v));
+            std::for_each(m_spec.rectangle.begin(), m_spec.rectangle.end(), widen);
         else
             for (const geom::Float3& v : m_mesh->positions)
-                most = std::max({most, double(std::abs(v[0])), double(std::abs(v[1])),
-                                 double(std::abs(v[2]))});
+                std::for_each(v.begin(), v.end(), widen);
         return most;
     }
 

@@ -431,16 +431,16 @@ void check_placed_size(const SceneFile& file, const Entries& entries,
         }
     }
     const std::size_t max_instances = SceneLimits{}.max_instances;
+    const std::string what =
+        file.file.string() + ": plants: the placements with their organs (-o>) ";
     if (instances > double(max_instances))
-        throw Error(file.file.string() + ": plants: the placements with their organs (-o>) "
-                    "make " + std::to_string(std::uint64_t(instances)) +
+        throw Error(what + "make " + std::to_string(std::uint64_t(instances)) +
                     " instances, more than the limit of " + std::to_string(max_instances));
     double bytes = instances * instance_bytes + primitives * primitive_bytes;
     if (bytes > double(options.max_memory_bytes))
-        throw Error(file.file.string() + ": plants: the placements with their organs (-o>) "
-                    "need about " + byte_size_text(std::uint64_t(bytes)) +
-                    ", more than the memory budget of " +
-                    byte_size_text(options.max_memory_bytes) + " (--max-memory)");
+        throw Error(what + "need about " + byte_size_text(std::uint64_t(bytes)) +
+                    ", more than the memory budget of " + byte_size_text(options.max_memory_bytes) +
+                    " (--max-memory)");
 }
 
 }  // namespace

@@ -582,9 +582,9 @@ void check_structure(const std::string& text, const std::string& name, const Sce
             }
         } else if (c == '{' || c == '[') {
             if (open.size() == limits.max_nesting)
-                throw Error(location(name, text, i),
-                            "JSON nested more than " + std::to_string(limits.max_nesting) +
-                                " levels deep");
+                throw Error(
+                    location(name, text, i),
+                    "JSON nested more than " + std::to_string(limits.max_nesting) + " levels deep");
             open.push_back({c == '{', {}});
             expect_key = c == '{';
             ++i;

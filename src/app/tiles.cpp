@@ -140,8 +140,9 @@ render::Image assemble_tiles(const fs::path& output, int count, int width, int h
         // Its size is bounded by the band it must hold before anything is read: a regular
         // file no larger than that band with every layer (the header then says exactly).
         render::PixelRect rect = band(i, count, width, height);
-        std::uintmax_t most = magic.size() + sizeof(Header) +
-                              std::uintmax_t(rect.width) * std::uintmax_t(rect.height) * 11 * sizeof(float);
+        std::uintmax_t most =
+            magic.size() + sizeof(Header) +
+            std::uintmax_t(rect.width) * std::uintmax_t(rect.height) * 11 * sizeof(float);
         std::string bytes = geom::read_file(file, "the tile", most);
         Tile tile = decode_tile(bytes, file.string());
         if (tile.index != i || tile.count != count || tile.width != width ||

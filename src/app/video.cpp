@@ -55,7 +55,8 @@ fs::path require_ffmpeg(const fs::path& video)
 
 fs::path video_frame_pattern(const PrivateFolder& folder) { return folder.path() / "%06d.png"; }
 
-void encode_video(const fs::path& ffmpeg, const PrivateFolder& folder, int fps, const fs::path& video)
+void encode_video(const fs::path& ffmpeg, const PrivateFolder& folder, int fps,
+                  const fs::path& video)
 {
     // Relative names inside the private folder, where ffmpeg runs: its -y can only
     // replace what this run made there.
@@ -63,13 +64,13 @@ void encode_video(const fs::path& ffmpeg, const PrivateFolder& folder, int fps, 
     bool webm = lower_extension(video) == ".webm";
     ProcessIo io;
     io.capture = false;  // ffmpeg's messages go to the user
-    ProcessResult result = run_process(
-        {fs::absolute(ffmpeg).string(), "-nostdin", "-hide_banner", "-loglevel", "error", "-y",
-         "-framerate", std::to_string(fps), "-pattern_type", "glob", "-i", "*.png", "-c:v",
-         webm ? "libvpx-vp9" : "libx264", "-pix_fmt", "yuv420p",
-         // yuv420p needs even dimensions
-         "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", encoded},
-        folder.path(), io, ProcessLimits{0, 0, 0, 0});
+    ProcessResult result =
+        run_process({fs::absolute(ffmpeg).string(), "-nostdin", "-hide_banner", "-loglevel",
+                     "error", "-y", "-framerate", std::to_string(fps), "-pattern_type", "glob",
+                     "-i", "*.png", "-c:v", webm ? "libvpx-vp9" : "libx264", "-pix_fmt", "yuv420p",
+                     // yuv420p needs even dimensions
+                     "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", encoded},
+                    folder.path(), io, ProcessLimits{0, 0, 0, 0});
     if (result.end != ProcessResult::End::exited || result.exit_code != 0)
         throw Error(FileLoc{video.string()},
                     "ffmpeg could not encode the frames (see ffmpeg's message above)");

@@ -186,11 +186,14 @@ AnimationFile parse_animation_file(std::string_view text, std::string_view name)
         else if (command == "swap interval")
             a.swap_interval = value.integer("a whole number");
         else if (command == "first frame")
-            a.first_frame = std::max(0, value.bounded("a frame number", -max_animation_frame));  // cpfg clamps to 0
+            a.first_frame = std::max(
+                0, value.bounded("a frame number", -max_animation_frame));  // cpfg clamps to 0
         else if (command == "last frame")
-            a.last_frame = value.bounded("a frame number", -max_animation_frame);  // negative: the derivation length
+            a.last_frame = value.bounded("a frame number",
+                                         -max_animation_frame);  // negative: the derivation length
         else if (command == "step")
-            a.step = std::max(1, value.bounded("the step", -max_animation_frame));  // cpfg: 0 or less is 1
+            a.step = std::max(
+                1, value.bounded("the step", -max_animation_frame));  // cpfg: 0 or less is 1
         else if (command == "frame intervals") {
             a.intervals.clear();
             do {

@@ -258,7 +258,7 @@ Contour parse_one(LineCursor& lines)
         // Compared before combining: 100 * major overflows int for a large major.
         if (major != 1 || minor < 1 || minor > 3)
             throw Error(version_at, "unknown contour format " + std::to_string(major) + "." +
-                                std::to_string(minor) + " (cpfg reads 1 1, 1 2 and 1 3)");
+                                        std::to_string(minor) + " (cpfg reads 1 1, 1 2 and 1 3)");
         c = parse_versioned(lines, 100 * major + minor);
     } else {
         c = parse_plain(lines);

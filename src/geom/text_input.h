@@ -19,7 +19,8 @@ constexpr std::uintmax_t max_text_file_bytes = 64u << 20;
 /// size is compared with the limit before anything is read or allocated. Error naming
 /// the file (and `what` it is) when it is missing, not a regular file, unreadable or
 /// too large.
-std::string read_file(const std::filesystem::path& file, const char* what, std::uintmax_t max_bytes);
+std::string read_file(const std::filesystem::path& file, const char* what,
+                      std::uintmax_t max_bytes);
 
 /// The size of `file` when it is a regular file of at most `max_bytes` (read_file's
 /// checks, for readers that stream a file instead of holding it); Error otherwise.

@@ -78,6 +78,22 @@ std::string error_of(const SceneFolder& folder, const std::string& text)
     return "";
 }
 
+/// A scene's text and a part of the message it must give.
+struct ErrorCase {
+    std::string text, message;
+};
+
+/// Each case's scene gives an error holding its message.
+void expect_errors(const SceneFolder& folder, const std::vector<ErrorCase>& cases)
+{
+    for (const ErrorCase& c : cases) {
+        std::string message = error_of(folder, c.text);
+        EXPECT_NE(message.find(c.message), std::string::npos)
+            << "scene: " << c.text.substr(0, 300) << "\nexpected: " << c.message
+            << "\ngot: " << message;
+    }
+}
+
 const char* tiny_plant = R"("model": "m", "command": "cpfg p.l p.v")";
 
 std::string with_plant(const std::string& plant_rest, const std::string& rest = "")
@@ -171,10 +187,7 @@ TEST(SceneFile, ErrorsNameTheFileAndTheJsonPath)
 {
     SceneFolder f("bad");
     f.tiny_model("m");
-    struct Case {
-        std::string text, message;
-    };
-    const std::vector<Case> cases = {
+    expect_errors(f, {
         {R"({"plants": []})", "field.json: plants: must be a non-empty list"},
         {R"({"plant": []})", "field.json: plant: unknown key"},
         {with_plant(R"("placements": {"scatter": {"rectangle": [0,0,1,1], "count": 0}})"),
@@ -226,12 +239,7 @@ TEST(SceneFile, ErrorsNameTheFileAndTheJsonPath)
          "render.spp: must be an integer from 1 to"},
         {with_plant(R"("placements": {"scatter": {"mesh": "none.obj", "count": 3}})"),
          "plants[0].placements.scatter.mesh: "},
-    };
-    for (const Case& c : cases) {
-        std::string message = error_of(f, c.text);
-        EXPECT_NE(message.find(c.message), std::string::npos)
-            << "scene: " << c.text << "\nexpected: " << c.message << "\ngot: " << message;
-    }
+    });
     // Syntax errors keep nlohmann's position as line and column.
     std::string syntax = error_of(f, "{\n  \"plants\": [\n    {\"model\": }\n  ]\n}\n");
     EXPECT_NE(syntax.find("field.json:3:15:"), std::string::npos) << syntax;
@@ -255,10 +263,7 @@ TEST(SceneFile, DuplicateKeysDeepNestingAndHugeNumbersAreErrorsWithPlaces)
 {
     SceneFolder f("json");
     f.tiny_model("m");
-    struct Case {
-        std::string text, message;
-    };
-    const std::vector<Case> cases = {
+    expect_errors(f, {
         // a reviewer reading the first "plants" would not see the folder the second names
         {"{\"plants\": [],\n \"plants\": []}",
          "field.json:2:2: error: the key \"plants\" appears twice in one object"},
@@ -270,13 +275,7 @@ TEST(SceneFile, DuplicateKeysDeepNestingAndHugeNumbersAreErrorsWithPlaces)
          "field.json:1:36: error: the number 1e999 is out of range"},
         {"{\"plants\": " + std::string(200000, '[') + std::string(200000, ']') + "}",
          "field.json:1:75: error: JSON nested more than 64 levels deep"},
-    };
-    for (const Case& c : cases) {
-        std::string message = error_of(f, c.text);
-        EXPECT_NE(message.find(c.message), std::string::npos)
-            << "scene: " << c.text.substr(0, 200) << "\nexpected: " << c.message
-            << "\ngot: " << message;
-    }
+    });
     // the same key in different objects, and in strings and comments, is no duplicate
     std::string fine = error_of(
         f, R"({"plants": [{"model": "m", "command": "cpfg p.l p.v", "placements": [{"scale": 1}, {"scale": 2}]}],
