@@ -11,6 +11,7 @@
 
 #include "app/scene_file.h"
 #include "base/diagnostics.h"
+#include "geom/text_input.h"
 
 namespace cambium::app {
 namespace {
@@ -27,9 +28,16 @@ private:
 };
 
 /// Accepted points in a hash grid of cells min_spacing wide, for the spacing test.
+/// Cells are never narrower than 2^-40 of the largest coordinate `extent`: a tiny
+/// spacing over a large area would otherwise give cell indices past long long's range
+/// (undefined, then every point in one cell). Wider cells still hold every neighbour
+/// closer than the spacing within one cell of a point's.
 class SpacingGrid {
 public:
-    explicit SpacingGrid(double spacing) : m_spacing(spacing) {}
+    SpacingGrid(double spacing, double extent)
+        : m_spacing(spacing), m_cell(std::max(spacing, extent * 0x1p-40))
+    {
+    }
 
     bool far_enough(const geom::Vec3& p) const
     {
@@ -59,9 +67,9 @@ public:
 private:
     std::array<long long, 3> cell(const geom::Vec3& p) const
     {
-        return {static_cast<long long>(std::floor(p.x / m_spacing)),
-                static_cast<long long>(std::floor(p.y / m_spacing)),
-                static_cast<long long>(std::floor(p.z / m_spacing))};
+        return {static_cast<long long>(std::floor(p.x / m_cell)),
+                static_cast<long long>(std::floor(p.y / m_cell)),
+                static_cast<long long>(std::floor(p.z / m_cell))};
     }
     static std::uint64_t key(long long x, long long y, long long z)
     {
@@ -70,6 +78,7 @@ private:
     }
 
     double m_spacing;
+    double m_cell;  ///< at least m_spacing
     std::unordered_map<std::uint64_t, std::vector<geom::Vec3>> m_cells;
 };
 
@@ -87,6 +96,19 @@ public:
         }
         if (!(total > 0))
             throw Error("the scatter's mesh has no area");
+    }
+
+    /// The largest absolute coordinate a point can have.
+    double extent() const
+    {
+        double most = 0;
+        auto widen = [&](double v) { most = std::max(most, std::abs(v)); };
+        if (!m_mesh)
+            std::for_each(m_spec.rectangle.begin(), m_spec.rectangle.end(), widen);
+        else
+            for (const geom::Float3& v : m_mesh->positions)
+                std::for_each(v.begin(), v.end(), widen);
+        return most;
     }
 
     geom::Vec3 operator()(Uniform& u) const
@@ -163,7 +185,7 @@ std::vector<Transform> scatter(const ScatterSpec& spec, const GroundMesh* mesh)
 {
     Uniform u(spec.seed);
     PointSource source(spec, mesh);
-    SpacingGrid grid(spec.min_spacing);
+    SpacingGrid grid(spec.min_spacing, source.extent());
     std::vector<Transform> out;
     out.reserve(spec.count);
     // Rejection: a bounded number of candidates per wanted point, so a full area ends
@@ -187,20 +209,28 @@ std::vector<Transform> scatter(const ScatterSpec& spec, const GroundMesh* mesh)
     return out;
 }
 
-GroundMesh read_obj_mesh(const std::filesystem::path& file, std::size_t max_triangles)
+GroundMesh read_obj_mesh(const std::filesystem::path& file, const SceneLimits& limits)
 {
-    std::ifstream in(file);
+    const std::size_t max_triangles = limits.max_mesh_triangles;
+    geom::regular_file_size(file, "the mesh", limits.max_mesh_bytes);
+    std::ifstream in(file, std::ios::binary);
     if (!in)
         throw Error(FileLoc{file.string()}, "cannot read the mesh");
     GroundMesh mesh;
-    std::string text;
+    // a line is read into a buffer of the limit's size, never grown to the whole file
+    std::vector<char> buffer(limits.max_mesh_line_bytes + 1);
     int line = 0;
-    while (std::getline(in, text)) {
+    while (in.getline(buffer.data(), std::streamsize(buffer.size())) || in.gcount() > 0) {
         ++line;
-        std::istringstream words(text);
+        FileLoc loc{file.string(), line, 1};
+        if (in.fail() && !in.eof()) {
+            loc.column = int(limits.max_mesh_line_bytes) + 1;
+            throw Error(loc, "the line is longer than " +
+                                 std::to_string(limits.max_mesh_line_bytes) + " bytes");
+        }
+        std::istringstream words(std::string(buffer.data()));
         std::string kind;
         words >> kind;
-        FileLoc loc{file.string(), line, 1};
         if (kind == "v") {
             double x, y, z;
             if (!(words >> x >> y >> z) || !std::isfinite(x) || !std::isfinite(y) ||

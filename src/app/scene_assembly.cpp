@@ -23,6 +23,7 @@
 
 #include "app/pipeline.h"
 #include "base/diagnostics.h"
+#include "base/limits.h"
 #include "base/subprocess.h"
 #include "geom/background_scene.h"
 #include "geom/placed_geometry.h"
@@ -128,6 +129,13 @@ bool same_texture(const geom::TextureDef& x, const geom::TextureDef& y)
 /// Tables appended to a combined table: (offset, size) each.
 using Tables = std::vector<std::pair<std::size_t, std::size_t>>;
 
+/// The primitives `g` draws (each about 100 B in the BVH and its arrays).
+std::size_t primitive_count(const geom::Geometry& g)
+{
+    return g.lines.segment_count() + g.curves.segment_count() + g.spheres.size() + g.discs.size() +
+           g.mesh.size();
+}
+
 /// A plant variant ready to place: its prototype, its organs' instances in its own
 /// frame, its bounds.
 struct PlacedVariant {
@@ -210,9 +218,7 @@ private:
         constexpr double instance_bytes = 150, primitive_bytes = 100;
         double drawn = 0;
         for (const geom::Instance& i : variant.instances) {
-            const geom::Geometry& g = variant.prototypes.at(i.prototype).geometry;
-            drawn += double(g.lines.segment_count() + g.curves.segment_count() +
-                            g.spheres.size() + g.discs.size() + g.mesh.size()) *
+            drawn += double(primitive_count(variant.prototypes.at(i.prototype).geometry)) *
                      primitive_bytes;
         }
         double placed = double(variant.instances.size()) * double(placements) * instance_bytes;
@@ -307,7 +313,7 @@ void add_ground(geom::Scene& out, const SceneGround& ground, const SceneLimits& 
         // counter-clockwise seen from above: the front faces +y
         mesh.triangles = {{0, 2, 1}, {0, 3, 2}};
     } else {
-        mesh = read_obj_mesh(*ground.mesh, limits.max_mesh_triangles);
+        mesh = read_obj_mesh(*ground.mesh, limits);
     }
     geom::Bounds3 extent;
     for (const geom::Float3& p : mesh.positions)
@@ -402,6 +408,44 @@ std::vector<geom::Light> scene_lights(const SceneFile& file)
 
 }  // namespace
 
+namespace {
+
+/// What placing every plant adds, counted before any is placed: each placement brings
+/// its plant and every organ its view composes (-o> objects), or a copy of the whole
+/// plant when inlined. The scene file bounded the placements alone; their product with
+/// the organs is bounded here, by the instance limit and the memory budget.
+template <typename Entries>
+void check_placed_size(const SceneFile& file, const Entries& entries,
+                       const std::vector<std::vector<PlacedVariant>>& placed,
+                       const AssemblyOptions& how, const Options& options)
+{
+    constexpr double instance_bytes = 150, primitive_bytes = 100;  // as flattening_is_smaller
+    double instances = 0, primitives = 0;
+    for (std::size_t e = 0; e < file.plants.size(); ++e) {
+        const auto& ref = entries[e];
+        for (std::size_t i = 0; i < file.plants[e].placements.size(); ++i) {
+            const PlacedVariant& v = placed[ref.group][ref.variants[i % ref.variants.size()]];
+            if (how.inline_plants)
+                primitives += double(primitive_count(v.flat));
+            else
+                instances += double(v.prototype ? 1 : 0) + double(v.organs.size());
+        }
+    }
+    const std::size_t max_instances = SceneLimits{}.max_instances;
+    const std::string what =
+        file.file.string() + ": plants: the placements with their organs (-o>) ";
+    if (instances > double(max_instances))
+        throw Error(what + "make " + std::to_string(std::uint64_t(instances)) +
+                    " instances, more than the limit of " + std::to_string(max_instances));
+    double bytes = instances * instance_bytes + primitives * primitive_bytes;
+    if (bytes > double(options.max_memory_bytes))
+        throw Error(what + "need about " + byte_size_text(std::uint64_t(bytes)) +
+                    ", more than the memory budget of " + byte_size_text(options.max_memory_bytes) +
+                    " (--max-memory)");
+}
+
+}  // namespace
+
 geom::Scene assemble_scene(const SceneFile& file, const Options& options,
                            const AssemblyOptions& how, AssemblyReport* report)
 {
@@ -467,6 +511,7 @@ geom::Scene assemble_scene(const SceneFile& file, const Options& options,
     }
     out.line_radius_in_pixels = pixel_lines;
 
+    check_placed_size(file, entries, placed, how, options);
     AssemblyReport r;
     for (std::size_t e = 0; e < file.plants.size(); ++e) {
         const ScenePlant& plant = file.plants[e];

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <regex>
 #include <set>
@@ -15,6 +16,7 @@
 #include "app/shot_options.h"
 #include "base/confinement.h"
 #include "base/diagnostics.h"
+#include "geom/text_input.h"
 
 namespace cambium::app {
 namespace {
@@ -156,8 +158,13 @@ fs::path resolve_under(const Node& n, const fs::path& folder, const std::string&
     if (p.is_absolute())
         n.fail("'" + name + "' is an absolute path; files must lie in the scene's folder "
                "(or give --allow-file-access)");
-    fs::path base = fs::weakly_canonical(folder);
-    fs::path full = fs::weakly_canonical(base / p);
+    // a link loop (a folder linked to itself) is a message at the JSON path, not a raw
+    // filesystem exception
+    std::error_code ec;
+    fs::path base = fs::weakly_canonical(folder, ec);
+    fs::path full = ec ? fs::path() : fs::weakly_canonical(base / p, ec);
+    if (ec)
+        n.fail("'" + name + "' cannot be resolved: " + ec.message());
     if (!is_within(base, full))
         n.fail("'" + name + "' lies outside the folder " + folder.string() +
                " (give --allow-file-access to allow it)");
@@ -354,7 +361,7 @@ std::vector<Transform> placements(const Node& n, Context& c)
         std::optional<GroundMesh> mesh;
         if (spec.mesh) {
             try {
-                mesh = read_obj_mesh(*spec.mesh, c.limits.max_mesh_triangles);
+                mesh = read_obj_mesh(*spec.mesh, c.limits);
             } catch (const Error& e) {
                 sn["mesh"].fail(nested_message(e));
             }
@@ -379,7 +386,8 @@ ScenePlant plant(const Node& n, Context& c)
     ScenePlant p;
     p.path = n.path();
     p.folder = resolve_under(n["model"], c.folder, n["model"].string(), c.options.allow_file_access);
-    if (!fs::is_directory(p.folder))
+    std::error_code ec;
+    if (!fs::is_directory(p.folder, ec))
         n["model"].fail("'" + n["model"].string() + "' is not a folder");
     p.command = n["command"].string();
     p.model = model_options(n["command"], p.folder, c.options.allow_file_access);
@@ -519,39 +527,106 @@ SceneRender render_settings(const Node& n)
     return r;
 }
 
+/// The line and column of byte `at` of `text`.
+FileLoc location(const std::string& name, const std::string& text, std::size_t at)
+{
+    FileLoc loc{name, 1, 1};
+    for (std::size_t i = 0; i < std::min(at, text.size()); ++i) {
+        if (text[i] == '\n') {
+            ++loc.line;
+            loc.column = 1;
+        } else {
+            ++loc.column;
+        }
+    }
+    return loc;
+}
+
+/// What the JSON parser accepts silently or reports without a place, checked first at
+/// file:line:column: nesting deeper than limits.max_nesting (each level is a value the
+/// parser builds: 63 MiB of '[' would be 66 million), a key twice in one object (the last
+/// would win unseen), a number past double's range. Malformed text is left to the parser.
+void check_structure(const std::string& text, const std::string& name, const SceneLimits& limits)
+{
+    struct Open {
+        bool object;
+        std::set<std::string> keys;
+    };
+    std::vector<Open> open;
+    bool expect_key = false;  // a string here, in an object, is a key
+    const std::size_t n = text.size();
+    for (std::size_t i = 0; i < n;) {
+        char c = text[i];
+        if (c == '/' && i + 1 < n && (text[i + 1] == '/' || text[i + 1] == '*')) {
+            std::size_t end = text[i + 1] == '/' ? text.find('\n', i) : text.find("*/", i + 2);
+            if (end == std::string::npos)
+                return;
+            i = end + (text[i + 1] == '/' ? 1 : 2);
+        } else if (c == '"') {
+            std::size_t start = i++;
+            for (; i < n && text[i] != '"'; ++i)
+                if (text[i] == '\\')
+                    ++i;
+            if (i >= n)
+                return;
+            ++i;
+            if (expect_key && !open.empty() && open.back().object) {
+                std::string key = text.substr(start, i - start);
+                try {
+                    key = json::parse(key).get<std::string>();  // "\u0061" is "a"
+                } catch (const json::exception&) {
+                }
+                if (!open.back().keys.insert(key).second)
+                    throw Error(location(name, text, start),
+                                "the key " + json(key).dump() +
+                                    " appears twice in one object (the last would win unseen)");
+                expect_key = false;
+            }
+        } else if (c == '{' || c == '[') {
+            if (open.size() == limits.max_nesting)
+                throw Error(
+                    location(name, text, i),
+                    "JSON nested more than " + std::to_string(limits.max_nesting) + " levels deep");
+            open.push_back({c == '{', {}});
+            expect_key = c == '{';
+            ++i;
+        } else if (c == '}' || c == ']') {
+            if (!open.empty())
+                open.pop_back();
+            expect_key = false;
+            ++i;
+        } else if (c == ',') {
+            expect_key = !open.empty() && open.back().object;
+            ++i;
+        } else if (c == '-' || (c >= '0' && c <= '9')) {
+            std::size_t end = std::min(text.find_first_not_of("0123456789+-.eE", i), n);
+            std::string number = text.substr(i, end - i);
+            if (std::isinf(std::strtod(number.c_str(), nullptr)))
+                throw Error(location(name, text, i),
+                            "the number " + number.substr(0, 40) + " is out of range");
+            i = end;
+        } else {
+            ++i;
+        }
+    }
+}
+
 json parse_document(const fs::path& file, const std::string& name, const SceneLimits& limits)
 {
-    std::error_code ec;
-    std::uintmax_t size = fs::file_size(file, ec);
-    if (ec || !fs::is_regular_file(file))
-        throw Error(FileLoc{name}, "cannot read the scene file");
-    if (size > limits.max_file_bytes)
-        throw Error(FileLoc{name}, "the scene file is larger than " +
-                                       std::to_string(limits.max_file_bytes >> 20) + " MiB");
-    std::ifstream in(file, std::ios::binary);
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (!in && !in.eof())
-        throw Error(FileLoc{name}, "cannot read the scene file");
+    std::string text = geom::read_file(file, "the scene file", limits.max_file_bytes);
+    check_structure(text, name, limits);
     try {
         // Comments are allowed: scenes are written by hand.
         return json::parse(text, nullptr, true, true);
     } catch (const json::parse_error& e) {
         // nlohmann gives the byte offset of the error: turn it into line and column.
-        std::size_t at = std::min<std::size_t>(e.byte > 0 ? e.byte - 1 : 0, text.size());
-        int line = 1, column = 1;
-        for (std::size_t i = 0; i < at; ++i) {
-            if (text[i] == '\n') {
-                ++line;
-                column = 1;
-            } else {
-                ++column;
-            }
-        }
+        FileLoc at = location(name, text, e.byte > 0 ? e.byte - 1 : 0);
         std::string what = e.what();
         // "[json.exception.parse_error.101] parse error at line 1, column 2: syntax error ..."
         std::size_t colon = what.find(": ");
-        throw Error(FileLoc{name, line, column},
-                    "JSON " + (colon == std::string::npos ? what : what.substr(colon + 2)));
+        throw Error(at, "JSON " + (colon == std::string::npos ? what : what.substr(colon + 2)));
+    } catch (const json::exception& e) {
+        throw Error(FileLoc{name}, std::string("JSON ") + e.what());
     }
 }
 

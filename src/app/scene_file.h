@@ -20,10 +20,13 @@ namespace cambium::app {
 /// entries and the instances it places (the scatters' counts included).
 struct SceneLimits {
     std::uintmax_t max_file_bytes = 64u << 20;
+    std::size_t max_nesting = 64;  ///< JSON objects and arrays within one another
     std::size_t max_plants = 10'000;
     std::size_t max_variants = 1'000;       ///< distinct (model, command, steps, seed)
     std::size_t max_instances = 10'000'000; ///< placements of plants, all entries together
     std::size_t max_mesh_triangles = 10'000'000;  ///< a ground or scatter OBJ mesh
+    std::uintmax_t max_mesh_bytes = 1u << 30;     ///< its file (a regular file)
+    std::size_t max_mesh_line_bytes = 64u << 10;  ///< one line of it
 };
 
 /// A 3x4 column-major transform, as geom::Instance::transform.
@@ -119,8 +122,10 @@ SceneFile read_scene_file(const std::filesystem::path& file, const Options& opti
 /// within `scale`. Over `mesh` (when given) points are uniform in area.
 std::vector<Transform> scatter(const ScatterSpec& spec, const GroundMesh* mesh = nullptr);
 
-/// Reads the vertices (`v`) and faces (`f`, fanned into triangles) of an OBJ file.
-GroundMesh read_obj_mesh(const std::filesystem::path& file, std::size_t max_triangles);
+/// Reads the vertices (`v`) and faces (`f`, fanned into triangles) of an OBJ file: a
+/// regular file within limits.max_mesh_bytes, lines within max_mesh_line_bytes, at most
+/// max_mesh_triangles triangles (errors at file:line otherwise).
+GroundMesh read_obj_mesh(const std::filesystem::path& file, const SceneLimits& limits);
 
 /// The transform of an explicit placement: scale, then rotation about +y, then translation.
 Transform placement_transform(const geom::Vec3& translate, double rotate_y_deg, double scale);

@@ -738,17 +738,21 @@ int run_sequence(const Options& options, const SequenceOutputs& outputs)
     fs::path ffmpeg;
     if (!videos.empty())
         ffmpeg = require_ffmpeg(videos.front());  // before any work
+    // Each video's frames and encoding in a fresh private folder beside it, removed
+    // however the run ends (nothing a model folder plants there can be reached).
+    std::vector<PrivateFolder> work;
+    work.reserve(videos.size());
     for (const fs::path& video : videos) {
-        fs::create_directories(video_frames_folder(video));
-        frames.images.push_back(video_frames_folder(video) / "%06d.png");
+        work.emplace_back(video);
+        frames.images.push_back(video_frame_pattern(work.back()));
     }
     int status = options.shot.turntable > 0 ? run_turntable(options, frames)
                                             : run_animation(options, frames);
     if (status != 0 || (outputs.mpi && outputs.mpi->rank() != 0))
         return status;
-    for (const fs::path& video : videos) {
-        encode_video(ffmpeg, video_frames_folder(video), options.shot.fps, video);
-        outputs.say("wrote " + video.string());
+    for (std::size_t i = 0; i < videos.size(); ++i) {
+        encode_video(ffmpeg, work[i], options.shot.fps, videos[i]);
+        outputs.say("wrote " + videos[i].string());
     }
     return 0;
 }

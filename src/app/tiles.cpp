@@ -4,13 +4,12 @@
 
 #include <algorithm>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <limits>
 
 #include <fmt/format.h>
 
 #include "base/diagnostics.h"
+#include "geom/text_input.h"
 
 namespace cambium::app {
 namespace {
@@ -135,11 +134,16 @@ render::Image assemble_tiles(const fs::path& output, int count, int width, int h
     render::Image whole;
     for (int i = 0; i < count; ++i) {
         fs::path file = tile_file(output, i, count);
-        std::ifstream in(file, std::ios::binary);
-        if (!in)
+        if (!fs::exists(file))
             throw Error(FileLoc{file.string()},
                         fmt::format("cannot be read: tile {} of {} is missing", i, count));
-        std::string bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+        // Its size is bounded by the band it must hold before anything is read: a regular
+        // file no larger than that band with every layer (the header then says exactly).
+        render::PixelRect rect = band(i, count, width, height);
+        std::uintmax_t most =
+            magic.size() + sizeof(Header) +
+            std::uintmax_t(rect.width) * std::uintmax_t(rect.height) * 11 * sizeof(float);
+        std::string bytes = geom::read_file(file, "the tile", most);
         Tile tile = decode_tile(bytes, file.string());
         if (tile.index != i || tile.count != count || tile.width != width ||
             tile.height != height || tile.rect != band(i, count, width, height))

@@ -2,17 +2,15 @@
 // Video outputs (-o turn.mp4): frames encoded by Debian's ffmpeg, when it is installed.
 #include "app/video.h"
 
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cctype>
 #include <cstdlib>
 #include <string>
-#include <vector>
 
 #include "base/diagnostics.h"
+#include "base/subprocess.h"
 
 namespace cambium::app {
 
@@ -55,53 +53,28 @@ fs::path require_ffmpeg(const fs::path& video)
                 "apt-get install ffmpeg), or write frames with -o frame%03d.png");
 }
 
-fs::path video_frames_folder(const fs::path& video)
-{
-    fs::path folder = video;
-    folder += ".frames";
-    return folder;
-}
+fs::path video_frame_pattern(const PrivateFolder& folder) { return folder.path() / "%06d.png"; }
 
-void encode_video(const fs::path& ffmpeg, const fs::path& folder, int fps, const fs::path& video)
+void encode_video(const fs::path& ffmpeg, const PrivateFolder& folder, int fps,
+                  const fs::path& video)
 {
-    fs::path temporary = video;
-    temporary += ".cambium-tmp" + video.extension().string();
+    // Relative names inside the private folder, where ffmpeg runs: its -y can only
+    // replace what this run made there.
+    std::string encoded = "encoded" + video.extension().string();
     bool webm = lower_extension(video) == ".webm";
-    std::vector<std::string> args = {
-        ffmpeg.string(), "-hide_banner", "-loglevel", "error", "-y",
-        "-framerate", std::to_string(fps),
-        "-pattern_type", "glob", "-i", (folder / "*.png").string(),
-        "-c:v", webm ? "libvpx-vp9" : "libx264", "-pix_fmt", "yuv420p",
-        // yuv420p needs even dimensions
-        "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2",
-        temporary.string()};
-    std::vector<char*> argv;
-    for (std::string& a : args)
-        argv.push_back(a.data());
-    argv.push_back(nullptr);
-
-    pid_t child = ::fork();
-    if (child < 0)
-        throw Error(FileLoc{video.string()}, "cannot start ffmpeg");
-    if (child == 0) {
-        ::execv(argv[0], argv.data());
-        ::_exit(127);
-    }
-    int status = 0;
-    while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
-    }
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-        std::error_code ignored;
-        fs::remove(temporary, ignored);
+    ProcessIo io;
+    io.capture = false;  // ffmpeg's messages go to the user
+    ProcessResult result =
+        run_process({fs::absolute(ffmpeg).string(), "-nostdin", "-hide_banner", "-loglevel",
+                     "error", "-y", "-framerate", std::to_string(fps), "-pattern_type", "glob",
+                     "-i", "*.png", "-c:v", webm ? "libvpx-vp9" : "libx264", "-pix_fmt", "yuv420p",
+                     // yuv420p needs even dimensions
+                     "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", encoded},
+                    folder.path(), io, ProcessLimits{0, 0, 0, 0});
+    if (result.end != ProcessResult::End::exited || result.exit_code != 0)
         throw Error(FileLoc{video.string()},
-                    "ffmpeg could not encode the frames in " + folder.string() +
-                        " (they are kept; see ffmpeg's message above)");
-    }
-    std::error_code ec;
-    fs::rename(temporary, video, ec);
-    if (ec)
-        throw Error(FileLoc{video.string()}, "cannot be written: " + ec.message());
-    fs::remove_all(folder, ec);
+                    "ffmpeg could not encode the frames (see ffmpeg's message above)");
+    folder.move_onto(encoded, video);
 }
 
 }  // namespace cambium::app

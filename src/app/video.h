@@ -4,6 +4,8 @@
 
 #include <filesystem>
 
+#include "base/atomic_file.h"
+
 namespace cambium::app {
 
 /// Whether `file` names a video (.mp4, .mov, .mkv, .webm) rather than an image.
@@ -12,15 +14,16 @@ bool is_video(const std::filesystem::path& file);
 /// ffmpeg's path on $PATH; throws cambium::Error saying how to install it when absent.
 std::filesystem::path require_ffmpeg(const std::filesystem::path& video);
 
-/// The folder a video's frames are rendered into first (kept until the encoding has
-/// succeeded, so --resume can continue an interrupted sequence).
-std::filesystem::path video_frames_folder(const std::filesystem::path& video);
+/// The frames' file pattern inside a video's private folder (PrivateFolder beside the
+/// video: only frames this run renders are there, so only they are encoded).
+std::filesystem::path video_frame_pattern(const PrivateFolder& folder);
 
 /// Encodes the PNG frames of `folder`, in the order of their names, into `video` at
 /// `fps` frames per second (H.264 or VP9 by extension, yuv420p) by running ffmpeg
-/// directly (fork and exec with fixed arguments, no shell); writes a temporary file
-/// and renames it, then removes the folder. Throws cambium::Error when ffmpeg fails.
-void encode_video(const std::filesystem::path& ffmpeg, const std::filesystem::path& folder,
-                  int fps, const std::filesystem::path& video);
+/// directly (no shell, standard input /dev/null, in `folder`); ffmpeg writes inside the
+/// folder and the result is renamed over `video`. Throws cambium::Error when ffmpeg
+/// fails, Interrupted on Ctrl-C (ffmpeg is stopped first).
+void encode_video(const std::filesystem::path& ffmpeg, const PrivateFolder& folder, int fps,
+                  const std::filesystem::path& video);
 
 }  // namespace cambium::app

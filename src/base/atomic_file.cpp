@@ -7,8 +7,10 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <cstring>
 #include <string>
+#include <utility>
 
 #include "base/diagnostics.h"
 
@@ -24,23 +26,32 @@ mode_t current_umask()
     return mask;
 }
 
+/// The private temporary's mkstemp pattern beside `file`: a hidden name that keeps its
+/// stem, then `extension` (image writers pick their format from it).
+std::string temporary_pattern(const std::filesystem::path& file, const std::string& extension)
+{
+    // Appended piece by piece: GCC 12 reports a false -Wrestrict on "." + std::string.
+    std::string name(1, '.');
+    name += file.filename().stem().string();
+    name += ".cambium-XXXXXX";
+    return (file.parent_path() / (name + extension)).string();
+}
+
+[[noreturn]] void cannot_write(const std::filesystem::path& file)
+{
+    throw Error(FileLoc{file.string()}, std::string("cannot be written: ") + std::strerror(errno));
+}
+
 /// Removes the temporary unless released.
 class TemporaryFile {
 public:
     explicit TemporaryFile(const std::filesystem::path& file)
     {
-        // A hidden name beside the file, keeping its extension (image writers pick
-        // their format from it).
-        // Appended piece by piece: GCC 12 reports a false -Wrestrict on "." + std::string.
-        std::string name(1, '.');
-        name += file.filename().stem().string();
-        name += ".cambium-XXXXXX";
         std::string extension = file.extension().string();
-        std::string pattern = (file.parent_path() / (name + extension)).string();
+        std::string pattern = temporary_pattern(file, extension);
         m_fd = ::mkstemps(pattern.data(), int(extension.size()));
         if (m_fd < 0)
-            throw Error(FileLoc{file.string()},
-                        std::string("cannot be written: ") + std::strerror(errno));
+            cannot_write(file);
         ::fcntl(m_fd, F_SETFD, FD_CLOEXEC);
         m_path = pattern;
     }
@@ -88,9 +99,35 @@ void write_file_atomically(const std::filesystem::path& file,
     ::fchmod(temporary.fd(), 0666 & ~current_umask());
     write(temporary.writable_path());
     if (::rename(temporary.path().c_str(), file.c_str()) != 0)
-        throw Error(FileLoc{file.string()},
-                    std::string("cannot be written: ") + std::strerror(errno));
+        cannot_write(file);
     temporary.release();
+}
+
+PrivateFolder::PrivateFolder(const std::filesystem::path& file)
+{
+    std::string pattern = temporary_pattern(file, "");
+    if (::mkdtemp(pattern.data()) == nullptr)
+        cannot_write(file);
+    m_path = pattern;
+}
+
+PrivateFolder::PrivateFolder(PrivateFolder&& other) noexcept : m_path(std::move(other.m_path))
+{
+    other.m_path.clear();
+}
+
+PrivateFolder::~PrivateFolder()
+{
+    // remove_all deletes links it finds inside, never what they point to
+    std::error_code ignored;
+    if (!m_path.empty())
+        std::filesystem::remove_all(m_path, ignored);
+}
+
+void PrivateFolder::move_onto(const std::string& name, const std::filesystem::path& file) const
+{
+    if (::rename((m_path / name).c_str(), file.c_str()) != 0)
+        cannot_write(file);
 }
 
 }  // namespace cambium

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <string>
 
 namespace cambium {
 
@@ -16,5 +17,27 @@ namespace cambium {
 /// `file`. The new file gets the usual permissions (0666 less the umask).
 void write_file_atomically(const std::filesystem::path& file,
                            const std::function<void(const std::filesystem::path& temporary)>& write);
+
+/// A fresh private folder beside `file` for work that ends in `file` (a video's frames
+/// and encoding): made with mkdtemp (mode 0700, a random name that nothing planted can
+/// take), removed with its contents on destruction, whatever way the caller leaves.
+/// Throws cambium::Error naming `file`.
+class PrivateFolder {
+public:
+    explicit PrivateFolder(const std::filesystem::path& file);
+    ~PrivateFolder();
+    PrivateFolder(PrivateFolder&& other) noexcept;
+    PrivateFolder& operator=(PrivateFolder&&) = delete;
+    PrivateFolder(const PrivateFolder&) = delete;
+    PrivateFolder& operator=(const PrivateFolder&) = delete;
+
+    const std::filesystem::path& path() const { return m_path; }
+    /// Renames `name`, a file made inside the folder, over `file` in one step (a link
+    /// at `file` is replaced, never followed). Throws cambium::Error naming `file`.
+    void move_onto(const std::string& name, const std::filesystem::path& file) const;
+
+private:
+    std::filesystem::path m_path;
+};
 
 }  // namespace cambium

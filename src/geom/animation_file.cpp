@@ -51,6 +51,20 @@ public:
         return false;
     }
     int integer(const char* what) { return number<int>(what); }
+    /// A whole number from `low` to max_animation_frame (a frame number or a step).
+    int bounded(const char* what, int low)
+    {
+        std::size_t at = m_at;
+        int n = integer(what);
+        if (n < low || n > max_animation_frame) {
+            m_at = at;
+            skip_blanks();
+            fail(std::string(what) + " must be from " + std::to_string(low) + " to " +
+                 std::to_string(max_animation_frame) + " (the derivation length's limit), not " +
+                 std::to_string(n));
+        }
+        return n;
+    }
     double real(const char* what) { return number<double>(what); }
     [[noreturn]] void fail(const std::string& message) const
     {
@@ -100,18 +114,16 @@ bool read_flag(LineValue& value)
 FrameInterval read_interval(LineValue& value)
 {
     FrameInterval interval;
-    interval.from = value.integer("a frame number");
+    interval.from = value.bounded("a frame number", 0);
     interval.to = interval.from;
     if (value.take('-'))
-        interval.to = value.integer("the last frame of the range");
+        interval.to = value.bounded("the last frame of the range", 0);
     if (interval.from < 0 || interval.to < interval.from)
         value.fail("a frame range goes from a frame to a later one");
     for (std::string_view word = value.peek_word(); !word.empty(); word = value.peek_word()) {
         value.skip(word.size());
         if (word == "step" && !interval.step) {
-            interval.step = value.integer("the step of the range");
-            if (*interval.step < 0)
-                value.fail("the step of a range is 0 or more");
+            interval.step = value.bounded("the step of the range", 0);
         } else if ((word == "rotate" || word == "scale") &&
                    interval.change == FrameInterval::Change::none) {
             interval.change = word == "rotate" ? FrameInterval::Change::rotate
@@ -174,16 +186,22 @@ AnimationFile parse_animation_file(std::string_view text, std::string_view name)
         else if (command == "swap interval")
             a.swap_interval = value.integer("a whole number");
         else if (command == "first frame")
-            a.first_frame = std::max(0, value.integer("a frame number"));  // cpfg clamps to 0
+            a.first_frame = std::max(
+                0, value.bounded("a frame number", -max_animation_frame));  // cpfg clamps to 0
         else if (command == "last frame")
-            a.last_frame = value.integer("a frame number");
+            a.last_frame = value.bounded("a frame number",
+                                         -max_animation_frame);  // negative: the derivation length
         else if (command == "step")
-            a.step = std::max(1, value.integer("a whole number"));  // cpfg: 0 or less is 1
+            a.step = std::max(
+                1, value.bounded("the step", -max_animation_frame));  // cpfg: 0 or less is 1
         else if (command == "frame intervals") {
             a.intervals.clear();
-            do
+            do {
+                if (a.intervals.size() == max_frame_intervals)
+                    value.fail("more than " + std::to_string(max_frame_intervals) +
+                               " frame intervals");
                 a.intervals.push_back(read_interval(value));
-            while (value.take(','));
+            } while (value.take(','));
         } else if (command == "display on request" || command == "frame numbers") {
             value.peek_word();  // later cpfg versions' interactive settings: nothing to do
             continue;
@@ -211,11 +229,16 @@ namespace {
 
 /// Steps from `frame` to the next selected frame, as cpfg decides it after each frame;
 /// applies the interval's rotation or scaling to `next`. A range with step 0 shows the
-/// next frame number without deriving.
-void advance_to_next_frame(const AnimationFile& a, AnimationFrame& next)
+/// next frame number without deriving. Intervals before `first_live` hold no frame
+/// after the current one; as frame numbers only grow, an interval found so stays so,
+/// and skipping them keeps the selection linear in intervals plus frames.
+void advance_to_next_frame(const AnimationFile& a, AnimationFrame& next, std::size_t& first_live)
 {
     int current = next.number;
-    for (const FrameInterval& interval : a.intervals) {
+    for (std::size_t i = first_live; i < a.intervals.size(); ++i) {
+        const FrameInterval& interval = a.intervals[i];
+        // every interval from first_live to i is dead: the scan stops at the first live one
+        first_live = i + 1;
         if (current >= interval.to)
             continue;
         int step = interval.step ? std::max(*interval.step, 1) : a.step;
@@ -224,6 +247,7 @@ void advance_to_next_frame(const AnimationFile& a, AnimationFrame& next)
             n += ((current - n) / step + 1) * step;
         if (n > interval.to)
             continue;
+        first_live = i;
         if (interval.change == FrameInterval::Change::rotate)
             next.rotation_deg += interval.amount;
         else if (interval.change == FrameInterval::Change::scale)
@@ -254,12 +278,13 @@ std::vector<AnimationFrame> select_frames(const AnimationFile& a, int derivation
     frame.number = a.first_frame;
     frame.derive_steps = a.first_frame;
     frames.push_back(frame);
+    std::size_t first_live = 0;
     while (frame.number < last) {
         if (static_cast<int>(frames.size()) >= max_frames)
             throw Error("the animation selects more than " + std::to_string(max_frames) +
                         " frames (first frame " + std::to_string(a.first_frame) +
                         ", last frame " + std::to_string(last) + ")");
-        advance_to_next_frame(a, frame);
+        advance_to_next_frame(a, frame, first_live);
         frames.push_back(frame);
     }
     return frames;

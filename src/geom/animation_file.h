@@ -2,6 +2,7 @@
 // cpfg's animation file (.a, manual 5.3) and the frames it selects.
 #pragma once
 
+#include <cstddef>
 #include <filesystem>
 #include <optional>
 #include <string_view>
@@ -10,6 +11,13 @@
 #include "geom/vec.h"
 
 namespace cambium::geom {
+
+/// Frame numbers (`first frame`, `last frame`, interval ends) and steps are derivation
+/// steps: at most the derivation length's limit (lsys::max_derivation_steps). Larger
+/// values are errors at their file:line:column, not billions of steps.
+constexpr int max_animation_frame = 1'000'000;
+/// At most this many `frame intervals:` items (more could not each select a frame).
+constexpr std::size_t max_frame_intervals = 1'000'000;
 
 /// One item of `frame intervals:`: a single frame (from == to), or a range with an
 /// optional step and an optional rotation or scaling of the object after each frame.

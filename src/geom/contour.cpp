@@ -252,13 +252,14 @@ Contour parse_one(LineCursor& lines)
     if (text.starts_with("cver")) {
         const SourceLine& line = lines.next("its version");
         ValueReader in(line.text, line.text.find("cver") + 4, lines.loc(line));
+        FileLoc version_at = in.loc();
         int major = in.integer();
         int minor = in.integer();
-        int version = 100 * major + minor;
-        if (version < 101 || version > 103)
-            throw Error(at, "unknown contour format " + std::to_string(major) + "." +
-                                std::to_string(minor) + " (cpfg reads 1 1, 1 2 and 1 3)");
-        c = parse_versioned(lines, version);
+        // Compared before combining: 100 * major overflows int for a large major.
+        if (major != 1 || minor < 1 || minor > 3)
+            throw Error(version_at, "unknown contour format " + std::to_string(major) + "." +
+                                        std::to_string(minor) + " (cpfg reads 1 1, 1 2 and 1 3)");
+        c = parse_versioned(lines, 100 * major + minor);
     } else {
         c = parse_plain(lines);
     }

@@ -35,16 +35,31 @@ std::string format_label(const std::string& format, std::span<const float> value
             ++i;
             continue;
         }
-        // only flags, width and precision may stand between '%' and the conversion
-        std::size_t end = format.find_first_not_of("-+ #0123456789.", i + 1);
-        if (end == std::string::npos || end - i > 12 ||
+        // only flags, then a width and a precision of at most 2 digits each (as the
+        // L-system's printf), may stand between '%' and the conversion: a longer width
+        // would pad a label with up to two billion characters
+        std::size_t end = format.find_first_not_of("-+ #0", i + 1);
+        auto digits = [&](std::size_t at) {
+            std::size_t stop = format.find_first_not_of("0123456789", at);
+            return (stop == std::string::npos ? format.size() : stop) - at;
+        };
+        std::size_t width = end == std::string::npos ? 0 : digits(end);
+        std::size_t precision = 0;
+        if (end != std::string::npos) {
+            end += width;
+            if (end < format.size() && format[end] == '.') {
+                precision = digits(end + 1);
+                end += 1 + precision;
+            }
+        }
+        if (end >= format.size() || end - i > 12 || width > 2 || precision > 2 ||
             std::string_view("diouxXeEfFgG").find(format[end]) == std::string_view::npos) {
             out += format[i];
             continue;
         }
         std::string spec = format.substr(i, end - i + 1);
         double value = next < values.size() ? static_cast<double>(values[next++]) : 0.0;
-        char buffer[128];
+        char buffer[256];  // 99 digits of precision after 39 of a float's largest value
         char conversion = format[end];
         // an integer conversion of a value no long long holds prints it as %g
         bool integral = std::abs(value) < 9e18;

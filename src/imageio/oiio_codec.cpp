@@ -18,13 +18,16 @@ MapTexels read_oiio_map(const std::filesystem::path& file, float scale, std::siz
     if (w <= 0 || h <= 0 || std::size_t(w) * std::size_t(h) > max_texels || channels <= 0)
         throw Error(file.string() + ": environment map of " + std::to_string(w) + "x" +
                     std::to_string(h) + " texels is empty or larger than 2^25 texels");
-    std::vector<float> pixels(std::size_t(w) * h * channels);
-    if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data()))
+    // Only the channels used are decoded (RGB, or the first as grey): a header may
+    // declare thousands, which the texel limit alone would multiply.
+    const int used = channels >= 3 ? 3 : 1;
+    std::vector<float> pixels(std::size_t(w) * std::size_t(h) * std::size_t(used));
+    if (!in->read_image(0, 0, 0, used, OIIO::TypeDesc::FLOAT, pixels.data()))
         throw Error(file.string() + ": cannot read the environment map: " + in->geterror());
     MapTexels map{w, h, std::vector<float>(std::size_t(w) * h * 3)};
     for (std::size_t p = 0; p < std::size_t(w) * h; ++p)
         for (int c = 0; c < 3; ++c)
-            map.rgb[p * 3 + c] = pixels[p * channels + (channels >= 3 ? c : 0)] * scale;
+            map.rgb[p * 3 + c] = pixels[p * std::size_t(used) + (used == 3 ? c : 0)] * scale;
     return map;
 }
 

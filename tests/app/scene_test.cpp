@@ -4,6 +4,7 @@
 // inline.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <array>
@@ -75,6 +76,22 @@ std::string error_of(const SceneFolder& folder, const std::string& text)
         return e.what();
     }
     return "";
+}
+
+/// A scene's text and a part of the message it must give.
+struct ErrorCase {
+    std::string text, message;
+};
+
+/// Each case's scene gives an error holding its message.
+void expect_errors(const SceneFolder& folder, const std::vector<ErrorCase>& cases)
+{
+    for (const ErrorCase& c : cases) {
+        std::string message = error_of(folder, c.text);
+        EXPECT_NE(message.find(c.message), std::string::npos)
+            << "scene: " << c.text.substr(0, 300) << "\nexpected: " << c.message
+            << "\ngot: " << message;
+    }
 }
 
 const char* tiny_plant = R"("model": "m", "command": "cpfg p.l p.v")";
@@ -170,10 +187,7 @@ TEST(SceneFile, ErrorsNameTheFileAndTheJsonPath)
 {
     SceneFolder f("bad");
     f.tiny_model("m");
-    struct Case {
-        std::string text, message;
-    };
-    const std::vector<Case> cases = {
+    expect_errors(f, {
         {R"({"plants": []})", "field.json: plants: must be a non-empty list"},
         {R"({"plant": []})", "field.json: plant: unknown key"},
         {with_plant(R"("placements": {"scatter": {"rectangle": [0,0,1,1], "count": 0}})"),
@@ -225,12 +239,7 @@ TEST(SceneFile, ErrorsNameTheFileAndTheJsonPath)
          "render.spp: must be an integer from 1 to"},
         {with_plant(R"("placements": {"scatter": {"mesh": "none.obj", "count": 3}})"),
          "plants[0].placements.scatter.mesh: "},
-    };
-    for (const Case& c : cases) {
-        std::string message = error_of(f, c.text);
-        EXPECT_NE(message.find(c.message), std::string::npos)
-            << "scene: " << c.text << "\nexpected: " << c.message << "\ngot: " << message;
-    }
+    });
     // Syntax errors keep nlohmann's position as line and column.
     std::string syntax = error_of(f, "{\n  \"plants\": [\n    {\"model\": }\n  ]\n}\n");
     EXPECT_NE(syntax.find("field.json:3:15:"), std::string::npos) << syntax;
@@ -246,6 +255,43 @@ TEST(SceneFile, ErrorsNameTheFileAndTheJsonPath)
         EXPECT_NE(std::string(e.what()).find("plants[0].placements.scatter.count"), std::string::npos)
             << e.what();
     }
+}
+
+// What the JSON parser would accept silently, build without bound or report without a
+// place is an error at file:line:column before it parses.
+TEST(SceneFile, DuplicateKeysDeepNestingAndHugeNumbersAreErrorsWithPlaces)
+{
+    SceneFolder f("json");
+    f.tiny_model("m");
+    expect_errors(f, {
+        // a reviewer reading the first "plants" would not see the folder the second names
+        {"{\"plants\": [],\n \"plants\": []}",
+         "field.json:2:2: error: the key \"plants\" appears twice in one object"},
+        {R"({"plants": [], /* "plants": */ "pl\u0061nts": []})",
+         "field.json:1:32: error: the key \"plants\" appears twice"},
+        {with_plant(R"("placements": [{"scale": 1, "translate": [0, 0, 0], "scale": 2}])"),
+         "field.json:1:107: error: the key \"scale\" appears twice"},
+        {R"({"plants": [{"model": "m", "seed": 1e999}]})",
+         "field.json:1:36: error: the number 1e999 is out of range"},
+        {"{\"plants\": " + std::string(200000, '[') + std::string(200000, ']') + "}",
+         "field.json:1:75: error: JSON nested more than 64 levels deep"},
+    });
+    // the same key in different objects, and in strings and comments, is no duplicate
+    std::string fine = error_of(
+        f, R"({"plants": [{"model": "m", "command": "cpfg p.l p.v", "placements": [{"scale": 1}, {"scale": 2}]}],
+              // "plants": 
+              "render": {"spp": 1}})");
+    EXPECT_EQ(fine, "");
+}
+
+// A model folder that is a link to itself is an error at its JSON path.
+TEST(SceneFile, SelfLinkedModelFolderNamesTheJsonPath)
+{
+    SceneFolder f("self_link");
+    fs::create_directory_symlink("loop", f.dir() / "loop");
+    std::string message =
+        error_of(f, R"({"plants": [{"model": "loop", "command": "cpfg p.l p.v", "placements": [{}]}]})");
+    EXPECT_NE(message.find("field.json: plants[0].model: 'loop'"), std::string::npos) << message;
 }
 
 TEST(SceneFile, FilesOutsideTheFolderNeedFileAccess)
@@ -304,12 +350,27 @@ TEST(Scatter, SameSeedSamePlacementsAndSpacingHolds)
             EXPECT_GE(distance_xz(crowded[i], crowded[j]), 1.0 - 1e-6);
 }
 
+// A spacing far below the area's size (cell indices past long long's range before)
+// neither overflows nor puts every point in one cell (200 000 points, 2·10¹⁰ distance
+// tests in one cell).
+TEST(Scatter, TinySpacingOverAHugeRectangle)
+{
+    app::ScatterSpec spec;
+    spec.rectangle = {-1e7, -1e7, 1e7, 1e7};
+    spec.count = 200'000;
+    spec.seed = 3;
+    spec.min_spacing = 1e-300;
+    EXPECT_EQ(app::scatter(spec).size(), 200'000u);
+}
+
 TEST(Scatter, OverAMeshPointsLieOnItsTriangles)
 {
     SceneFolder f("mesh");
     // a slope: y = 0.5 x over x in [0, 4], z in [0, 2]; a quad written as one face
     f.write("slope.obj", "# a slope\nv 0 0 0\nv 4 2 0\nv 4 2 2\nv 0 0 2\nvn 0 1 0\nf 1//1 2//1 3//1 4//1\n");
-    app::GroundMesh mesh = app::read_obj_mesh(f.dir() / "slope.obj", 100);
+    app::SceneLimits small;
+    small.max_mesh_triangles = 100;
+    app::GroundMesh mesh = app::read_obj_mesh(f.dir() / "slope.obj", small);
     ASSERT_EQ(mesh.triangles.size(), 2u);
     app::ScatterSpec spec;
     spec.mesh = f.dir() / "slope.obj";
@@ -325,9 +386,42 @@ TEST(Scatter, OverAMeshPointsLieOnItsTriangles)
         mean_x += t[9] / 200.0;
     }
     EXPECT_NEAR(mean_x, 2.0, 0.3);  // uniform over the area, not bunched on one triangle
-    EXPECT_THROW(app::read_obj_mesh(f.dir() / "missing.obj", 100), Error);
+    EXPECT_THROW(app::read_obj_mesh(f.dir() / "missing.obj", small), Error);
     f.write("bad.obj", "v 0 0 0\nf 1 2 3\n");
-    EXPECT_THROW(app::read_obj_mesh(f.dir() / "bad.obj", 100), Error);
+    EXPECT_THROW(app::read_obj_mesh(f.dir() / "bad.obj", small), Error);
+}
+
+/// The message of the error reading `file` as a mesh.
+std::string mesh_error(const fs::path& file, const app::SceneLimits& limits)
+{
+    try {
+        app::read_obj_mesh(file, limits);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+// A mesh is a regular file within its size and line limits, checked before reading:
+// a FIFO would block forever, a huge file or line would be held whole.
+TEST(Scatter, MeshFilesAreRegularAndBounded)
+{
+    SceneFolder f("mesh_bounds");
+    ASSERT_EQ(::mkfifo((f.dir() / "fifo.obj").c_str(), 0600), 0);
+    app::SceneLimits limits;
+    EXPECT_NE(mesh_error(f.dir() / "fifo.obj", limits).find("not a regular file"),
+              std::string::npos);
+    EXPECT_NE(mesh_error(f.dir(), limits).find("not a regular file"), std::string::npos);
+    std::string quad = "v 0 0 0\nv 1 0 0\nv 1 0 1\nf 1 2 3\n";
+    f.write("long.obj", quad + "# " + std::string(200, 'x') + "\n");
+    limits.max_mesh_line_bytes = 100;
+    EXPECT_NE(mesh_error(f.dir() / "long.obj", limits).find("long.obj:5:101: error: the line is longer than 100 bytes"),
+              std::string::npos)
+        << mesh_error(f.dir() / "long.obj", limits);
+    limits.max_mesh_line_bytes = 202;  // the comment line just fits
+    EXPECT_EQ(app::read_obj_mesh(f.dir() / "long.obj", limits).triangles.size(), 1u);
+    limits.max_mesh_bytes = 20;
+    EXPECT_NE(mesh_error(f.dir() / "long.obj", limits).find("too large"), std::string::npos);
 }
 
 TEST(SceneAssembly, EachDistinctVariantIsDerivedOnce)
@@ -345,7 +439,8 @@ TEST(SceneAssembly, EachDistinctVariantIsDerivedOnce)
     const std::string m = R"("model": "m", "command": "cpfg p.l p.v", )";
     const std::string three = R"("placements": [{}, {"translate": [2, 0, 0]}, {"translate": [4, 0, 0]}])";
     // two entries of one model and steps: one load, one derivation, six plants
-    auto [r1, instances1] = report_of("{" + m + "\"steps\": 2, " + three + "}, {" + m +
+    // (the second's command differs in spaces only)
+    auto [r1, instances1] = report_of("{" + m + "\"steps\": 2, " + three + "}, {\"model\": \"m\", " +
                                       "\"command\": \"cpfg  p.l   p.v\", \"steps\": 2, " + three + "}");
     EXPECT_EQ(r1.models_loaded, 1u);
     EXPECT_EQ(r1.derivations, 1u);
@@ -447,6 +542,34 @@ TEST(SceneAssembly, CameraUpIsHonoured)
     EXPECT_NEAR(up.x, std::sqrt(0.5), 1e-6);
     EXPECT_NEAR(up.y, std::sqrt(0.5), 1e-6);
     EXPECT_NEAR(up.z, 0, 1e-6);
+}
+
+// Placements times the organs each one composes are counted against the memory budget
+// before any instance is made (the scene file bounds the placements alone).
+TEST(SceneAssembly, PlacementsTimesOrgansAreWithinTheMemoryBudget)
+{
+    SceneFolder f("organs_budget");
+    f.tiny_model("m");
+    app::SceneFile s = app::read_scene_file(
+        f.scene(with_plant(R"("steps": 3, "placements": {"scatter": {"rectangle": [0, 0, 100, 100], "count": 1000}})")),
+        app::Options{});
+    // 1000 plants with 3 flowers each: 4000 instances of about 150 B, 600 kB
+    app::Options budget;
+    budget.max_memory_bytes = 400'000;
+    try {
+        app::assemble_scene(s, budget, {app::OrganPlacement::compose, false});
+        ADD_FAILURE() << "4000 instances passed a budget of 400 kB";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("field.json: plants: the placements with their organs (-o>) need about"),
+                  std::string::npos)
+            << e.what();
+    }
+    budget.max_memory_bytes = 800'000;
+    EXPECT_EQ(app::assemble_scene(s, budget, {app::OrganPlacement::compose, false}).instances.size(),
+              4000u);
+    // drawn inline, every copy's primitives count (7 a plant: 100 B each)
+    budget.max_memory_bytes = 400'000;
+    EXPECT_THROW(app::assemble_scene(s, budget, {app::OrganPlacement::compose, true}), Error);
 }
 
 TEST(SceneAssembly, InstancedFieldRendersAsTheSamePlantsInline)

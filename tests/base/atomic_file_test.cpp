@@ -98,5 +98,59 @@ TEST(AtomicFile, FailureLeavesNothingAndKeepsTheOldFile)
     }
 }
 
+std::size_t entries(const fs::path& dir)
+{
+    return std::size_t(std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
+}
+
+// A private folder is fresh (never a planted one), owner-only, and gone afterwards
+// with its contents; a link made inside is removed, not what it points to.
+TEST(PrivateFolder, FreshOwnerOnlyAndRemoved)
+{
+    fs::path dir = scratch("private");
+    fs::create_directories(dir / "outside");
+    std::ofstream(dir / "outside" / "victim") << "precious";
+    // The names a predictable scheme would give, planted as links to elsewhere.
+    fs::create_directory_symlink(dir / "outside", dir / "v.mp4.frames");
+    fs::create_directory_symlink(dir / "outside", dir / ".v.cambium-XXXXXX");
+    fs::path first, second;
+    {
+        PrivateFolder a(dir / "v.mp4"), b(dir / "v.mp4");
+        first = a.path();
+        second = b.path();
+        EXPECT_NE(first, second);
+        EXPECT_EQ(first.parent_path(), dir);
+        EXPECT_FALSE(fs::is_symlink(first));
+        EXPECT_EQ(fs::status(first).permissions() & fs::perms::all, fs::perms::owner_all);
+        EXPECT_EQ(entries(first), 0u);
+        std::ofstream(first / "000001.png") << "frame";
+        fs::create_symlink(dir / "outside" / "victim", first / "link.png");
+        fs::create_directory_symlink(dir / "outside", first / "sub");
+    }
+    EXPECT_FALSE(fs::exists(first));
+    EXPECT_FALSE(fs::exists(second));
+    EXPECT_EQ(contents(dir / "outside" / "victim"), "precious");
+    EXPECT_EQ(entries(dir / "outside"), 1u);
+    EXPECT_EQ(entries(dir), 3u);  // outside and the two planted links, nothing else
+}
+
+// The result replaces a link planted at the target instead of writing through it.
+TEST(PrivateFolder, MoveOntoReplacesALinkAtTheTarget)
+{
+    fs::path dir = scratch("private_move");
+    std::ofstream(dir / "victim") << "precious";
+    fs::create_symlink(dir / "victim", dir / "v.mp4");
+    {
+        PrivateFolder folder(dir / "v.mp4");
+        std::ofstream(folder.path() / "encoded.mp4") << "video";
+        folder.move_onto("encoded.mp4", dir / "v.mp4");
+    }
+    EXPECT_EQ(contents(dir / "victim"), "precious");
+    EXPECT_FALSE(fs::is_symlink(dir / "v.mp4"));
+    EXPECT_EQ(contents(dir / "v.mp4"), "video");
+    EXPECT_EQ(entries(dir), 2u);
+    EXPECT_THROW(PrivateFolder(dir / "missing" / "v.mp4"), Error);
+}
+
 }  // namespace
 }  // namespace cambium

@@ -733,6 +733,42 @@ TEST(Sequence, TurntableVideoWithFfmpeg)
     EXPECT_FALSE(fs::exists(dir / "t.mp4.frames"));  // the frames go once encoded
 }
 
+// A model folder that plants links and frames at the names videos once used reaches
+// nothing: a stand-in ffmpeg (the real one is not needed to check this) writes the list
+// of frames it was given as the "video".
+TEST(Sequence, VideoWorksInAPrivateFolder)
+{
+    fs::path dir = growing_plant(scratch("video_planted"));
+    fs::path outside = dir / "outside";
+    fs::create_directories(outside / "frames");
+    write(outside / "victim", "precious");
+    fs::create_symlink(outside / "victim", dir / "t.mp4.cambium-tmp.mp4");
+    fs::create_directory_symlink(outside / "frames", dir / "t.mp4.frames");
+    fs::create_directories(dir / "u.mp4.frames");
+    write(dir / "u.mp4.frames" / "000000.png", "planted");
+    ::mkfifo((dir / "u.mp4.cambium-tmp.mp4").c_str(), 0600);
+    fs::path bin = dir / "bin";
+    fs::create_directories(bin);
+    write(bin / "ffmpeg", "#!/bin/sh\nfor last; do :; done\nls *.png > \"$last\"\n");
+    fs::permissions(bin / "ffmpeg", fs::perms::owner_all);
+    std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+    setenv("PATH", (bin.string() + ":" + path).c_str(), 1);
+    Result r = run("-q -w 8 6 --spp 1 --turntable 3 -o " + (dir / "t.mp4").string() + " -o " +
+                   (dir / "u.mp4").string() + " " + plant_files(dir));
+    setenv("PATH", path.c_str(), 1);
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::string frames = "000001.png\n000002.png\n000003.png\n";
+    std::ifstream t(dir / "t.mp4"), u(dir / "u.mp4");
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(t), {}), frames);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(u), {}), frames);  // not 000000
+    std::ifstream victim(outside / "victim");
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(victim), {}), "precious");
+    EXPECT_TRUE(fs::is_empty(outside / "frames"));
+    for (const auto& entry : fs::directory_iterator(dir))  // no work folder left
+        EXPECT_EQ(entry.path().filename().string().find(".t.cambium-"), std::string::npos);
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir), fs::directory_iterator()), 10);
+}
+
 TEST(Staging, GroundUnderThePlantAndShadowCatcher)
 {
     fs::path dir = growing_plant(scratch("ground"));

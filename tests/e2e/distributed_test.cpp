@@ -4,6 +4,7 @@
 // equal a single process's byte for byte.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <array>
@@ -135,6 +136,36 @@ TEST(Tiles, DamagedFilesAreRefused)
     std::string wrong = bytes;
     wrong[std::string("cambium tile 1\n").size() + 4 * 4] = 9;  // x beyond the image
     EXPECT_THROW(decode_tile(wrong, "f"), Error);
+}
+
+/// The message of assembling `count` tiles of a width x height image named `output`.
+std::string assembly_error(const fs::path& output, int count, int width, int height)
+{
+    try {
+        assemble_tiles(output, count, width, height);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+// A tile is a regular file no larger than its band could need, both checked before it
+// is read: a FIFO would block forever, a huge file would be held whole.
+TEST(Tiles, AssemblyReadsOnlyRegularFilesOfTheirBandsSize)
+{
+    fs::path dir = scratch("tile_files");
+    fs::path out = dir / "t.png";
+    ASSERT_EQ(::mkfifo(tile_file(out, 0, 2).c_str(), 0600), 0);
+    EXPECT_NE(assembly_error(out, 2, 4, 4).find("t.tile0of2.ctile: error: cannot open the tile: not a regular file"),
+              std::string::npos)
+        << assembly_error(out, 2, 4, 4);
+    fs::remove(tile_file(out, 0, 2));
+    // the band is 4x2 pixels: 15 + 40 + 8 * 11 * 4 = 407 bytes at most
+    std::ofstream(tile_file(out, 0, 2)) << std::string(408, 'x');
+    EXPECT_NE(assembly_error(out, 2, 4, 4).find("the tile is too large (408 bytes; the limit is 407)"),
+              std::string::npos)
+        << assembly_error(out, 2, 4, 4);
+    fs::remove_all(dir);
 }
 
 TEST(TileCommand, AssembledTilesEqualTheSingleRun)

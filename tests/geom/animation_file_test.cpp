@@ -178,5 +178,52 @@ TEST(AnimationFile, TooManyFramesIsAnError)
     EXPECT_EQ(select_frames(a, 1, 2001).size(), 2001u);
 }
 
+/// The column of the error `text` gives, with its message checked for `words`.
+int error_column(const std::string& text, const std::string& words)
+{
+    try {
+        parse_animation_file(text, "t.a");
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+        return e.loc().column;
+    }
+    ADD_FAILURE() << "no error for " << text;
+    return 0;
+}
+
+// Frame numbers and steps are derivation steps: past the derivation length's limit
+// they are errors at their column, not billions of steps derived without a word.
+TEST(AnimationFile, FrameNumbersAndStepsAreBounded)
+{
+    EXPECT_EQ(error_column("first frame: 2000000000\n", "from -1000000 to 1000000"), 14);
+    EXPECT_EQ(error_column("last frame: 1000001\n", "not 1000001"), 13);
+    EXPECT_EQ(error_column("step: 2000000000\n", "the step must be"), 7);
+    EXPECT_EQ(error_column("frame intervals: 1-5, 7-2000000000\n", "last frame of the range"), 25);
+    EXPECT_EQ(error_column("frame intervals: 1-5 step 1000001\n", "step of the range"), 27);
+    EXPECT_EQ(error_column("frame intervals: 3000000\n", "a frame number"), 18);
+    EXPECT_EQ(parse_animation_file("first frame: 1000000\nlast frame: -1\n", "t.a").first_frame,
+              1000000);
+    std::string many = "frame intervals: ";
+    for (std::size_t i = 0; i <= max_frame_intervals; ++i)
+        many += "1,";
+    many += "1\n";
+    EXPECT_EQ(error_column(many, "more than 1000000 frame intervals"),
+              int(17 + 2 * max_frame_intervals + 1));
+}
+
+// Intervals that hold no frame ahead are passed once, not once per frame: 200 000 of
+// them before a range of 200 000 frames would take 4·10¹⁰ comparisons otherwise.
+TEST(AnimationFile, DeadIntervalsAreSkippedOnce)
+{
+    std::string text = "frame intervals: ";
+    for (int i = 0; i < 200000; ++i)
+        text += "0, ";
+    text += "1-200000\n";
+    std::vector<int> frames = numbers(select_frames(parse_animation_file(text, "t.a"), 1));
+    ASSERT_EQ(frames.size(), 200001u);
+    EXPECT_EQ(frames[1], 1);
+    EXPECT_EQ(frames.back(), 200000);
+}
+
 }  // namespace
 }  // namespace cambium::geom

@@ -120,6 +120,19 @@ TEST(Contour, MalformedFilesAreErrorsWithLines)
         EXPECT_EQ(e.loc().line, 6);
     }
     EXPECT_THROW(parse_contour("cver 2 0\n", "bad.con"), Error);
+    // 100 * 42949673 + 97 wraps around to 101 in 32 bits: refused, not read as 1.1.
+    try {
+        parse_contour("cver 42949673 97\nname: x\npoints: 4 4\ntype: closed\n0 0 0 1\n"
+                      "1 0 0 1\n1 1 0 1\n0 1 0 1\n",
+                      "big.con");
+        FAIL() << "expected an error";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.loc().line, 1);
+        EXPECT_EQ(e.loc().column, 6);
+        EXPECT_NE(std::string(e.what()).find("unknown contour format 42949673.97"),
+                  std::string::npos)
+            << e.what();
+    }
     EXPECT_THROW(parse_contour("3 2 open\n0 0\n1 0\n2 0\n", "bad.con"), Error);  // 4 needed
     EXPECT_THROW(parse_contour("4 5 closed\n", "bad.con"), Error);
     EXPECT_THROW(parse_contour("999999999 2 closed\n", "bad.con"), Error);

@@ -245,6 +245,10 @@ TEST(TurtleFeatures, LabelsTakeTheirStringAndValues)
     // conversions it cannot fill safely are copied as text
     Scene odd = interpret_text("@L(0,3,4)", "", {"%s and %5.1f%% %d"});
     EXPECT_EQ(odd.labels[0].text, "%s and   3.0% 4");
+    // widths and precisions of more than 2 digits (the L-system printf's rule) too:
+    // %999999999d would pad the label with a billion spaces
+    Scene wide = interpret_text("@L(0,7,8,9)", "", {"%999999999d|%.123f|%99.99f"});
+    EXPECT_EQ(wide.labels[0].text, "%999999999d|%.123f|7." + std::string(99, '0'));
 }
 
 TEST(TurtleFeatures, SystemCallsAndRayshadeModulesAreIgnored)

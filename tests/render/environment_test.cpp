@@ -171,6 +171,33 @@ TEST(MapEnvironment, ReadsLatLongFilesWithUpAtTheTopAndMinusZInTheCentre)
     EXPECT_THROW(make_map_environment(2, 2, std::vector<float>(5)), Error);
 }
 
+// A map whose header declares many channels is decoded in its first three only (the
+// texel limit does not multiply by channels); the others never reach the radiance.
+TEST(Environment, MapWithManyChannelsUsesItsFirstThree)
+{
+    auto dir = std::filesystem::temp_directory_path() /
+               ("cambium_env_channels_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    auto file = dir / "many.exr";
+    const int w = 8, h = 4, channels = 64;
+    std::vector<float> values(std::size_t(w) * h * channels, 100.0f);
+    for (std::size_t p = 0; p < std::size_t(w) * h; ++p)
+        for (int c = 0; c < 3; ++c)
+            values[p * channels + std::size_t(c)] = float(c + 1);
+    {
+        auto out = OIIO::ImageOutput::create(file.string());
+        ASSERT_TRUE(out);
+        OIIO::ImageSpec spec(w, h, channels, OIIO::TypeDesc::FLOAT);
+        ASSERT_TRUE(out->open(file.string(), spec));
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, values.data()));
+        out->close();
+    }
+    auto env = make_map_environment(file, 1.0f);
+    EXPECT_EQ(env.radiance({0, 1, 0}), Vec3f(1, 2, 3));
+    EXPECT_EQ(env.radiance({0, -1, 0}), Vec3f(1, 2, 3));
+    std::filesystem::remove_all(dir);
+}
+
 /// A Monte Carlo estimate and its standard error.
 struct Estimate {
     double mean = 0, se = 0;
