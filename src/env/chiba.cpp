@@ -488,13 +488,6 @@ private:
     std::uint32_t m_ray = 0;
 };
 
-/// The first `at_most` numbers of the value (fewer when fewer are written: the program
-/// keeps its defaults for the rest).
-std::vector<double> leading_numbers(const SpecLine& line, std::size_t at_most)
-{
-    return numbers_value(line, std::min(at_most, value_tokens(line).size()));
-}
-
 }  // namespace
 
 std::unique_ptr<Environment> make_chiba(const std::vector<std::string>& args, const Context& context)

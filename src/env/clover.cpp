@@ -174,13 +174,6 @@ std::vector<Cell> cells_from(const Settings& s, const Context& context)
     return cells;
 }
 
-/// The first `at_most` numbers of the value (fewer when fewer are written: the program
-/// keeps its defaults for the rest). A number may run into text ("100view.pnl" is 100).
-std::vector<double> leading_numbers(const SpecLine& line, std::size_t at_most)
-{
-    return numbers_value(line, std::min(at_most, value_tokens(line).size()));
-}
-
 }  // namespace
 
 std::unique_ptr<Environment> make_clover(const std::vector<std::string>& args, const Context& context)

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <sstream>
 
+#include "env/spec_values.h"
 #include "geom/text_input.h"
 
 namespace cambium::env {
@@ -89,14 +90,7 @@ CommSpec read_comm_spec(const std::filesystem::path& file)
     CommSpec spec;
     spec.file = file;
     const std::string text = geom::read_text_file(file, "communication specification file");
-    std::istringstream in(text);
-    int number = 0;
-    for (std::string line; std::getline(in, line);) {
-        ++number;
-        if (!line.empty() && line.back() == '\r')
-            line.pop_back();
-        if (line.find_first_not_of(" \t") == std::string::npos)
-            continue;
+    for (const auto& [number, line] : non_blank_lines(text)) {
         const std::size_t colon = line.find(':');
         const FileLoc loc{file.string(), number, 1};
         if (colon == std::string::npos)

@@ -2,9 +2,9 @@
 // The pieces every environment shares: its files, read as vlab's programs read them.
 #include "env/environment.h"
 
-#include <sstream>
 
 #include "base/confinement.h"
+#include "env/spec_values.h"
 #include "geom/text_input.h"
 
 namespace cambium::env {
@@ -25,14 +25,7 @@ std::vector<SpecLine> read_spec_file(const std::filesystem::path& file, const Co
     const std::filesystem::path path = model_file(file.string(), context);
     const std::string text = geom::read_text_file(path, "specification file");
     std::vector<SpecLine> lines;
-    std::istringstream in(text);
-    int number = 0;
-    for (std::string line; std::getline(in, line);) {
-        ++number;
-        if (!line.empty() && line.back() == '\r')
-            line.pop_back();
-        if (line.find_first_not_of(" \t") == std::string::npos)
-            continue;
+    for (const auto& [number, line] : non_blank_lines(text)) {
         SpecLine spec;
         const std::size_t colon = line.find(':');
         spec.keyword = line.substr(0, colon);

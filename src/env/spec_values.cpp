@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "env/spec_values.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
+#include <sstream>
 
 namespace cambium::env {
 
@@ -40,6 +42,26 @@ std::vector<double> numbers_value(const SpecLine& line, std::size_t count)
 }
 
 double number_value(const SpecLine& line) { return numbers_value(line, 1)[0]; }
+
+std::vector<double> leading_numbers(const SpecLine& line, std::size_t at_most)
+{
+    return numbers_value(line, std::min(at_most, value_tokens(line).size()));
+}
+
+std::vector<std::pair<int, std::string>> non_blank_lines(const std::string& text)
+{
+    std::vector<std::pair<int, std::string>> lines;
+    std::istringstream in(text);
+    int number = 0;
+    for (std::string line; std::getline(in, line);) {
+        ++number;
+        if (!line.empty() && line.back() == '\r')
+            line.pop_back();
+        if (line.find_first_not_of(" \t") != std::string::npos)
+            lines.emplace_back(number, std::move(line));
+    }
+    return lines;
+}
 
 bool switch_value(const SpecLine& line, std::initializer_list<const char*> words)
 {

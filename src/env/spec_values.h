@@ -5,6 +5,7 @@
 
 #include <initializer_list>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "env/environment.h"
@@ -18,11 +19,19 @@ std::vector<std::string> value_tokens(const SpecLine& line);
 /// not a number.
 std::vector<double> numbers_value(const SpecLine& line, std::size_t count);
 
+/// The first `at_most` numbers of the value (fewer when fewer tokens are written: the
+/// programs keep their defaults for the rest).
+std::vector<double> leading_numbers(const SpecLine& line, std::size_t at_most);
+
 /// The first token as a number (numbers_value(line, 1)[0]).
 double number_value(const SpecLine& line);
 
 /// Whether the first token is one of `words` ("on", "yes": each program has its own).
 bool switch_value(const SpecLine& line, std::initializer_list<const char*> words);
+
+/// A text file's lines that hold more than blanks, numbered from 1, without a trailing
+/// carriage return: how `.e` and specification files are read.
+std::vector<std::pair<int, std::string>> non_blank_lines(const std::string& text);
 
 /// The specification file named by a program's arguments: the first argument that is
 /// not an option. Error naming the program when there is none.
