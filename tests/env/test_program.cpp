@@ -14,12 +14,19 @@
 //   deaf      closes its input before the start-up byte, then waits
 //   twice     answers each query twice
 //   later     ?E(x) after the pass's last chunk, in chunks of 100 as the library writes
+// Started as `obcheck -e FILE.e OBSTACLES` (its file name obcheck), it is a stand-in for
+// the corpus's CelticKnot program, written from FACTS-environment.md's description: the
+// obstacles are `x1 y1 x2 y2` segments after a `coordinates:` line; ?E(0) marks where a
+// segment starts (no answer), ?E(1) answers 1 when the segment from there to here
+// crosses an obstacle, else 0 (and here starts the next segment). It answers at once.
 #include <unistd.h>
 
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -28,7 +35,42 @@ namespace {
 struct Pending {
     unsigned long address;
     std::size_t params;
-    float x;
+    float x, y;
+    float first;  ///< the ?E's first parameter
+};
+
+/// obcheck's obstacles and the start of the segment being tested (kept across passes).
+struct Obstacles {
+    std::vector<std::array<float, 4>> segments;
+    float start_x = 0, start_y = 0;
+
+    explicit Obstacles(const char* file)
+    {
+        std::ifstream in(file);
+        std::string line;
+        while (std::getline(in, line) && line.rfind("coordinates:", 0) != 0) {
+        }
+        for (std::array<float, 4> s{}; in >> s[0] >> s[1] >> s[2] >> s[3];)
+            segments.push_back(s);
+    }
+
+    /// The program's unnormalised side test: each segment's ends lie on both sides of the
+    /// other's line, within 0.1.
+    bool crosses(float x, float y) const
+    {
+        auto side = [](float ax, float ay, float bx, float by, float px, float py) {
+            return (bx - ax) * (py - ay) - (by - ay) * (px - ax);
+        };
+        for (const auto& o : segments) {
+            const float v11 = side(start_x, start_y, x, y, o[0], o[1]);
+            const float v12 = side(start_x, start_y, x, y, o[2], o[3]);
+            const float v21 = side(o[0], o[1], o[2], o[3], start_x, start_y);
+            const float v22 = side(o[0], o[1], o[2], o[3], x, y);
+            if (v11 * v12 <= 0.1f && v21 * v22 <= 0.1f)
+                return true;
+        }
+        return false;
+    }
 };
 
 /// Turtle lines that follow each query line: one per `turtle ...:` line of the .e file.
@@ -62,7 +104,12 @@ int main(int argc, char** argv)
 {
     if (argc < 4 || std::strcmp(argv[1], "-e") != 0)
         return 2;
-    const std::string mode = argv[3];
+    const std::string name = argv[0];
+    const bool obcheck = name.size() >= 7 && name.compare(name.size() - 7, 7, "obcheck") == 0;
+    const std::string mode = obcheck ? "obcheck" : argv[3];
+    std::unique_ptr<Obstacles> obstacles;
+    if (obcheck)
+        obstacles = std::make_unique<Obstacles>(argv[3]);
     if (mode == "mute") {
         for (int c; (c = std::getchar()) != EOF;) {
         }
@@ -119,10 +166,11 @@ int main(int argc, char** argv)
             for (;;) std::fputs("\n\n\n\n\n\n\n\n", stdout);
         if (mode == "long")
             for (;;) std::fputs("xxxxxxxx", stdout);
-        Pending p{std::strtoul(line, nullptr, 10), 0, 0};
+        Pending p{std::strtoul(line, nullptr, 10), 0, 0, 0, 0};
         const char* e = std::strchr(line, 'E');
         if (e && e[1] == '(') {
             p.params = 1;
+            p.first = std::strtof(e + 2, nullptr);
             for (const char* c = e + 2; *c && *c != ')'; ++c) p.params += *c == ',';
         }
         for (int k = 0; k < turtle; ++k) {
@@ -131,8 +179,24 @@ int main(int argc, char** argv)
                 return 4;
             if (k == 0) {
                 const char* colon = std::strchr(field, ':');
-                p.x = std::strtof(colon ? colon + 1 : field, nullptr);
+                char* end = nullptr;
+                p.x = std::strtof(colon ? colon + 1 : field, &end);
+                p.y = std::strtof(end, nullptr);
             }
+        }
+        if (obcheck) {
+            if (p.first != 0) {
+                const bool hit = obstacles->crosses(p.x, p.y);
+                std::printf("%lu E(%d)\n", p.address, hit ? 1 : 0);
+                if (!hit) {
+                    obstacles->start_x = p.x;
+                    obstacles->start_y = p.y;
+                }
+            } else {
+                obstacles->start_x = p.x;
+                obstacles->start_y = p.y;
+            }
+            continue;
         }
         if (mode == "echo")
             answer(mode, p);  // at once: it may write while the plant is still writing
