@@ -108,14 +108,10 @@ env::RgbImage read_environment_image(const std::filesystem::path& file, std::uin
     return image;
 }
 
-/// Connects the `-e` file's environment to the derivation (manual 7): the environmental
-/// step runs where the query pass runs, on the same string.
-void connect_environment(const Options& options, lsys::LoadOptions& load,
-                         const std::shared_ptr<QueryContext>& queries)
+}  // namespace
+
+env::Connection model_environment(const Options& options, const env::CommSpec& spec)
 {
-    if (!options.environment_file)
-        return;
-    env::CommSpec spec = env::read_comm_spec(*options.environment_file);
     env::Context context;
     context.folder = model_folder(options);
     context.allow_file_access = options.allow_file_access;
@@ -131,6 +127,28 @@ void connect_environment(const Options& options, lsys::LoadOptions& load,
     env::Connection connection = env::connect(spec, context, programs);
     if (!options.quiet)
         std::fprintf(stderr, "environment: %s\n", connection.description.c_str());
+    return connection;
+}
+
+namespace {
+
+/// Connects the `-e` file's environment to the derivation (manual 7): the environmental
+/// step runs where the query pass runs, on the same string.
+void connect_environment(const Options& options, lsys::LoadOptions& load,
+                         const std::shared_ptr<QueryContext>& queries, const EnvironmentSeat* seat)
+{
+    if (!options.environment_file)
+        return;
+    env::CommSpec spec = env::read_comm_spec(*options.environment_file);
+    env::Connection connection;
+    if (seat) {
+        connection.make = [environment = seat->environment, plant = seat->plant] {
+            return environment->participant(plant);
+        };
+        connection.placement = seat->placement;
+    } else {
+        connection = model_environment(options, spec);
+    }
     load.environment = [queries, spec = std::move(spec), connection = std::move(connection)] {
         auto step = std::make_shared<env::EnvironmentalStep>(spec, connection);
         return [queries, step](lsys::ModuleString& string, int n) {
@@ -181,7 +199,7 @@ std::shared_ptr<const geom::ViewFile> read_view(const Options& options)
     return view;
 }
 
-Model load_model(const Options& options)
+Model load_model(const Options& options, const EnvironmentSeat* seat)
 {
     geom::Palette palette = load_palette(options);
     std::shared_ptr<const geom::ViewFile> view = read_view(options);
@@ -208,7 +226,7 @@ Model load_model(const Options& options)
         if (queries->symbols)
             geom::answer_queries(string, *queries->symbols, *queries->view);
     };
-    connect_environment(options, load, queries);
+    connect_environment(options, load, queries, seat);
     // Fragmentation (manual 5.1.9): the turtles saved at `%(par)` before each step are
     // the model's, for drawing `%(par, index)`; each derivation run starts them afresh.
     auto fragments = std::make_shared<std::vector<geom::Turtle>>();

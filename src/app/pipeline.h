@@ -3,10 +3,13 @@
 // interpreted. The `cambium` command and the corpus tests share this path to a Scene.
 #pragma once
 
+#include <array>
 #include <filesystem>
 #include <memory>
 
 #include "app/command_line.h"
+#include "env/environmental_step.h"
+#include "env/shared_environment.h"
 #include "geom/function.h"
 #include "geom/palette.h"
 #include "geom/scene.h"
@@ -39,10 +42,24 @@ std::filesystem::path model_folder(const Options& options);
 /// unless options.allow_file_access. Relative names are the view file's folder's.
 std::shared_ptr<const geom::ViewFile> read_view(const Options& options);
 
+/// The environment a model's `.e` file (`spec`, read from options.environment_file)
+/// names, for this model alone: a built-in, or an external program when the options
+/// allow it; a line says which unless quiet. Throws cambium::Error.
+env::Connection model_environment(const Options& options, const env::CommSpec& spec);
+
+/// A plant's seat at an environment shared with other plants (a scene file's field of
+/// open L-systems, docs/environment.md): its number there and where it stands.
+struct EnvironmentSeat {
+    std::shared_ptr<env::SharedEnvironment> environment;
+    std::size_t plant = 0;
+    std::array<float, 12> placement{};
+};
+
 /// Reads the colour files, the view file, its functions and then the L-system, in that
 /// order (a function set defines names for the L-system's preprocessor). Throws
-/// cambium::Error naming file, line and column.
-Model load_model(const Options& options);
+/// cambium::Error naming file, line and column. With a seat, the `-e` file's environment
+/// is the shared one (each derivation run takes the seat: derive such a model once).
+Model load_model(const Options& options, const EnvironmentSeat* seat = nullptr);
 
 /// The string after the derivation length (or --steps), decomposition included: what
 /// cpfg's -str writes (homomorphism_in_string: after the homomorphism, as -homo).

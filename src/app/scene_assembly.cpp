@@ -17,11 +17,13 @@
 #include <map>
 #include <mutex>
 #include <numbers>
+#include <thread>
 #include <sstream>
 
 #include <tbb/parallel_for.h>
 
 #include "app/pipeline.h"
+#include "app/shared_environments.h"
 #include "base/diagnostics.h"
 #include "base/limits.h"
 #include "base/subprocess.h"
@@ -45,6 +47,7 @@ double seconds_since(Clock::time_point start)
 /// Plants that share a model, its command line and seed: loaded once.
 struct Group {
     const ScenePlant* first = nullptr;          ///< the entry that named it first
+    const EnvironmentSeat* seat = nullptr;      ///< an open plant's shared environment
     std::vector<std::optional<int>> steps;      ///< distinct, in order of appearance
     std::vector<geom::Scene> variants;          ///< per step, interpreted
 };
@@ -89,16 +92,29 @@ struct Timing {
 
 void derive_group(Group& g, const SceneFile& file, const Options& options, Timing& t)
 {
+    // A seated plant leaves its shared environment once derived, or when it fails, so
+    // that the others' steps never wait for it.
+    struct Leave {
+        const EnvironmentSeat* seat;
+        void now() const
+        {
+            if (seat)
+                seat->environment->leave(seat->plant);
+        }
+        ~Leave() { now(); }
+    } leave{g.seat};
     try {
         Options o = plant_options(options, *g.first);
         auto start = Clock::now();
-        Model model = load_model(o);
+        Model model = load_model(o, g.seat);
         t.add(t.load_us, start);
         ++t.models;
         for (const std::optional<int>& steps : g.steps) {
             o.steps = steps;
             start = Clock::now();
             lsys::ModuleString derived = derive(model, o);
+            if (g.seat)
+                leave.now();  // a seated plant has one variant
             t.add(t.derive_us, start);
             ++t.derivations;
             start = Clock::now();
@@ -108,9 +124,37 @@ void derive_group(Group& g, const SceneFile& file, const Options& options, Timin
     } catch (const Interrupted&) {
         throw;
     } catch (const Error& e) {
+        if (g.seat)
+            g.seat->environment->abandon("another plant sharing this environment failed");
         throw Error(file.file.string() + ": " + g.first->path + " (" + g.first->command +
                     "): " + nested_message(e));
     }
+}
+
+/// Derives the seated groups together, each in a thread of its own: they meet at every
+/// step of their shared environments, so none may wait for a thread pool's free worker.
+/// The first failure is thrown (the others it caused are not).
+void derive_seated_groups(std::vector<Group>& groups, const std::vector<std::size_t>& seated,
+                          const SceneFile& file, const Options& options, Timing& timing)
+{
+    std::vector<std::exception_ptr> errors(seated.size());
+    std::atomic<int> first{-1};
+    {
+        std::vector<std::jthread> threads;
+        threads.reserve(seated.size());
+        for (std::size_t k = 0; k < seated.size(); ++k)
+            threads.emplace_back([&, k] {
+                try {
+                    derive_group(groups[seated[k]], file, options, timing);
+                } catch (...) {
+                    errors[k] = std::current_exception();
+                    int none = -1;
+                    first.compare_exchange_strong(none, static_cast<int>(k));
+                }
+            });
+    }
+    if (first >= 0)
+        std::rethrow_exception(errors[static_cast<std::size_t>(first.load())]);
 }
 
 bool same_material(const geom::Material& x, const geom::Material& y)
@@ -446,8 +490,10 @@ void check_placed_size(const SceneFile& file, const Entries& entries,
 
 }  // namespace
 
-geom::Scene assemble_scene(const SceneFile& file, const Options& options,
-                           const AssemblyOptions& how, AssemblyReport* report)
+namespace {
+
+geom::Scene assemble(const SceneFile& file, const std::vector<std::optional<EnvironmentSeat>>& seats,
+                     const Options& options, const AssemblyOptions& how, AssemblyReport* report)
 {
     auto start = Clock::now();
     // Group the entries and their steps: each distinct variant derived once.
@@ -458,10 +504,14 @@ geom::Scene assemble_scene(const SceneFile& file, const Options& options,
         std::vector<std::size_t> variants;  ///< per entry step: index in the group
     };
     std::vector<EntryRef> entries;
-    for (const ScenePlant& p : file.plants) {
-        auto [it, added] = group_of_key.emplace(group_key(p), groups.size());
+    for (std::size_t k = 0; k < file.plants.size(); ++k) {
+        const ScenePlant& p = file.plants[k];
+        const EnvironmentSeat* seat = k < seats.size() && seats[k] ? &*seats[k] : nullptr;
+        // a seated plant is a group of its own: its neighbours shape it
+        const std::string key = group_key(p) + (seat ? "\nseat " + std::to_string(k) : "");
+        auto [it, added] = group_of_key.emplace(key, groups.size());
         if (added)
-            groups.push_back(Group{&p, {}, {}});
+            groups.push_back(Group{&p, seat, {}, {}});
         Group& g = groups[it->second];
         EntryRef e{it->second, {}};
         for (const std::optional<int>& s : p.steps) {
@@ -474,9 +524,13 @@ geom::Scene assemble_scene(const SceneFile& file, const Options& options,
     }
 
     Timing timing;
-    tbb::parallel_for(std::size_t{0}, groups.size(), [&](std::size_t i) {
-        derive_group(groups[i], file, options, timing);
+    std::vector<std::size_t> closed, seated;
+    for (std::size_t i = 0; i < groups.size(); ++i)
+        (groups[i].seat ? seated : closed).push_back(i);
+    tbb::parallel_for(std::size_t{0}, closed.size(), [&](std::size_t i) {
+        derive_group(groups[closed[i]], file, options, timing);
     });
+    derive_seated_groups(groups, seated, file, options, timing);
 
     geom::Scene out;
     out.materials.clear();
@@ -557,6 +611,19 @@ geom::Scene assemble_scene(const SceneFile& file, const Options& options,
     if (report)
         *report = r;
     return out;
+}
+
+}  // namespace
+
+geom::Scene assemble_scene(const SceneFile& file, const Options& options,
+                           const AssemblyOptions& how, AssemblyReport* report)
+{
+    SeatedPlants seated = seat_open_plants(file, options);
+    if (!seated.any)
+        return assemble(file, {}, options, how, report);
+    SceneFile split = file;
+    split.plants = std::move(seated.plants);
+    return assemble(split, seated.seats, options, how, report);
 }
 
 void apply_scene_settings(const SceneFile& file, Options& o)

@@ -74,6 +74,9 @@ public:
     /// step counter cpfg sends at the pass's end (0 for the axiom's pass). Replies may
     /// come in any order; a reply to an address that was not sent is ignored.
     virtual std::vector<Reply> pass(const std::vector<Query>& queries, int step) = 0;
+    /// A step whose string holds no ?E: cpfg sends nothing, so an environment of its
+    /// own sees nothing; one shared by several plants counts this plant as done.
+    virtual void idle(int /*step*/) {}
 };
 
 /// One `keyword: value` line of a built-in's specification file (vlab's `.spec` files).

@@ -39,6 +39,19 @@ SentVector sent_scalar(const std::optional<TurtleFormat>& format, double v)
     return s;
 }
 
+/// The turtle in the world of a placed plant: position moved, frame turned (unit length).
+void place(geom::TurtleAtModule& t, const std::array<float, 12>& m)
+{
+    auto linear = [&](const geom::Vec3& v) {
+        return geom::Vec3{m[0] * v.x + m[3] * v.y + m[6] * v.z, m[1] * v.x + m[4] * v.y + m[7] * v.z,
+                          m[2] * v.x + m[5] * v.y + m[8] * v.z};
+    };
+    const geom::Vec3 p = linear(t.position);
+    t.position = {p.x + m[9], p.y + m[10], p.z + m[11]};
+    for (geom::Vec3* v : {&t.heading, &t.left, &t.up})
+        *v = geom::normalize(linear(*v));
+}
+
 }  // namespace
 
 Connection connect(const CommSpec& spec, const Context& context, const ProgramPermission& programs)
@@ -85,9 +98,11 @@ std::vector<Query> EnvironmentalStep::queries_of(const lsys::ModuleString& strin
     queries.reserve(turtles.size());
     offsets.clear();
     const std::size_t first = turtles.empty() ? 0 : turtles.front().module;
-    for (const geom::TurtleAtModule& t : turtles) {
+    for (geom::TurtleAtModule t : turtles) {
         if (static_cast<int>(string.symbol(t.module)) != communication)
             continue;
+        if (m_connection.placement)
+            place(t, *m_connection.placement);
         Query q;
         // cpfg's addresses count from the pass's first ?E; a module count serves the same
         // purpose (programs echo them back) and keeps string order
@@ -116,8 +131,10 @@ void EnvironmentalStep::run(lsys::ModuleString& string, const lsys::SymbolTable&
     bool any = false;
     for (std::size_t i = 0; i < string.size() && !any; ++i)
         any = static_cast<int>(string.symbol(i)) == communication;
-    if (!any)
-        return;  // cpfg sends nothing: the environment never sees this step
+    if (!any) {
+        m_environment->idle(step);  // cpfg sends nothing: the environment never sees this step
+        return;
+    }
 
     std::vector<std::size_t> offsets;
     const std::vector<Query> queries = queries_of(string, symbols, view, communication, offsets);

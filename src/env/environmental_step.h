@@ -3,7 +3,9 @@
 // ?E module to the environment and writes the answers back into their parameters.
 #pragma once
 
+#include <array>
 #include <functional>
+#include <optional>
 #include <memory>
 #include <string>
 
@@ -19,6 +21,9 @@ namespace cambium::env {
 struct Connection {
     std::function<std::unique_ptr<Environment>()> make;
     std::string description;  ///< "honda81 (built in)": for the line that says which
+    /// Where the plant stands (a 3x4 column-major transform, as a scene's placements):
+    /// the turtle's position and frame are sent in those world coordinates.
+    std::optional<std::array<float, 12>> placement;
 };
 
 /// Whether, and how, a `.e` file may start a program of its own.

@@ -650,3 +650,30 @@ TEST(SceneAssembly, OpenLSystemPlantsTalkToTheirEnvironment)
     EXPECT_EQ(closed, 14u);  // 2 + 4 + 8: every end branches
     EXPECT_EQ(open, 10u);    // the two blocked ends of step 2 do not
 }
+
+TEST(SceneAssembly, PlantsOfOneEnvironmentCompete)
+{
+    // Two placements of the plant above share honda81: far apart each grows as alone;
+    // on one spot every end of one meets the same end of the other (equal vigor blocks
+    // both), so neither grows at all
+    SceneFolder f("field");
+    f.write("m/p.l", "lsystem: 1\nderivation length: 3\naxiom: ?E(1)\n"
+                     "?E(c) : c == 1 --> [+F/(180)?E(1)]F?E(1)\nendlsystem\n");
+    f.write("m/p.v", "angle increment: 60\nline style: cylinder\ninitial line width: 0.1\n");
+    f.write("m/p.e", "executable: honda81 density.spec\nturtle position:P:%.4f %.4f %.0f\n");
+    f.write("m/density.spec", "radius: 0.01\n3d case: on\n");
+    auto drawn = [&](const std::string& placements) {
+        app::SceneFile s = app::read_scene_file(
+            f.scene(R"({"plants": [{"model": "m", "command": "cpfg -e p.e p.l p.v", "placements": )" +
+                    placements + "}]}"),
+            app::Options{});
+        Diagnostics quiet(Diagnostics::Output::quiet);
+        ScopedDiagnostics scope(quiet);
+        app::Options options;
+        options.quiet = true;
+        app::AssemblyOptions inline_plants{app::OrganPlacement::compose, true};
+        return segments(app::assemble_scene(s, options, inline_plants, nullptr));
+    };
+    EXPECT_EQ(drawn(R"([{}, {"translate": [100, 0, 0]}])"), 20u);
+    EXPECT_EQ(drawn("[{}, {}]"), 0u);
+}
