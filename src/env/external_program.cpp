@@ -18,6 +18,7 @@
 #include <exception>
 #include <string_view>
 
+#include "base/atomic_file.h"
 #include "base/subprocess.h"
 #include "geom/text_input.h"
 
@@ -232,32 +233,16 @@ public:
             }
             begin = end;
         }
-        std::string folder = (fs::temp_directory_path() / "cambium-env-XXXXXX").string();
-        if (::mkdtemp(folder.data()) == nullptr)
-            throw Error("cannot create a private folder for a copy of " + spec.file.string() +
-                        ": " + std::strerror(errno));
-        m_folder = folder;
-        m_file = m_folder / spec.file.filename();
-        try {
-            if (!write_private_file(m_file, out))
-                throw Error("'" + m_file.string() + "' exists");
-        } catch (...) {
-            remove();
-            throw;
-        }
+        m_folder = std::make_unique<PrivateFolder>(fs::temp_directory_path() / spec.file.filename());
+        m_file = m_folder->path() / spec.file.filename();
+        if (!write_private_file(m_file, out))
+            throw Error("'" + m_file.string() + "' exists");
     }
-    ~PipesCopy() { remove(); }
-    PipesCopy(const PipesCopy&) = delete;
-    PipesCopy& operator=(const PipesCopy&) = delete;
     const fs::path& file() const { return m_file; }
 
 private:
-    void remove()
-    {
-        std::error_code ec;
-        fs::remove_all(m_folder, ec);
-    }
-    fs::path m_folder, m_file;
+    std::unique_ptr<PrivateFolder> m_folder;  ///< removed with the copy when this goes
+    fs::path m_file;
 };
 
 class ExternalProgram final : public Environment {
