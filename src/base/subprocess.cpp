@@ -85,7 +85,7 @@ Pipe make_pipe()
 }
 
 /// While any is alive: SIGINT/SIGTERM/SIGHUP are noted (not fatal) and SIGPIPE is
-/// ignored (a helper that stops reading its input must not kill cambium). The first
+/// ignored (a child program that stops reading its input must not kill cambium). The first
 /// installs the handlers, the last restores them, so scopes may overlap across threads.
 class SignalScope {
 public:
@@ -448,7 +448,7 @@ Coprocess::Ready Coprocess::wait(bool writing, bool reading, std::chrono::millis
         polled[n++] = {m_output, POLLIN, 0};
     const int ms = int(std::clamp<long long>(timeout.count(), 0, 1 << 30));
     if (g_signal == 0 && ::poll(polled.data(), n, ms) < 0 && errno != EINTR)
-        throw Error(std::string("cannot wait for a helper program: ") + std::strerror(errno));
+        throw Error(std::string("cannot wait for a child program: ") + std::strerror(errno));
     if (g_signal != 0) {
         const int signal = g_signal;
         kill();

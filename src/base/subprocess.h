@@ -67,7 +67,7 @@ private:
 ProcessResult run_process(const std::vector<std::string>& argv, const std::filesystem::path& folder,
                           const ProcessIo& io, const ProcessLimits& limits);
 
-/// A helper program that runs beside cambium for a long time and talks to it through
+/// A child program that runs beside cambium for a long time and talks to it through
 /// two pipes (its standard input and output; standard error stays cambium's). Started
 /// as run_process starts one: no shell, in `folder`, in a process group of its own,
 /// dying with cambium. The whole group is killed and the program reaped on destruction.

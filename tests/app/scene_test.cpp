@@ -625,55 +625,51 @@ std::size_t segments(const geom::Scene& scene)
     return n;
 }
 
+/// The manual's L-system 3 (section 7.1) as model m, with honda81 answering 1 (free)
+/// or 0 (blocked): only free ends branch again.
+void open_sierpinski(const SceneFolder& f)
+{
+    f.write("m/p.l", "lsystem: 1\nderivation length: 3\naxiom: ?E(1)\n"
+                     "?E(c) : c == 1 --> [+F/(180)?E(1)]F?E(1)\nendlsystem\n");
+    f.write("m/p.v", "angle increment: 60\nline style: cylinder\ninitial line width: 0.1\n");
+    f.write("m/p.e", "executable: honda81 density.spec\nturtle position:P:%.4f %.4f %.0f\n");
+    f.write("m/density.spec", "radius: 0.01\n3d case: on\n");
+}
+
+/// The segments a scene of model m with `command` and `placements` draws, every plant
+/// drawn inline.
+std::size_t segments_drawn(const SceneFolder& f, const std::string& command, const std::string& placements)
+{
+    app::SceneFile s = app::read_scene_file(
+        f.scene(R"({"plants": [{"model": "m", "command": ")" + command + R"(", "placements": )" +
+                placements + "}]}"),
+        app::Options{});
+    Diagnostics quiet(Diagnostics::Output::quiet);
+    ScopedDiagnostics scope(quiet);
+    app::Options options;
+    options.quiet = true;
+    return segments(app::assemble_scene(s, options, {app::OrganPlacement::compose, true}, nullptr));
+}
+
 }  // namespace
 
 TEST(SceneAssembly, OpenLSystemPlantsTalkToTheirEnvironment)
 {
-    // the manual's L-system 3 with honda81: two ends meet after two steps and stop
+    // two ends meet after two steps and stop
     SceneFolder f("open");
-    f.write("m/p.l", "lsystem: 1\nderivation length: 3\naxiom: ?E(1)\n"
-                     "?E(c) : c == 1 --> [+F/(180)?E(1)]F?E(1)\nendlsystem\n");
-    f.write("m/p.v", "angle increment: 60\nline style: cylinder\ninitial line width: 0.1\n");
-    f.write("m/p.e", "executable: honda81 density.spec\nturtle position:P:%.4f %.4f %.0f\n");
-    f.write("m/density.spec", "radius: 0.01\n3d case: on\n");
-    auto drawn = [&](const std::string& command) {
-        app::SceneFile s = app::read_scene_file(
-            f.scene(R"({"plants": [{"model": "m", "command": ")" + command + R"(", "placements": [{}]}]})"),
-            app::Options{});
-        Diagnostics quiet(Diagnostics::Output::quiet);
-        ScopedDiagnostics scope(quiet);
-        app::Options options;
-        options.quiet = true;
-        return segments(app::assemble_scene(s, options, app::AssemblyOptions{}, nullptr));
-    };
-    const std::size_t open = drawn("cpfg -e p.e p.l p.v"), closed = drawn("cpfg p.l p.v");
-    EXPECT_EQ(closed, 14u);  // 2 + 4 + 8: every end branches
-    EXPECT_EQ(open, 10u);    // the two blocked ends of step 2 do not
+    open_sierpinski(f);
+    EXPECT_EQ(segments_drawn(f, "cpfg p.l p.v", "[{}]"), 14u);  // 2 + 4 + 8: every end branches
+    EXPECT_EQ(segments_drawn(f, "cpfg -e p.e p.l p.v", "[{}]"), 10u);  // the two blocked do not
 }
 
 TEST(SceneAssembly, PlantsOfOneEnvironmentCompete)
 {
-    // Two placements of the plant above share honda81: far apart each grows as alone;
-    // on one spot every end of one meets the same end of the other (equal vigor blocks
-    // both), so neither grows at all
+    // Two placements of that plant share honda81: far apart each grows as alone; on one
+    // spot every end of one meets the same end of the other (equal vigor blocks both),
+    // so neither grows at all
     SceneFolder f("field");
-    f.write("m/p.l", "lsystem: 1\nderivation length: 3\naxiom: ?E(1)\n"
-                     "?E(c) : c == 1 --> [+F/(180)?E(1)]F?E(1)\nendlsystem\n");
-    f.write("m/p.v", "angle increment: 60\nline style: cylinder\ninitial line width: 0.1\n");
-    f.write("m/p.e", "executable: honda81 density.spec\nturtle position:P:%.4f %.4f %.0f\n");
-    f.write("m/density.spec", "radius: 0.01\n3d case: on\n");
-    auto drawn = [&](const std::string& placements) {
-        app::SceneFile s = app::read_scene_file(
-            f.scene(R"({"plants": [{"model": "m", "command": "cpfg -e p.e p.l p.v", "placements": )" +
-                    placements + "}]}"),
-            app::Options{});
-        Diagnostics quiet(Diagnostics::Output::quiet);
-        ScopedDiagnostics scope(quiet);
-        app::Options options;
-        options.quiet = true;
-        app::AssemblyOptions inline_plants{app::OrganPlacement::compose, true};
-        return segments(app::assemble_scene(s, options, inline_plants, nullptr));
-    };
-    EXPECT_EQ(drawn(R"([{}, {"translate": [100, 0, 0]}])"), 20u);
-    EXPECT_EQ(drawn("[{}, {}]"), 0u);
+    open_sierpinski(f);
+    const std::string open = "cpfg -e p.e p.l p.v";
+    EXPECT_EQ(segments_drawn(f, open, R"([{}, {"translate": [100, 0, 0]}])"), 20u);
+    EXPECT_EQ(segments_drawn(f, open, "[{}, {}]"), 0u);
 }
