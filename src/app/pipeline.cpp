@@ -151,7 +151,7 @@ void connect_environment(const Options& options, lsys::LoadOptions& load,
     }
     load.environment = [queries, spec = std::move(spec), connection = std::move(connection)] {
         auto step = std::make_shared<env::EnvironmentalStep>(spec, connection);
-        return [queries, step](lsys::ModuleString& string, int n) {
+        return [queries, step](const lsys::TurtleString& string, int n) {
             if (queries->symbols)
                 step->run(string, *queries->symbols, *queries->view, n);
         };

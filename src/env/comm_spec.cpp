@@ -85,6 +85,62 @@ int send_through_format(const TurtleFormat& format, const double* values, int co
     return n;
 }
 
+bool InterpretedModules::matches(std::string_view name, std::size_t params) const
+{
+    if (all)
+        return true;
+    for (const InterpretedModule& m : modules)
+        if (m.name == name)
+            return !m.params || static_cast<std::size_t>(*m.params) == params;
+    return false;
+}
+
+namespace {
+
+/// `all`, or entries `M` / `M(n)` separated by blanks, commas or semicolons, read as vlab's
+/// library reads them (cpfg and the program must agree on which ?E carry polygons): a
+/// module is told by its one character, n is 0..6, a later entry for the same module
+/// replaces an earlier one, and nothing after `all` counts.
+InterpretedModules interpreted_modules(const std::string& value, const FileLoc& at)
+{
+    InterpretedModules result;
+    std::size_t i = 0;
+    auto separator = [](char c) { return c == ' ' || c == '\t' || c == ',' || c == ';'; };
+    while (i < value.size() && !result.all) {
+        if (separator(value[i])) {
+            ++i;
+            continue;
+        }
+        std::size_t end = i;
+        while (end < value.size() && !separator(value[end]))
+            ++end;
+        const std::string word = value.substr(i, end - i);
+        const FileLoc loc{at.file, at.line, at.column + static_cast<int>(i)};
+        i = end;
+        if (word == "all") {
+            result.all = true;
+            result.modules.clear();
+            continue;
+        }
+        const bool counted = word.size() == 4 && word[1] == '(' && word[3] == ')';
+        if (word.size() != 1 && !counted)
+            throw Error(loc, "interpreted modules: expected a one-character module M or M(n), found '" +
+                                 word + "' (vlab's library tells modules apart by one character)");
+        InterpretedModule m{word.substr(0, 1), std::nullopt};
+        if (counted) {
+            if (word[2] < '0' || word[2] > '6')
+                throw Error(loc, "interpreted modules: the parameter count in '" + word +
+                                     "' must be 0 to 6");
+            m.params = word[2] - '0';
+        }
+        std::erase_if(result.modules, [&](const InterpretedModule& e) { return e.name == m.name; });
+        result.modules.push_back(std::move(m));
+    }
+    return result;
+}
+
+}  // namespace
+
 CommSpec read_comm_spec(const std::filesystem::path& file)
 {
     CommSpec spec;
@@ -129,12 +185,8 @@ CommSpec read_comm_spec(const std::filesystem::path& file)
         } else if (name == "verbose") {
             spec.verbose = yes(value);
         } else if (name == "interpreted modules") {
-            std::istringstream words(value);
-            for (std::string w; std::getline(words, w, ',');) {
-                std::size_t a = w.find_first_not_of(" \t"), b = w.find_last_not_of(" \t");
-                if (a != std::string::npos)
-                    spec.interpreted_modules.push_back(w.substr(a, b - a + 1));
-            }
+            spec.interpreted = interpreted_modules(value, at);
+            spec.interpreted_loc = at;
         } else if (name == "turtle position" || name == "turtle heading" || name == "turtle left" ||
                    name == "turtle up") {
             TurtleFormat f = checked_format(raw, 3, raw_at);

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "base/diagnostics.h"
@@ -19,6 +20,24 @@ struct TurtleFormat {
     int conversions = 0;
 };
 
+/// One entry of `interpreted modules:`: a module name, with or without a parameter count.
+struct InterpretedModule {
+    std::string name;                 ///< as Cambium spells modules ("F", "@O", "~l")
+    std::optional<int> params;        ///< M(n): only with n parameters (0..6)
+
+    bool operator==(const InterpretedModule&) const = default;
+};
+
+/// The modules whose interpretation is sent (as GLS polygons) after the ?E they follow.
+struct InterpretedModules {
+    bool all = false;                        ///< `all`
+    std::vector<InterpretedModule> modules;  ///< otherwise these
+
+    bool any() const { return all || !modules.empty(); }
+    /// Whether a module of this name and parameter count is sent with its polygons.
+    bool matches(std::string_view name, std::size_t params) const;
+};
+
 struct CommSpec {
     std::filesystem::path file;            ///< the .e file, for messages
     std::vector<std::string> executable;   ///< program and its arguments, `-e file` removed
@@ -29,8 +48,9 @@ struct CommSpec {
     int queries_per_chunk = 0;
     bool following_module = true;          ///< cpfg's default, whatever the manual says
     std::optional<TurtleFormat> position, heading, left, up, line_width, scale_factor;
-    /// `interpreted modules:`: "all" or names with optional parameter counts, as written.
-    std::vector<std::string> interpreted_modules;
+    /// `interpreted modules:` (manual 7.4.1): whose polygons go with the ?E they follow.
+    InterpretedModules interpreted;
+    FileLoc interpreted_loc;               ///< its line, for messages
     bool verbose = false;
 };
 

@@ -39,7 +39,10 @@ struct Query {
     std::optional<SentModule> following;  ///< the next module (`following module: yes`)
     SentVector position, heading, left, up;
     SentVector line_width, scale_factor;  ///< one value each
-    std::vector<std::string> geometry;    ///< `interpreted modules:` polygons, as text lines
+    /// `interpreted modules:`: the GLS `polygon` statements of the module after the ?E
+    /// (its whole homomorphism successor) when that module is one the `.e` names; nullopt
+    /// when it is not (a program then expects no geometry block).
+    std::optional<std::vector<std::string>> geometry;
 };
 
 /// A reply: the ?E at `address` gets each given parameter; nullopt (an empty field)

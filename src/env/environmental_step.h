@@ -13,6 +13,7 @@
 #include "env/environment.h"
 #include "env/external_program.h"
 #include "geom/view_file.h"
+#include "lsys/lsystem.h"
 #include "lsys/module_string.h"
 
 namespace cambium::env {
@@ -45,17 +46,23 @@ class EnvironmentalStep {
 public:
     EnvironmentalStep(CommSpec spec, Connection connection);
 
-    /// One pass over `string` (as the turtle reads it) at cpfg's step counter `step`. A
-    /// string without ?E sends nothing.
-    void run(lsys::ModuleString& string, const lsys::SymbolTable& symbols,
+    /// One pass over `string` (as the turtle reads it, with the derived string it came
+    /// from) at cpfg's step counter `step`. A string without ?E sends nothing.
+    void run(const lsys::TurtleString& string, const lsys::SymbolTable& symbols,
              const geom::ViewFile& view, int step);
+    /// The same for a string without a homomorphism: the turtle reads it as derived.
+    void run(lsys::ModuleString& string, const lsys::SymbolTable& symbols,
+             const geom::ViewFile& view, int step)
+    {
+        run(lsys::TurtleString{string, string, {}}, symbols, view, step);
+    }
 
     /// Passes that sent something, and the ?E modules sent, since construction.
     std::size_t passes() const { return m_passes; }
     std::size_t queries() const { return m_queries; }
 
 private:
-    std::vector<Query> queries_of(const lsys::ModuleString& string, const lsys::SymbolTable& symbols,
+    std::vector<Query> queries_of(const lsys::TurtleString& string, const lsys::SymbolTable& symbols,
                                   const geom::ViewFile& view, int communication,
                                   std::vector<std::size_t>& modules) const;
 

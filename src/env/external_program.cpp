@@ -84,6 +84,15 @@ void append_query(std::string& out, const Query& q, const CommSpec& spec)
     append_turtle(out, spec.up, q.up);
     append_turtle(out, spec.line_width, q.line_width);
     append_turtle(out, spec.scale_factor, q.scale_factor);
+    if (q.geometry) {
+        // vlab's library reads the block between these two lines (DATA_BEGIN, DATA_END)
+        out += "Dbegin\n";
+        for (const std::string& statement : *q.geometry) {
+            out += statement;
+            out += '\n';
+        }
+        out += "Dend\n";
+    }
 }
 
 /// A line the program wrote: an answer, the end of its answers, nothing, or garbage.
@@ -586,10 +595,6 @@ std::unique_ptr<Environment> make_external_program(const CommSpec& spec, const C
     if (spec.executable.empty())
         throw Error(FileLoc{spec.file.string()},
                     "no 'executable:' line names the environmental program");
-    if (!spec.interpreted_modules.empty())
-        throw Error(spec.executable_loc,
-                    "'interpreted modules:' in " + spec.file.string() +
-                        ": Cambium does not send the modules' polygons to a program");
     if (!limits.message_folder.empty() && !is_real_directory(limits.message_folder))
         throw Error("message folder '" + limits.message_folder.string() + "' is not a directory");
     return std::make_unique<ExternalProgram>(spec, context, limits);

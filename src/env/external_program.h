@@ -30,8 +30,9 @@ struct ExternalLimits {
 /// Starts the program a `.e` file names (`-e <file.e>` inserted after the program's
 /// name, as cpfg does) in the model folder, and waits for its start-up byte. Pipes are
 /// spoken whatever the `communication type:`: for files, memory or sockets the program
-/// is given a private copy of the `.e` saying pipes. `interpreted modules:` is an Error
-/// naming the line (the polygons are not sent). Errors name the program.
+/// is given a private copy of the `.e` saying pipes. With `interpreted modules:`, a query
+/// whose following module is named carries its polygons between `Dbegin` and `Dend`
+/// lines, as vlab's library reads them. Errors name the program.
 std::unique_ptr<Environment> make_external_program(const CommSpec& spec, const Context& context,
                                                    const ExternalLimits& limits);
 

@@ -14,6 +14,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "geom/gls_polygons.h"
 #include "geom/label.h"
 #include "geom/object_instancing.h"
 #include "geom/patch.h"
@@ -124,9 +125,13 @@ public:
                        m_root == this) {
                 fragment_module(m);
             } else {
+                if (m_capture)
+                    begin_captures();
                 interpret_module(m, m_root == this);
             }
             ++m_module_index;
+            if (m_capture)
+                end_captures();
             if (m_root == this && m_module_index % memory_check_interval == 0)
                 check_memory();
         });
@@ -167,6 +172,16 @@ public:
 
     /// Records the turtle at each communication module ?E while interpreting.
     void collect_communication(std::vector<TurtleAtModule>* turtles) { m_communication = turtles; }
+
+    /// Records, for each range of modules (sorted by begin), the polygons its modules
+    /// draw: polygons[k] for ranges[k].
+    void collect_polygons(std::span<const ModuleRange> ranges,
+                          std::vector<std::vector<GlsPolygon>>* polygons)
+    {
+        polygons->assign(ranges.size(), {});
+        m_capture = ranges.empty() ? nullptr : polygons;
+        m_capture_ranges = ranges;
+    }
 
     Scene take() { return std::move(m_scene); }
 
@@ -1087,6 +1102,32 @@ private:
     std::vector<double> m_sub_scales;                    ///< cpfg's sub-L-system scale stack
     std::vector<QueryAnswer>* m_answers = nullptr;
     std::vector<TurtleAtModule>* m_communication = nullptr;
+    /// collect_polygons: the ranges, the next to begin, and those begun, with the
+    /// scene's arrays when they began
+    std::vector<std::vector<GlsPolygon>>* m_capture = nullptr;
+    std::span<const ModuleRange> m_capture_ranges;
+    std::size_t m_capture_next = 0;
+    std::vector<std::pair<std::size_t, GeometryMark>> m_captures_open;
+
+    void begin_captures()
+    {
+        while (m_capture_next < m_capture_ranges.size() &&
+               m_capture_ranges[m_capture_next].begin <= m_module_index) {
+            if (m_capture_ranges[m_capture_next].begin == m_module_index)
+                m_captures_open.emplace_back(m_capture_next, geometry_mark(m_scene));
+            ++m_capture_next;
+        }
+    }
+
+    void end_captures()
+    {
+        std::erase_if(m_captures_open, [&](const auto& open) {
+            if (m_capture_ranges[open.first].end > m_module_index)
+                return false;
+            append_polygons_since(m_scene, open.second, (*m_capture)[open.first]);
+            return true;
+        });
+    }
     std::vector<Turtle>* m_fresh_turtles = nullptr;           ///< the fragment pass's
     std::vector<std::uint32_t>* m_fragment_starts = nullptr;  ///< ... and their modules
     std::size_t m_fresh_limit = 0;
@@ -1176,11 +1217,15 @@ std::vector<QueryAnswer> collect_query_answers(const lsys::ModuleString& string,
 
 std::vector<TurtleAtModule> collect_communication_turtles(const lsys::ModuleString& string,
                                                           const lsys::SymbolTable& symbols,
-                                                          const ViewFile& view)
+                                                          const ViewFile& view,
+                                                          std::span<const ModuleRange> ranges,
+                                                          std::vector<std::vector<GlsPolygon>>* polygons)
 {
     std::vector<TurtleAtModule> turtles;
     Interpreter interpreter(view, InterpretOptions{});
     interpreter.collect_communication(&turtles);
+    if (polygons)
+        interpreter.collect_polygons(ranges, polygons);
     interpreter.run(string, symbols);
     return turtles;
 }

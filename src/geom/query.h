@@ -4,8 +4,10 @@
 
 #include <array>
 #include <cstddef>
+#include <span>
 #include <vector>
 
+#include "geom/gls_polygons.h"
 #include "geom/vec.h"
 #include "geom/view_file.h"
 #include "lsys/module_string.h"
@@ -40,9 +42,17 @@ struct TurtleAtModule {
     double scale = 1;
 };
 
-/// The turtle at every `?E` module, in string order (defined in interpreter.cpp).
-std::vector<TurtleAtModule> collect_communication_turtles(const lsys::ModuleString& string,
-                                                          const lsys::SymbolTable& symbols,
-                                                          const ViewFile& view);
+/// Modules [begin, end) of a string.
+struct ModuleRange {
+    std::size_t begin = 0, end = 0;
+};
+
+/// The turtle at every `?E` module, in string order (defined in interpreter.cpp). With
+/// `polygons`, also the polygons each of `ranges` (sorted by begin; they may nest) draws,
+/// as polygons[k] for ranges[k]: cpfg's `interpreted modules:` (manual 7.4.1).
+std::vector<TurtleAtModule> collect_communication_turtles(
+    const lsys::ModuleString& string, const lsys::SymbolTable& symbols, const ViewFile& view,
+    std::span<const ModuleRange> ranges = {},
+    std::vector<std::vector<GlsPolygon>>* polygons = nullptr);
 
 }  // namespace cambium::geom

@@ -799,13 +799,14 @@ ParamLink make_link(std::size_t from, std::size_t to, std::size_t count)
 }  // namespace
 
 void Deriver::apply_homomorphism(const ModuleString& in, ModuleString& out,
-                                 std::vector<ParamLink>* query_links, bool keep_objects)
+                                 std::vector<ParamLink>* query_links, bool keep_objects,
+                                 std::vector<std::uint32_t>* origins)
 {
     m_keep_objects = keep_objects;
     m_in_homomorphism = true;
     m_source = &in;
     try {
-        homomorphism_located(in, out, query_links);
+        homomorphism_located(in, out, query_links, origins);
     } catch (const EvaluationError& e) {
         m_keep_objects = m_in_homomorphism = false;
         fail(e);
@@ -817,11 +818,14 @@ void Deriver::apply_homomorphism(const ModuleString& in, ModuleString& out,
 }
 
 void Deriver::homomorphism_located(const ModuleString& in, ModuleString& out,
-                                   std::vector<ParamLink>* query_links)
+                                   std::vector<ParamLink>* query_links,
+                                   std::vector<std::uint32_t>* origins)
 {
     out.clear();
     if (query_links)
         query_links->clear();
+    if (origins)
+        origins->clear();
     bool any = false, contexts = false;
     for (const auto& ls : m_program.lsystems) {
         any |= !ls.homomorphism.productions.empty();
@@ -834,6 +838,9 @@ void Deriver::homomorphism_located(const ModuleString& in, ModuleString& out,
                 if (is_query(in.symbol(i)))
                     query_links->push_back(make_link(offset, offset, in.param_count(i)));
         out.append(in);
+        if (origins)
+            for (std::size_t i = 0; i < in.size(); ++i)
+                origins->push_back(static_cast<std::uint32_t>(i));
         return;
     }
     Indexed ctx;
@@ -889,6 +896,8 @@ void Deriver::homomorphism_located(const ModuleString& in, ModuleString& out,
             offset += in.param_count(i);
             ++i;
         }
+        if (origins)
+            origins->resize(out.size(), static_cast<std::uint32_t>(first));
         check_size(out);
         // sub-L-system switching follows the original string, as in derivation
         for (std::size_t k = first, o = first_offset; k < i; o += in.param_count(k), ++k) {

@@ -108,16 +108,19 @@ public:
     /// `keep_objects`, a module that an object production (-o>, one module, no
     /// context) applies to stays as it is, for geom to instance; otherwise objects are
     /// expanded like the others. With `query_links`, says where each ?P ?H ?L ?U module
-    /// of `in` that the homomorphism leaves as it is went.
+    /// of `in` that the homomorphism leaves as it is went. With `origins`, origins[k] is
+    /// the module of `in` whose successor module k of `out` is part of.
     void apply_homomorphism(const ModuleString& in, ModuleString& out,
                             std::vector<ParamLink>* query_links = nullptr,
-                            bool keep_objects = false);
+                            bool keep_objects = false,
+                            std::vector<std::uint32_t>* origins = nullptr);
 
 private:
     void start();
     void step_located();
     void homomorphism_located(const ModuleString& in, ModuleString& out,
-                              std::vector<ParamLink>* query_links);
+                              std::vector<ParamLink>* query_links,
+                              std::vector<std::uint32_t>* origins);
     /// What is being evaluated, for messages: a production, else a block
     void in_block(const char* block)
     {

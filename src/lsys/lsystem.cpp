@@ -237,16 +237,20 @@ bool Derivation::stop_runs_end() const { return m_deriver->stop_runs_end(); }
 void Derivation::go_on_after_stop_one() { m_go_on_after_stop_one = true; }
 ModuleString Derivation::take_string() { return m_deriver->take_string(); }
 
-void LSystem::run_query(Deriver& deriver) const { turtle_pass(deriver, m_options.query); }
-
-void LSystem::run_environment(Deriver& deriver,
-                              const std::function<void(ModuleString&, int)>& pass) const
+void LSystem::run_query(Deriver& deriver) const
 {
-    const int step = deriver.steps_done();
-    turtle_pass(deriver, [&](ModuleString& s) { pass(s, step); });
+    turtle_pass(deriver, [&](const TurtleString& s) { m_options.query(s.modules); });
 }
 
-void LSystem::turtle_pass(Deriver& deriver, const std::function<void(ModuleString&)>& pass) const
+void LSystem::run_environment(Deriver& deriver,
+                              const std::function<void(const TurtleString&, int)>& pass) const
+{
+    const int step = deriver.steps_done();
+    turtle_pass(deriver, [&](const TurtleString& s) { pass(s, step); });
+}
+
+void LSystem::turtle_pass(Deriver& deriver,
+                          const std::function<void(const TurtleString&)>& pass) const
 {
     ModuleString& s = deriver.mutable_string();
     auto changed_count = [&] {
@@ -254,13 +258,14 @@ void LSystem::turtle_pass(Deriver& deriver, const std::function<void(ModuleStrin
                      "internal: a turtle pass changed the number of parameters");
     };
     if (!m_has_homomorphism && m_program->split_commands.empty()) {
-        pass(s);
+        pass(TurtleString{s, s, {}});
         return;
     }
     if (!m_has_homomorphism) {
         // '@' has no parameters, so the joined string holds the same values in the same order
-        ModuleString joined = join_at_commands(s);
-        pass(joined);
+        std::vector<std::uint32_t> origins;
+        ModuleString joined = join_at_commands(s, &origins);
+        pass(TurtleString{joined, s, origins});
         if (joined.param_total() != s.param_total())
             throw changed_count();
         std::copy_n(joined.param_data(), joined.param_total(), s.mutable_params().data());
@@ -270,10 +275,11 @@ void LSystem::turtle_pass(Deriver& deriver, const std::function<void(ModuleStrin
     // variables; the modules the homomorphism keeps in place take their values back
     ModuleString expanded;
     std::vector<ParamLink> links;
-    deriver.apply_homomorphism(s, expanded, &links);
-    ModuleString joined = joined_at_commands(std::move(expanded));
+    std::vector<std::uint32_t> origins;
+    deriver.apply_homomorphism(s, expanded, &links, false, &origins);
+    ModuleString joined = joined_at_commands(std::move(expanded), &origins);
     std::size_t total = joined.param_total();
-    pass(joined);
+    pass(TurtleString{joined, s, origins});
     if (joined.param_total() != total)
         throw changed_count();
     float* params = s.mutable_params().data();
@@ -358,18 +364,22 @@ std::uint32_t LSystem::run_fragment_pass(Deriver& deriver, std::uint32_t first_t
     return static_cast<std::uint32_t>(reached.size());
 }
 
-ModuleString LSystem::joined_at_commands(ModuleString s) const
+ModuleString LSystem::joined_at_commands(ModuleString s, std::vector<std::uint32_t>* origins) const
 {
     if (m_program->split_commands.empty())
         return s;  // moved out, not copied
-    return join_at_commands(s);
+    return join_at_commands(s, origins);
 }
 
-ModuleString LSystem::join_at_commands(const ModuleString& s) const
+ModuleString LSystem::join_at_commands(const ModuleString& s, std::vector<std::uint32_t>* origins) const
 {
     const auto& commands = m_program->split_commands;
     if (commands.empty())
         return s;
+    std::vector<std::uint32_t> joined_origins;
+    auto origin = [&](std::size_t i) {
+        return origins && !origins->empty() ? (*origins)[i] : static_cast<std::uint32_t>(i);
+    };
     SymbolId at = commands.front().parts.front();
     ModuleString out;
     out.reserve(s.size(), s.param_total());
@@ -388,6 +398,8 @@ ModuleString LSystem::join_at_commands(const ModuleString& s) const
                     best = &c;
             }
         }
+        if (origins)
+            joined_origins.push_back(origin(i));
         if (best) {
             std::size_t last = i + best->parts.size() - 1;
             out.append(best->joined,
@@ -400,6 +412,8 @@ ModuleString LSystem::join_at_commands(const ModuleString& s) const
             ++i;
         }
     }
+    if (origins)
+        *origins = std::move(joined_origins);
     return out;
 }
 

@@ -6,6 +6,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -19,6 +20,19 @@ namespace cambium::lsys {
 struct Program;
 struct Runtime;
 class Deriver;
+
+/// The string a turtle pass reads (the homomorphism applied, split @-commands joined) and
+/// the derived string it was made from: module i of `modules` came from module
+/// origins[i] of `derived` (one derived module may give many, or none). `origins` is
+/// empty when the two strings are alike module for module.
+struct TurtleString {
+    ModuleString& modules;
+    const ModuleString& derived;
+    std::span<const std::uint32_t> origins;
+
+    /// The derived module that module i came from.
+    std::size_t origin(std::size_t i) const { return origins.empty() ? i : origins[i]; }
+};
 
 struct LoadOptions {
     std::vector<std::string> defines;      ///< extra -D NAME[=VALUE] for the preprocessor
@@ -50,10 +64,11 @@ struct LoadOptions {
     /// runs must not share it). The run calls that pass, when the program has
     /// communication modules ?E, before every derivation step (after `query`, at the same
     /// points), with the string as the turtle reads it (as `query` gets it) and cpfg's
-    /// step counter (0 for the axiom's pass). It may change parameter values only; those
-    /// of the ?E modules the homomorphism leaves in place go back into the derived string,
-    /// the others (made by the homomorphism) are dropped.
-    std::function<std::function<void(ModuleString&, int step)>()> environment;
+    /// step counter (0 for the axiom's pass), and the derived string with each module's
+    /// origin in it. It may change parameter values only; those of the ?E modules the
+    /// homomorphism leaves in place go back into the derived string, the others (made by
+    /// the homomorphism) are dropped.
+    std::function<std::function<void(const TurtleString&, int step)>()> environment;
     /// Fragmentation's turtle pass (manual 5.1.9 `%(par)`), from geom. Called before every
     /// step whose string holds a one-parameter `%` (after `query`), with the string as the
     /// turtle reads it (as `query` gets it) and the index of the first turtle this pass
@@ -129,7 +144,7 @@ private:
     bool m_track_lineage = false;
     bool m_go_on_after_stop_one = false;
     std::uint32_t m_saved_turtles = 0;  ///< by fragment starts in this run (manual 5.1.9)
-    std::function<void(ModuleString&, int step)> m_environment;  ///< this run's (manual 7)
+    std::function<void(const TurtleString&, int step)> m_environment;  ///< this run's (manual 7)
     std::vector<std::uint32_t> m_lineage;
 };
 
@@ -195,18 +210,21 @@ private:
     friend class Derivation;
     explicit LSystem(std::unique_ptr<Program> program, LoadOptions options);
     void run_query(Deriver& deriver) const;
-    void run_environment(Deriver& deriver, const std::function<void(ModuleString&, int)>& pass) const;
+    void run_environment(Deriver& deriver,
+                         const std::function<void(const TurtleString&, int)>& pass) const;
     /// Calls `pass` on the string as the turtle reads it (homomorphism applied,
     /// @-commands joined), then copies the parameters of the query and communication
     /// modules that string keeps in place back into the derived string.
-    void turtle_pass(Deriver& deriver, const std::function<void(ModuleString&)>& pass) const;
+    void turtle_pass(Deriver& deriver, const std::function<void(const TurtleString&)>& pass) const;
     /// Marks the fragment starts of the deriver's string for its next step; returns the
     /// turtles saved (numbered from `first_turtle`).
     std::uint32_t run_fragment_pass(Deriver& deriver, std::uint32_t first_turtle) const;
-    ModuleString join_at_commands(const ModuleString& s) const;
+    /// The string with split @-commands joined. With `origins` (each module's origin, or
+    /// empty for the identity), they are carried to the joined string's modules.
+    ModuleString join_at_commands(const ModuleString& s, std::vector<std::uint32_t>* origins = nullptr) const;
     /// join_at_commands of a string the caller gives up: the string itself when there is
     /// no split command (no copy)
-    ModuleString joined_at_commands(ModuleString s) const;
+    ModuleString joined_at_commands(ModuleString s, std::vector<std::uint32_t>* origins = nullptr) const;
 
     std::unique_ptr<Program> m_program;
     LoadOptions m_options;

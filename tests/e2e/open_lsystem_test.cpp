@@ -82,4 +82,38 @@ TEST(OpenLSystem, AProgramThatIsNotBuiltInIsRefusedBeforeAnyWork)
     }
 }
 
+/// `?E(0,0) X` derived once with the protocol test program answering ?E(polygons, top):
+/// the number of polygons sent after the ?E and their highest y.
+std::string polygons_sent(const std::string& name, const std::string& interpreted,
+                          const std::string& homomorphism)
+{
+    app::Options o = cambium::testing::write_model(
+        "open_polygons_" + name, "Lsystem: 1\nderivation length: 1\nAxiom: ?E(0,0)X(2)\n"
+                                 "?E(n,t) --> ?E(n,t)\nhomomorphism\n" +
+                                     homomorphism + "endlsystem\n");
+    const auto folder = o.lsystem.parent_path();
+    std::ofstream(folder / "plant.e") << "executable: " << CAMBIUM_TEST_PROGRAM
+                                      << " polygons\nturtle position:P:%g %g %g\n"
+                                      << interpreted;
+    o.environment_file = folder / "plant.e";
+    o.allow_environment_program = true;
+    o.quiet = true;
+    return derived(o);
+}
+
+TEST(OpenLSystem, InterpretedModulesSendTheirPolygons)
+{
+    // X(2) drawn as a cylinder of length 2 up the turtle's heading (+y): the wall of
+    // eight quads (geom::gls_sides) reaches y = 2
+    const std::string cylinder = "X(l) --> F(l)\n";
+    EXPECT_EQ(polygons_sent("named", "interpreted modules: X(1)\n", cylinder), "?E(8,2)X(2)");
+    EXPECT_EQ(polygons_sent("all", "interpreted modules: all\n", cylinder), "?E(8,2)X(2)");
+    // the whole homomorphism successor of the module is sent, not only its first module
+    EXPECT_EQ(polygons_sent("successor", "interpreted modules: X\n", "X(l) --> F(l)F(l)\n"),
+              "?E(16,4)X(2)");
+    // a module the .e does not name (here: another parameter count) sends no block
+    EXPECT_EQ(polygons_sent("other", "interpreted modules: X(2)\n", cylinder), "?E(0,0)X(2)");
+    EXPECT_EQ(polygons_sent("none", "", cylinder), "?E(0,0)X(2)");
+}
+
 }  // namespace

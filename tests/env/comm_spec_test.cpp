@@ -34,7 +34,7 @@ TEST(CommSpec, ReadsEveryDocumentedCommand)
                                 "turtle line width: %.3f\n"
                                 "turtle scale factor: %g\n"
                                 "following module: no\n"
-                                "interpreted modules: F(1), @O\n"
+                                "interpreted modules: F(1), L;A B(0) A(2)\n"
                                 "verbose: on\n");
     EXPECT_EQ(s.executable, (std::vector<std::string>{"honda81", "density.spec"}));
     EXPECT_EQ(s.communication_type, "files");
@@ -45,7 +45,17 @@ TEST(CommSpec, ReadsEveryDocumentedCommand)
     EXPECT_EQ(s.left->conversions, 1);
     EXPECT_TRUE(s.up && s.line_width && s.scale_factor);
     EXPECT_FALSE(s.following_module);
-    EXPECT_EQ(s.interpreted_modules, (std::vector<std::string>{"F(1)", "@O"}));
+    EXPECT_FALSE(s.interpreted.all);
+    // as vlab's library: a later entry for a module replaces an earlier one
+    EXPECT_EQ(s.interpreted.modules,
+              (std::vector<InterpretedModule>{{"F", 1}, {"L", std::nullopt}, {"B", 0}, {"A", 2}}));
+    EXPECT_TRUE(s.interpreted.matches("F", 1));
+    EXPECT_FALSE(s.interpreted.matches("F", 2));  // F(1): only with one parameter
+    EXPECT_TRUE(s.interpreted.matches("L", 3));
+    EXPECT_FALSE(s.interpreted.matches("A", 0));
+    EXPECT_FALSE(s.interpreted.matches("G", 0));
+    CommSpec all = spec_of("every", "executable: a\ninterpreted modules: all F(1)\n");
+    EXPECT_TRUE(all.interpreted.all && all.interpreted.matches("G", 5));
     EXPECT_TRUE(s.verbose);
 }
 
@@ -78,6 +88,11 @@ TEST(CommSpec, BadLinesNameFileLineAndColumn)
     EXPECT_NE(message("type", "executable: a\ncommunication type: carrier pigeon\n").find("plant.e:2:21"),
               std::string::npos);
     EXPECT_NE(message("none", "verbose: on\n").find("executable"), std::string::npos);
+    // vlab's library tells at most six parameters apart
+    EXPECT_NE(message("seven", "executable: a\ninterpreted modules: F, G(7)\n").find("plant.e:2:25"),
+              std::string::npos);
+    EXPECT_NE(message("long", "executable: a\ninterpreted modules: @O\n").find("plant.e:2:22"),
+              std::string::npos);
 }
 
 TEST(CommSpec, ValuesTravelAsTheFormatPrintsThem)

@@ -14,6 +14,8 @@
 //   deaf      closes its input before the start-up byte, then waits
 //   twice     answers each query twice
 //   later     ?E(x) after the pass's last chunk, in chunks of 100 as the library writes
+//   polygons  ?E(n, top): the polygons after the query (`interpreted modules:`, between
+//             Dbegin and Dend lines) and their highest y (0, 0 without a block)
 // Started as `obcheck -e FILE.e OBSTACLES` (its file name obcheck), it is a stand-in for
 // the corpus's CelticKnot program, written from FACTS-environment.md's description: the
 // obstacles are `x1 y1 x2 y2` segments after a `coordinates:` line; ?E(0) marks where a
@@ -21,6 +23,7 @@
 // crosses an obstacle, else 0 (and here starts the next segment). It answers at once.
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <cstdlib>
@@ -37,6 +40,8 @@ struct Pending {
     std::size_t params;
     float x, y;
     float first;  ///< the ?E's first parameter
+    int polygons = 0;
+    float top = -1e30f;  ///< the highest y of their vertices
 };
 
 /// obcheck's obstacles and the start of the segment being tested (kept across passes).
@@ -86,6 +91,8 @@ void answer(const std::string& mode, const Pending& p)
 {
     if (mode == "echo" || mode == "later")
         std::printf("%lu E(%g)\n", p.address, double(p.x));
+    else if (mode == "polygons")
+        std::printf("%lu E(%d,%g)\n", p.address, p.polygons, p.polygons ? double(p.top) : 0.0);
     else if (mode == "twice")
         std::printf("%lu E(1)\n%lu E(2)\n", p.address, p.address);
     else if (mode == "unknown")
@@ -158,6 +165,28 @@ int main(int argc, char** argv)
                 steps += std::to_string(step) + "\n";
             std::printf("Control: 5\n");
             std::fflush(stdout);
+            continue;
+        }
+        if (std::strncmp(line, "Dbegin", 6) == 0) {
+            // the polygons of the last query's following module, up to Dend
+            if (pending.empty())
+                return 5;
+            Pending& p = pending.back();
+            while (std::fgets(line, sizeof line, stdin) && std::strncmp(line, "Dend", 4) != 0) {
+                if (std::strncmp(line, "polygon ", 8) != 0)
+                    return 6;
+                ++p.polygons;
+                char* at = line + 8;
+                for (int k = 0;; ++k) {
+                    char* end = nullptr;
+                    const float v = std::strtof(at, &end);
+                    if (end == at)
+                        break;
+                    if (k % 3 == 1)
+                        p.top = std::max(p.top, v);
+                    at = end;
+                }
+            }
             continue;
         }
         if (mode == "die")
