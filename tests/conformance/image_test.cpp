@@ -4,6 +4,7 @@
 // Renders are small in samples (2 per pixel) so the whole corpus takes seconds.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <optional>
 #include <set>
 
@@ -28,6 +29,9 @@ const std::set<std::pair<std::string, std::string>> known_differences = {
 /// rasterised differently from ray-traced ones).
 constexpr int tolerance_px = 2;
 constexpr double min_agreement = 0.95;
+/// How far (of 255) a pixel may lie from the background colour and still count as
+/// background: the tolerance read_cpfg_image gives cpfg's picture.
+constexpr float background_tolerance = 3;
 constexpr double max_hue_difference_deg = 15;
 /// Hue is compared only where enough pixels of both images have one.
 constexpr std::size_t min_hue_pixels = 200;
@@ -38,7 +42,10 @@ constexpr std::size_t min_hue_pixels = 200;
 constexpr double min_value_ratio = 0.5, max_value_ratio = 2.0;
 
 /// Our render of the model at cpfg's window size, as display colours, with the plant
-/// being every pixel the plant covers at least half of.
+/// being every pixel the plant covers at least half of, unless it shows the window's
+/// background colour: cpfg's picture tells the plant by colour alone (read_cpfg_image),
+/// so geometry drawn in the background colour (a black disc on black) is no more part
+/// of the visible silhouette in ours than in cpfg's.
 PlantImage render_model(const CorpusModel& model)
 {
     app::Options options = model_options(model);
@@ -61,9 +68,15 @@ PlantImage render_model(const CorpusModel& model)
         for (int x = 0; x < image.width; ++x) {
             std::size_t i = std::size_t(y) * image.width + x;
             float alpha = image.at(x, y, 3);
-            out.plant[i] = alpha >= 0.5f;
-            for (int c = 0; c < 3; ++c)  // straight colour from the premultiplied
+            bool shows_background = true;
+            for (int c = 0; c < 3; ++c) {  // straight colour from the premultiplied
                 out.rgb[3 * i + c] = alpha > 0 ? render::linear_to_srgb(image.at(x, y, c) / alpha) : 0;
+                const float background = c == 0 ? scene.background.r : c == 1 ? scene.background.g
+                                                                              : scene.background.b;
+                shows_background = shows_background &&
+                                   std::abs(out.rgb[3 * i + c] - background) * 255 <= background_tolerance;
+            }
+            out.plant[i] = alpha >= 0.5f && !shows_background;
         }
     return out;
 }
