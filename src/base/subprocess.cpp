@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cstring>
@@ -136,6 +137,80 @@ private:
     static inline Pipe s_pipe;
     static inline std::array<struct sigaction, forwarded_signals.size()> s_saved{};
     static inline struct sigaction s_saved_pipe {};
+};
+
+/// The process groups of the coprocesses alive now. Between their waits (which note
+/// SIGINT, SIGTERM and SIGHUP themselves) such a signal ends cambium: a guard handler
+/// kills the groups first, since only the program itself would die with cambium
+/// (PR_SET_PDEATHSIG), not what it started. Slots hold 0 when free.
+class LiveGroups {
+public:
+    static void add(pid_t group)
+    {
+        std::lock_guard lock(mutex());
+        for (auto& slot : s_groups) {
+            pid_t free = 0;
+            if (slot.compare_exchange_strong(free, group))
+                break;
+        }
+        if (s_users++ == 0)
+            install();
+    }
+    static void remove(pid_t group)
+    {
+        std::lock_guard lock(mutex());
+        for (auto& slot : s_groups) {
+            pid_t held = group;
+            if (slot.compare_exchange_strong(held, 0))
+                break;
+        }
+        if (--s_users == 0)
+            restore();
+    }
+
+private:
+    static void install()
+    {
+        struct sigaction guard {};
+        guard.sa_handler = guard_signal;
+        sigemptyset(&guard.sa_mask);
+        for (std::size_t i = 0; i < forwarded_signals.size(); ++i)
+            ::sigaction(forwarded_signals[i], &guard, &s_before[i]);
+    }
+    static void restore()
+    {
+        for (std::size_t i = 0; i < forwarded_signals.size(); ++i)
+            ::sigaction(forwarded_signals[i], &s_before[i], nullptr);
+    }
+    /// Async-signal-safe: kill, sigaction and raise only.
+    static void guard_signal(int signal)
+    {
+        for (auto& slot : s_groups)
+            if (const pid_t group = slot.load(); group > 0)
+                ::kill(-group, SIGKILL);
+        for (std::size_t i = 0; i < forwarded_signals.size(); ++i) {
+            if (forwarded_signals[i] != signal)
+                continue;
+            const struct sigaction& before = s_before[i];
+            if (before.sa_handler == SIG_IGN)
+                return;
+            if (before.sa_handler != SIG_DFL && !(before.sa_flags & SA_SIGINFO)) {
+                before.sa_handler(signal);  // whoever handled it before (a cleanup) still does
+                return;
+            }
+            ::sigaction(signal, &before, nullptr);
+            ::raise(signal);  // delivered when this handler returns: ends cambium as before
+        }
+    }
+    static std::mutex& mutex()
+    {
+        static std::mutex m;
+        return m;
+    }
+    static constexpr std::size_t max_groups = 256;
+    static inline std::array<std::atomic<pid_t>, max_groups> s_groups{};
+    static inline int s_users = 0;
+    static inline std::array<struct sigaction, forwarded_signals.size()> s_before{};
 };
 
 /// The started child: its whole process group is killed and the child reaped on
@@ -388,6 +463,7 @@ Coprocess::Coprocess(const std::vector<std::string>& argv, const std::filesystem
                    report.write.get(), parent, limits);
     ::setpgid(pid, pid);  // also here: no race with a kill before the child's own call
     m_pid = pid;
+    LiveGroups::add(pid);
     in_pipe.read.reset();
     out_pipe.write.reset();
     report.write.reset();
@@ -427,6 +503,7 @@ void Coprocess::kill()
     if (m_reaped || m_pid < 0)
         return;
     ::kill(-m_pid, SIGKILL);
+    LiveGroups::remove(m_pid);  // before the reaping, after which the id may be reused
     int status = 0;
     for (;;) {
         pid_t r = ::waitpid(m_pid, &status, 0);

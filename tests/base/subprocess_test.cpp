@@ -5,7 +5,10 @@
 #include <gtest/gtest.h>
 
 #include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -182,6 +185,39 @@ TEST(Coprocess, DestructionKillsItsWholeGroup)
         std::istringstream(line) >> background;
         ASSERT_GT(background, 0);
     }
+    EXPECT_TRUE(dies_soon(background));
+}
+
+// Ctrl-C between waits ends cambium as it would, and kills the program's whole group
+// first: only the program itself would die with cambium (PR_SET_PDEATHSIG), not the
+// background job it started.
+TEST(Coprocess, AnInterruptBetweenWaitsKillsItsWholeGroup)
+{
+    int report[2];
+    ASSERT_EQ(::pipe(report), 0);
+    const pid_t plant = ::fork();
+    ASSERT_GE(plant, 0);
+    if (plant == 0) {
+        ::close(report[0]);
+        Coprocess c({"sh", "-c", "sleep 60 & echo $!; read x"}, ".", {});
+        std::string line;
+        for (std::string more; line.find('\n') == std::string::npos && !(more = read_from(c, 1)).empty();)
+            line += more;
+        [[maybe_unused]] auto written = ::write(report[1], line.data(), line.size());
+        ::close(report[1]);
+        ::raise(SIGINT);
+        ::_exit(0);  // not reached: SIGINT ends it
+    }
+    ::close(report[1]);
+    std::string line(64, '\0');
+    const ssize_t got = ::read(report[0], line.data(), line.size());
+    ::close(report[0]);
+    int status = 0;
+    ASSERT_EQ(::waitpid(plant, &status, 0), plant);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGINT);
+    pid_t background = 0;
+    std::istringstream(line.substr(0, std::size_t(std::max<ssize_t>(got, 0)))) >> background;
+    ASSERT_GT(background, 0);
     EXPECT_TRUE(dies_soon(background));
 }
 
