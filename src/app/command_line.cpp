@@ -188,6 +188,9 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     Options options;
     std::vector<std::string> args = take_ground_option(take_cpfg_options(words, options),
                                                        options.shot);
+    // -rgb and -tga images join -o's, which CLI11 assigns whole
+    std::vector<std::filesystem::path> cpfg_images = std::move(options.outputs);
+    options.outputs.clear();
 
     CLI::App cli{"cambium: renders cpfg plant models physically.\n"
                  "cpfg options: -w W H (image size, default 640 480), -m[n] file.map, -M[n] file.mat, -c<n>, -w W H, -str file,\n"
@@ -317,6 +320,7 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     } catch (const CLI::ParseError& e) {
         throw Error(std::string(e.what()) + " (see cambium --help)");
     }
+    options.outputs.insert(options.outputs.end(), cpfg_images.begin(), cpfg_images.end());
     // A budget or a noise target decides when to stop; --spp, when given, still caps it.
     if (cli.count("--spp") == 0 && options.time_budget_s > 0)
         options.samples_per_pixel = 1 << 16;

@@ -29,6 +29,7 @@
 #include "base/subprocess.h"
 #include "geom/view_volume.h"
 #include "lsys/string_io.h"
+#include "render/output_format.h"
 #include "render/render.h"
 
 namespace cambium::app {
@@ -96,10 +97,11 @@ render::RenderSettings render_settings(const Options& options,
         settings.environment = std::make_shared<const render::Environment>(
             std::move(*environment).rotated(options.environment_rotation));
     settings.progress = !options.quiet && isatty(fileno(stderr));
-    // The albedo, normal and depth layers cost a camera-ray intersection; only EXR keeps them.
+    // The albedo, normal and depth layers cost a camera-ray intersection: only for a
+    // format that keeps them.
     settings.aovs = std::any_of(images.begin(), images.end(), [](const auto& f) {
-        std::string ext = f.extension().string();
-        return ext == ".exr" || ext == ".EXR";
+        const render::OutputFormat* format = render::find_output_format(f);
+        return format && format->keeps_layers;
     });
     settings.cancel = render::install_interrupt_handler();
     apply_staging(settings, options);

@@ -11,6 +11,7 @@
 
 #include "base/diagnostics.h"
 #include "base/subprocess.h"
+#include "render/output_format.h"
 
 namespace cambium::app {
 
@@ -30,8 +31,8 @@ std::string lower_extension(const fs::path& file)
 
 bool is_video(const fs::path& file)
 {
-    std::string ext = lower_extension(file);
-    return ext == ".mp4" || ext == ".mov" || ext == ".mkv" || ext == ".webm";
+    const render::OutputFormat* format = render::find_output_format(file);
+    return format && format->video;
 }
 
 fs::path require_ffmpeg(const fs::path& video)

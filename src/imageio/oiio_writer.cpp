@@ -14,6 +14,7 @@
 
 #include "base/diagnostics.h"
 #include "render/color.h"
+#include "render/output_format.h"
 
 namespace cambium::render {
 
@@ -128,7 +129,7 @@ void write_with_oiio(const Image& image, const std::filesystem::path& temp, Imag
         ok = out->open(temp.string(), spec) &&
              out->write_image(OIIO::TypeDesc::UINT16, pixels.data());
     } else {
-        int channels = format == ImageFormat::png && image.transparent ? 4 : 3;
+        int channels = output_format(format).keeps_alpha && image.transparent ? 4 : 3;
         OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::UINT8);
         spec.attribute("oiio:ColorSpace", "sRGB");
         without_time_stamp(spec);

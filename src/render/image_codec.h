@@ -26,8 +26,8 @@ struct MapTexels {
     std::vector<float> rgb;
 };
 
-/// The image file formats write_image knows, from the file's extension.
-enum class ImageFormat { png, jpeg, tiff, exr };
+/// The image file formats write_image knows (render/output_format.h: by extension).
+enum class ImageFormat { png, jpeg, tiff, exr, sgi, targa };
 
 class ImageCodec {
 public:

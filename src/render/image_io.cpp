@@ -9,26 +9,20 @@
 #include "base/atomic_file.h"
 #include "base/diagnostics.h"
 #include "render/image_codec.h"
+#include "render/output_format.h"
 
 namespace cambium::render {
 
 namespace {
 
+/// The image format of `file`; Error naming the extensions that are.
 ImageFormat format_of(const std::filesystem::path& file)
 {
-    std::string ext = file.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    if (ext == ".png")
-        return ImageFormat::png;
-    if (ext == ".jpg" || ext == ".jpeg")
-        return ImageFormat::jpeg;
-    if (ext == ".tif" || ext == ".tiff")
-        return ImageFormat::tiff;
-    if (ext == ".exr")
-        return ImageFormat::exr;
-    throw Error(file.string() + ": unknown image format '" + ext +
-                "' (use .png, .exr, .tif or .jpg)");
+    const OutputFormat* format = find_output_format(file);
+    if (!format || format->video)
+        throw Error(file.string() + ": unknown image format '" + file.extension().string() +
+                    "' (use " + image_extensions_text() + ")");
+    return format->image;
 }
 
 }  // namespace

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// The rendered image and its output through OpenImageIO (PNG, EXR, TIFF, JPEG).
+// The rendered image and its output through OpenImageIO (render/output_format.h).
 #pragma once
 
 #include <filesystem>
@@ -38,11 +38,12 @@ struct WriteOptions {
     ToneMap tonemap = ToneMap::none;
 };
 
-/// Writes by extension: .png (8-bit sRGB; RGB, or RGBA with straight alpha when the
-/// image is transparent), .jpg/.jpeg (8-bit sRGB RGB; a transparent image comes out over
-/// black), .tif/.tiff (16-bit sRGB RGBA, straight alpha), .exr (half-float linear RGBA
-/// with A = coverage, plus layers albedo.{R,G,B}, normal.{X,Y,Z} and a float Z for the
-/// depth when the image has them). The image is written to a temporary name in the same
+/// Writes by extension (render/output_format.h): .png, .rgb/.sgi (SGI) and .tga (Targa)
+/// as 8-bit sRGB (RGB, or RGBA with straight alpha when the image is transparent),
+/// .jpg/.jpeg (8-bit sRGB RGB; a transparent image comes out over black), .tif/.tiff
+/// (16-bit sRGB RGBA, associated alpha), .exr (half-float linear RGBA with A = coverage,
+/// plus layers albedo.{R,G,B}, normal.{X,Y,Z} and a float Z for the depth when the image
+/// has them). The image is written to a temporary name in the same
 /// folder and renamed, so a failure never leaves a partial file. Throws cambium::Error
 /// naming the file on failure.
 void write_image(const Image& image, const std::filesystem::path& file,

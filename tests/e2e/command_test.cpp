@@ -322,6 +322,30 @@ TEST(Command, UnknownOutputFormatFailsBeforeRendering)
     EXPECT_EQ(r.output.find("rendered"), std::string::npos) << r.output;
 }
 
+// cpfg's -rgb and -tga write the picture as SGI and Targa files: the PNG's pixels.
+TEST(Command, CpfgsRgbAndTgaOutputsHoldThePicture)
+{
+    fs::path dir = scratch("rgb");
+    write(dir / "p.l", "lsystem: 1\nderivation length: 1\naxiom: F\nF --> F[+F]F\nendlsystem\n");
+    write(dir / "p.v", "line style: cylinder\ninitial line width: 0.2\n");
+    Result r = run("-q -w 32 24 --spp 2 -rgb " + (dir / "p.rgb").string() + " -tga " +
+                   (dir / "p.tga").string() + " -o " + (dir / "p.png").string() + " " +
+                   (dir / "p.l").string() + " " + (dir / "p.v").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    Picture png = read_picture(dir / "p.png");
+    for (const char* name : {"p.rgb", "p.tga"}) {
+        Picture other = read_picture(dir / name);
+        EXPECT_EQ(other.width, 32) << name;
+        EXPECT_EQ(other.pixels, png.pixels) << name;
+    }
+    // no library here writes Sun raster files: said, and nothing written
+    Result ras = run("-w 8 8 --spp 1 -ras " + (dir / "p.ras").string() + " -o " +
+                     (dir / "q.png").string() + " " + (dir / "p.l").string() + " " +
+                     (dir / "p.v").string());
+    EXPECT_NE(ras.output.find("p.ras is not written"), std::string::npos) << ras.output;
+    EXPECT_FALSE(fs::exists(dir / "p.ras"));
+}
+
 // --turbidity and --env-rotate are accepted with what they change, refused without it or
 // out of range (the model's fit covers turbidity 1.7 .. 10).
 TEST(Command, SkyTurbidityAndEnvironmentRotation)

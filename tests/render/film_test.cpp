@@ -135,6 +135,30 @@ TEST(WriteImage, TiffAndJpegAreReadable)
     }
 }
 
+// cpfg's -rgb and -tga snapshots: SGI and Targa files hold the same 8-bit sRGB pixels
+// as the PNG, and keep a transparent render's alpha.
+TEST(WriteImage, SgiAndTargaHoldThePngsPixels)
+{
+    TempDir dir;
+    Image img = gradient(16, 8);
+    write_image(img, dir.path() / "g.png");
+    OIIO::ImageSpec png_spec;
+    const auto png = read_back(dir.path() / "g.png", png_spec);
+    for (const char* name : {"g.rgb", "g.SGI", "g.tga"}) {
+        write_image(img, dir.path() / name);
+        OIIO::ImageSpec spec;
+        const auto px = read_back(dir.path() / name, spec);
+        EXPECT_EQ(spec.width, 16) << name;
+        EXPECT_EQ(spec.nchannels, png_spec.nchannels) << name;
+        EXPECT_EQ(px, png) << name;
+    }
+    img.transparent = true;
+    write_image(img, dir.path() / "t.tga");
+    OIIO::ImageSpec spec;
+    read_back(dir.path() / "t.tga", spec);
+    EXPECT_EQ(spec.nchannels, 4);
+}
+
 // The target is an existing folder: OIIO writes the temporary file, the rename fails.
 // The temporary file must be gone and the error must name the target.
 TEST(WriteImage, FailedRenameLeavesNoTemporaryFileAndNamesTarget)
@@ -179,6 +203,14 @@ TEST(WriteImage, MissingFolderAndUnknownFormatFailCleanly)
     TempDir dir;
     EXPECT_THROW(write_image(gradient(4, 4), dir.path() / "no" / "such.png"), Error);
     EXPECT_THROW(write_image(gradient(4, 4), dir.path() / "out.xyz"), Error);
+    try {  // cpfg's Sun raster and Utah RLE: no library here writes them
+        check_output_format(dir.path() / "out.ras");
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find(".png, .exr, .tif, .jpg, .rgb or .tga"), std::string::npos)
+            << e.what();
+    }
+    EXPECT_THROW(write_image(gradient(4, 4), dir.path() / "out.mp4"), Error);  // a video, not an image
     EXPECT_THROW(write_image(Image{}, dir.path() / "out.png"), Error);
     EXPECT_TRUE(fs::is_empty(dir.path()));
 }
