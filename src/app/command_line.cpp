@@ -34,6 +34,16 @@ std::function<void(Options&, const std::vector<std::string>&)> unsupported_outpu
     };
 }
 
+/// cpfg's -gls: the geometry as graphics library statements, an output like -o's whose
+/// format Cambium reads from the name.
+void gls_output(Options& o, const std::vector<std::string>& a)
+{
+    if (std::filesystem::path(a[0]).extension() != ".gls")
+        throw Error("-gls " + a[0] + ": name the file with .gls (Cambium chooses every output's "
+                    "format by its extension)");
+    o.outputs.emplace_back(a[0]);
+}
+
 /// A whole number from `low` to `high` spelled as `word`, or an Error naming `option`.
 int whole_number(const std::string& option, const std::string& word, int low, int high)
 {
@@ -76,8 +86,8 @@ const std::map<std::string, CpfgOption>& cpfg_options()
         {"-ray", {1, unsupported_output("rayshade")}},
         {"-ps", {1, unsupported_output("PostScript")}},
         {"-iv", {1, unsupported_output("Inventor")}},
-        {"-gls", {1, unsupported_output("gls")}},
-        {"-glsl", {1, unsupported_output("gls")}},
+        {"-gls", {1, gls_output}},
+        {"-glsl", {1, gls_output}},
         // cpfg's animate mode: every frame of the animation file (or its defaults).
         {"-a", {0, [](Options& o, auto&) { o.shot.animate = true; }}},
         // Window-system and interactive options of cpfg: meaningless offline.
@@ -194,7 +204,7 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
 
     CLI::App cli{"cambium: renders cpfg plant models physically.\n"
                  "cpfg options: -w W H (image size, default 640 480), -m[n] file.map, -M[n] file.mat, -c<n>, -w W H, -str file,\n"
-                 "-strb file, -homo, -vv file, -rgb file, -tga file, -v, -V, -P cpp, -e file,\n"
+                 "-strb file, -homo, -vv file, -rgb file, -tga file, -gls file, -v, -V, -P cpp, -e file,\n"
                  "-a (every frame of the animation file); window options (-g -wp -wt -mb -pm -sb -s<n>)\n"
                  "are accepted and ignored.\n"
                  "--ground [COLOUR|FILE]: a ground plane under the plant, grey (default), a colour\n"

@@ -29,7 +29,8 @@
 #include "base/subprocess.h"
 #include "geom/view_volume.h"
 #include "lsys/string_io.h"
-#include "render/output_format.h"
+#include "base/output_format.h"
+#include "geom/mesh_export.h"
 #include "render/render.h"
 
 namespace cambium::app {
@@ -100,7 +101,7 @@ render::RenderSettings render_settings(const Options& options,
     // The albedo, normal and depth layers cost a camera-ray intersection: only for a
     // format that keeps them.
     settings.aovs = std::any_of(images.begin(), images.end(), [](const auto& f) {
-        const render::OutputFormat* format = render::find_output_format(f);
+        const OutputFormat* format = find_output_format(f);
         return format && format->keeps_layers;
     });
     settings.cancel = render::install_interrupt_handler();
@@ -202,11 +203,63 @@ int run_sequence_with_stats(const Options& options, const SequenceOutputs& outpu
 /// Renders a still of `scene` (the camera options applied first) and writes `images`: the
 /// whole image, band I of --tile I/N into its tile file, or shared among --mpi's ranks
 /// (rank 0 writes).
+/// The outputs of the command, checked before any work: images by write_image's rules,
+/// videos by ffmpeg's, meshes (a still's geometry only) by their folder.
+void check_outputs(const Options& options, const std::vector<std::filesystem::path>& outputs)
+{
+    for (const auto& out : outputs) {
+        const OutputFormat* format = find_output_format(out);
+        if (format && format->mesh != MeshFormat::none) {
+            if (is_sequence(options))
+                throw Error(out.string() + ": a " + std::string(format->name) +
+                            " file holds one still's geometry; an animation or turntable "
+                            "writes images or a video");
+            std::error_code ec;
+            if (out.has_parent_path() && !std::filesystem::is_directory(out.parent_path(), ec))
+                throw Error(out.string() + ": the folder " + out.parent_path().string() +
+                            " does not exist");
+        } else if (!is_video(out)) {
+            render::check_output_format(out);
+        }
+    }
+}
+
+/// Writes the mesh outputs among `outputs` from `scene` (rank 0 alone under --mpi) and
+/// returns the others, the pictures to render.
+std::vector<std::filesystem::path> write_meshes(const geom::Scene& scene, const Options& options,
+                                                const std::vector<std::filesystem::path>& outputs,
+                                                const std::function<void(const std::string&)>& say,
+                                                bool writes)
+{
+    std::vector<std::filesystem::path> pictures;
+    for (const auto& out : outputs) {
+        const OutputFormat* format = find_output_format(out);
+        if (!format || format->mesh == MeshFormat::none) {
+            pictures.push_back(out);
+            continue;
+        }
+        if (!writes)
+            continue;
+        geom::MeshExportOptions mesh;
+        mesh.texture_folder = options.scene ? options.scene->parent_path() : options.view.parent_path();
+        mesh.max_memory_bytes = options.max_memory_bytes;
+        geom::write_mesh(scene, out, format->mesh, mesh);
+        say("wrote " + out.string());
+    }
+    return pictures;
+}
+
 int render_and_write_still(geom::Scene& scene, const Options& options,
-                           const std::vector<std::filesystem::path>& images,
+                           const std::vector<std::filesystem::path>& outputs,
                            const std::function<void(const std::string&)>& say, RunStats& stats,
                            Clock::time_point command_start, Mpi* mpi)
 {
+    const std::vector<std::filesystem::path> images =
+        write_meshes(scene, options, outputs, say, !mpi || mpi->rank() == 0);
+    if (images.empty()) {  // only the geometry was asked for
+        report_stats(stats, options);
+        return 0;
+    }
     render::RenderSettings settings = render_settings(options, images);
     apply_camera_options(scene, options);
     if (options.tile) {
@@ -259,9 +312,7 @@ int run_scene(Options options, const std::function<void(const std::string&)>& sa
         for (ScenePlant& plant : file.plants)
             plant.steps = {options.steps};
     std::vector<std::filesystem::path> images = image_outputs(options);
-    for (const auto& out : images)
-        if (!is_video(out))
-            render::check_output_format(out);  // fail before the work, not after
+    check_outputs(options, images);  // fail before the work, not after
     RunStats stats;
     auto make_scene = [&]() {
         AssemblyReport report;
@@ -305,9 +356,7 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
     if (options.scene)
         return run_scene(options, say, command_start, mpi);
     std::vector<std::filesystem::path> images = image_outputs(options);
-    for (const auto& out : images)
-        if (!is_video(out))
-            render::check_output_format(out);  // fail before the work, not after
+    check_outputs(options, images);  // fail before the work, not after
     if (options.assemble)
         return assemble(options, images, say);
     // With --mpi, rank 0 alone writes files.

@@ -11,7 +11,7 @@
 
 #include "base/diagnostics.h"
 #include "base/subprocess.h"
-#include "render/output_format.h"
+#include "base/output_format.h"
 
 namespace cambium::app {
 
@@ -31,7 +31,7 @@ std::string lower_extension(const fs::path& file)
 
 bool is_video(const fs::path& file)
 {
-    const render::OutputFormat* format = render::find_output_format(file);
+    const OutputFormat* format = find_output_format(file);
     return format && format->video;
 }
 

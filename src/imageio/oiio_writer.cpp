@@ -14,7 +14,7 @@
 
 #include "base/diagnostics.h"
 #include "render/color.h"
-#include "render/output_format.h"
+#include "base/output_format.h"
 
 namespace cambium::render {
 

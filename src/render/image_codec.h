@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "base/output_format.h"
 #include "geom/scene.h"
 #include "render/image_io.h"
 #include "render/mip_map.h"
@@ -26,8 +27,6 @@ struct MapTexels {
     std::vector<float> rgb;
 };
 
-/// The image file formats write_image knows (render/output_format.h: by extension).
-enum class ImageFormat { png, jpeg, tiff, exr, sgi, targa };
 
 class ImageCodec {
 public:

@@ -9,7 +9,7 @@
 #include "base/atomic_file.h"
 #include "base/diagnostics.h"
 #include "render/image_codec.h"
-#include "render/output_format.h"
+#include "base/output_format.h"
 
 namespace cambium::render {
 
@@ -19,7 +19,7 @@ namespace {
 ImageFormat format_of(const std::filesystem::path& file)
 {
     const OutputFormat* format = find_output_format(file);
-    if (!format || format->video)
+    if (!format || !format->is_image())
         throw Error(file.string() + ": unknown image format '" + file.extension().string() +
                     "' (use " + image_extensions_text() + ")");
     return format->image;

@@ -104,13 +104,13 @@ std::string polygons_sent(const std::string& name, const std::string& interprete
 TEST(OpenLSystem, InterpretedModulesSendTheirPolygons)
 {
     // X(2) drawn as a cylinder of length 2 up the turtle's heading (+y): the wall of
-    // eight quads (geom::gls_sides) reaches y = 2
+    // eight sides (geom::gls_tessellation), two triangles each, reaches y = 2
     const std::string cylinder = "X(l) --> F(l)\n";
-    EXPECT_EQ(polygons_sent("named", "interpreted modules: X(1)\n", cylinder), "?E(8,2)X(2)");
-    EXPECT_EQ(polygons_sent("all", "interpreted modules: all\n", cylinder), "?E(8,2)X(2)");
+    EXPECT_EQ(polygons_sent("named", "interpreted modules: X(1)\n", cylinder), "?E(16,2)X(2)");
+    EXPECT_EQ(polygons_sent("all", "interpreted modules: all\n", cylinder), "?E(16,2)X(2)");
     // the whole homomorphism successor of the module is sent, not only its first module
     EXPECT_EQ(polygons_sent("successor", "interpreted modules: X\n", "X(l) --> F(l)F(l)\n"),
-              "?E(16,4)X(2)");
+              "?E(32,4)X(2)");
     // a module the .e does not name (here: another parameter count) sends no block
     EXPECT_EQ(polygons_sent("other", "interpreted modules: X(2)\n", cylinder), "?E(0,0)X(2)");
     EXPECT_EQ(polygons_sent("none", "", cylinder), "?E(0,0)X(2)");

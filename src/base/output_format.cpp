@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
-#include "render/output_format.h"
+#include "base/output_format.h"
 
 #include <algorithm>
 #include <cctype>
 
-namespace cambium::render {
+namespace cambium {
 
 const OutputFormat* find_output_format(const std::filesystem::path& file)
 {
@@ -24,9 +24,9 @@ std::string image_extensions_text()
     std::string text;
     std::size_t left = 0;
     for (const OutputFormat& f : output_formats)
-        left += !f.video;
+        left += f.is_image();
     for (const OutputFormat& f : output_formats) {
-        if (f.video)
+        if (!f.is_image())
             continue;
         text += f.extensions.front();
         --left;
@@ -35,4 +35,4 @@ std::string image_extensions_text()
     return text;
 }
 
-}  // namespace cambium::render
+}  // namespace cambium

@@ -1,0 +1,43 @@
+// SPDX-License-Identifier: Apache-2.0
+// Every primitive of a Scene as triangles: what mesh formats (OBJ, PLY, GLS) and an
+// environmental program (`interpreted modules:`) receive instead of round primitives.
+#pragma once
+
+#include <cstddef>
+
+#include "geom/scene.h"
+
+namespace cambium::geom {
+
+/// How round primitives become triangles.
+struct Tessellation {
+    int sides = 12;          ///< around a cylinder, disc or sphere (meridians)
+    int curve_pieces = 4;    ///< along one generalized-cylinder segment
+};
+
+/// How far a Scene's primitive arrays had grown at one moment of interpretation.
+struct GeometryMark {
+    std::size_t line_segments = 0, curve_segments = 0, spheres = 0, discs = 0, triangles = 0;
+    std::size_t instances = 0;
+};
+
+GeometryMark geometry_mark(const Scene& scene);
+
+/// Appends to `out` (smooth normals; uvs where the scene's mesh has them, else zero;
+/// the front material and texture) every primitive `scene` gained since `since`:
+/// triangles as they are, line and generalized-cylinder segments as their side walls,
+/// spheres as `sides` meridians and half as many parallels, discs as fans, and the
+/// primitives of placed instances (predefined surfaces, objects) moved into place.
+/// Lines measured in pixels (`line style: pixel`) have no size in the scene and give
+/// nothing.
+void tessellate_since(const Scene& scene, const GeometryMark& since, const Tessellation& how,
+                      TriangleMesh& out);
+
+/// The whole scene as triangles.
+TriangleMesh tessellate(const Scene& scene, const Tessellation& how);
+
+/// The triangles tessellate() makes of `scene`, counted without making them (to check an
+/// export against the memory budget first).
+std::size_t tessellated_triangles(const Scene& scene, const Tessellation& how);
+
+}  // namespace cambium::geom

@@ -1,0 +1,123 @@
+// SPDX-License-Identifier: Apache-2.0
+// The plant as mesh files: OBJ, PLY and GLS hold the tessellated plant, each read back
+// by a reader that is not the writer's (the scene files' OBJ reader, the background
+// scene's GLS reader, the PLY header and bytes by hand).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "app/pipeline.h"
+#include "app/scene_file.h"
+#include "base/diagnostics.h"
+#include "geom/background_scene.h"
+#include "geom/mesh_export.h"
+#include "geom/tessellate.h"
+#include "model_folder.h"
+
+using namespace cambium;
+
+namespace {
+
+namespace fs = std::filesystem;
+
+geom::Vec3 vec(const geom::Float3& p) { return {p[0], p[1], p[2]}; }
+
+/// A stem with a coloured branch ending in a sphere: two cylinders of 12 sides (24
+/// triangles each) and a sphere of 12 meridians and 6 bands (120 triangles).
+struct Plant {
+    app::Options options;
+    geom::Scene scene;
+    fs::path folder;
+
+    Plant()
+    {
+        options = cambium::testing::write_model("mesh_export", "Lsystem: 1\nderivation length: 0\n"
+                                                      "Axiom: F(1)[+(30);(2)F(1)@O(0.2)]\nendlsystem\n");
+        options.quiet = true;
+        folder = options.lsystem.parent_path();
+        app::Model model = app::load_model(options);
+        scene = app::interpret(model, app::derive(model, options), options);
+    }
+};
+
+TEST(Tessellate, EveryTriangleFacesWhereItsNormalsPoint)
+{
+    Plant plant;
+    const geom::TriangleMesh mesh = geom::tessellate(plant.scene, {});
+    ASSERT_EQ(mesh.size(), 2 * 24u + 120u);
+    EXPECT_EQ(geom::tessellated_triangles(plant.scene, {}), mesh.size());
+    for (const auto& t : mesh.triangles) {
+        const geom::Vec3 a = vec(mesh.positions[t[0]]), b = vec(mesh.positions[t[1]]),
+                         c = vec(mesh.positions[t[2]]);
+        const geom::Vec3 face = geom::cross(b - a, c - a);
+        if (geom::length(face) < 1e-9)
+            continue;  // a pole's sliver
+        const geom::Vec3 n = vec(mesh.normals[t[0]]) + vec(mesh.normals[t[1]]) + vec(mesh.normals[t[2]]);
+        EXPECT_GT(geom::dot(face, n), 0);
+    }
+}
+
+TEST(MeshExport, ObjPlyAndGlsHoldTheTessellatedPlant)
+{
+    Plant plant;
+    const geom::TriangleMesh mesh = geom::tessellate(plant.scene, {});
+    for (const char* name : {"plant.obj", "plant.ply", "plant.gls"})
+        geom::write_mesh(plant.scene, plant.folder / name,
+                         find_output_format(plant.folder / name)->mesh);
+
+    // OBJ: the positions in order, through the scene files' OBJ reader
+    const app::GroundMesh obj = app::read_obj_mesh(plant.folder / "plant.obj", app::SceneLimits{});
+    ASSERT_EQ(obj.triangles.size(), mesh.size());
+    ASSERT_EQ(obj.positions.size(), mesh.positions.size());
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i)
+        EXPECT_LT(geom::length(vec(obj.positions[i]) - vec(mesh.positions[i])), 1e-5);
+    std::ifstream mtl(plant.folder / "plant.mtl");
+    std::stringstream materials;
+    materials << mtl.rdbuf();
+    EXPECT_NE(materials.str().find("newmtl colour2"), std::string::npos);  // the branch's ;(2)
+
+    // GLS: the background scene's reader builds the same triangles with the same colours
+    const geom::BackgroundScene gls = geom::read_background_scene(
+        "plant.gls", plant.folder, geom::Material{}, FileLoc{}, plant.folder);
+    ASSERT_EQ(gls.geometry.mesh.size(), mesh.size());
+    for (std::size_t t = 0; t < mesh.size(); ++t)
+        for (int k = 0; k < 3; ++k)
+            EXPECT_LT(geom::length(vec(gls.geometry.mesh.positions[gls.geometry.mesh.triangles[t][k]]) -
+                                   vec(mesh.positions[mesh.triangles[t][k]])),
+                      1e-6);
+    const geom::Material& branch = plant.scene.materials[2];
+    const geom::Material& read = gls.materials.at(gls.geometry.mesh.material.back());
+    EXPECT_EQ(read.diffuse, branch.diffuse);
+    EXPECT_EQ(read.ambient, branch.ambient);
+
+    // PLY: binary little-endian vertices with the material's diffuse colour as bytes
+    std::ifstream ply(plant.folder / "plant.ply", std::ios::binary);
+    std::string line, header;
+    while (std::getline(ply, line) && line != "end_header")
+        header += line + "\n";
+    EXPECT_NE(header.find("element vertex " + std::to_string(mesh.positions.size())), std::string::npos);
+    EXPECT_NE(header.find("element face " + std::to_string(mesh.size())), std::string::npos);
+    float xyz[6];
+    unsigned char rgb[3];
+    ply.read(reinterpret_cast<char*>(xyz), sizeof xyz);
+    ply.read(reinterpret_cast<char*>(rgb), sizeof rgb);
+    EXPECT_EQ(xyz[0], mesh.positions[0][0]);
+    EXPECT_EQ(rgb[0], static_cast<unsigned char>(
+                          std::lround(plant.scene.materials[mesh.material[0]].diffuse.r * 255)));
+}
+
+TEST(MeshExport, PastTheMemoryBudgetNothingIsWritten)
+{
+    Plant plant;
+    geom::MeshExportOptions small;
+    small.max_memory_bytes = 1000;
+    EXPECT_THROW(geom::write_mesh(plant.scene, plant.folder / "big.obj", MeshFormat::obj, small), Error);
+    EXPECT_FALSE(fs::exists(plant.folder / "big.obj"));
+    EXPECT_FALSE(fs::exists(plant.folder / "big.mtl"));
+}
+
+}  // namespace
