@@ -48,7 +48,7 @@
 // work), `raw_embree_cpu_s` (raw Embree's CPU seconds for the same numbers of rays of
 // each kind; `raw_embree_first_round_cpu_s` at the first replay round's rates alone),
 // `path_tracer_rays_per_s`, `raw_embree_rays_per_s` (wall) and
-// `path_tracer_fraction_of_raw_cpu` (raw_embree_cpu_s / trace_cpu_s: issue 16 asks for at
+// `path_tracer_fraction_of_raw_cpu` (raw_embree_cpu_s / trace_cpu_s: the target is at
 // least 0.8). These renders come after every series so that the logs' memory stays out
 // of the series' peak RSS. --raw-embree-only runs only them (no references are needed);
 // --no-raw-embree leaves them out.

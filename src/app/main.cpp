@@ -384,7 +384,7 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
                       options.steps.value_or(model.lsystem.derivation_length()), say);
     if (images.empty()) {
         // Only strings and the view volume are written: the turtle walks the string for
-        // -vv without building geometry, and has nothing to do otherwise (issue 16.6).
+        // -vv without building geometry, and has nothing to do otherwise.
         if (options.view_volume && writes) {
             lap = Clock::now();
             geom::write_view_volume(view_volume(model, string, options), *options.view_volume);

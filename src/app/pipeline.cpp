@@ -346,8 +346,8 @@ void light_by_colour_index(geom::Scene& scene, const geom::ViewFile& view,
 }
 /// The scene's own lines: with no texture on any of them, the per-key texture v and the
 /// per-segment texture index say nothing (scene.h lets both be empty), so they go, and
-/// the other buffers give back their growth slack (issue 15.3: a quarter of tree10m's
-/// Scene memory). Prototypes keep theirs: an instance's texture falls on their
+/// the other buffers give back their growth slack (a quarter of tree10m's Scene memory,
+/// build/benchmarks/render --stats). Prototypes keep theirs: an instance's texture falls on their
 /// untextured primitives.
 void release_unused_line_buffers(geom::LinearCurves& l)
 {

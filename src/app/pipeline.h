@@ -78,15 +78,15 @@ lsys::ModuleString turtle_string(const Model& model, const lsys::ModuleString& d
 /// Whether turtle_string() would return the derived string unchanged: no homomorphism
 /// production and no split `@` command (nor, without --homo in the string, any object to
 /// keep whole). The caller then interprets the derived string itself and saves a copy of
-/// it (issue 15.3: two full copies of a 23 M-module string cost a fifth of the tree's
-/// time to first pixel).
+/// it (two full copies of a 23 M-module string cost a fifth of the tree's time to
+/// first pixel, build/benchmarks/render).
 bool turtle_reads_derived_string(const Model& model, const Options& options);
 /// ... and its interpretation into a Scene.
 geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString& string,
                                     const Options& options);
 
 /// What -vv writes: the view volume of a derived string (the view file's `box:` wins, as
-/// in cpfg, unless not `box_wins`). The turtle walks the string without storing geometry (issue 16.6), so a
+/// in cpfg, unless not `box_wins`). The turtle walks the string without storing geometry, so a
 /// -vv without an image costs the walk alone; the bounds equal interpret()'s.
 geom::Bounds3 view_volume(const Model& model, const lsys::ModuleString& derived,
                           const Options& options, bool box_wins = true);

@@ -188,7 +188,7 @@ std::uint64_t embree_primitives(const RunStats& s) { return s.primitives.total()
 /// All of Cambium's geometry buffers: the Scene's and the renderer's.
 std::uint64_t cambium_total(const RunStats& s) { return s.cambium_bytes + s.render_buffer_bytes; }
 
-/// Issue 15.3's "memory per primitive within 1.2x of what Embree itself needs": what
+/// Memory per primitive against what Embree itself needs (docs/benchmarks.md): what
 /// Embree needs is its own allocations (those its memory monitor reports, and its instance
 /// geometries, which it does not) plus the buffers it reads in place (keys, indices: with
 /// rtcSetNewGeometryBuffer it would allocate them itself); what is used is Embree's
@@ -201,8 +201,8 @@ double ratio_to_embree_need(const RunStats& s)
     return need > 0 ? double(embree + cambium_total(s)) / double(need) : 0.0;
 }
 
-/// The same with Embree's allocations as its memory monitor reports them alone (before
-/// 2026-11-24, session 7): it leaves out Embree's instance geometries, about 300 B each.
+/// The same with Embree's allocations as its memory monitor reports them alone: it
+/// leaves out Embree's instance geometries, about 300 B each.
 double ratio_to_embree_monitor(const RunStats& s)
 {
     std::uint64_t need = s.embree_bytes + s.embree_shared_bytes;

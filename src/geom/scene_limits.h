@@ -96,8 +96,8 @@ void fit_buffer(std::vector<T>& v, std::size_t pad_bytes = 0)
 }
 
 /// Gives a mesh's buffers back their growth slack, leaving positions and triangles padded
-/// for Embree to read in place (issue 15.3: a leaf's vertex no longer lives both in the
-/// Scene and in Embree), and drops what no hit reads: texture indices when none is set,
+/// for Embree to read in place (a leaf's vertex lives once, not both in the Scene and
+/// in Embree), and drops what no hit reads: texture indices when none is set,
 /// texture coordinates when all are zero (render reads a missing uv as 0) or when nothing
 /// textures the mesh (`textured_by_instances`: a prototype whose instances bring a texture).
 void fit_mesh_buffers(TriangleMesh& mesh, bool textured_by_instances);

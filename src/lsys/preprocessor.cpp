@@ -290,7 +290,7 @@ std::string megabytes(std::size_t bytes) { return std::to_string(bytes >> 20) + 
 /// Whether cpp (the default one, without -D) would give `source` back unchanged but for
 /// whitespace and line markers: no directive, comment, line splice, character or string
 /// literal, trigraph, or name of cpp's own (__LINE__). Such a file is parsed as it is:
-/// starting cpp costs more than deriving a small model (issue 16.7).
+/// starting cpp costs more than deriving a small model (build/benchmarks/derive).
 bool needs_no_preprocessing(std::string_view source, const PreprocessOptions& options)
 {
     if (options.preprocessor != "cpp" || !options.defines.empty())

@@ -136,7 +136,7 @@ struct Mat3 {
 /// What a hit on an instance reads of its Instance besides the transform: the prototype and
 /// the materials and texture that replace inherit_material and no_texture. Instances that
 /// agree share one (Embree user data of their instance geometry), so an instance costs
-/// Cambium nothing beside what Embree keeps of it (issue 15.3).
+/// Cambium nothing beside what Embree keeps of it.
 struct InstanceStyle {
     std::uint32_t prototype = 0;
     std::uint16_t material = 0;
@@ -808,7 +808,7 @@ struct HitResolver {
     /// own, each placed once, untransformed, by a top-level instance (none: no such scene).
     /// Embree's leaves hold primitives of one geometry only: caps and joints beside every
     /// segment in one BVH left most leaves with one primitive, and cost 187 B per segment
-    /// instead of about 70 (issue 15.3). Up to EmbreeScene::line_ends_beside_up_to
+    /// instead of about 70 (tree10m, build/benchmarks/render). Up to EmbreeScene::line_ends_beside_up_to
     /// segments they stay beside the lines, which saves every ray two traversals.
     struct PlacedEnds {
         std::uint32_t instance = PrimId::none;

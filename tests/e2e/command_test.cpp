@@ -411,14 +411,14 @@ fs::path corpus_model(const std::string& id)
 }  // namespace
 
 // As cpfg users run it, inside the model's folder: the background scene (two spheres,
-// cylinders, a cone, polygons) is drawn (issue 14, item 2: it used to vanish).
+// cylinders, a cone, polygons) is drawn.
 TEST(Command, BackgroundSceneFromInsideTheModelFolder)
 {
     fs::path model = corpus_model("10-manuals/11-CPFG/BackgroundScene");
     if (!fs::exists(model / "plant.v"))
         GTEST_SKIP() << "corpus not found";
     fs::path dir = scratch("background");
-    // a tiny image: -vv alone walks the turtle without building geometry (issue 16.6)
+    // a tiny image: -vv alone walks the turtle without building geometry
     Result r = run("-M plant.mat plant.l plant.v -w 8 6 --spp 1 -o " + (dir / "p.png").string() +
                        " < /dev/null",
                    model);

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // --stats and --stats-json on a plant whose primitives are known, and string-only runs
-// that interpret nothing (issue 16.6).
+// that interpret nothing.
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -323,7 +323,7 @@ TEST(Stats, TurntableBuildsOnceAndCountsOnlyTheSelectedFrames)
 
 TEST(Stats, ViewVolumeAloneMatchesTheOneWrittenBesideAnImage)
 {
-    // -vv without an image walks the turtle without building geometry (issue 16.6).
+    // -vv without an image walks the turtle without building geometry.
     RunResult r = run_growing_plant("vvwalk", "-vv alone.vv");
     ASSERT_EQ(r.status, 0) << r.output;
     RunResult with_image = run_growing_plant("vvimage", "-vv beside.vv -w 8 8 --spp 1 -o g.png");

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The turtle reads the derived string itself when the homomorphism would copy it
-// unchanged (issue 15.3: the copy cost a fifth of a 12 M-segment tree's time to first
-// pixel); the Scene is the same either way.
+// unchanged (the copy cost a fifth of a 12 M-segment tree's time to first pixel); the
+// Scene is the same either way.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -61,7 +61,7 @@ TEST(TurtleString, ReadingTheDerivedStringGivesTheSameScene)
     EXPECT_GT(applied.geometry.lines.segment_count(), direct.geometry.lines.segment_count());
 }
 
-// Untextured lines carry no texture v or texture index, and no growth slack (issue 15.3).
+// Untextured lines carry no texture v or texture index, and no growth slack.
 TEST(TurtleString, UntexturedLinesKeepNoTextureBuffers)
 {
     app::Options options = write_model("untextured", plain);

@@ -277,8 +277,8 @@ std::string error_of(const std::string& list, const std::filesystem::path& base)
 }  // namespace
 
 // Run inside the model's folder (`cambium plant.l plant.v`, view file named without a
-// folder), a preprocessed background file used to be lost: cpp got an empty -I and read
-// standard input instead (issue 14, item 2).
+// folder), a preprocessed background file is read: cpp must not get an empty -I (it
+// would read standard input instead).
 TEST(BackgroundScene, RelativeFileInTheCurrentFolderIsPreprocessed)
 {
     std::filesystem::path dir = std::filesystem::temp_directory_path() / "cambium_bg_relative";

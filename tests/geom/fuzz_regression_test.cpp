@@ -35,7 +35,7 @@ std::string error_of(Run&& run)
     return "";
 }
 
-// Issue 11, row 6 (float to int conversions of user values): `derivation length: 2^56`
+// Float to int conversions of user values: `derivation length: 2^56`
 // was converted to int unchecked (UBSan: "7.20576e+16 is outside the range of
 // representable values of type 'int'", src/lsys/deriver.cpp Deriver::start).
 TEST(FuzzRegression, DerivationLengthOutOfIntRange)

@@ -150,7 +150,7 @@ endlsystem
     EXPECT_EQ(derive_text(src), "X[B]");
 }
 
-// The pipe model (issue 14): a node's width is the sum of its lateral branches' and its
+// The pipe model: a node's width is the sum of its lateral branches' and its
 // continuation's first widths. Under consider: I[] the right context [I(...)=] matches
 // the '[' that opens a lateral branch, its first I, then '=' skips to that branch's ']'
 // (past a nested branch and modules consider: leaves out), so I(0,0,0) sums 1 + 2 + 4

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// Hostile L-system files (issue 11, docs/security.md): printf formats, file access
+// Hostile L-system files (docs/security.md): printf formats, file access
 // outside the model's folder, deep nesting, out-of-range numbers, the memory budget.
 // Each asserts the exact diagnostic: file, line, column and message.
 #include <sys/resource.h>

@@ -181,7 +181,7 @@ TEST(Primitives, InstancesPlaceInheritAndTransformNormals)
     EXPECT_EQ(other_sphere->shape, Shape::sphere);
 }
 
-// Issue 15.3's savings must not change what a hit reads: meshes fitted for Embree
+// The memory savings must not change what a hit reads: meshes fitted for Embree
 // (positions and triangles read in place, all-zero uvs dropped) and instances that keep no
 // placement beside the transform Embree holds shade exactly as the unfitted scene does,
 // and each hit still names its instance in Scene::instances.

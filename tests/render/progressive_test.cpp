@@ -262,7 +262,7 @@ TEST(Progressive, CancelReturnsTheImageSoFar)
 }
 
 // A budget that is over before the first tile still gives every pixel one sample: the
-// image is the 1-spp image, never one with unsampled bands (issue 11, row 10).
+// image is the 1-spp image, never one with unsampled bands.
 TEST(Progressive, SpentTimeBudgetStillSamplesEveryPixelOnce)
 {
     geom::Scene s = crossing_scene();
