@@ -203,15 +203,17 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     options.outputs.clear();
 
     CLI::App cli{"cambium: renders cpfg plant models physically.\n"
-                 "cpfg options: -w W H (image size, default 640 480), -m[n] file.map, -M[n] file.mat, -c<n>, -w W H, -str file,\n"
+                 "cpfg options: -w W H (image size, default 640 480), -m[n] file.map, -M[n] file.mat, -c<n>, -str file,\n"
                  "-strb file, -homo, -vv file, -rgb file, -tga file, -gls file, -v, -V, -P cpp, -e file,\n"
                  "-a (every frame of the animation file); window options (-g -wp -wt -mb -pm -sb -s<n>)\n"
                  "are accepted and ignored.\n"
                  "--ground [COLOUR|FILE]: a ground plane under the plant, grey (default), a colour\n"
                  "(#rrggbb or R,G,B) or a tiled texture image."};
+    cli.name("cambium");
     cli.set_version_flag("--version", "cambium " CAMBIUM_VERSION);
     cli.add_option("-o", options.outputs,
-                   "Output image (.png .exr .tif .jpg); may be given more than once")
+                   "Output: an image (.png .exr .tif .jpg .rgb .tga), a video (.mp4 .mov .mkv .webm) "
+                   "or the still's geometry (.obj .ply .gls); may be given more than once")
         ->take_all()
         ->allow_extra_args(false);
     cli.add_option("--spp", options.samples_per_pixel, "Samples per pixel (default 64)")
@@ -316,6 +318,7 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
             scene = true;
     cli.add_option("files", files, "plant.l plant.v [plant.a], or scene.json (docs/scenes.md)")
         ->required()
+        ->type_name("FILE")
         ->expected(scene ? 1 : 2, 3);
 
     std::vector<std::string> reversed(args.rbegin(), args.rend());
