@@ -72,7 +72,7 @@ int main(int argc, char** argv)
     try {
         for (const Model& m : models) {
             // a counter's steps are cheap, a shoot's cost its length
-            const int s = largest > 0 ? largest : (std::strcmp(m.name, "counter") == 0 ? 1'000'000 : 4000);
+            const int s = largest > 0 ? largest : (std::strcmp(m.name, "counter") == 0 ? 1'000'000 : 20'000);
             fs::create_directories(dir / m.name);
             std::ofstream(dir / m.name / "p.l") << m.lsystem;
             std::ofstream(dir / m.name / "p.v") << "angle factor: 8\ninitial line width: 0.1\n";
@@ -119,11 +119,11 @@ int main(int argc, char** argv)
             std::printf("{\"model\": \"%s\", \"variants\": %d, \"largest_steps\": %d, "
                         "\"separate\": {\"steps\": %llu, \"seconds\": %.3f}, "
                         "\"one_derivation\": {\"steps\": %llu, \"derivations\": %zu, "
-                        "\"seconds\": %.3f, \"derive_s\": %.3f, \"interpret_s\": %.3f}, "
+                        "\"seconds\": %.3f, \"load_s\": %.3f, \"derive_s\": %.3f, \"interpret_s\": %.3f}, "
                         "\"speedup\": %.2f, \"segments\": [%zu, %zu], \"peak_rss_mb\": %.1f}\n",
                         m.name, variants, s, static_cast<unsigned long long>(separate_steps),
                         separate_s, static_cast<unsigned long long>(report.derivation_steps),
-                        report.derivations, shared_s, report.derive_s, report.interpret_s,
+                        report.derivations, shared_s, report.load_s, report.derive_s, report.interpret_s,
                         separate_s / shared_s, primitives, scene_primitives,
                         double(usage.ru_maxrss) / 1024.0);
             std::fflush(stdout);
