@@ -458,6 +458,8 @@ int run_animation(const Options& options, const SequenceOutputs& out)
             Clock::time_point& start;
             ~Restart() { start = Clock::now(); }
         } restart{derivation_start};
+        if (const int signal = SignalNote::signal())
+            throw Interrupted(signal);  // a video's run: no further frame is derived
         if (status != 0)
             return;
         if (filter.to_render(number))

@@ -60,11 +60,12 @@ SignalNote::~SignalNote()
 {
     for (std::size_t i = 0; i < noted_signals.size(); ++i)
         ::sigaction(noted_signals[i], &m_saved[i], nullptr);
+    g_signal.store(0);
 }
 
 const std::atomic<bool>* SignalNote::cancel() const { return &g_noted; }
 
-int SignalNote::signal() const { return g_signal.load(); }
+int SignalNote::signal() { return g_signal.load(); }
 
 bool is_video(const fs::path& file)
 {

@@ -16,7 +16,8 @@ namespace cambium::app {
 /// process where it stands: the handler only notes the signal (stores into atomics, which
 /// is async-signal-safe), the renders stop at their next pass (cancel() as
 /// RenderSettings::cancel) and the caller leaves by its normal path, so that the video's
-/// private folders are removed by their destructors, then ends with 128 + signal(). Each
+/// private folders are removed by their destructors, then ends with 128 + signal() (an
+/// animation stops deriving at its next frame). Each
 /// handler is installed with SA_RESETHAND: a second signal acts as it would have. The
 /// handlers found are put back on destruction. One at a time.
 class SignalNote {
@@ -28,8 +29,8 @@ public:
 
     /// True once a signal is noted.
     const std::atomic<bool>* cancel() const;
-    /// The signal noted (the last one), 0 while none is.
-    int signal() const;
+    /// The signal a SignalNote alive noted (the last one), 0 while none is (or none lives).
+    static int signal();
 
 private:
     std::array<struct sigaction, 3> m_saved{};

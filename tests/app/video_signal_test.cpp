@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -98,12 +99,15 @@ TEST(VideoSignals, ASignalledRenderLeavesNoPrivateFolder)
     // a stand-in ffmpeg: the run is stopped before it would encode
     write(dir / "bin" / "ffmpeg", "#!/bin/sh\nexit 1\n");
     fs::permissions(dir / "bin" / "ffmpeg", fs::perms::owner_all);
-    for (int signal : {SIGTERM, SIGINT, SIGHUP}) {
-        // a render far longer than the test: only the signal ends it
-        Signalled r = run_and_signal(dir, dir / "bin",
-                                     {"-q", "-w", "64", "48", "--spp", "1048576", "--turntable",
-                                      "2", "-o", "t.mp4", "g.l", "g.v"},
-                                     signal);
+    // a turntable, and an animation (cpfg's frames 1 to 3), rendered far longer than the
+    // test lasts: only the signal ends them
+    const std::vector<std::string> turntable{"--turntable", "2"}, animation{"-a"};
+    for (auto [signal, sequence] : {std::pair{SIGTERM, turntable}, {SIGINT, turntable},
+                                    {SIGHUP, turntable}, {SIGTERM, animation}}) {
+        std::vector<std::string> args{"-q", "-w", "64", "48", "--spp", "1048576"};
+        args.insert(args.end(), sequence.begin(), sequence.end());
+        args.insert(args.end(), {"-o", "t.mp4", "g.l", "g.v"});
+        Signalled r = run_and_signal(dir, dir / "bin", args, signal);
         EXPECT_TRUE(r.folder_seen) << "signal " << signal;
         for (const auto& entry : fs::directory_iterator(dir))  // no .t.cambium-XXXXXX
             EXPECT_TRUE(entry.path().filename() == "bin" || !entry.is_directory())
