@@ -319,9 +319,11 @@ int run_scene(Options options, const std::function<void(const std::string&)>& sa
         geom::Scene scene = assemble_scene(file, options, {}, &report);
         stats.add_assembly(report.load_s, report.derive_s, report.interpret_s, report.wall_s);
         stats.add_scene(scene);
-        say(fmt::format("{} plants ({} models, {} derivations) in {:.2f} s: load {:.2f} s, "
-                        "derive {:.2f} s, interpret {:.2f} s; {} instances ({} of organs)",
+        say(fmt::format("{} plants ({} models, {} derivations of {} steps, {} variants) in "
+                        "{:.2f} s: load {:.2f} s, derive {:.2f} s, interpret {:.2f} s; {} "
+                        "instances ({} of organs)",
                         report.plant_instances, report.models_loaded, report.derivations,
+                        report.derivation_steps, report.variants,
                         report.wall_s, report.load_s, report.derive_s, report.interpret_s,
                         scene.instances.size(), report.organ_instances));
         return scene;

@@ -2,7 +2,8 @@
 // From a scene file to one geom::Scene.
 //
 // Plants are grouped by (model folder, command line, seed): one group loads its model
-// once and derives each of its step counts once; groups run in parallel (a Model keeps
+// once and derives it once, to its largest step count, interpreting the string at each
+// of its step counts on the way; groups run in parallel (a Model keeps
 // the last derivation's globals for its interpretation, so one Model is never shared
 // between threads). Each plant variant becomes a prototype; each placement an
 // instance. Embree (as Debian builds it) has one instance level, so the organs a plant
@@ -83,7 +84,8 @@ Options plant_options(const Options& options, const ScenePlant& plant)
 
 struct Timing {
     std::atomic<std::int64_t> load_us{0}, derive_us{0}, interpret_us{0};
-    std::atomic<std::size_t> models{0}, derivations{0};
+    std::atomic<std::size_t> models{0}, derivations{0}, variants{0};
+    std::atomic<std::uint64_t> steps{0};
     void add(std::atomic<std::int64_t>& to, Clock::time_point start)
     {
         to += std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - start).count();
@@ -109,18 +111,21 @@ void derive_group(Group& g, const SceneFile& file, const Options& options, Timin
         Model model = load_model(o, g.seat);
         t.add(t.load_us, start);
         ++t.models;
-        for (const std::optional<int>& steps : g.steps) {
-            o.steps = steps;
-            start = Clock::now();
-            lsys::ModuleString derived = derive(model, o);
-            if (g.seat)
-                leave.now();  // a seated plant has one variant
-            t.add(t.derive_us, start);
-            ++t.derivations;
-            start = Clock::now();
-            g.variants.push_back(interpret(model, derived, o));
-            t.add(t.interpret_us, start);
-        }
+        g.variants.resize(g.steps.size());
+        std::int64_t interpret_us = 0;
+        start = Clock::now();
+        VariantRuns runs = derive_variants(model, g.steps, [&](std::size_t k, const lsys::ModuleString& s) {
+            leave.now();  // a seated plant has one variant
+            auto begin = Clock::now();
+            g.variants[k] = interpret(model, s, o);
+            interpret_us += std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - begin).count();
+        });
+        t.derive_us += std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - start).count() -
+                       interpret_us;
+        t.interpret_us += interpret_us;
+        t.derivations += runs.runs;
+        t.steps += runs.steps;
+        t.variants += g.steps.size();
     } catch (const Interrupted&) {
         throw;
     } catch (const Error& e) {
@@ -604,6 +609,8 @@ geom::Scene assemble(const SceneFile& file, const std::vector<std::optional<Envi
 
     r.models_loaded = timing.models;
     r.derivations = timing.derivations;
+    r.variants = timing.variants;
+    r.derivation_steps = timing.steps;
     r.load_s = double(timing.load_us) * 1e-6;
     r.derive_s = double(timing.derive_us) * 1e-6;
     r.interpret_s = double(timing.interpret_us) * 1e-6;
@@ -614,6 +621,48 @@ geom::Scene assemble(const SceneFile& file, const std::vector<std::optional<Envi
 }
 
 }  // namespace
+
+VariantRuns derive_variants(const Model& model, const std::vector<std::optional<int>>& steps,
+                            const std::function<void(std::size_t, const lsys::ModuleString&)>& each)
+{
+    // One run derives to the largest step count and hands out the string at each smaller
+    // one on the way, as a derivation that stops there would leave it: the End block
+    // then runs on a copy of the globals (which the homomorphism reads) and the run goes
+    // on from before it. An End block that uses files cannot run on a copy: then each
+    // step count is derived from the axiom.
+    const bool one_run = !model.lsystem.end_block_uses_files();
+    VariantRuns done;
+    std::optional<lsys::Derivation> run(model.lsystem.start());
+    ++done.runs;
+    // fewest steps first; no step count: the derivation length the Start block leaves
+    std::vector<std::pair<int, std::size_t>> order;
+    for (std::size_t k = 0; k < steps.size(); ++k)
+        order.emplace_back(steps[k].value_or(run->derivation_length()), k);
+    std::stable_sort(order.begin(), order.end());
+    for (const auto& [n, k] : order) {
+        if (!run) {
+            run.emplace(model.lsystem.start());
+            ++done.runs;
+        }
+        const int before = run->steps_done();
+        run->advance(n - before);
+        done.steps += std::uint64_t(run->steps_done() - before);
+        // as LSystem::derive: a stop() before the last step skips the End block, unless
+        // its argument is other than 1
+        const bool stopped_early = run->stopped() && run->steps_done() < n;
+        if (!stopped_early || run->stop_runs_end()) {
+            if (one_run && n < order.back().first)
+                run->finish_on_copy();
+            else
+                run->finish();
+        }
+        run->release_buffers();
+        each(k, run->string());
+        if (!one_run)
+            run.reset();
+    }
+    return done;
+}
 
 geom::Scene assemble_scene(const SceneFile& file, const Options& options,
                            const AssemblyOptions& how, AssemblyReport* report)

@@ -5,8 +5,13 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <vector>
 
 #include "app/command_line.h"
+#include "app/pipeline.h"
 #include "app/scene_file.h"
 #include "geom/scene.h"
 
@@ -36,7 +41,11 @@ struct AssemblyOptions {
 /// What assembling took (for --stats and the tests).
 struct AssemblyReport {
     std::size_t models_loaded = 0;   ///< distinct (model, command, seed)
-    std::size_t derivations = 0;     ///< distinct (model, command, seed, steps)
+    /// Derivation runs from the axiom: one per model loaded, each handing out the
+    /// strings of the model's step counts on the way to the largest
+    std::size_t derivations = 0;
+    std::size_t variants = 0;        ///< distinct (model, command, seed, steps)
+    std::uint64_t derivation_steps = 0;  ///< steps derived, all runs together
     std::size_t plant_instances = 0; ///< placements of plants
     std::size_t organ_instances = 0; ///< top-level instances of organs (compose)
     double load_s = 0, derive_s = 0, interpret_s = 0;  ///< summed over threads
@@ -49,6 +58,22 @@ struct AssemblyReport {
 /// --allow-system-calls ...). Errors name the scene file and the plant's JSON path.
 geom::Scene assemble_scene(const SceneFile& file, const Options& options,
                            const AssemblyOptions& how = {}, AssemblyReport* report = nullptr);
+
+/// What derive_variants did.
+struct VariantRuns {
+    std::size_t runs = 0;      ///< derivation runs from the axiom
+    std::uint64_t steps = 0;   ///< steps derived, all runs together
+};
+
+/// The derived strings of `model` after each of `steps` (nullopt: the derivation length
+/// the Start block leaves), each what derive() gives for it, from one derivation run to
+/// the largest: `each(k, string)` gets the string of steps[k] as the run reaches it (the
+/// fewest steps first), while the model's globals are those that derivation would leave,
+/// for interpret(); the string is the run's own, gone once `each` returns. Derived from
+/// the axiom for each step count instead when the End block uses files
+/// (lsys::LSystem::end_block_uses_files()). Throws what derive() throws.
+VariantRuns derive_variants(const Model& model, const std::vector<std::optional<int>>& steps,
+                            const std::function<void(std::size_t, const lsys::ModuleString&)>& each);
 
 /// Applies the scene file's camera size, render settings, sky and environment to
 /// `options`, except where the command line gave them (Options::given).

@@ -23,6 +23,7 @@
 #include "app/shot_options.h"
 #include "app/video.h"
 #include "base/diagnostics.h"
+#include "base/subprocess.h"
 #include "geom/view_file.h"
 #include "geom/view_volume.h"
 #include "lsys/inbetween.h"
@@ -457,6 +458,8 @@ int run_animation(const Options& options, const SequenceOutputs& out)
             Clock::time_point& start;
             ~Restart() { start = Clock::now(); }
         } restart{derivation_start};
+        if (const int signal = SignalNote::signal())
+            throw Interrupted(signal);  // a video's run: no further frame is derived
         if (status != 0)
             return;
         if (filter.to_render(number))
@@ -738,6 +741,13 @@ int run_sequence(const Options& options, const SequenceOutputs& outputs)
     fs::path ffmpeg;
     if (!videos.empty())
         ffmpeg = require_ffmpeg(videos.front());  // before any work
+    // SIGINT, SIGTERM and SIGHUP, noted before the first folder exists, stop the renders
+    // and end the run by this path, through the folders' destructors.
+    std::optional<SignalNote> signals;
+    if (!videos.empty()) {
+        signals.emplace();
+        frames.settings.cancel = signals->cancel();
+    }
     // Each video's frames and encoding in a fresh private folder beside it, removed
     // however the run ends (nothing a model folder plants there can be reached).
     std::vector<PrivateFolder> work;
@@ -748,6 +758,8 @@ int run_sequence(const Options& options, const SequenceOutputs& outputs)
     }
     int status = options.shot.turntable > 0 ? run_turntable(options, frames)
                                             : run_animation(options, frames);
+    if (signals && signals->signal() != 0)
+        throw Interrupted(signals->signal());  // the folders go as this leaves
     if (status != 0 || (outputs.mpi && outputs.mpi->rank() != 0))
         return status;
     for (std::size_t i = 0; i < videos.size(); ++i) {

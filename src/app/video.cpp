@@ -29,6 +29,45 @@ std::string lower_extension(const fs::path& file)
 
 }  // namespace
 
+namespace {
+
+constexpr std::array<int, 3> noted_signals{SIGINT, SIGTERM, SIGHUP};
+std::atomic<bool> g_noted{false};
+std::atomic<int> g_signal{0};
+static_assert(std::atomic<bool>::is_always_lock_free && std::atomic<int>::is_always_lock_free,
+              "a signal handler may only store into lock-free atomics");
+
+extern "C" void note_video_signal(int signal)
+{
+    g_signal.store(signal);
+    g_noted.store(true);
+}
+
+}  // namespace
+
+SignalNote::SignalNote()
+{
+    g_signal.store(0);
+    g_noted.store(false);
+    struct sigaction note {};
+    note.sa_handler = note_video_signal;
+    sigemptyset(&note.sa_mask);
+    note.sa_flags = SA_RESETHAND | SA_RESTART;
+    for (std::size_t i = 0; i < noted_signals.size(); ++i)
+        ::sigaction(noted_signals[i], &note, &m_saved[i]);
+}
+
+SignalNote::~SignalNote()
+{
+    for (std::size_t i = 0; i < noted_signals.size(); ++i)
+        ::sigaction(noted_signals[i], &m_saved[i], nullptr);
+    g_signal.store(0);
+}
+
+const std::atomic<bool>* SignalNote::cancel() const { return &g_noted; }
+
+int SignalNote::signal() { return g_signal.load(); }
+
 bool is_video(const fs::path& file)
 {
     const OutputFormat* format = find_output_format(file);

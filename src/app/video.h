@@ -2,11 +2,39 @@
 // Video outputs (-o turn.mp4): frames encoded by Debian's ffmpeg, when it is installed.
 #pragma once
 
+#include <signal.h>
+
+#include <array>
+#include <atomic>
 #include <filesystem>
 
 #include "base/atomic_file.h"
 
 namespace cambium::app {
+
+/// While alive (a video is being made), SIGINT, SIGTERM and SIGHUP no longer end the
+/// process where it stands: the handler only notes the signal (stores into atomics, which
+/// is async-signal-safe), the renders stop at their next pass (cancel() as
+/// RenderSettings::cancel) and the caller leaves by its normal path, so that the video's
+/// private folders are removed by their destructors, then ends with 128 + signal() (an
+/// animation stops deriving at its next frame). Each
+/// handler is installed with SA_RESETHAND: a second signal acts as it would have. The
+/// handlers found are put back on destruction. One at a time.
+class SignalNote {
+public:
+    SignalNote();
+    ~SignalNote();
+    SignalNote(const SignalNote&) = delete;
+    SignalNote& operator=(const SignalNote&) = delete;
+
+    /// True once a signal is noted.
+    const std::atomic<bool>* cancel() const;
+    /// The signal a SignalNote alive noted (the last one), 0 while none is (or none lives).
+    static int signal();
+
+private:
+    std::array<struct sigaction, 3> m_saved{};
+};
 
 /// Whether `file` names a video (.mp4, .mov, .mkv, .webm) rather than an image.
 bool is_video(const std::filesystem::path& file);

@@ -7,6 +7,7 @@
 #include <climits>
 #include <cmath>
 #include <new>
+#include <utility>
 
 #include "base/diagnostics.h"
 
@@ -281,6 +282,28 @@ void Deriver::finish()
     } catch (const EvaluationError& e) {
         fail(e);
     }
+}
+
+Runtime Deriver::finish_on_copy()
+{
+    Runtime saved = m_runtime;
+    std::vector<double> frame = m_frame;
+    try {
+        finish();
+    } catch (...) {
+        m_runtime = std::move(saved);
+        m_frame = std::move(frame);
+        throw;
+    }
+    Runtime after = std::exchange(m_runtime, std::move(saved));
+    m_frame = std::move(frame);
+    return after;
+}
+
+void Deriver::release_buffers()
+{
+    m_next = ModuleString();
+    m_indexed = Indexed{};
 }
 
 void Deriver::decompose()

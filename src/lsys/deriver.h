@@ -73,6 +73,14 @@ public:
     void clear_stop() { m_runtime.stop_requested = m_runtime.stop_runs_end = false; }
     void step();
     void finish();
+    /// Runs the End block on a copy of the globals and the block variables and returns
+    /// the globals it leaves; the derivation's own state stays as before (a later step()
+    /// goes on as if the End block had not run). Files the End block uses are shared
+    /// with the derivation (OpenFiles), so a caller checks that it uses none.
+    Runtime finish_on_copy();
+    /// Frees the buffers a step reuses (the string the last step was built from, the
+    /// context index): the next step() allocates them again.
+    void release_buffers();
     /// The fragment starts of the current string, in string order, for the next step()
     /// (manual 5.1.9): that step derives each one's fragment (from after the `%(par)` to
     /// its branch's `]`, the next `%` with parameters or a sub-L-system's `$`) at the end

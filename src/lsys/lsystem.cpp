@@ -152,6 +152,20 @@ ModuleString LSystem::axiom() const
 
 bool LSystem::has_queries() const { return m_has_queries; }
 
+bool LSystem::end_block_uses_files() const
+{
+    for (const Instr& in : m_program->end_block.instrs) {
+        if (in.op == Op::FilePrint || in.op == Op::FileScan)
+            return true;
+        if (in.op == Op::Call) {
+            const auto f = static_cast<Function>(in.arg);
+            if (f == Function::Fopen || f == Function::Fclose || f == Function::Fflush)
+                return true;
+        }
+    }
+    return false;
+}
+
 ModuleString LSystem::derive(std::optional<int> steps) const
 {
     Derivation derivation = start();
@@ -228,6 +242,13 @@ void Derivation::finish()
     m_deriver->finish();
     m_lsystem->m_last_runtime = std::make_shared<Runtime>(m_deriver->runtime());
 }
+
+void Derivation::finish_on_copy()
+{
+    m_lsystem->m_last_runtime = std::make_shared<Runtime>(m_deriver->finish_on_copy());
+}
+
+void Derivation::release_buffers() { m_deriver->release_buffers(); }
 
 const ModuleString& Derivation::string() const { return m_deriver->string(); }
 int Derivation::steps_done() const { return m_deriver->steps_done(); }

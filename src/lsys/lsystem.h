@@ -113,6 +113,16 @@ public:
     void advance(int steps);
     /// Runs the End block once (later calls do nothing).
     void finish();
+    /// For a string handed out on the way to a later step (a scene's plant variants of
+    /// one model share one derivation run, docs/scenes.md): runs the End block on a copy
+    /// of the globals, which LSystem::interpretation_string() then reads, while the
+    /// derivation goes on from its state before the block, as if it had not run. Only
+    /// for programs whose End block uses no file (LSystem::end_block_uses_files()).
+    void finish_on_copy();
+    /// Frees the buffers only the next advance() needs (the string the last step was
+    /// built from, the context index), so that the string alone is held while it is
+    /// interpreted; the next step allocates them again.
+    void release_buffers();
     const ModuleString& string() const;
     /// Steps derived since the axiom.
     int steps_done() const;
@@ -188,6 +198,9 @@ public:
 
     /// Whether an axiom or successor holds ?P ?H ?L or ?U (then LoadOptions::query runs).
     bool has_queries() const;
+    /// Whether the End block calls fopen, fclose, fflush, fprintf or fscanf (its files
+    /// are the derivation's own: it cannot run on a copy, Derivation::finish_on_copy()).
+    bool end_block_uses_files() const;
     /// The string the turtle interprets: `derived` with the homomorphism applied
     /// (recursively to each set's `maximum depth:`, default 1; its `seed:` makes it
     /// stochastic; `warnings` reports reaching the depth), object productions (-o>)

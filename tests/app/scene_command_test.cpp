@@ -52,7 +52,7 @@ TEST(SceneCommand, RendersAndTheCommandLineOverridesTheFile)
     // -w overrides the camera's size; without -o the image is named after the scene
     Result r = run("-w 40 30 field.json", dir);
     ASSERT_EQ(r.status, 0) << r.output;
-    EXPECT_NE(r.output.find("2 plants (1 models, 1 derivations)"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("2 plants (1 models, 1 derivations of 2 steps, 1 variants)"), std::string::npos) << r.output;
     auto in = OIIO::ImageInput::open((dir / "field.png").string());
     ASSERT_TRUE(in);
     EXPECT_EQ(in->spec().width, 40);

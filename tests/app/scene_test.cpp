@@ -445,17 +445,21 @@ TEST(SceneAssembly, EachDistinctVariantIsDerivedOnce)
     EXPECT_EQ(r1.models_loaded, 1u);
     EXPECT_EQ(r1.derivations, 1u);
     EXPECT_EQ(r1.plant_instances, 6u);
-    // steps [1, 2] and [2]: two derivations of one model; placements alternate variants
+    // steps [1, 2] and [2]: two variants of one model, both from one derivation of two
+    // steps; placements alternate variants
     auto [r2, instances2] = report_of("{" + m + "\"steps\": [1, 2], " + three + "}, {" + m +
                                       "\"steps\": 2, " + three + "}");
     EXPECT_EQ(r2.models_loaded, 1u);
-    EXPECT_EQ(r2.derivations, 2u);
+    EXPECT_EQ(r2.derivations, 1u);
+    EXPECT_EQ(r2.variants, 2u);
+    EXPECT_EQ(r2.derivation_steps, 2u);
     // another model, or another seed, is another load
     auto [r3, instances3] = report_of("{" + m + three + "}, {" + m + "\"seed\": 3, " + three +
                                       "}, {\"model\": \"n\", \"command\": \"cpfg p.l p.v\", " +
                                       three + "}");
     EXPECT_EQ(r3.models_loaded, 3u);
     EXPECT_EQ(r3.derivations, 3u);
+    EXPECT_EQ(r3.variants, 3u);
     EXPECT_EQ(r3.plant_instances, 9u);
     // each plant of 3 steps has 3 flowers (objects): composed, one instance each
     EXPECT_EQ(r3.organ_instances, 27u);
