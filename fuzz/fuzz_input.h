@@ -5,6 +5,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <filesystem>
+#include <fstream>
 #include <string_view>
 
 #include "base/diagnostics.h"
@@ -33,6 +35,16 @@ int run(std::size_t size, Read&& read)
     } catch (const cambium::Error&) {
     }
     return 0;
+}
+
+/// Writes the input to `name` in the current folder (scripts/fuzz.sh runs each target in
+/// a scratch folder of its own) for readers that take a path, as the command's do.
+inline std::filesystem::path write_input(const std::uint8_t* data, std::size_t size,
+                                         const char* name)
+{
+    std::ofstream(name, std::ios::binary | std::ios::trunc)
+        .write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(size));
+    return name;
 }
 
 }  // namespace cambium::fuzz

@@ -12,7 +12,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
 
-targets=(lsystem view_file surface tsurface contour function curve background string_text string_binary animation)
+targets=(lsystem view_file surface tsurface contour function curve background string_text string_binary animation
+         scene_file obj_mesh tile label env_map comm_spec spec)
 target=${1:-all}
 minutes=${2:-5}
 build=${FUZZ_BUILD:-build-fuzz}
@@ -64,6 +65,10 @@ seed() {  # seed TARGET: fills $build/seeds/TARGET
         background)  mapfile -t files < <(corpus_files '*.dat') ;;
         string_text) mapfile -t files < <(corpus_files '*.str') ;;
         animation)   mapfile -t files < <(corpus_files '*.a') ;;
+        scene_file)  mapfile -t files < <(find scenes -name '*.json' | sort) ;;
+        obj_mesh)    mapfile -t files < <(corpus_files '*.obj') ;;
+        comm_spec)   mapfile -t files < <(corpus_files '*.e') ;;
+        spec)        mapfile -t files < <(corpus_files '*.spec') ;;
       esac
       local i=0
       for f in "${files[@]}"; do cp "$f" "$dir/corpus$((i++))"; done ;;

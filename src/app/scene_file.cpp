@@ -56,13 +56,17 @@ public:
     {
         if (!m_value->is_object())
             fail("must be an object");
-        for (const auto& [key, v] : m_value->items())
+        for (const auto& item : m_value->items()) {
+            // not a structured binding: clang before 16 cannot capture one in a lambda
+            const std::string& key = item.key();
             if (std::none_of(known.begin(), known.end(), [&](const char* k) { return key == k; })) {
                 std::string list;
                 for (const char* k : known)
                     list += (list.empty() ? "" : ", ") + std::string(k);
-                Node(*m_file, v, join(key.c_str())).fail("unknown key (expected one of " + list + ")");
+                Node(*m_file, item.value(), join(key.c_str()))
+                    .fail("unknown key (expected one of " + list + ")");
             }
+        }
         return *this;
     }
 

@@ -18,7 +18,7 @@ struct Circle {
     std::array<float, 3> position;
     float radius;
     float vigor;
-    int group;
+    double group;  ///< group_of the second parameter
     std::uint64_t address;
 };
 
@@ -39,7 +39,7 @@ public:
             Circle c{{t[0], m_three_d ? t[1] : t[2], m_three_d ? t[2] : 0.0f},
                      p[0],
                      m_vigor ? p[1] : 1.0f,
-                     !m_vigor && p.size() > 1 ? static_cast<int>(p[1]) : 0,
+                     !m_vigor && p.size() > 1 ? group_of(p[1]) : 0.0,
                      q.address};
             largest = std::max(largest, std::fabs(c.radius));
             circles.push_back(c);

@@ -15,7 +15,7 @@ namespace {
 struct Point {
     std::array<float, 3> position;
     float vigor;
-    int group;
+    double group;  ///< group_of the second parameter
     std::uint64_t address;
 };
 
@@ -34,7 +34,7 @@ public:
             const auto& p = q.position.values;
             Point point{{p[0], m_three_d ? p[1] : p[2], m_three_d ? p[2] : 0.0f},
                         q.module.params[0],
-                        q.module.params.size() > 1 ? static_cast<int>(q.module.params[1]) : 0,
+                        q.module.params.size() > 1 ? group_of(q.module.params[1]) : 0.0,
                         q.address};
             points.push_back(point);
             cells.push_back(point.position);

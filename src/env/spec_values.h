@@ -3,6 +3,7 @@
 // cut into tokens at blanks, commas, semicolons, colons and the letter 'x' ("32x32x32").
 #pragma once
 
+#include <cmath>
 #include <initializer_list>
 #include <string>
 #include <utility>
@@ -32,6 +33,12 @@ bool switch_value(const SpecLine& line, std::initializer_list<const char*> words
 /// A text file's lines that hold more than blanks, numbered from 1, without a trailing
 /// carriage return: how `.e` and specification files are read.
 std::vector<std::pair<int, std::string>> non_blank_lines(const std::string& text);
+
+/// The group a ?E parameter names, as the programs' int conversion of it: the value
+/// truncated toward zero, kept as a double so that a value no int holds (which C's
+/// conversion leaves undefined) names a group of its own and NaN names none (it equals
+/// nothing).
+inline double group_of(float parameter) { return std::trunc(static_cast<double>(parameter)); }
 
 /// The specification file named by a program's arguments: the first argument that is
 /// not an option. Error naming the program when there is none.

@@ -149,6 +149,7 @@ public:
         for (const Prototype& p : m_scene.prototypes)
             bytes += geometry_bytes(p.geometry);
         bytes += m_scene.instances.capacity() * sizeof(Instance);
+        bytes += m_label_text_bytes + m_scene.labels.capacity() * sizeof(Label);
         if (bytes > m_options.max_memory_bytes)
             throw Error("the scene's geometry needs " + byte_size_text(bytes) + " after " +
                         std::to_string(m_module_index) +
@@ -902,7 +903,23 @@ private:
             label.text = std::move(*text);
         else if (!m_options.strings.empty() || !p.empty())
             warn_once(m_warned_label, "@L without a known string: label text left empty");
-        m_scene.labels.push_back(std::move(label));
+        // The labels' text and entries count against the memory budget before they are
+        // stored: a string of @L modules with wide formats would otherwise grow without
+        // bound between two checks of the geometry (every memory_check_interval modules).
+        std::vector<Label>& labels = m_scene.labels;
+        std::size_t capacity = labels.size() < labels.capacity()
+                                   ? labels.capacity()
+                                   : std::max<std::size_t>(1, 2 * labels.capacity());
+        std::uint64_t& text_bytes = m_root->m_label_text_bytes;
+        text_bytes += label.text.size();
+        std::uint64_t bytes = text_bytes + std::uint64_t(capacity) * sizeof(Label);
+        if (bytes > m_options.max_memory_bytes)
+            throw Error("the @L labels need " + byte_size_text(bytes) + " for " +
+                        std::to_string(labels.size() + 1) + " labels at module " +
+                        std::to_string(m_module_index) + " of the string, more than the " +
+                        "memory budget of " + byte_size_text(m_options.max_memory_bytes) +
+                        " (--max-memory); use fewer or shorter labels or raise --max-memory");
+        labels.push_back(std::move(label));
     }
 
 
@@ -1145,6 +1162,7 @@ private:
     std::size_t m_polygon_floor = 0;       ///< polygons below this index began before the object
     std::vector<std::vector<PolygonCorner>> m_outer_polygons;
     std::size_t m_module_index = 0;
+    std::uint64_t m_label_text_bytes = 0;  ///< of every label this one's root stored
     bool m_warned_system = false, m_warned_include = false, m_warned_grid = false;
     bool m_warned_scale = false, m_warned_unmatched_polygon = false, m_warned_movement = false;
     bool m_warned_unmatched_sub = false, m_warned_label = false;

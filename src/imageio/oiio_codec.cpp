@@ -4,12 +4,73 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <cstring>
+#include <fstream>
+#include <string>
+
 #include "base/diagnostics.h"
 
 namespace cambium::render {
 
+namespace {
+
+/// Checks an OpenEXR file's headers before OpenImageIO opens it: OpenEXR allocates each
+/// attribute's declared size before reading its value, so a few hundred bytes could ask
+/// for gigabytes. Every attribute must fit in what the file has left; the walk seeks past
+/// the values and reads only names (at most 256 bytes each). Other files are left alone.
+void check_exr_headers(const std::filesystem::path& file)
+{
+    std::ifstream in(file, std::ios::binary);
+    char magic[8];
+    if (!in.read(magic, sizeof magic) || std::memcmp(magic, "\x76\x2f\x31\x01", 4) != 0)
+        return;
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(file, ec);
+    if (ec)
+        return;  // OpenImageIO reports it
+    const bool multipart = (static_cast<unsigned char>(magic[5]) & 0x10) != 0;
+    auto fail = [&](const std::string& why) {
+        throw Error(FileLoc{file.string()}, "is not a valid OpenEXR file: " + why);
+    };
+    auto text = [&](const char* what) {
+        std::string s;
+        for (char c; in.get(c) && c != '\0';) {
+            s += c;
+            if (s.size() > 255)
+                fail(std::string("a header's ") + what + " is longer than 255 bytes");
+        }
+        if (!in)
+            fail("a header is cut short");
+        return s;
+    };
+    for (;;) {  // headers: one, or a multi-part file's list ended by an empty one
+        std::size_t attributes = 0;
+        for (;; ++attributes) {
+            std::string name = text("attribute name");
+            if (name.empty())
+                break;
+            text("attribute type");
+            unsigned char b[4];
+            if (!in.read(reinterpret_cast<char*>(b), 4))
+                fail("a header is cut short");
+            const std::uint32_t declared = std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 |
+                                           std::uint32_t(b[2]) << 16 | std::uint32_t(b[3]) << 24;
+            const auto at = static_cast<std::uintmax_t>(in.tellg());
+            if (declared > 0x7fffffffu || declared > size - at)
+                fail("the header's attribute '" + name + "' declares " + std::to_string(declared) +
+                     " bytes, more than the " + std::to_string(size - at) + " the file has left");
+            in.seekg(std::streamoff(declared), std::ios::cur);
+        }
+        if (!multipart || attributes == 0)
+            return;
+    }
+}
+
+}  // namespace
+
 MapTexels read_oiio_map(const std::filesystem::path& file, float scale, std::size_t max_texels)
 {
+    check_exr_headers(file);
     auto in = OIIO::ImageInput::open(file.string());
     if (!in)
         throw Error(file.string() + ": cannot read the environment map: " + OIIO::geterror());

@@ -3,7 +3,10 @@
 // position, in the label's colour, hidden where the plant is in front of it.
 #pragma once
 
+#include <cstdint>
 #include <optional>
+
+#include "base/limits.h"
 
 #include "geom/scene.h"
 #include "render/accel.h"
@@ -26,8 +29,17 @@ namespace cambium::render {
 struct LabelCanvas {
     int x = 0, y = 0, width = 0, height = 0;
 };
-/// `canvas`: none when the image is the whole picture.
+/// What drawing labels may cost (docs/security.md): the glyphs of the font and one depth
+/// per image pixel (the first surface along its ray, traced once for all labels) within
+/// the memory budget, and at most `max_glyph_pixels` coverage pixels composited in all
+/// (about a second of work; a million ten-character labels at 12 pixels take ~6e8).
+struct LabelLimits {
+    std::uint64_t max_memory_bytes = default_max_memory_bytes();
+    std::uint64_t max_glyph_pixels = std::uint64_t{1} << 30;
+};
+/// `canvas`: none when the image is the whole picture. Throws cambium::Error naming the
+/// limit when `limits` are exceeded, before anything is drawn.
 void draw_labels(Image& image, const geom::Scene& scene, const Camera& camera, const EmbreeScene& accel,
-                 std::optional<LabelCanvas> canvas = std::nullopt);
+                 std::optional<LabelCanvas> canvas = std::nullopt, const LabelLimits& limits = {});
 
 }  // namespace cambium::render

@@ -1103,7 +1103,8 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         Image image = resolve(film, region, out_rect, settings);
         // Labels over the image, as cpfg's window draws them (on the crop's pixels).
         draw_labels(image, scene, camera, *accel,
-                    LabelCanvas{out_rect.x, out_rect.y, settings.width, settings.height});
+                    LabelCanvas{out_rect.x, out_rect.y, settings.width, settings.height},
+                    LabelLimits{settings.max_memory_bytes});
         rep.seconds = elapsed();
         if (!on_view(view, image, rep) || rep.cancelled)
             break;

@@ -3,6 +3,8 @@
 // programs compute (docs/environment.md).
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "env_fixture.h"
 
 namespace cambium::env {
@@ -43,6 +45,22 @@ TEST(Honda81, GroupsDoNotMeet)
     auto answers = first_params(env->pass({query_at(1, {0, 0, 0}, {0, 1}), query_at(2, {0, 0, 0}, {5, 2})}, 0));
     EXPECT_EQ(answers.at(1), 1.0f);
     EXPECT_EQ(answers.at(2), 1.0f);
+}
+
+TEST(Honda81, GroupsBeyondIntegersStayApart)
+{
+    // 3e9 and 4e9 are no int: C's conversion of them is undefined (on x86 both became
+    // INT_MIN, one group). They name two groups, which do not meet; NaN names none.
+    auto env = honda81("big_groups", "radius: 1\n3d case: on\n");
+    auto answers = first_params(env->pass({query_at(1, {0, 0, 0}, {0, 3e9f}), query_at(2, {0, 0, 0}, {5, 4e9f}),
+                                          query_at(3, {0, 0, 0}, {0, NAN}), query_at(4, {0, 0, 0}, {1, NAN})},
+                                         0));
+    EXPECT_EQ(answers.at(1), 1.0f);
+    EXPECT_EQ(answers.at(2), 1.0f);
+    EXPECT_EQ(answers.at(3), 1.0f);
+    EXPECT_EQ(answers.at(4), 1.0f);
+    auto same = first_params(env->pass({query_at(1, {0, 0, 0}, {0, 3e9f}), query_at(2, {0, 0, 0}, {5, 3e9f})}, 1));
+    EXPECT_EQ(same.at(1), 0.0f);  // one group: the lower vigor is blocked
 }
 
 TEST(Honda81, TwoDimensionsCompareXAndZ)
@@ -132,6 +150,16 @@ TEST(Ecosystem, ASmallerIntersectingCircleIsDominated)
     EXPECT_EQ(answers.at(1), 0.0f);  // radius 1 reaches radius 2 at distance 2.5 (in x, z)
     EXPECT_EQ(answers.at(2), 1.0f);
     EXPECT_EQ(answers.at(3), 1.0f);
+}
+
+TEST(Ecosystem, GroupsBeyondIntegersStayApart)
+{
+    auto env = ecosystem("big_groups", "vigor: off\n");
+    auto answers = first_params(env->pass({query_at(1, {0, 0, 0}, {1, 3e9f}), query_at(2, {0, 0, 0}, {2, 4e9f})}, 0));
+    EXPECT_EQ(answers.at(1), 1.0f);  // groups 3e9 and 4e9 do not meet
+    EXPECT_EQ(answers.at(2), 1.0f);
+    auto same = first_params(env->pass({query_at(1, {0, 0, 0}, {1, 3e9f}), query_at(2, {0, 0, 0}, {2, 3e9f})}, 1));
+    EXPECT_EQ(same.at(1), 0.0f);  // one group: the smaller circle is dominated
 }
 
 TEST(Ecosystem, TheKeywordIsCaseSensitiveSoCapitalThreeDStaysPlanar)

@@ -163,6 +163,39 @@ TEST(Interpreter, SceneGeometryPastTheMemoryBudgetIsAnError)
               20000u);
 }
 
+TEST(Interpreter, LabelTextPastTheMemoryBudgetIsAnError)
+{
+    // 100 labels of 12 formats padded to 99 characters: about 120 KiB of text, found at
+    // the label that crosses a budget of 64 KiB, long before the first geometry check
+    lsys::SymbolTable symbols;
+    std::string text;
+    for (int i = 0; i < 100; ++i)
+        text += "@L(0)";
+    lsys::ModuleString s = text_modules(symbols, text);
+    std::string wide;
+    for (int i = 0; i < 12; ++i)
+        wide += "%99d";
+    std::vector<std::string> strings{wide};
+    InterpretOptions options;
+    options.strings = strings;
+    options.max_memory_bytes = 64 << 10;
+    try {
+        interpret(s, symbols, parse_view_file("", "t.v"), options);
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        std::string message = e.what();
+        EXPECT_EQ(message.rfind("error: the @L labels need ", 0), 0u) << message;
+        EXPECT_NE(message.find(" for 52 labels at module 51 of the string, more than the memory "
+                               "budget of 64.0 KiB (--max-memory)"),
+                  std::string::npos)
+            << message;
+    }
+    options.max_memory_bytes = 64 << 20;  // the same labels within a larger budget
+    Scene scene = interpret(s, symbols, parse_view_file("", "t.v"), options);
+    ASSERT_EQ(scene.labels.size(), 100u);
+    EXPECT_EQ(scene.labels[0].text.size(), 12u * 99u);
+}
+
 // Manual 5.2.3: `interpretation past %: on` (default) lets the turtle interpret past a %;
 // off: the symbols after it (up to the end of its branch) are not interpreted.
 TEST(Interpreter, InterpretationPastCutOnDrawsTheCutBranch)

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <numbers>
 #include <unistd.h>
 
@@ -169,6 +170,33 @@ TEST(MapEnvironment, ReadsLatLongFilesWithUpAtTheTopAndMinusZInTheCentre)
     EXPECT_THROW(make_map_environment(dir / "missing.exr"), Error);
     EXPECT_THROW(make_map_environment(0, 4, {}), Error);
     EXPECT_THROW(make_map_environment(2, 2, std::vector<float>(5)), Error);
+}
+
+// OpenEXR allocates an attribute's declared size before reading it: an attribute that
+// declares more bytes than the file holds is refused before OpenImageIO opens the file
+// (a 600-byte file once asked for 1.8 GB).
+TEST(Environment, ExrAttributeLargerThanTheFileIsRefusedBeforeReading)
+{
+    auto dir = std::filesystem::temp_directory_path() /
+               ("cambium_env_attribute_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    auto file = dir / "huge.exr";
+    std::string bytes("\x76\x2f\x31\x01\x02\x00\x00\x00", 8);
+    bytes += std::string("comments\0string\0", 16);
+    bytes += std::string("\x00\x00\x00\x70", 4);  // 0x70000000 bytes
+    bytes += "abc";
+    std::ofstream(file, std::ios::binary) << bytes;
+    std::string message;
+    try {
+        make_map_environment(file, 1.0f);
+    } catch (const Error& e) {
+        message = e.what();
+    }
+    EXPECT_NE(message.find("huge.exr: error: is not a valid OpenEXR file: the header's attribute "
+                           "'comments' declares 1879048192 bytes, more than the 3 the file has left"),
+              std::string::npos)
+        << message;
+    std::filesystem::remove_all(dir);
 }
 
 // A map whose header declares many channels is decoded in its first three only (the
