@@ -155,22 +155,42 @@ TEST(Staging, GroundUnderAnEnvironmentReflectsAlbedoTimesItsRadiance)
     }
 }
 
-// The ground's grain under the default --sky: the spread of an open patch's pixels at 64
-// spp relative to their mean (the true radiance is the same at every pixel: no plant
-// shadows it). Measured 1.4% (R) and 1.3% (G) with the tabulated dome and the sun as its
-// own strategy, 9.5% and 7.5% with the sun cone and the uniform sphere at 1/2 each; the
-// bound, 3%, leaves twice the measurement.
+// The ground's grain under the default --sky with FernLeaf's two view lights: the spread
+// of an open patch's pixels at 64 spp relative to their mean (the true radiance is the
+// same at every pixel: nothing shadows it). Measured 4.4% (R) and 3.9% (G); with the
+// lights chosen by power and the dome sampled uniformly over the sphere (the sun's cone
+// at 1/2) 13.1% and 11.6%, as on FernLeaf's staged still; with only the dome's sampling
+// reverted, 5.7% and 5.1%. Bound: 6%. The sky alone with independent (white-noise)
+// samples shows the dome's sampling itself: measured 8.1% and 7.7%, 10.2% and 9.6% with
+// the uniform sphere; bound 9.5% (the renders are deterministic: the margin is for
+// changes elsewhere, not for chance).
 TEST(Staging, GroundUnderTheSkyHasLittleGrainAt64Spp)
 {
     OpenGround g;
     g.settings.environment = std::make_shared<const Environment>(make_sky_environment());
+    // FernLeaf's view lights: one from above at 26 degrees, one from below the ground.
+    g.scene.lights.push_back(directional_light({0.5, 1, 2}));
+    g.scene.lights.push_back(directional_light({-0.5, -1, -2}));
+    g.scene.lights.back().diffuse = {0.6f, 0.6f, 0.6f};
     Image image = render(g.scene, g.camera, g.settings);
     for (int c = 0; c < 2; ++c) {
         auto [mean, spread] = OpenGround::mean_and_spread(image, c);
         ASSERT_GT(mean, 0.01) << c;
         std::printf("[sky ground] channel %d: mean %.4f, relative spread %.4f\n", c, mean,
                     spread / mean);
-        EXPECT_LT(spread / mean, 0.03) << "channel " << c;
+        EXPECT_LT(spread / mean, 0.06) << "channel " << c;
+    }
+    // The sky alone, each sample's own variance (independent samples): the dome sampled
+    // as its radiance, nothing spent below the horizon.
+    OpenGround open;
+    open.settings.environment = g.settings.environment;
+    open.settings.sampler = SampleSequence::white;
+    Image alone = render(open.scene, open.camera, open.settings);
+    for (int c = 0; c < 2; ++c) {
+        auto [mean, spread] = OpenGround::mean_and_spread(alone, c);
+        std::printf("[sky ground] sky alone, white noise, channel %d: relative spread %.4f\n",
+                    c, spread / mean);
+        EXPECT_LT(spread / mean, 0.095) << "channel " << c;
     }
 }
 
