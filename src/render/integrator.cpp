@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // The unidirectional path tracer: next-event estimation toward one light per vertex, chosen
-// by power from the view file's lights, the environment and emissive primitives (MIS
-// against BSDF sampling), transmission, opacity, Russian roulette, ray cones for texture
-// filtering.
+// by what each can deliver there from the view file's lights, the environment and
+// emissive primitives (MIS against BSDF sampling), transmission, opacity, Russian
+// roulette, ray cones for texture filtering.
 //
 // Sampler dimensions: each path vertex spends the fixed block sample_dimension::vertex(depth)
 // (light choice, light point, BSDF, opacity, roulette), whatever it meets (sampler.h).

@@ -71,7 +71,10 @@ struct ChosenLight {
     float probability = 0;
 };
 
-/// Every light next-event estimation samples, one at a time, chosen in proportion to its
+/// Every light next-event estimation samples, one at a time: chosen at each shading point
+/// by what each can deliver there where the set holds the environment or emissive
+/// primitives (per_point; the integrator weighs them), by what each gives the point among
+/// delta lights only (delta_only), and otherwise (choose()) in proportion to its
 /// power (pbrt's power light sampler): a delta light by the irradiance pi |colour| it gives
 /// a surface facing it (attenuation at distance 0, the spot cone ignored), the
 /// environment by the integral of its luminance over the sphere (a quarter of it reaches an
