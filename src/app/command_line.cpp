@@ -292,6 +292,9 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     cli.add_option("--env-rotate", options.environment_rotation,
                    "Turn the --env map (or --sky) by DEG about the up axis +y")
         ->check(CLI::Range(-3600.0f, 3600.0f));
+    cli.add_flag("--no-view-lights", options.no_view_lights,
+                 "Leave out the view file's lights (and cpfg's default light): light with "
+                 "the --sky or --env alone");
     cli.add_flag("--allow-system-calls", options.allow_system_calls,
                  "Run the commands of @S modules (never done by default)");
     cli.add_flag("--allow-environment-program", options.allow_environment_program,
@@ -346,6 +349,9 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
                         "' is not a size such as 8G, 512M or 1000000 (bytes, at least 1)");
         options.max_memory_bytes = *bytes;
     }
+    // `--background sky` shows the sky: without --env it brings the --sky itself.
+    if (options.shot.background == "sky" && !options.sky && !options.environment_map)
+        options.sky = true;
     if (options.sky && options.environment_map)
         throw Error("--sky and --env both set what surrounds the plant; give one");
     if (cli.count("--turbidity") > 0 && !options.sky)

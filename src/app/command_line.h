@@ -113,6 +113,9 @@ struct Options {
     std::optional<std::filesystem::path> environment_map;  ///< --env file.exr|.hdr
     float environment_scale = 1;       ///< --env-scale
     float environment_rotation = 0;    ///< --env-rotate DEG about +y (with --env or --sky)
+    /// --no-view-lights: the view file's lights (or cpfg's default light where it has no
+    /// `light:`) are left out; the sky, the map, the ambient and emissive surfaces light.
+    bool no_view_lights = false;
 
     ShotOptions shot;
 

@@ -82,6 +82,7 @@ render::RenderSettings render_settings(const Options& options,
     settings.focus_distance = options.focus_distance;
     settings.transparent_background = options.transparent;
     settings.ambient = {options.ambient, options.ambient, options.ambient};
+    settings.view_lights = !options.no_view_lights;
     std::optional<render::Environment> environment;
     if (options.sky) {
         render::SkyParameters sky;

@@ -160,7 +160,7 @@ void check_shot_options(const Options& options)
     if (shot.frames)
         frame_range(*shot.frames);
     if (shot.background == "sky" && !options.sky)
-        throw Error("--background sky shows the --sky behind the plant; give --sky too");
+        throw Error("--background sky shows the --sky behind the plant, not the --env map");
     if (shot.background == "env" && !options.environment_map)
         throw Error("--background env shows the --env map behind the plant; give --env too");
     if (shot.background && *shot.background != "sky" && *shot.background != "env")

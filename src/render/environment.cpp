@@ -21,8 +21,9 @@
 //   to black at 6 deg below (civil twilight), a documented approximation.
 // - ground (y < 0): ground_albedo / pi times the irradiance of sun and dome on a
 //   horizontal plane (the dome's integrated once, numerically).
-// Sampling: the sun cone with probability 1/2 (when the sun is up), else the uniform
-// sphere; pdf() is that mixture, so MIS weights are exact.
+// Sampling: the sun's cone with probability in proportion to its share of the luminous
+// power (within [1/4, 3/4]; when the sun is up), else the dome tabulated by luminance
+// (LatLongTable, the maps' sampler); pdf() is that mixture, so MIS weights are exact.
 #include "render/environment.h"
 
 #include <algorithm>
@@ -141,7 +142,44 @@ Sky::Sky(const SkyParameters& p)
     Vec3f sun_irradiance = m_sun_up ? colour * (pi * p.sun_intensity * m_sun.y) : Vec3f();
     m_ground = p.ground_albedo * (sun_irradiance + dome_irradiance()) * (1 / pi);
     m_black = !(m_zenith_Y > 0) && !m_sun_up;
-    m_sun_probability = m_sun_up ? 0.5f : 0.0f;
+    tabulate(false);
+}
+
+void Sky::tabulate(bool hidden)
+{
+    // The dome's mean luminance over each cell (a 3 x 3 grid of directions uniform in
+    // solid angle), the ground's below the horizon: the table's density follows the
+    // dome to within its variation over a cell (2.8 x 2.8 degrees).
+    constexpr int width = 128, height = 64, sub = 3;
+    std::vector<float> weight(std::size_t(width) * height);
+    const float ground = luminance(m_ground);
+    for (int j = 0; j < height; ++j) {
+        const float c0 = std::cos(pi * float(j) / height), c1 = std::cos(pi * float(j + 1) / height);
+        for (int i = 0; i < width; ++i) {
+            float sum = 0;
+            for (int a = 0; a < sub; ++a)
+                for (int b = 0; b < sub; ++b) {
+                    float c = c0 + (c1 - c0) * (a + 0.5f) / sub;
+                    Vec3f d = LatLongTable::direction((i + (b + 0.5f) / sub) / width, c);
+                    sum += d.y < 0 ? ground : luminance(dome(d));
+                }
+            bool below = j >= height / 2;
+            weight[std::size_t(j) * width + std::size_t(i)] =
+                hidden && below ? 0.0f : sum / (sub * sub);
+        }
+    }
+    m_table = LatLongTable(width, height, weight);
+    // The sun's strategy by its share of the luminous power, within [1/4, 3/4]: each
+    // strategy keeps enough samples for the points the other serves badly (the plant's
+    // shadow on the ground, where the sun's samples are all blocked).
+    const double sun_power = m_sun_up ? double(luminance(m_sun_radiance)) * m_sun_solid_angle : 0;
+    const double total = sun_power + m_table.integral();
+    if (!m_sun_up)
+        m_sun_probability = 0;
+    else if (m_table.empty())
+        m_sun_probability = 1;
+    else
+        m_sun_probability = float(std::clamp(sun_power / total, 0.25, 0.75));
 }
 
 Vec3f Sky::radiance(const Vec3f& d) const
@@ -166,15 +204,19 @@ EnvironmentSample Sky::sample(float u1, float u2) const
         make_basis(m_sun, t, b);
         d = normalize(t * (sin_t * std::cos(phi)) + b * (sin_t * std::sin(phi)) + m_sun * cos_t);
     } else {
+        if (m_table.empty())
+            return {};
         float u = (u1 - m_sun_probability) / (1 - m_sun_probability);
-        d = uniform_sphere(std::min(u, 0x1.fffffep-1f), u2);
+        float density = 0;
+        int i = 0, j = 0;
+        d = m_table.sample(std::min(u, 0x1.fffffep-1f), u2, density, i, j);
     }
     return {d, radiance(d), pdf(d)};
 }
 
 float Sky::pdf(const Vec3f& d) const
 {
-    float p = (1 - m_sun_probability) * inv_4pi;
+    float p = m_sun_probability < 1 ? (1 - m_sun_probability) * m_table.pdf(d) : 0.0f;
     if (m_sun_up && dot(d, m_sun) >= m_cos_sun)
         p += m_sun_probability / m_sun_solid_angle;
     return p;
@@ -238,8 +280,8 @@ float Distribution1D::density(std::size_t bin) const
     return integral > 0 ? float(func[bin] / integral) : 1.0f;
 }
 
-Map::Map(int width, int height, std::vector<float> rgb)
-    : m_width(width), m_height(height), m_rgb(std::move(rgb)), m_marginal(std::vector<float>(1))
+LatLongTable::LatLongTable(int width, int height, const std::vector<float>& weight)
+    : m_width(width), m_height(height)
 {
     m_cos.resize(std::size_t(height) + 1);
     for (int j = 0; j <= height; ++j)
@@ -249,72 +291,120 @@ Map::Map(int width, int height, std::vector<float> rgb)
     m_conditional.reserve(std::size_t(height));
     for (int j = 0; j < height; ++j) {
         std::vector<float> f(static_cast<std::size_t>(width));
-        for (int i = 0; i < width; ++i)
-            f[std::size_t(i)] = std::max(0.0f, luminance(texel(i, j)));
+        for (int i = 0; i < width; ++i) {
+            float w = weight[std::size_t(j) * std::size_t(width) + std::size_t(i)];
+            f[std::size_t(i)] = std::isfinite(w) ? std::max(0.0f, w) : 0.0f;
+        }
         m_conditional.emplace_back(std::move(f));
         row_sums[std::size_t(j)] = static_cast<float>(m_conditional.back().integral) * row_band(j);
     }
-    m_marginal = Distribution1D(std::move(row_sums));
-    m_black = !(m_marginal.integral > 0);
+    Distribution1D marginal(std::move(row_sums));
+    // The marginal's mean is that of each row's mean weight times its cos band:
+    // times 2 pi for a row's solid angle, times the rows for the sum.
+    m_integral = marginal.integral * 2 * double(pi) * double(height);
+    if (m_integral > 0)
+        m_marginal.push_back(std::move(marginal));
+}
+
+/// The direction at azimuth fraction u (of a full turn from +z, through -x) and
+/// cos(polar angle from +y) c.
+Vec3f LatLongTable::direction(float u, float c)
+{
+    float s = std::sqrt(std::max(0.0f, 1 - c * c));
+    float phi = 2 * pi * u;
+    return {-s * std::sin(phi), c, s * std::cos(phi)};
+}
+
+Vec3f LatLongTable::sample(float u1, float u2, float& pdf, int& i, int& j) const
+{
+    if (m_marginal.empty()) {
+        pdf = 0;
+        i = j = 0;
+        return {0, 1, 0};
+    }
+    std::size_t row = 0, column = 0;
+    float pv = 0, pu = 0;
+    float v = m_marginal.front().sample(u1, row, pv);
+    float u = m_conditional[row].sample(u2, column, pu);
+    float t = std::clamp(v * float(m_height) - float(row), 0.0f, 1.0f);
+    float cos_t = m_cos[row] + t * (m_cos[row + 1] - m_cos[row]);
+    i = int(column);
+    j = int(row);
+    pdf = density(i, j);
+    return direction(u, cos_t);
+}
+
+/// The band of cos(theta) that row j covers (its solid angle / 2 pi).
+float LatLongTable::row_band(int j) const
+{
+    return m_cos[std::size_t(j)] - m_cos[std::size_t(j) + 1];
+}
+
+/// Solid-angle density over cell (i, j): P(cell) / its solid angle.
+float LatLongTable::density(int i, int j) const
+{
+    float band = row_band(j);
+    if (band <= 0 || m_marginal.empty())
+        return 0;
+    return m_marginal.front().density(std::size_t(j)) *
+           m_conditional[std::size_t(j)].density(std::size_t(i)) /
+           (2 * pi * float(m_height) * band);
+}
+
+std::pair<int, int> LatLongTable::cell_of(const Vec3f& d) const
+{
+    float theta = std::acos(std::clamp(d.y, -1.0f, 1.0f));
+    float phi = std::atan2(-d.x, d.z);
+    if (phi < 0)
+        phi += 2 * pi;
+    int i = std::clamp(int(phi / (2 * pi) * float(m_width)), 0, m_width - 1);
+    int j = std::clamp(int(theta / pi * float(m_height)), 0, m_height - 1);
+    return {i, j};
+}
+
+Map::Map(int width, int height, std::vector<float> rgb)
+    : m_width(width), m_height(height),
+      m_rgb(std::make_shared<const std::vector<float>>(std::move(rgb)))
+{
+    tabulate(false);
+    m_black = m_table.empty();
     // Each texel equal to the one before it (values three floats apart).
-    m_constant = std::equal(m_rgb.begin() + 3, m_rgb.end(), m_rgb.begin());
+    m_constant = std::equal(m_rgb->begin() + 3, m_rgb->end(), m_rgb->begin());
+}
+
+void Map::tabulate(bool hidden)
+{
+    std::vector<float> weight(std::size_t(m_width) * std::size_t(m_height));
+    for (int j = 0; j < m_height; ++j) {
+        // A row whose top border is at or below the horizon lies wholly below it.
+        bool below = hidden && std::cos(pi * float(j) / float(m_height)) <= 0;
+        for (int i = 0; i < m_width; ++i)
+            weight[std::size_t(j) * std::size_t(m_width) + std::size_t(i)] =
+                below ? 0.0f : std::max(0.0f, luminance(texel(i, j)));
+    }
+    m_table = LatLongTable(m_width, m_height, weight);
 }
 
 Vec3f Map::radiance(const Vec3f& d) const
 {
-    auto [i, j] = texel_of(d);
+    auto [i, j] = m_table.cell_of(d);
     return texel(i, j);
 }
 
 EnvironmentSample Map::sample(float u1, float u2) const
 {
-    std::size_t row = 0, column = 0;
-    float pv = 0, pu = 0;
-    float v = m_marginal.sample(u1, row, pv);
-    float u = m_conditional[row].sample(u2, column, pu);
-    float t = std::clamp(v * float(m_height) - float(row), 0.0f, 1.0f);
-    float cos_t = m_cos[row] + t * (m_cos[row + 1] - m_cos[row]);
-    float sin_t = std::sqrt(std::max(0.0f, 1 - cos_t * cos_t));
-    float phi = 2 * pi * u;
-    Vec3f d{sin_t * std::sin(phi), cos_t, sin_t * std::cos(phi)};
-    return {d, texel(int(column), int(row)), density(int(column), int(row))};
-}
-
-float Map::pdf(const Vec3f& d) const
-{
-    auto [i, j] = texel_of(d);
-    return density(i, j);
-}
-
-/// The band of cos(theta) that row j covers (its solid angle / 2 pi).
-float Map::row_band(int j) const { return m_cos[std::size_t(j)] - m_cos[std::size_t(j) + 1]; }
-
-/// Solid-angle density over texel (i, j): P(texel) / its solid angle.
-float Map::density(int i, int j) const
-{
-    float band = row_band(j);
-    if (band <= 0)
-        return 0;
-    return m_marginal.density(std::size_t(j)) *
-           m_conditional[std::size_t(j)].density(std::size_t(i)) /
-           (2 * pi * float(m_height) * band);
+    float density = 0;
+    int i = 0, j = 0;
+    Vec3f d = m_table.sample(u1, u2, density, i, j);
+    if (!(density > 0))
+        return {};
+    return {d, texel(i, j), density};
 }
 
 Vec3f Map::texel(int i, int j) const
 {
-    const float* p = &m_rgb[(std::size_t(j) * m_width + i) * 3];
+    const float* p = &(*m_rgb)[(std::size_t(j) * std::size_t(m_width) + std::size_t(i)) * 3];
     return {p[0], p[1], p[2]};
-}
-
-std::pair<int, int> Map::texel_of(const Vec3f& d) const
-{
-    float theta = std::acos(std::clamp(d.y, -1.0f, 1.0f));
-    float phi = std::atan2(d.x, d.z);
-    if (phi < 0)
-        phi += 2 * pi;
-    int i = std::clamp(int(phi / (2 * pi) * m_width), 0, m_width - 1);
-    int j = std::clamp(int(theta / pi * m_height), 0, m_height - 1);
-    return {i, j};
 }
 
 }  // namespace environment_kind
@@ -354,6 +444,16 @@ bool Environment::uniform() const
     case Kind::map: return std::get<environment_kind::Map>(m_kind).constant();
     }
     return false;
+}
+
+Environment Environment::hidden_below_horizon() const
+{
+    Environment e = *this;
+    if (auto* sky = std::get_if<environment_kind::Sky>(&e.m_kind))
+        sky->hide_below_horizon();
+    else if (auto* map = std::get_if<environment_kind::Map>(&e.m_kind))
+        map->hide_below_horizon();
+    return e;
 }
 
 Environment Environment::rotated(float degrees) const&

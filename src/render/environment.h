@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -56,33 +57,6 @@ struct Uniform {
     bool black() const { return !(value.x > 0 || value.y > 0 || value.z > 0); }
 };
 
-/// Preetham's sky with the sun disk, sampled in the sun's cone with probability 1/2 (when
-/// the sun is up), else uniformly over the sphere.
-class Sky {
-public:
-    explicit Sky(const SkyParameters& parameters);
-    Vec3f radiance(const Vec3f& d) const;
-    EnvironmentSample sample(float u1, float u2) const;
-    float pdf(const Vec3f& d) const;
-    bool black() const { return m_black; }
-
-private:
-    /// The Perez luminance distribution's five coefficients.
-    struct Perez {
-        float a, b, c, d, e;
-        float operator()(float cos_theta, float gamma, float cos_gamma) const;
-    };
-    Vec3f dome(const Vec3f& d) const;
-    Vec3f dome_irradiance() const;
-
-    Vec3f m_sun, m_sun_dome, m_ground, m_sun_radiance;
-    Perez m_Y{}, m_x{}, m_y{};
-    float m_theta_s = 0, m_zenith_Y = 0, m_zenith_x = 0, m_zenith_y = 0;
-    float m_norm_Y = 1, m_norm_x = 1, m_norm_y = 1;
-    float m_cos_sun = 1, m_sun_solid_angle = 0, m_sun_probability = 0;
-    bool m_sun_up = false, m_black = false;
-};
-
 /// A piecewise-constant 1D distribution over [0, 1) with n equal bins.
 struct Distribution1D {
     std::vector<float> func;
@@ -95,30 +69,110 @@ struct Distribution1D {
     float density(std::size_t bin) const;
 };
 
-/// A latitude-longitude map (make_map_environment), texels drawn in proportion to
-/// luminance times solid angle and uniformly in solid angle within one (uniform in
-/// cos(theta) and phi), so the density is constant over each texel.
+/// A piecewise-constant density over directions on a latitude-longitude grid of
+/// `width` x `height` cells: cell (i, j) covers the polar band pi j / height .. pi (j + 1)
+/// / height from +y and the azimuth 2 pi i / width .. 2 pi (i + 1) / width, the direction
+/// of azimuth phi and polar angle t being (-sin t sin phi, cos t, sin t cos phi): phi 0
+/// along +z, pi along -z, a quarter turn along -x (a lat-long image seen from inside,
+/// unmirrored, as Blender and Mitsuba 3 read one: README, "Staging a still"). A cell is
+/// drawn with probability in proportion to its weight times its solid angle (marginal
+/// and conditional CDFs), and uniformly in solid angle within it, so the density is
+/// constant over each cell. The one direction sampler of maps and of the sky's dome.
+class LatLongTable {
+public:
+    LatLongTable() = default;
+    /// `weight`: width x height values, rows top (+y) to bottom; negative or non-finite
+    /// ones count as 0. All 0: the table is empty and its density 0 everywhere.
+    LatLongTable(int width, int height, const std::vector<float>& weight);
+    /// A direction, its density (per steradian) and its cell; pdf 0 when empty.
+    Vec3f sample(float u1, float u2, float& pdf, int& i, int& j) const;
+    float pdf(const Vec3f& d) const
+    {
+        auto [i, j] = cell_of(d);
+        return density(i, j);
+    }
+    /// The cell that holds d.
+    std::pair<int, int> cell_of(const Vec3f& d) const;
+    /// The density over cell (i, j).
+    float density(int i, int j) const;
+    /// The weights' integral over the sphere (weight times solid angle, summed).
+    double integral() const { return m_integral; }
+    bool empty() const { return !(m_integral > 0); }
+    /// The direction at azimuth fraction u (of a turn from +z, through -x) and
+    /// cos(polar angle from +y) c.
+    static Vec3f direction(float u, float c);
+
+private:
+    float row_band(int j) const;
+
+    int m_width = 0, m_height = 0;
+    std::vector<float> m_cos;  ///< cos(theta) at the row borders, top to bottom
+    std::vector<Distribution1D> m_conditional;
+    std::vector<Distribution1D> m_marginal;  ///< one, or none while empty
+    double m_integral = 0;
+};
+
+/// Preetham's sky with the sun disk, sampled by two strategies, one chosen per sample: the
+/// sun's cone (when the sun is up) with probability in proportion to the sun's share of
+/// the sky's luminous power, kept within [1/4, 3/4], else the dome (and the ground's
+/// radiance below the horizon) tabulated as a LatLongTable of 128 x 64 cells by their
+/// mean luminance. pdf() is that mixture, so MIS against BSDF sampling stays exact.
+class Sky {
+public:
+    explicit Sky(const SkyParameters& parameters);
+    Vec3f radiance(const Vec3f& d) const;
+    EnvironmentSample sample(float u1, float u2) const;
+    float pdf(const Vec3f& d) const;
+    bool black() const { return m_black; }
+    /// From now on sample nothing below the horizon (an opaque ground hides it).
+    void hide_below_horizon() { tabulate(true); }
+    /// The probability of the sun's strategy (0 when the sun is down).
+    float sun_probability() const { return m_sun_probability; }
+
+private:
+    /// The Perez luminance distribution's five coefficients.
+    struct Perez {
+        float a, b, c, d, e;
+        float operator()(float cos_theta, float gamma, float cos_gamma) const;
+    };
+    Vec3f dome(const Vec3f& d) const;
+    Vec3f dome_irradiance() const;
+    /// Fills m_table and m_sun_probability (hidden: rows below the horizon weigh 0).
+    void tabulate(bool hidden);
+
+    LatLongTable m_table;
+
+    Vec3f m_sun, m_sun_dome, m_ground, m_sun_radiance;
+    Perez m_Y{}, m_x{}, m_y{};
+    float m_theta_s = 0, m_zenith_Y = 0, m_zenith_x = 0, m_zenith_y = 0;
+    float m_norm_Y = 1, m_norm_x = 1, m_norm_y = 1;
+    float m_cos_sun = 1, m_sun_solid_angle = 0, m_sun_probability = 0;
+    bool m_sun_up = false, m_black = false;
+};
+
+/// A latitude-longitude map (make_map_environment): a texel per LatLongTable cell, drawn
+/// in proportion to luminance times solid angle and uniformly in solid angle within one.
+/// Copies share the texels (a copy that hides the lower hemisphere has its own table).
 class Map {
 public:
     Map(int width, int height, std::vector<float> rgb);
     Vec3f radiance(const Vec3f& d) const;
     EnvironmentSample sample(float u1, float u2) const;
-    float pdf(const Vec3f& d) const;
+    float pdf(const Vec3f& d) const { return m_table.pdf(d); }
     bool black() const { return m_black; }
     /// Whether every texel has the same colour.
     bool constant() const { return m_constant; }
+    /// From now on sample nothing below the horizon (an opaque ground hides it): rows
+    /// wholly below it weigh 0.
+    void hide_below_horizon() { tabulate(true); }
 
 private:
-    float row_band(int j) const;
-    float density(int i, int j) const;
     Vec3f texel(int i, int j) const;
-    std::pair<int, int> texel_of(const Vec3f& d) const;
+    void tabulate(bool hidden);
 
     int m_width, m_height;
-    std::vector<float> m_rgb;
-    std::vector<float> m_cos;  ///< cos(theta) at the row borders, top to bottom
-    std::vector<Distribution1D> m_conditional;
-    Distribution1D m_marginal;
+    std::shared_ptr<const std::vector<float>> m_rgb;
+    LatLongTable m_table;
     bool m_black = true, m_constant = false;
 };
 
@@ -154,6 +208,12 @@ public:
     Environment rotated(float degrees) &&;
     /// The whole turn about +y, in degrees.
     double rotation_degrees() const { return m_degrees; }
+    /// A copy whose sampling spends nothing below the horizon (y < 0), for scenes where an
+    /// opaque ground plane hides it from every shading point: radiance is the same, and
+    /// sample() and pdf() leave the lower hemisphere to BSDF sampling (pdf 0 there, so
+    /// a BSDF ray that finds it takes full weight). A uniform environment is unchanged
+    /// (it is never sampled for next-event estimation). Shares a map's texels.
+    Environment hidden_below_horizon() const;
 
 private:
     using Kinds = std::variant<environment_kind::Uniform, environment_kind::Sky,
@@ -180,11 +240,13 @@ Environment make_sky_environment(const SkyParameters& parameters = {});
 
 /// A latitude-longitude HDR map (EXR, HDR or anything OpenImageIO reads), linear RGB,
 /// times `scale`. Texel coordinates (u, v) in [0, 1)^2, v down from the top row, look
-/// along (sin t sin p, cos t, sin t cos p) with t = pi v, p = 2 pi u: row 0 is straight
-/// up (+y) and the centre column is seen looking along -z, behind the plant in cpfg's
-/// default view. Radiance is constant over a texel (nearest lookup). Texels are sampled
-/// in proportion to luminance times solid angle (marginal and conditional CDFs), and
-/// uniformly in solid angle within one. Throws cambium::Error naming the file when it
+/// along (-sin t sin p, cos t, sin t cos p) with t = pi v, p = 2 pi u: row 0 is straight
+/// up (+y), the centre column is seen looking along -z (behind the plant in cpfg's
+/// default view), the column a quarter in from the left looking along -x, the one a
+/// quarter in from the right along +x: the image as seen from inside the sphere,
+/// unmirrored, the convention of Blender's and Mitsuba 3's lat-long maps
+/// (README, "Staging a still"). Radiance is constant over a texel (nearest lookup). Texels are
+/// sampled through a LatLongTable of their luminance. Throws cambium::Error naming the file when it
 /// cannot be read or is larger than 2^25 texels.
 Environment make_map_environment(const std::filesystem::path& file, float scale = 1);
 

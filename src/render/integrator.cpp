@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: Apache-2.0
 // The unidirectional path tracer: next-event estimation toward one light per vertex, chosen
-// by power from the view file's lights, the environment and emissive primitives (MIS
-// against BSDF sampling), transmission, opacity, Russian roulette, ray cones for texture
-// filtering.
+// by what each can deliver there from the view file's lights, the environment and
+// emissive primitives (MIS against BSDF sampling), transmission, opacity, Russian
+// roulette, ray cones for texture filtering.
 //
 // Sampler dimensions: each path vertex spends the fixed block sample_dimension::vertex(depth)
 // (light choice, light point, BSDF, opacity, roulette), whatever it meets (sampler.h).
@@ -338,14 +338,98 @@ LightUniforms light_uniforms(const LightSet& lights, const Sampler& sampler,
     return u;
 }
 
+/// The probabilities with which a vertex's next-event estimation chose the environment
+/// and the emissive primitives: what a BSDF ray leaving that vertex is weighed against
+/// when it finds them (0: not sampled there, full weight).
+struct ChoiceAt {
+    float environment = 0, area = 0;
+};
+
+/// A light chosen for the vertex by what each light can deliver there (LightSet::
+/// per_point): a delta light by its unshadowed f |cos| Li, exactly, and nothing when the
+/// opaque ground lies between (FernLeaf's second light shines from below it); the
+/// environment by its irradiance estimate on the surface's two sides times the BSDF's
+/// albedo on each; the emissive primitives by their irradiance estimate times the
+/// albedo. Every light that can give the point something keeps a chance, except a delta
+/// light the ground hides (its contribution is 0), so the estimate stays unbiased; the
+/// environment and emissive primitives' probabilities go to `choice` for MIS.
+using PointWeights = std::array<float, LightSet::max_point_choice>;
+
+/// choose_at's weights of each light at the vertex, and their sum.
+float point_weights(const PathContext& ctx, const LightSet& lights, const Vertex& v,
+                    PointWeights& weight)
+{
+    const std::uint32_t n = static_cast<std::uint32_t>(lights.size());
+    const Bsdf& b = v.bsdf.bsdf;
+    const float front = luminance(b.reflect) + luminance(b.glossy);
+    const float back = luminance(b.transmit);
+    const bool ground = ground_blocks(ctx, v.hit.prim());
+    float total = 0;
+    for (std::uint32_t i = 0; i < n; ++i) {
+        float w = 0;
+        switch (lights.kind(i)) {
+        case LightKind::point:
+        case LightKind::spot:
+        case LightKind::directional: {
+            const LightLiSample ls = lights.sample_li(i, v.hit.position, 0, 0, 0);
+            if (ground && ls.pdf > 0 && ctx.ground->distance(v.hit.position, ls.wi, ls.tfar))
+                break;  // the opaque ground is in the way
+            w = luminance(unshadowed(v, ls));
+            break;
+        }
+        case LightKind::environment:
+            w = (front * lights.environment_irradiance(v.bsdf.n) +
+                 back * lights.environment_irradiance(-v.bsdf.n)) *
+                std::numbers::inv_pi_v<float>;
+            break;
+        case LightKind::area:
+            w = (front + back) * lights.area_irradiance() * std::numbers::inv_pi_v<float>;
+            break;
+        }
+        weight[i] = std::isfinite(w) && w > 0 ? w : 0.0f;
+        total += weight[i];
+    }
+    return total;
+}
+
+std::optional<ChosenLight> choose_at(const PathContext& ctx, const LightSet& lights,
+                                     const Vertex& v, float u, ChoiceAt& choice)
+{
+    const std::uint32_t n = static_cast<std::uint32_t>(lights.size());
+    PointWeights weight;
+    const float total = point_weights(ctx, lights, v, weight);
+    if (!(total > 0) || !std::isfinite(total))
+        return std::nullopt;
+    float target = u * total;
+    std::uint32_t chosen = n;
+    for (std::uint32_t i = 0; i < n; ++i) {
+        if (!(weight[i] > 0))
+            continue;
+        chosen = i;
+        if (target < weight[i])
+            break;
+        target -= weight[i];
+    }
+    for (std::uint32_t i = 0; i < n; ++i) {
+        if (lights.kind(i) == LightKind::environment)
+            choice.environment = weight[i] / total;
+        else if (lights.kind(i) == LightKind::area)
+            choice.area = weight[i] / total;
+    }
+    return ChosenLight{chosen, weight[chosen] / total};
+}
+
 /// Direct light from one light (pbrt's SampleLd): among delta lights only, chosen by what
-/// each gives the point (sample_delta_ld); otherwise chosen by power, a delta light at
-/// full weight, the others weighted against BSDF sampling of the same direction by the
-/// power heuristic (full weight at the path's last vertex, where no BSDF ray follows).
+/// each gives the point (sample_delta_ld); with the environment or emissive primitives,
+/// chosen by what each can deliver (choose_at), else by power; a delta light at full
+/// weight, the others weighted against BSDF sampling of the same direction by the power
+/// heuristic (full weight at the path's last vertex, where no BSDF ray follows). The
+/// choice's probabilities of the environment and the area lights go to `choice`.
 Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, const Vertex& v,
-                bool last, const Sampler& sampler, std::uint32_t block)
+                bool last, const Sampler& sampler, std::uint32_t block, ChoiceAt& choice)
 {
     const LightSet& lights = facts.lights;
+    choice = {};
     if (lights.delta_only()) {
         // A delta light needs no point on it: only the choice is drawn, and only when
         // there is a choice.
@@ -354,7 +438,24 @@ Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, co
             return *ld;
     }
     std::optional<ChosenLight> chosen;
-    const LightUniforms u = light_uniforms(lights, sampler, block, chosen);
+    LightUniforms u{};
+    if (lights.per_point()) {
+        auto [choose, area] = sampler.get2d(block + sample_dimension::light_choice);
+        u.choose = choose;
+        u.u0 = area;
+        chosen = choose_at(ctx, lights, v, u.choose, choice);
+        if (chosen) {
+            LightKind k = lights.kind(chosen->index);
+            if (k == LightKind::area || k == LightKind::environment) {
+                auto [u1, u2] = sampler.get2d(block + sample_dimension::light_point);
+                u.u1 = u1;
+                u.u2 = u2;
+            }
+        }
+    } else {
+        u = light_uniforms(lights, sampler, block, chosen);
+        choice = {lights.environment_probability(), lights.area_probability()};
+    }
     if (!chosen || !(chosen->probability > 0))
         return {};
     LightLiSample ls = lights.sample_li(chosen->index, v.hit.position, u.u0, u.u1, u.u2);
@@ -482,9 +583,17 @@ void prepare_path_context(PathContext& ctx)
     std::vector<float> opacity;
     for (const SurfaceMaterial& m : ctx.materials)
         opacity.push_back(m.opacity);
+    // Under an opaque ground every shading point is at or above it, and a ray toward the
+    // lower hemisphere from above meets it: light sampling spends nothing there (a BSDF
+    // ray that escapes downward from a point on the plane still finds it, at full weight).
+    std::shared_ptr<const Environment> sampled;
+    if (nee && ctx.ground && !ctx.ground->shadow_catcher) {
+        sampled = std::make_shared<const Environment>(env->hidden_below_horizon());
+        env = sampled.get();
+    }
     ctx.prepared = PathContext::SceneFlags{
         any_transparent(ctx), std::move(opacity), black, nee,
-        LightSet(ctx.lights, ctx.area_lights, env, nee, ctx.scene_radius)};
+        LightSet(ctx.lights, ctx.area_lights, env, nee, ctx.scene_radius), sampled};
 }
 
 namespace {
@@ -556,6 +665,7 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
     PrimId leaving;        // the primitive the current ray leaves (none for the camera ray)
     float bsdf_pdf_prev = 0;  // pdf the current ray's direction was drawn with
     Vec3f scatter_prev;       // where it was drawn (the last scattering vertex)
+    ChoiceAt choice;          // how that vertex chose its light (MIS of the ray's finds)
     int passes = 0;
     float travelled = 0;  // along the path, for the ray cone
     PassThroughDraws pass_through(sampler, sample_dimension::vertex(0) + sample_dimension::opacity);
@@ -573,7 +683,8 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             if (depth == 0) {
                 result.radiance += beta * seen_by_camera(ctx, dir);
             } else if (!facts.environment_black) {
-                float w = bsdf_hit_weight(bsdf_pdf_prev, lights.pdf_li(dir));
+                float w = bsdf_hit_weight(bsdf_pdf_prev,
+                                          choice.environment * lights.environment_pdf(dir));
                 result.radiance += beta * env_radiance(dir) * w;
             }
             break;
@@ -635,7 +746,8 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             result.radiance += beta * material.ambient_glow * tint;
         if (!is_black(material.emission)) {
             // A BSDF-sampled hit on a listed light: weighted against sampling the light.
-            float w = depth > 0 ? bsdf_hit_weight(bsdf_pdf_prev, lights.pdf_li(scatter_prev, *hit))
+            float w = depth > 0 ? bsdf_hit_weight(bsdf_pdf_prev,
+                                                  choice.area * lights.area_pdf(scatter_prev, *hit))
                                 : 1.0f;
             result.radiance += beta * material.emission * w;
         }
@@ -650,7 +762,7 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         const BsdfAt at = bsdf_at(bsdf, hit->normal, -dir);
         Vertex vertex{*hit, at};
         const bool last = depth + 1 == ctx.max_depth;
-        result.radiance += beta * sample_ld(ctx, facts, vertex, last, sampler, block);
+        result.radiance += beta * sample_ld(ctx, facts, vertex, last, sampler, block, choice);
         if (++depth == ctx.max_depth)
             break;
 
@@ -686,6 +798,34 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
         scatter_prev = hit->position;
     }
     return result;
+}
+
+std::vector<float> light_choice_probabilities(const PathContext& ctx, const SurfaceHit& hit,
+                                              const BsdfAt& bsdf)
+{
+    if (!ctx.prepared)
+        unprepared_path_context("light_choice_probabilities");
+    const LightSet& lights = ctx.prepared->lights;
+    std::vector<float> p(lights.size(), 0.0f);
+    const Vertex v{hit, bsdf};
+    PointWeights weight{};
+    float total = 0;
+    if (lights.per_point()) {
+        total = point_weights(ctx, lights, v, weight);
+    } else if (lights.delta_only()) {
+        for (std::uint32_t i = 0; i < lights.size(); ++i) {
+            weight[i] = luminance(unshadowed(v, lights.sample_li(i, hit.position, 0, 0, 0)));
+            total += weight[i];
+        }
+    } else {
+        for (std::uint32_t i = 0; i < lights.size(); ++i)
+            p[i] = lights.probability(i);
+        return p;
+    }
+    if (total > 0)
+        for (std::size_t i = 0; i < p.size(); ++i)
+            p[i] = weight[i] / total;
+    return p;
 }
 
 }  // namespace cambium::render

@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: Apache-2.0
 // The unidirectional path tracer: next-event estimation toward one light per vertex, chosen
-// by power from the view file's lights, the environment and emissive primitives (MIS
-// against BSDF sampling), transmission, opacity, Russian roulette, ray cones for texture
-// filtering.
+// by what each can deliver there from the view file's lights, the environment and
+// emissive primitives (MIS against BSDF sampling), transmission, opacity, Russian
+// roulette, ray cones for texture filtering.
 #pragma once
 
 #include <limits>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -72,6 +73,9 @@ struct PathContext {
         bool environment_black = true; ///< escaping rays see nothing
         bool environment_nee = false;  ///< the environment is sampled for NEE
         LightSet lights;               ///< what next-event estimation samples
+        /// The environment as the light set samples it, where that differs from
+        /// `environment` (under an opaque ground: Environment::hidden_below_horizon).
+        std::shared_ptr<const Environment> sampled_environment;
     };
     std::optional<SceneFlags> prepared;
 };
@@ -151,6 +155,12 @@ inline PathResult camera_miss(const PathContext& ctx, const Vec3f& dir)
         result.radiance += seen_by_camera(ctx, dir);
     return result;
 }
+
+/// The probability with which next-event estimation at `hit` (its BSDF seen as `bsdf`)
+/// chooses each light of the prepared light set, in the set's order: what the path
+/// tracer draws its one light from there (LightSet::per_point, delta_only or by power).
+std::vector<float> light_choice_probabilities(const PathContext& ctx, const SurfaceHit& hit,
+                                              const BsdfAt& bsdf);
 
 /// Traces the camera ray (org, dir), which ends at tfar (far clipping), with the sampler's
 /// dimensions; fills `first` when given. `camera_hit`, when given: the camera ray's first

@@ -153,10 +153,12 @@ LightSet::LightSet(const std::vector<RenderLight>& lights, const AreaLights* are
         m_area = area_lights;
         float r = scene_radius > 0 ? scene_radius : 1.0f;
         add({LightKind::area, {}}, area_lights->power() / (double(r) * r));
+        m_area_irradiance = static_cast<float>(area_lights->power() / (pi * double(r) * r));
     }
     if (environment && environment_nee) {
         m_environment = environment;
         add({LightKind::environment, {}}, environment_luminance(*environment) / 4);
+        tabulate_irradiance();
     }
     // Every light keeps a chance: a weight of 0 (black, or a failed estimate) would make
     // its light unreachable, which is bias, not just variance.
@@ -176,6 +178,8 @@ LightSet::LightSet(const std::vector<RenderLight>& lights, const AreaLights* are
                    std::none_of(m_lights.begin(), m_lights.end(), [](const Entry& e) {
                        return e.kind == LightKind::area || e.kind == LightKind::environment;
                    });
+    m_per_point = !m_delta_only && m_lights.size() <= max_point_choice &&
+                  (m_area != nullptr || m_environment != nullptr);
     for (std::size_t i = 0; i < m_lights.size(); ++i) {
         float p = static_cast<float>(m_cdf[i + 1] - m_cdf[i]);
         if (m_lights[i].kind == LightKind::area)
@@ -230,6 +234,61 @@ LightLiSample LightSet::sample_li_other(std::uint32_t index, const Vec3f& p, flo
     }
     }
     return {};
+}
+
+namespace {
+constexpr int irradiance_azimuths = 16, irradiance_bands = 8;
+}  // namespace
+
+void LightSet::tabulate_irradiance()
+{
+    // 256 directions of the environment's own sampling (a fixed stratified grid, so
+    // images stay a function of the seed), each L / pdf, projected on every normal.
+    constexpr int n = 16;
+    struct Ray {
+        Vec3f d;
+        float weight;
+    };
+    std::vector<Ray> rays;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            EnvironmentSample s = m_environment->sample((i + 0.5f) / n, (j + 0.5f) / n);
+            float w = s.pdf > 0 ? luminance(s.radiance) / s.pdf : 0.0f;
+            if (std::isfinite(w) && w > 0)
+                rays.push_back({s.direction, w / (n * n)});
+        }
+    m_irradiance.assign(std::size_t(irradiance_azimuths) * irradiance_bands, 0.0f);
+    float largest = 0;
+    for (int b = 0; b < irradiance_bands; ++b)
+        for (int a = 0; a < irradiance_azimuths; ++a) {
+            float c = std::cos(pi * (b + 0.5f) / irradiance_bands);
+            Vec3f normal = environment_kind::LatLongTable::direction((a + 0.5f) / irradiance_azimuths, c);
+            float e = 0;
+            for (const Ray& r : rays)
+                e += r.weight * std::max(0.0f, dot(normal, r.d));
+            m_irradiance[std::size_t(b) * irradiance_azimuths + std::size_t(a)] = e;
+            largest = std::max(largest, e);
+        }
+    m_irradiance_floor = largest / 20;
+}
+
+float LightSet::environment_irradiance(const Vec3f& n) const
+{
+    if (m_irradiance.empty())
+        return 0;
+    float theta = std::acos(std::clamp(n.y, -1.0f, 1.0f));
+    float phi = std::atan2(-n.x, n.z);
+    if (phi < 0)
+        phi += 2 * pi;
+    int a = std::clamp(int(phi / (2 * pi) * irradiance_azimuths), 0, irradiance_azimuths - 1);
+    int b = std::clamp(int(theta / pi * irradiance_bands), 0, irradiance_bands - 1);
+    float e = m_irradiance[std::size_t(b) * irradiance_azimuths + std::size_t(a)];
+    return std::isfinite(e) ? std::max(e, m_irradiance_floor) : m_irradiance_floor;
+}
+
+float LightSet::area_pdf(const Vec3f& p, const SurfaceHit& hit) const
+{
+    return m_area ? m_area->pdf(p, hit) : 0.0f;
 }
 
 float LightSet::pdf_li(const Vec3f& p, const SurfaceHit& hit) const

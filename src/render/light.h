@@ -71,7 +71,10 @@ struct ChosenLight {
     float probability = 0;
 };
 
-/// Every light next-event estimation samples, one at a time, chosen in proportion to its
+/// Every light next-event estimation samples, one at a time: chosen at each shading point
+/// by what each can deliver there where the set holds the environment or emissive
+/// primitives (per_point; the integrator weighs them), by what each gives the point among
+/// delta lights only (delta_only), and otherwise (choose()) in proportion to its
 /// power (pbrt's power light sampler): a delta light by the irradiance pi |colour| it gives
 /// a surface facing it (attenuation at distance 0, the spot cone ignored), the
 /// environment by the integral of its luminance over the sphere (a quarter of it reaches an
@@ -101,6 +104,11 @@ public:
     bool delta_only() const { return m_delta_only; }
     static constexpr std::size_t max_delta_choice = 8;  ///< OpenGL's (cpfg's) eight lights
 
+    /// The probability with which choose() picks light `index`.
+    float probability(std::uint32_t index) const
+    {
+        return static_cast<float>(m_cdf[index + 1] - m_cdf[index]);
+    }
     /// The light for the uniform u; nullopt when the set is empty.
     std::optional<ChosenLight> choose(float u) const;
     /// Light from light `index` at p, from three uniforms; pdf 0 when it sends none.
@@ -113,6 +121,36 @@ public:
             return directional_li(e.delta);
         return sample_li_other(index, p, u0, u1, u2);
     }
+    /// Whether next-event estimation chooses among the lights by what each can deliver
+    /// to the shading point (sets with the environment or emissive primitives, at most
+    /// max_point_choice lights): a delta light by its exact unshadowed contribution (0
+    /// where the opaque ground hides it), the environment by environment_irradiance() on
+    /// either side of the surface, the emissive primitives by area_irradiance(), each
+    /// times the BSDF's albedo on that side. The choice probabilities then differ from
+    /// vertex to vertex, and the integrator carries them to weigh the next BSDF ray.
+    bool per_point() const { return m_per_point; }
+    static constexpr std::size_t max_point_choice = 16;
+    /// The luminance of the irradiance the sampled environment gives a surface facing n
+    /// (unshadowed), estimated once from 256 of its own samples for 128 normals and
+    /// looked up at the nearest, never below 1/20 of the largest (an estimate only
+    /// steers variance). 0 without a sampled environment.
+    float environment_irradiance(const Vec3f& n) const;
+    /// The emissive primitives' power over pi r^2 (the irradiance they give a surface r
+    /// away, r the scene's radius); 0 when they are not sampled.
+    float area_irradiance() const { return m_area_irradiance; }
+    /// The density of the environment's own sampling along wi (no choice); 0 when it is
+    /// not sampled.
+    float environment_pdf(const Vec3f& wi) const
+    {
+        return m_environment ? m_environment->pdf(wi) : 0.0f;
+    }
+    /// The density of the area lights' own sampling of `hit` from p (no choice).
+    float area_pdf(const Vec3f& p, const SurfaceHit& hit) const;
+    /// The choice probabilities by power (choose()) of the environment and of the area
+    /// lights (0 when not in the set).
+    float environment_probability() const { return m_environment_probability; }
+    float area_probability() const { return m_area_probability; }
+
     /// The density (choice included) with which sampling the set finds the emissive
     /// point `hit` seen from p; 0 when it is not a sampled area light.
     float pdf_li(const Vec3f& p, const SurfaceHit& hit) const;
@@ -130,6 +168,8 @@ private:
         RenderLight delta;  ///< point, spot, directional
     };
     void add(const Entry& entry, double weight);
+    /// Fills m_irradiance from the environment's own samples.
+    void tabulate_irradiance();
     /// sample_li() of a directional light: its irradiance along its direction, no end.
     static LightLiSample directional_li(const RenderLight& l)
     {
@@ -147,7 +187,12 @@ private:
     const AreaLights* m_area = nullptr;
     const Environment* m_environment = nullptr;
     float m_area_probability = 0, m_environment_probability = 0;
-    bool m_delta_only = false;
+    float m_area_irradiance = 0;
+    /// environment_irradiance() by normal: 16 azimuths x 8 polar bands (LatLongTable's
+    /// directions), and its floor.
+    std::vector<float> m_irradiance;
+    float m_irradiance_floor = 0;
+    bool m_delta_only = false, m_per_point = false;
 };
 
 }  // namespace cambium::render

@@ -932,16 +932,22 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         PathContext ctx;
         ctx.accel = accel.get();
         ctx.textures = textures.get();
-        ctx.materials = make_materials(scene.materials, settings.opengl_ambient
-                                                           ? opengl_ambient_light(scene.lights)
-                                                           : geom::Rgb{0, 0, 0});
+        const std::vector<geom::Light> no_lights;
+        const std::vector<geom::Light>& scene_lights =
+            settings.view_lights ? scene.lights : no_lights;
+        // Without the scene's lights there is no OpenGL ambient term either (an empty
+        // list would mean cpfg's default light to opengl_ambient_light).
+        ctx.materials = make_materials(scene.materials,
+                                       settings.opengl_ambient && settings.view_lights
+                                           ? opengl_ambient_light(scene.lights)
+                                           : geom::Rgb{0, 0, 0});
         if (scene.colour_index_light) {
             ctx.index_light = *scene.colour_index_light;
             ctx.index_ramps = make_index_ramps(scene.materials, ctx.index_light);
         }
         if (settings.ground.enabled)
             ctx.ground = make_ground(scene, settings, ctx.materials);
-        ctx.lights = make_lights(scene.lights);
+        ctx.lights = make_lights(scene_lights);
         std::unique_ptr<AreaLights> area_lights;
         if (settings.area_lights) {
             area_lights = std::make_unique<AreaLights>(scene, ctx.materials);

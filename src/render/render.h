@@ -70,6 +70,11 @@ struct RenderSettings {
     /// Add cpfg's OpenGL ambient term (material ambient x the lights' ambient) where
     /// camera rays meet a surface (docs/materials.md).
     bool opengl_ambient = true;
+    /// Light with the scene's lights (the view file's `light:`s, or cpfg's default light
+    /// where it has none; a scene file's lights). Off (--no-view-lights): they are left
+    /// out, with the OpenGL ambient term they bring, so a staged still is lit by its sky
+    /// or map (and emissive surfaces) alone.
+    bool view_lights = true;
     /// What escaping rays see instead of `ambient` (make_sky_environment,
     /// make_map_environment); null = the uniform ambient.
     std::shared_ptr<const Environment> environment;

@@ -389,6 +389,27 @@ TEST(Command, SkyTurbidityAndEnvironmentRotation)
     Result turn = run(out + "--env-rotate 90 " + files);
     EXPECT_NE(turn.status, 0);
     EXPECT_NE(turn.output.find("--env-rotate"), std::string::npos) << turn.output;
+
+    // `--background sky` brings the sky it shows: the same image as with --sky.
+    Picture shown = sky_png("shown.png", "--background sky --turbidity 9 --sun 1 1 0");
+    Picture given = sky_png("given.png", "--sky --background sky --turbidity 9 --sun 1 1 0");
+    ASSERT_FALSE(shown.pixels.empty());
+    EXPECT_EQ(rgb_difference(shown, given), 0);
+    // --no-view-lights leaves out cpfg's default light (q.v has no light:): under the sky
+    // the plant is lit by the sky alone, a different image; without the sky and with no
+    // ambient the plant is black against the background.
+    Picture skylit = sky_png("skylit.png", "--sky --turbidity 9 --sun 1 1 0 --no-view-lights");
+    ASSERT_FALSE(skylit.pixels.empty());
+    EXPECT_GT(rgb_difference(haze, skylit), 0.001);
+    Picture with_light = sky_png("lamp.png", "--ambient 0 --background 1,1,1");
+    Picture unlit = sky_png("unlit.png", "--ambient 0 --background 1,1,1 --no-view-lights");
+    ASSERT_FALSE(unlit.pixels.empty());
+    EXPECT_GT(rgb_difference(with_light, unlit), 0.01);
+    int black = 0;
+    for (int y = 0; y < unlit.height; ++y)
+        for (int x = 0; x < unlit.width; ++x)
+            black += unlit.at(x, y, 0) == 0 && unlit.at(x, y, 1) == 0 && unlit.at(x, y, 2) == 0;
+    EXPECT_GT(black, 0);  // the plant's pixels
 }
 
 namespace {

@@ -135,7 +135,7 @@ TEST(MapEnvironment, ConstantMapEqualsTheUniformEnvironment)
     EXPECT_FALSE(make_sky_environment().uniform());
 }
 
-TEST(MapEnvironment, ReadsLatLongFilesWithUpAtTheTopAndMinusZInTheCentre)
+TEST(MapEnvironment, ReadsLatLongFilesWithUpAtTheTopMinusZInTheCentreAndMinusXLeft)
 {
     auto dir = std::filesystem::temp_directory_path() /
                ("cambium_env_test_" + std::to_string(::getpid()));
@@ -152,6 +152,8 @@ TEST(MapEnvironment, ReadsLatLongFilesWithUpAtTheTopAndMinusZInTheCentre)
     for (int i = 0; i < w; ++i)
         set(i, 0, 5, 0, 0);  // the top row: straight up
     set(4, 1, 0, 7, 0);      // centre column, just above the horizon: toward -z
+    set(2, 1, 0, 0, 3);      // a quarter in from the left: toward -x (seen from inside)
+    set(6, 1, 4, 4, 0);      // a quarter in from the right: toward +x
     {
         auto out = OIIO::ImageOutput::create(file.string());
         ASSERT_TRUE(out);
@@ -165,6 +167,9 @@ TEST(MapEnvironment, ReadsLatLongFilesWithUpAtTheTopAndMinusZInTheCentre)
     // Row 1 covers polar angles 45..90 deg; (0, 0.5, -1) is at 63 deg, column 4 of 8.
     EXPECT_EQ(env.radiance(normalize({0, 0.5f, -1})), Vec3f(0, 14, 0));
     EXPECT_EQ(env.radiance(normalize({0, 0.5f, 1})), Vec3f(2, 2, 2));
+    // Looking along -z with +y up, -x is on the left: the image is not mirrored.
+    EXPECT_EQ(env.radiance(normalize({-1, 0.5f, -0.2f})), Vec3f(0, 0, 6));
+    EXPECT_EQ(env.radiance(normalize({1, 0.5f, 0.2f})), Vec3f(8, 8, 0));
     EXPECT_EQ(env.radiance({0, -1, 0}), Vec3f(2, 2, 2));
     std::filesystem::remove_all(dir);
     EXPECT_THROW(make_map_environment(dir / "missing.exr"), Error);
@@ -280,8 +285,10 @@ TEST(SkyEnvironment, PdfIsTheSunAndSphereMixtureAndSamplesAgree)
         double integral = sun_mass + outside.mean * 4 * std::numbers::pi;
         double se = std::hypot(in_cone.se * cone, outside.se * 4 * std::numbers::pi);
         EXPECT_NEAR(integral, 1.0, 5 * se + 1e-5) << "seed " << seed;
-        // Half of the samples go to the sun's cone, and the density says so.
-        EXPECT_NEAR(sun_mass, 0.5, 5 * in_cone.se * cone + 1e-5) << "seed " << seed;
+        // The sun's strategy takes its share of the power, within [1/4, 3/4], and the
+        // density says so.
+        EXPECT_GE(sun_mass, 0.25 - 5 * in_cone.se * cone) << "seed " << seed;
+        EXPECT_LE(sun_mass, 0.75 + 5 * in_cone.se * cone) << "seed " << seed;
 
         int in_sun = 0, n = 100000;
         for (int i = 0; i < n; ++i) {
@@ -328,7 +335,7 @@ TEST(SkyEnvironment, SunDiskDeliversTheStatedIrradiance)
     // A sun below the horizon has no disk and is never sampled.
     p.sun_direction = {0, -1, 0};
     auto night = make_sky_environment(p);
-    EXPECT_FLOAT_EQ(night.pdf({0, -1, 0}), 1 / (4 * pi));
+    EXPECT_EQ(night.pdf({0, -1, 0}), 0.0f);  // nothing to sample: black everywhere
     EXPECT_TRUE(night.black());  // 90 degrees down: past civil twilight
 }
 
@@ -405,7 +412,7 @@ TEST(RotatedEnvironment, LightComesFromTheTurnedDirection)
         rgb[(std::size_t(bj) * w + bi) * 3 + c] = 1000;
     // Its centre direction from the documented layout (t = pi v, p = 2 pi u).
     float theta = pi * (bj + 0.5f) / h, phi = 2 * pi * (bi + 0.5f) / w;
-    Vec3f d0{std::sin(theta) * std::sin(phi), std::cos(theta),
+    Vec3f d0{-std::sin(theta) * std::sin(phi), std::cos(theta),
              std::sin(theta) * std::cos(phi)};
     Environment map = make_map_environment(w, h, rgb);
     EXPECT_GT(map.radiance(d0).x, 100.0f);
@@ -416,7 +423,18 @@ TEST(RotatedEnvironment, LightComesFromTheTurnedDirection)
     EXPECT_GT(turned.radiance(d1).x, 100.0f);
     EXPECT_LT(turned.radiance(d0).x, 1.0f);
     EXPECT_NEAR(turned.pdf(d1), map.pdf(d0), 1e-6f * map.pdf(d0));
-    EXPECT_NEAR(pdf_integral(turned, 20000), 1.0, 0.05);
+    // The density is nearly all in one texel (1/512 of the sphere): a midpoint rule over
+    // (cos theta, phi), not uniform random directions, integrates it.
+    double integral = 0;
+    const int nc = 1024, np = 2048;
+    for (int i = 0; i < nc; ++i) {
+        float c = 1 - 2 * (i + 0.5f) / nc, sn = std::sqrt(std::max(0.0f, 1 - c * c));
+        for (int j = 0; j < np; ++j) {
+            float ph = 2 * pi * (j + 0.5f) / np;
+            integral += turned.pdf({sn * std::cos(ph), c, sn * std::sin(ph)});
+        }
+    }
+    EXPECT_NEAR(integral * 4 * std::numbers::pi / (double(nc) * np), 1.0, 0.01);
     // Nearly all samples come from around d1, and agree with pdf().
     Sampler s(3, 3, 3, 3, SampleSequence::white);
     int near = 0, n = 2000;

@@ -137,6 +137,29 @@ TEST(Render, LitSideIsBrighterThanUnlitSide)
     EXPECT_LE(img.at(100, 41, 1), albedo * 1.001f);
 }
 
+// Without the scene's lights (--no-view-lights) the same lit cylinder is lit by the
+// environment alone: under a black one it is black, the OpenGL ambient term included (an
+// empty light list is not mistaken for cpfg's default light, whose ambient is 1).
+TEST(Render, SceneLightsCanBeLeftOut)
+{
+    geom::Scene s = empty_scene({-20, -5, 0}, {20, 5, 0});
+    add_segment(s, {-10, 0, 0}, {10, 0, 0}, 2.0f);
+    s.materials[1].diffuse = {0.8f, 0.8f, 0.8f};
+    s.materials[1].ambient = {0.5f, 0.5f, 0.5f};
+    s.lights.push_back(directional({0, 1, 0}));
+    RenderSettings set = small(200, 100, 4);
+    set.opengl_ambient = true;
+    Image lit = render(s, set);
+    EXPECT_GT(lit.at(100, 45, 1), 0.05f);
+    EXPECT_GT(lit.at(100, 55, 1), 0.0f);  // the ambient term on the unlit side
+    set.view_lights = false;
+    Image dark = render(s, set);
+    for (int y : {41, 45, 50, 55})
+        EXPECT_EQ(dark.at(100, y, 1), 0.0f) << y;
+    s.lights.clear();
+    EXPECT_EQ(render(s, set).at(100, 55, 1), 0.0f);
+}
+
 // `render mode: filled`: the same cylinder shows its flat colour on both sides, unlit;
 // `flat`: lit by the facet normal (a round tube's is its smooth normal: still shaded).
 TEST(Render, FilledRenderModeShowsFlatColours)
