@@ -329,6 +329,10 @@ void fit_scene_buffers(Scene& scene)
     for (std::size_t p = 0; p < scene.prototypes.size(); ++p)
         fit_mesh_buffers(scene.prototypes[p].geometry.mesh, textured[p]);
     fit_buffer(scene.instances);
+    fit_buffer(scene.geometry.modules.records);  // one record per organ: millions in a tree
+    fit_buffer(scene.geometry.curves.module);
+    fit_buffer(scene.geometry.spheres.module);
+    fit_buffer(scene.geometry.discs.module);
 }
 
 std::size_t scene_buffer_bytes(const Scene& scene)
