@@ -124,7 +124,7 @@ int main(int argc, char** argv)
             name = "synthetic-" + std::to_string(organs);
             scene = synthetic(organs);
         } else {
-            std::vector<std::string> args{"cambium", argv[1], argv[2]};
+            std::vector<std::string> args{argv[1], argv[2]};
             for (int i = 3; i < argc; ++i) {
                 if (std::strcmp(argv[i], "--allow-file-access") == 0)
                     args.emplace_back(argv[i]);
@@ -148,17 +148,28 @@ int main(int argc, char** argv)
         interpret_s = seconds_since(t);
         render::LightReportSettings settings;
         settings.rays = rays;
+        auto cpu_seconds = [] {
+            struct rusage u {};
+            getrusage(RUSAGE_SELF, &u);
+            return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+                   1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+        };
+        const double cpu_before = cpu_seconds();
         t = Clock::now();
         render::LightReport report = render::trace_light(scene, settings);
         const double trace_s = seconds_since(t);
+        // CPU seconds too: on a loaded machine wall time says little
+        const double trace_cpu_s = cpu_seconds() - cpu_before;
         struct rusage usage {};
         getrusage(RUSAGE_SELF, &usage);
         std::printf("{\"model\": \"%s\", \"primitives\": %zu, \"organs\": %zu, \"rays\": %llu, "
-                    "\"threads\": %d, \"prepare_s\": %.3f, \"trace_s\": %.3f, \"rays_per_s\": %.0f, "
+                    "\"threads\": %d, \"prepare_s\": %.3f, \"trace_s\": %.3f, \"trace_cpu_s\": %.3f, "
+                    "\"rays_per_s\": %.0f, \"rays_per_cpu_s\": %.0f, "
                     "\"emitted\": %.6g, \"absorbed\": %.6g, \"escaped\": %.6g, \"peak_rss_mib\": %.1f}\n",
                     name.c_str(), primitives(scene), report.organs.size(),
                     static_cast<unsigned long long>(report.rays), tbb::info::default_concurrency(),
-                    interpret_s, trace_s, double(report.rays) / trace_s, report.emitted,
+                    interpret_s, trace_s, trace_cpu_s, double(report.rays) / trace_s,
+                    double(report.rays) / trace_cpu_s, report.emitted,
                     report.absorbed, report.escaped, double(usage.ru_maxrss) / 1024);
         return 0;
     } catch (const std::exception& e) {
