@@ -228,7 +228,12 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     cli.add_option("--stats-json", options.stats_json, "Write the --stats figures as JSON to FILE");
     cli.add_option("--light-report", options.light_report,
                    "Trace the view file's directional lights onto every organ and write the "
-                   "light each absorbs to FILE (.json or .csv; docs/light.md)");
+                   "light each absorbs to FILE (.json or .csv; docs/light.md)")
+        ->check([](const std::string& file) {  // refused before the work, not after
+            const auto ext = std::filesystem::path(file).extension();
+            return ext == ".json" || ext == ".csv" ? std::string()
+                                                   : std::string("expected a .json or .csv file");
+        });
     cli.add_option("--light-rays", options.light_rays,
                    "Rays from the lights for --light-report (default 1e6)")
         ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{10'000'000'000}));
