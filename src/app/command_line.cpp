@@ -241,6 +241,17 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
                  "time to first pixel, primitives, instances, Embree's and Cambium's memory, "
                  "peak memory, rays/s and samples/s");
     cli.add_option("--stats-json", options.stats_json, "Write the --stats figures as JSON to FILE");
+    cli.add_option("--light-report", options.light_report,
+                   "Trace the view file's directional lights onto every organ and write the "
+                   "light each absorbs to FILE (.json or .csv; docs/light.md)")
+        ->check([](const std::string& file) {  // refused before the work, not after
+            const auto ext = std::filesystem::path(file).extension();
+            return ext == ".json" || ext == ".csv" ? std::string()
+                                                   : std::string("expected a .json or .csv file");
+        });
+    cli.add_option("--light-rays", options.light_rays,
+                   "Rays from the lights for --light-report (default 1e6)")
+        ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{10'000'000'000}));
     cli.add_option("--max-modules", options.max_modules,
                    "Stop a derivation whose string grows past this many modules (default 1e8)")
         ->check(CLI::Range(std::size_t{1}, std::size_t{1'000'000'000}));
@@ -317,7 +328,7 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     bool scene = false;
     for (std::size_t i = 0; i < args.size(); ++i)
         if (args[i].rfind('-', 0) != 0 && std::filesystem::path(args[i]).extension() == ".json" &&
-            !(i > 0 && args[i - 1] == "--stats-json"))
+            !(i > 0 && (args[i - 1] == "--stats-json" || args[i - 1] == "--light-report")))
             scene = true;
     cli.add_option("files", files, "plant.l plant.v [plant.a], or scene.json (docs/scenes.md)")
         ->required()

@@ -81,6 +81,9 @@ struct Options {
     // Statistics (app/stats.h): a readable block on stderr, and JSON
     bool stats = false;                                   ///< --stats
     std::optional<std::filesystem::path> stats_json;     ///< --stats-json FILE
+    /// --light-report FILE: the light each organ absorbs (docs/light.md), .json or .csv
+    std::optional<std::filesystem::path> light_report;
+    std::uint64_t light_rays = 1'000'000;  ///< --light-rays N
 
     // Rendering
     int width = 640, height = 480;
@@ -133,7 +136,8 @@ struct Options {
     /// Whether an image is to be rendered: an -o was given, or no other output was.
     bool renders() const
     {
-        return !outputs.empty() || (!string_text && !string_binary && !view_volume);
+        return !outputs.empty() ||
+               (!string_text && !string_binary && !view_volume && !light_report);
     }
 };
 

@@ -31,6 +31,7 @@
 #include "lsys/string_io.h"
 #include "base/output_format.h"
 #include "geom/mesh_export.h"
+#include "render/light_report.h"
 #include "render/render.h"
 
 namespace cambium::app {
@@ -296,6 +297,23 @@ int render_and_write_still(geom::Scene& scene, const Options& options,
     return 0;
 }
 
+/// --light-report: the light each organ absorbs, traced and written (docs/light.md).
+void write_light_report(const geom::Scene& scene, const Options& options,
+                        const std::function<void(const std::string&)>& say)
+{
+    auto start = Clock::now();
+    render::LightReportSettings settings;
+    settings.rays = options.light_rays;
+    settings.threads = options.threads;
+    render::LightReport report = render::trace_light(scene, settings);
+    for (const std::string& skipped : report.skipped_lights)
+        warn("--light-report: " + skipped);
+    render::write_light_report(report, *options.light_report);
+    say(fmt::format("wrote {}: {} organs, {} rays, absorbed {:.6g} of {:.6g} in {:.2f} s",
+                    options.light_report->string(), report.organs.size(), report.rays,
+                    report.absorbed, report.emitted, seconds_since(start)));
+}
+
 /// `cambium scene.json`: many plants placed by instances (docs/scenes.md).
 int run_scene(Options options, const std::function<void(const std::string&)>& say,
               Clock::time_point command_start, Mpi* mpi)
@@ -307,6 +325,8 @@ int run_scene(Options options, const std::function<void(const std::string&)>& sa
     if (!options.colour_files.empty())
         throw Error("-m and -M name one model's colours; each plant of a scene names its own "
                     "in its command");
+    if (options.light_report)
+        throw Error("--light-report measures one plant's organs; not yet with a scene file");
     SceneFile file = read_scene_file(*options.scene, options);
     apply_scene_settings(file, options);
     if (options.steps)  // --steps derives every plant that many steps
@@ -364,6 +384,8 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
         return assemble(options, images, say);
     // With --mpi, rank 0 alone writes files.
     const bool writes = !mpi || mpi->rank() == 0;
+    if (options.light_report && is_sequence(options))
+        throw Error("--light-report measures a still; not with -a, --turntable or --inbetween");
     if (is_sequence(options)) {
         RunStats stats;
         auto strings = [&](const Model& model, const lsys::ModuleString& s, int step) {
@@ -379,13 +401,18 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
     Model model = load_model(options);
     stats.load_s = seconds_since(start);
     auto lap = Clock::now();
-    lsys::ModuleString string = derive(model, options);
+    // the light report names each organ's age: the derivation's lineage gives it
+    StringOrigins provenance;
+    lsys::ModuleString string =
+        options.light_report && !options.homomorphism_in_string
+            ? model.lsystem.derive_with_ages(options.steps, provenance.ages)
+            : derive(model, options);
     stats.derive_s = seconds_since(lap);
     say(fmt::format("derived {} modules in {:.3f} s", string.size(), seconds_since(start)));
     if (writes)
         write_strings(model, string, options,
                       options.steps.value_or(model.lsystem.derivation_length()), say);
-    if (images.empty()) {
+    if (images.empty() && !options.light_report) {
         // Only strings and the view volume are written: the turtle walks the string for
         // -vv without building geometry, and has nothing to do otherwise.
         if (options.view_volume && writes) {
@@ -401,12 +428,17 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
     }
 
     lap = Clock::now();
-    lsys::ModuleString turtle = turtle_reads_derived_string(model, options)
-                                    ? std::move(string)
-                                    : turtle_string(model, string, options);
-    string = lsys::ModuleString();  // freed before the geometry grows: a lower peak
-    geom::Scene scene = interpret_turtle_string(model, turtle, options);
-    turtle = lsys::ModuleString();
+    geom::Scene scene;
+    if (turtle_reads_derived_string(model, options)) {
+        scene = interpret_turtle_string(model, string, options, &provenance);
+    } else {
+        // the derived string is kept while the turtle reads: its modules name the organs
+        provenance.derived = &string;
+        lsys::ModuleString turtle = turtle_string(model, string, options, provenance.origins);
+        scene = interpret_turtle_string(model, turtle, options, &provenance);
+    }
+    string = lsys::ModuleString();  // freed before the geometry's BVH is built
+    provenance = StringOrigins();
     stats.interpret_s = seconds_since(lap);
     stats.assemble_s = stats.load_s + stats.derive_s + stats.interpret_s;
     stats.add_scene(scene);
@@ -421,6 +453,12 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
         // As cpfg, the view file's `box:` wins over the computed bounds.
         geom::write_view_volume(scene.view.box.value_or(scene.bounds), *options.view_volume);
         say("wrote " + options.view_volume->string());
+    }
+    if (options.light_report && writes)
+        write_light_report(scene, options, say);
+    if (images.empty()) {
+        report_stats(stats, options);
+        return 0;
     }
     return render_and_write_still(scene, options, images, say, stats, command_start, mpi);
 }

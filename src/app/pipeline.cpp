@@ -362,6 +362,7 @@ void release_unused_line_buffers(geom::LinearCurves& l)
     l.flags.shrink_to_fit();
     l.material.shrink_to_fit();
     l.texture.shrink_to_fit();
+    l.module.shrink_to_fit();
 }
 
 }  // namespace
@@ -406,6 +407,22 @@ lsys::ModuleString turtle_string(const Model& model, const lsys::ModuleString& d
     return model.lsystem.interpretation_string(derived, instanced_objects(model, options).empty()
                                                             ? lsys::ObjectHandling::expand
                                                             : lsys::ObjectHandling::keep);
+}
+
+lsys::ModuleString turtle_string(const Model& model, const lsys::ModuleString& derived,
+                                 const Options& options, std::vector<std::uint32_t>& origins)
+{
+    if (options.homomorphism_in_string) {
+        origins.resize(derived.size());
+        for (std::size_t i = 0; i < origins.size(); ++i)
+            origins[i] = static_cast<std::uint32_t>(i);
+        return derived;
+    }
+    return model.lsystem.interpretation_string(derived,
+                                               instanced_objects(model, options).empty()
+                                                   ? lsys::ObjectHandling::expand
+                                                   : lsys::ObjectHandling::keep,
+                                               origins);
 }
 
 namespace {
@@ -468,10 +485,15 @@ geom::Bounds3 view_volume(const Model& model, const lsys::ModuleString& derived,
 }
 
 geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString& string,
-                                    const Options& options)
+                                    const Options& options, const StringOrigins* origins)
 {
-    geom::Scene scene = geom::interpret(string, model.lsystem.symbols(), *model.view,
-                                        interpret_options(model, options));
+    geom::InterpretOptions turtle = interpret_options(model, options);
+    if (origins) {
+        turtle.derived = origins->derived;
+        turtle.origins = origins->origins;
+        turtle.ages = origins->ages;
+    }
+    geom::Scene scene = geom::interpret(string, model.lsystem.symbols(), *model.view, turtle);
     const bool index_lit = lit_by_colour_index(model);
     scene.shading = geom::render_mode(*model.view);
     scene.materials = model.palette.entries(options.colour_block);

@@ -81,9 +81,18 @@ lsys::ModuleString turtle_string(const Model& model, const lsys::ModuleString& d
 /// it (two full copies of a 23 M-module string cost a fifth of the tree's time to
 /// first pixel, build/benchmarks/render).
 bool turtle_reads_derived_string(const Model& model, const Options& options);
-/// ... and its interpretation into a Scene.
+/// Where the turtle string's modules came from (provenance, docs/architecture.md).
+struct StringOrigins {
+    const lsys::ModuleString* derived = nullptr;  ///< the derived string
+    std::vector<std::uint32_t> origins;  ///< per turtle-string module, its index in *derived
+    std::vector<std::uint16_t> ages;     ///< per derived module (empty: unknown)
+};
+/// turtle_string(), its modules' origins in `derived` written to `origins`.
+lsys::ModuleString turtle_string(const Model& model, const lsys::ModuleString& derived,
+                                 const Options& options, std::vector<std::uint32_t>& origins);
+/// ... and its interpretation into a Scene (its primitives' modules through `origins`).
 geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString& string,
-                                    const Options& options);
+                                    const Options& options, const StringOrigins* origins = nullptr);
 
 /// What -vv writes: the view volume of a derived string (the view file's `box:` wins, as
 /// in cpfg, unless not `box_wins`). The turtle walks the string without storing geometry, so a

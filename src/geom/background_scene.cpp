@@ -631,8 +631,62 @@ void cylinders_as_mesh(Geometry& geometry, int sides)
     lines = LinearCurves{};
 }
 
+/// Provenance entries of `a` (a_count primitives before the append) and `b`: kept when
+/// either side has them, a primitive without one is no_module's.
+void append_modules(std::vector<std::uint32_t>& a, std::size_t a_count,
+                    const std::vector<std::uint32_t>& b, std::size_t b_count)
+{
+    if (a.empty() && b.empty())
+        return;
+    a.resize(a_count, no_module);
+    if (b.size() == b_count)
+        append(a, b);
+    else
+        a.resize(a_count + b_count, no_module);
+}
+
+namespace {
+
+/// Provenance: `from`'s module records joined to `into`'s in string order (a module both
+/// name keeps into's record).
+void append_module_table(ModuleTable& into, const ModuleTable& from)
+{
+    if (from.records.empty())
+        return;
+    std::vector<std::uint16_t> name(from.names.size());
+    for (std::size_t i = 0; i < from.names.size(); ++i) {
+        auto at = std::find(into.names.begin(), into.names.end(), from.names[i]);
+        name[i] = static_cast<std::uint16_t>(at - into.names.begin());
+        if (at == into.names.end())
+            into.names.push_back(from.names[i]);
+    }
+    std::vector<ModuleRecord> merged;
+    merged.reserve(into.records.size() + from.records.size());
+    auto a = into.records.begin();
+    for (const ModuleRecord& r : from.records) {
+        while (a != into.records.end() && a->index < r.index)
+            merged.push_back(*a++);
+        if (a != into.records.end() && a->index == r.index)
+            continue;
+        merged.push_back({r.index, name[r.name], r.age});
+    }
+    merged.insert(merged.end(), a, into.records.end());
+    into.records = std::move(merged);
+}
+
+}  // namespace
+
 void append_geometry(Geometry& into, const Geometry& from)
 {
+    append_module_table(into.modules, from.modules);
+    append_modules(into.lines.module, into.lines.segment_count(), from.lines.module,
+                   from.lines.segment_count());
+    append_modules(into.curves.module, into.curves.segment_count(), from.curves.module,
+                   from.curves.segment_count());
+    append_modules(into.spheres.module, into.spheres.size(), from.spheres.module,
+                   from.spheres.size());
+    append_modules(into.discs.module, into.discs.size(), from.discs.module, from.discs.size());
+    append_modules(into.mesh.module, into.mesh.size(), from.mesh.module, from.mesh.size());
     append_curves(into.lines, from.lines, into.lines.keys, from.lines.keys);
     append(into.curves.tangents, from.curves.tangents);
     {

@@ -55,6 +55,8 @@ std::size_t flatten_small_instances(Scene& scene, const FlattenLimits& limits)
         if (in.prototype < small.size() && small[in.prototype]) {
             Geometry copy;
             copy.mesh = scene.prototypes[in.prototype].geometry.mesh;
+            if (in.module != no_module)  // provenance: the copies are the placing module's
+                copy.mesh.module.assign(copy.mesh.size(), in.module);
             place_geometry(copy, in);
             append_geometry(scene.geometry, copy);
             continue;

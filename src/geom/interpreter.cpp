@@ -77,6 +77,7 @@ class Interpreter {
     struct PolygonCorner {
         Vec3 position, heading, left;
         int color, back_color, texture;
+        std::size_t opened_at;  ///< the string index of the polygon's `{` (provenance)
     };
 
 public:
@@ -109,6 +110,7 @@ public:
         m_scene.lights = effective_lights(view);
         m_scene.label_font = label_font(view);
         m_scene.bounds.extend(Vec3{0, 0, 0});  // cpfg's box always holds the origin
+        m_provenance = m_root == this && options.provenance && !options.bounds_only;
         if (m_root == this) {
             load_surfaces();
             if (options.is_object && options.expand_object)
@@ -119,6 +121,7 @@ public:
     void run(const lsys::ModuleString& string, const lsys::SymbolTable& symbols)
     {
         prepare(symbols);
+        m_string = &string;
         string.for_each([&](lsys::ModuleRef m) {
             if (skipped_after_cut(m)) {
             } else if (static_cast<int>(m.symbol) == m_tables->cut && !m.params.empty() &&
@@ -129,6 +132,8 @@ public:
                     begin_captures();
                 interpret_module(m, m_root == this);
             }
+            if (m_provenance)
+                attribute(m_module_index);
             ++m_module_index;
             if (m_capture)
                 end_captures();
@@ -311,7 +316,7 @@ private:
         if (prototype >= 0)
             m_scene.instances.push_back(Instance{static_cast<std::uint32_t>(prototype), object_transform(m_turtle),
                                                  material(m_turtle.color), material(m_turtle.back_color),
-                                                 no_texture});  // a texture would reach untextured parts
+                                                 no_texture, no_module, Instance::no_plant});  // a texture would reach untextured parts
         advance(*e);
     }
 
@@ -718,6 +723,7 @@ private:
         if (m_polygons.size() >= max_open_polygons)
             throw Error("more than " + std::to_string(max_open_polygons) + " nested polygons");
         m_polygons.emplace_back();
+        m_polygon_starts.push_back(m_module_index);
     }
 
     void add_polygon_vertex()
@@ -726,7 +732,8 @@ private:
             throw Error("a polygon with more than " + std::to_string(max_polygon_vertices) +
                                        " vertices");
         m_polygons.back().push_back({m_turtle.position, m_turtle.heading, m_turtle.left,
-                                     m_turtle.color, m_turtle.back_color, m_turtle.texture});
+                                     m_turtle.color, m_turtle.back_color, m_turtle.texture,
+                                     m_polygon_starts.back()});
     }
 
     /// `}`: triangulates the innermost polygon.
@@ -745,6 +752,7 @@ private:
             emit_polygon(m_polygons.back());
         }
         m_polygons.pop_back();
+        m_polygon_starts.pop_back();
     }
 
     /// Materials and texture are the first vertex's (as cpfg's rayshade output
@@ -754,6 +762,18 @@ private:
     {
         if (m_options.bounds_only)
             return;  // its corners are turtle positions, in the bounds already
+        // a polygon is its `{`'s organ, not the `}`'s that draws it
+        if (m_provenance && !corners.empty()) {
+            attribute(m_module_index);
+            emit_polygon_now(corners);
+            attribute(corners.front().opened_at);
+            return;
+        }
+        emit_polygon_now(corners);
+    }
+
+    void emit_polygon_now(const std::vector<PolygonCorner>& corners)
+    {
         std::vector<Vec3> outline;
         outline.reserve(corners.size());
         for (const PolygonCorner& c : corners)
@@ -1163,6 +1183,63 @@ private:
     std::vector<std::vector<PolygonCorner>> m_outer_polygons;
     std::size_t m_module_index = 0;
     std::uint64_t m_label_text_bytes = 0;  ///< of every label this one's root stored
+    std::vector<std::size_t> m_polygon_starts;  ///< per open polygon, its `{`'s index
+    bool m_provenance = false;  ///< the root records each primitive's module
+    std::vector<int> m_name_of_symbol;  ///< provenance: ModuleTable::names index, or -1
+
+    /// Provenance: the primitives and instances made since the last call are module
+    /// `turtle_index`'s (through the origins, in the derived string); entries of ones cut
+    /// away since (an object's expansion, a generalized cylinder) go with them.
+    void attribute(std::size_t turtle_index)
+    {
+        const std::uint32_t module = m_options.origins.empty()
+                                         ? static_cast<std::uint32_t>(turtle_index)
+                                         : m_options.origins[turtle_index];
+        Geometry& g = m_scene.geometry;
+        bool grew = sync(g.lines.module, g.lines.segment_count(), module);
+        grew |= sync(g.curves.module, g.curves.segment_count(), module);
+        grew |= sync(g.spheres.module, g.spheres.size(), module);
+        grew |= sync(g.discs.module, g.discs.size(), module);
+        grew |= sync(g.mesh.module, g.mesh.size(), module);
+        for (std::size_t i = m_instances_attributed; i < m_scene.instances.size(); ++i, grew = true)
+            m_scene.instances[i].module = module;
+        m_instances_attributed = m_scene.instances.size();
+        if (grew)
+            record(module, turtle_index);
+    }
+
+    static bool sync(std::vector<std::uint32_t>& v, std::size_t n, std::uint32_t module)
+    {
+        const bool grew = v.size() < n;
+        v.resize(n, module);
+        return grew;
+    }
+
+    void record(std::uint32_t module, std::size_t turtle_index)
+    {
+        ModuleTable& t = m_scene.geometry.modules;
+        // string order, but a polygon's `{` is recorded when its `}` draws it
+        auto at = t.records.end();
+        if (!t.records.empty() && t.records.back().index >= module) {
+            at = std::lower_bound(t.records.begin(), t.records.end(), module,
+                                  [](const ModuleRecord& r, std::uint32_t i) { return r.index < i; });
+            if (at != t.records.end() && at->index == module)
+                return;
+        }
+        const lsys::SymbolId symbol = m_options.derived && module < m_options.derived->size()
+                                          ? m_options.derived->symbol(module)
+                                          : m_string->symbol(turtle_index);
+        if (symbol >= m_name_of_symbol.size())
+            m_name_of_symbol.resize(symbol + 1, -1);
+        if (m_name_of_symbol[symbol] < 0) {
+            m_name_of_symbol[symbol] = static_cast<int>(t.names.size());
+            t.names.emplace_back(m_tables->symbols->name(symbol));
+        }
+        const std::uint16_t age = module < m_options.ages.size() ? m_options.ages[module] : unknown_age;
+        t.records.insert(at, {module, static_cast<std::uint16_t>(m_name_of_symbol[symbol]), age});
+    }
+    std::size_t m_instances_attributed = 0;
+    const lsys::ModuleString* m_string = nullptr;  ///< the string run() interprets
     bool m_warned_system = false, m_warned_include = false, m_warned_grid = false;
     bool m_warned_scale = false, m_warned_unmatched_polygon = false, m_warned_movement = false;
     bool m_warned_unmatched_sub = false, m_warned_label = false;
@@ -1227,7 +1304,9 @@ std::vector<QueryAnswer> collect_query_answers(const lsys::ModuleString& string,
                                                const ViewFile& view)
 {
     std::vector<QueryAnswer> answers;
-    Interpreter interpreter(view, InterpretOptions{});
+    InterpretOptions options;
+    options.provenance = false;
+    Interpreter interpreter(view, options);
     interpreter.collect_queries(&answers);
     interpreter.run(string, symbols);
     return answers;
@@ -1240,7 +1319,9 @@ std::vector<TurtleAtModule> collect_communication_turtles(const lsys::ModuleStri
                                                           std::vector<std::vector<GlsPolygon>>* polygons)
 {
     std::vector<TurtleAtModule> turtles;
-    Interpreter interpreter(view, InterpretOptions{});
+    InterpretOptions options;
+    options.provenance = false;
+    Interpreter interpreter(view, options);
     interpreter.collect_communication(&turtles);
     if (polygons)
         interpreter.collect_polygons(ranges, polygons);

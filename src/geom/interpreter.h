@@ -64,6 +64,21 @@ struct InterpretOptions {
     /// The turtles saved at fragment starts over the derivation (manual 5.1.9), by index:
     /// `%(par, index)` sets the turtle to fragment_turtles[index] (save_fragment_turtles).
     std::span<const Turtle> fragment_turtles;
+
+    /// Provenance (docs/architecture.md): each primitive's `module` entry and instance's
+    /// `module` name the module that drew it, and Scene::modules its symbol and age.
+    /// Off: the `module` arrays stay empty (the turtle passes between steps).
+    bool provenance = true;
+    /// For each module of the string, its index in the derived string
+    /// (lsys::TurtleString::origins, through the homomorphism); empty: the string is the
+    /// derived one (or the indices are the string's own).
+    std::span<const std::uint32_t> origins;
+    /// The derived string `origins` point into: its modules' symbols name the organs
+    /// (X of X --> F F names both segments). Null: the string's own symbols.
+    const lsys::ModuleString* derived = nullptr;
+    /// Per module of the derived string, the step at which it appeared (lsys::module_ages);
+    /// empty: ages are unknown_age.
+    std::span<const std::uint16_t> ages;
 };
 
 Scene interpret(const lsys::ModuleString& string, const lsys::SymbolTable& symbols,

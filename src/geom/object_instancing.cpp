@@ -91,6 +91,9 @@ std::array<float, 12> object_transform(const Turtle& t)
 
 void append_placed_mesh(TriangleMesh& into, const TriangleMesh& from, const Instance& instance)
 {
+    // provenance: the copies are the placing module's (kept only where `into` keeps it)
+    if (into.module.size() == into.size() && (!into.module.empty() || into.size() == 0))
+        into.module.insert(into.module.end(), from.size(), instance.module);
     auto base = static_cast<std::uint32_t>(into.positions.size());
     for (std::size_t i = 0; i < from.positions.size(); ++i) {
         into.positions.push_back(place_point(instance.transform, from.positions[i]));

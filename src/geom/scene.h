@@ -7,11 +7,13 @@
 // may be left empty, meaning v = 0 and no_texture everywhere.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "geom/vec.h"
@@ -21,6 +23,36 @@ namespace cambium::geom {
 using Float4 = std::array<float, 4>;
 using Float3 = std::array<float, 3>;
 using Float2 = std::array<float, 2>;
+
+/// Provenance (docs/architecture.md): no module of the string drew the primitive (the
+/// background scene, wireframe edges), or it is unknown.
+inline constexpr std::uint32_t no_module = 0xffffffffu;
+/// Provenance: the module's age is unknown (the derivation recorded no lineage).
+inline constexpr std::uint16_t unknown_age = 0xffff;
+
+/// Provenance: one module that drew primitives (an organ), in a ModuleTable.
+struct ModuleRecord {
+    std::uint32_t index = 0;     ///< in the derived string
+    std::uint16_t name = 0;      ///< in ModuleTable::names
+    std::uint16_t age = unknown_age;  ///< the derivation step at which the module appeared
+};
+
+/// Provenance: the modules that drew a Geometry's primitives or placed instances, in
+/// string order, with their symbols and ages: 8 bytes a module (each primitive holds
+/// only its module's index, 4 bytes).
+struct ModuleTable {
+    std::vector<ModuleRecord> records;  ///< sorted by index, each index once
+    std::vector<std::string> names;     ///< symbol names, each once
+
+    /// The record of module `index`, or null.
+    const ModuleRecord* find(std::uint32_t index) const
+    {
+        auto it = std::lower_bound(records.begin(), records.end(), index,
+                                   [](const ModuleRecord& r, std::uint32_t i) { return r.index < i; });
+        return it != records.end() && it->index == index ? &*it : nullptr;
+    }
+    std::string_view name(const ModuleRecord& r) const { return names[r.name]; }
+};
 
 /// Material index meaning "the instance's material" inside a prototype.
 inline constexpr std::uint16_t inherit_material = 0xffff;
@@ -48,6 +80,9 @@ struct LinearCurves {
     std::vector<std::uint8_t> flags;       ///< per segment, neighbour_* bits
     std::vector<std::uint16_t> material;   ///< per segment, index into Scene::materials
     std::vector<std::int16_t> texture;     ///< per segment, index into Scene::textures or no_texture
+    /// Per segment, optional (empty: unknown): the module of the derived string that drew it
+    /// (its index there, through the homomorphism), or no_module. Geometry::modules names it.
+    std::vector<std::uint32_t> module;
 
     std::size_t segment_count() const { return segments.size(); }
 };
@@ -68,6 +103,9 @@ struct HermiteCurves {
     /// `material` (cpfg's `render mode: interpolated` colours along a generalized
     /// cylinder). Empty, shorter than `segments` or equal to `material`: one material.
     std::vector<std::uint16_t> end_material;
+    /// Per segment, optional (empty: unknown): the module of the derived string that drew it
+    /// (its index there, through the homomorphism), or no_module. Geometry::modules names it.
+    std::vector<std::uint32_t> module;
 
     std::size_t segment_count() const { return segments.size(); }
 };
@@ -77,6 +115,9 @@ struct Spheres {
     std::vector<Float4> centres;           ///< x, y, z, radius
     std::vector<std::uint16_t> material;
     std::vector<std::int16_t> texture;
+    /// Per sphere, optional (empty: unknown): the module of the derived string that drew it
+    /// (its index there, through the homomorphism), or no_module. Geometry::modules names it.
+    std::vector<std::uint32_t> module;
 
     std::size_t size() const { return centres.size(); }
 };
@@ -87,6 +128,9 @@ struct Discs {
     std::vector<Float3> normals;           ///< unit, the front side
     std::vector<std::uint16_t> material;       ///< front
     std::vector<std::uint16_t> back_material;  ///< back
+    /// Per disc, optional (empty: unknown): the module of the derived string that drew it
+    /// (its index there, through the homomorphism), or no_module. Geometry::modules names it.
+    std::vector<std::uint32_t> module;
 
     std::size_t size() const { return centres.size(); }
 };
@@ -110,6 +154,9 @@ struct TriangleMesh {
     /// `render mode: wireframe` draws as its outline only (OpenGL's edge flags). Filled
     /// only for wireframe views.
     std::vector<std::uint8_t> hidden_edges;
+    /// Per triangle, optional (empty: unknown): the module of the derived string that drew it
+    /// (its index there, through the homomorphism), or no_module. Geometry::modules names it.
+    std::vector<std::uint32_t> module;
 
     std::size_t size() const { return triangles.size(); }
 };
@@ -121,6 +168,9 @@ struct Geometry {
     Spheres spheres;
     Discs discs;
     TriangleMesh mesh;
+    /// Provenance: the modules its primitives' `module` entries name (and, in the
+    /// Scene's own geometry, its instances'); empty for an organ's prototype.
+    ModuleTable modules;
 
     bool empty() const
     {
@@ -145,7 +195,16 @@ struct Instance {
     std::uint16_t material = 0;
     std::uint16_t back_material = 0;
     std::int16_t texture = no_texture;
+    /// Provenance: the module that placed it (an `-o>` object, a predefined surface),
+    /// which every primitive of the placed prototype takes, or no_module (then the
+    /// prototype's own `module` entries, if any, stand).
+    std::uint32_t module = no_module;
+    /// In a scene file (docs/scenes.md): the plant placement this instance belongs to
+    /// (an index in the file's placements), or no_plant.
+    std::uint32_t plant = no_plant;
+    static constexpr std::uint32_t no_plant = 0xffffffffu;
 };
+
 
 /// How cpfg's colormap mode lights a colour index (manual 5.2.5): it does not light it
 /// (pixel lines, filled modes, material files), it moves the index by `diffuse

@@ -104,7 +104,7 @@ void drop_from(Geometry& g, DroppedGeometry& d)
     LinearCurves& l = g.lines;
     std::vector<char> keep = usable_segments(l.segments, l.keys, [&](std::size_t k) { return valid_key(l.keys[k]); });
     d.line_segments += dropped(keep);
-    compact(keep, l.segments, l.flags, l.material, l.texture);
+    compact(keep, l.segments, l.flags, l.material, l.texture, l.module);
     clear_lost_neighbours(l.segments, l.flags);
     zero_non_finite(l.v, d.attributes);
 
@@ -117,7 +117,7 @@ void drop_from(Geometry& g, DroppedGeometry& d)
         if (!point_ok[k])
             c.tangents[k] = {0, 0, 0, 0};
     d.curve_segments += dropped(keep);
-    compact(keep, c.segments, c.flags, c.material, c.texture, c.end_material);
+    compact(keep, c.segments, c.flags, c.material, c.texture, c.end_material, c.module);
     clear_lost_neighbours(c.segments, c.flags);
     zero_non_finite(c.v, d.attributes);
 
@@ -126,7 +126,7 @@ void drop_from(Geometry& g, DroppedGeometry& d)
     for (std::size_t i = 0; i < keep.size(); ++i)
         keep[i] = valid_key(s.centres[i]) ? 1 : 0;
     d.spheres += dropped(keep);
-    compact(keep, s.centres, s.material, s.texture);
+    compact(keep, s.centres, s.material, s.texture, s.module);
 
     Discs& disc = g.discs;
     keep.assign(disc.centres.size(), 1);
@@ -136,7 +136,7 @@ void drop_from(Geometry& g, DroppedGeometry& d)
         keep[i] = valid_key(disc.centres[i]) && facing ? 1 : 0;
     }
     d.discs += dropped(keep);
-    compact(keep, disc.centres, disc.normals, disc.material, disc.back_material);
+    compact(keep, disc.centres, disc.normals, disc.material, disc.back_material, disc.module);
 
     TriangleMesh& m = g.mesh;
     std::vector<char> position_ok(m.positions.size());
@@ -148,7 +148,7 @@ void drop_from(Geometry& g, DroppedGeometry& d)
             if (v < position_ok.size() && !position_ok[v])
                 keep[t] = 0;
     d.triangles += dropped(keep);
-    compact(keep, m.triangles, m.material, m.back_material, m.texture);
+    compact(keep, m.triangles, m.material, m.back_material, m.texture, m.module);
     for (std::size_t k = 0; k < m.positions.size(); ++k)
         if (!position_ok[k])
             m.positions[k] = {0, 0, 0};
@@ -285,14 +285,16 @@ std::size_t geometry_bytes(const Geometry& g)
     const LinearCurves& l = g.lines;
     const HermiteCurves& c = g.curves;
     const TriangleMesh& m = g.mesh;
-    return vector_bytes(l.keys, l.v, l.segments, l.flags, l.material, l.texture) +
+    return vector_bytes(l.keys, l.v, l.segments, l.flags, l.material, l.texture, l.module) +
            vector_bytes(c.points, c.tangents, c.v, c.segments, c.flags, c.material, c.texture,
-                        c.end_material) +
-           vector_bytes(g.spheres.centres, g.spheres.material, g.spheres.texture) +
+                        c.end_material, c.module) +
+           vector_bytes(g.spheres.centres, g.spheres.material, g.spheres.texture,
+                        g.spheres.module) +
            vector_bytes(g.discs.centres, g.discs.normals, g.discs.material,
-                        g.discs.back_material) +
+                        g.discs.back_material, g.discs.module) +
            vector_bytes(m.positions, m.normals, m.uvs, m.triangles, m.material,
-                        m.back_material, m.texture);
+                        m.back_material, m.texture, m.module) +
+           g.modules.records.capacity() * sizeof(ModuleRecord);
 }
 
 void fit_mesh_buffers(TriangleMesh& mesh, bool textured_by_instances)
@@ -313,6 +315,7 @@ void fit_mesh_buffers(TriangleMesh& mesh, bool textured_by_instances)
     fit_buffer(mesh.back_material);
     fit_buffer(mesh.texture);
     fit_buffer(mesh.hidden_edges);
+    fit_buffer(mesh.module);
 }
 
 void fit_scene_buffers(Scene& scene)
@@ -326,6 +329,10 @@ void fit_scene_buffers(Scene& scene)
     for (std::size_t p = 0; p < scene.prototypes.size(); ++p)
         fit_mesh_buffers(scene.prototypes[p].geometry.mesh, textured[p]);
     fit_buffer(scene.instances);
+    fit_buffer(scene.geometry.modules.records);  // one record per organ: millions in a tree
+    fit_buffer(scene.geometry.curves.module);
+    fit_buffer(scene.geometry.spheres.module);
+    fit_buffer(scene.geometry.discs.module);
 }
 
 std::size_t scene_buffer_bytes(const Scene& scene)

@@ -274,8 +274,11 @@ void to_wireframe(Geometry& g, bool lines_in_pixels, const WireframeStyle& style
     disc_edges(g.discs, edges, style.sides);
     sphere_edges(g.spheres, edges, style);
     mesh_edges(g.mesh, edges);
+    ModuleTable modules = std::move(g.modules);  // instances still name theirs
     g = Geometry{};
+    g.modules = std::move(modules);
     g.lines = std::move(out);
+    g.lines.module.clear();  // edges name no module (provenance)
 }
 
 }  // namespace

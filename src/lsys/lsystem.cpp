@@ -177,6 +177,32 @@ ModuleString LSystem::derive(std::optional<int> steps) const
     return derivation.take_string();
 }
 
+ModuleString LSystem::derive_with_ages(std::optional<int> steps,
+                                       std::vector<std::uint16_t>& ages) const
+{
+    constexpr std::uint16_t oldest = 0xfffe;
+    Derivation derivation = start();
+    derivation.track_lineage();
+    ages.assign(derivation.string().size(), 0);
+    int n = steps.value_or(derivation.derivation_length());
+    // one step at a time: each advance's lineage is that step's
+    for (int k = 0; k < n && !derivation.stopped(); ++k) {
+        derivation.advance(1);
+        const std::vector<std::uint32_t>& lineage = derivation.lineage();
+        const auto step = static_cast<std::uint16_t>(std::min(derivation.steps_done(), int(oldest)));
+        std::vector<std::uint16_t> next(lineage.size());
+        for (std::size_t i = 0; i < lineage.size(); ++i)
+            next[i] = lineage[i] == no_parent || lineage[i] >= ages.size() ? step : ages[lineage[i]];
+        ages = std::move(next);
+    }
+    bool stopped_early = derivation.stopped() && derivation.steps_done() < n;
+    if (!stopped_early || derivation.stop_runs_end())
+        derivation.finish();
+    ModuleString out = derivation.take_string();
+    ages.resize(out.size(), oldest);
+    return out;
+}
+
 Derivation LSystem::start() const
 {
     auto deriver = std::make_unique<Deriver>(*m_program, limits_of(m_options));
@@ -436,6 +462,24 @@ ModuleString LSystem::join_at_commands(const ModuleString& s, std::vector<std::u
     if (origins)
         *origins = std::move(joined_origins);
     return out;
+}
+
+ModuleString LSystem::interpretation_string(const ModuleString& derived, ObjectHandling objects,
+                                           std::vector<std::uint32_t>& origins) const
+{
+    DeriveLimits limits = limits_of(m_options);
+    limits.start = m_last_runtime == nullptr;  // else the Start block gives the globals
+    Deriver deriver(*m_program, limits);
+    if (m_last_runtime)
+        deriver.set_runtime(*m_last_runtime);
+    ModuleString out;
+    origins.clear();
+    deriver.apply_homomorphism(derived, out, nullptr, objects == ObjectHandling::keep, &origins);
+    ModuleString joined = joined_at_commands(std::move(out), &origins);
+    if (origins.empty())  // the identity
+        for (std::size_t i = 0; i < joined.size(); ++i)
+            origins.push_back(static_cast<std::uint32_t>(i));
+    return joined;
 }
 
 ModuleString LSystem::interpretation_string(const ModuleString& derived,

@@ -191,6 +191,11 @@ public:
     /// (array subscript out of range, '%' by 0, file functions) throw cambium::Error
     /// naming file:line:col and the production or block.
     ModuleString derive(std::optional<int> steps = std::nullopt) const;
+    /// derive(), and for each module of its string the step at which the module appeared
+    /// (0: the axiom's; a module continues its parent as Derivation::lineage() says),
+    /// at most 0xfffe: the ages provenance reports (docs/architecture.md). The lineage
+    /// costs 4 bytes a module more while deriving.
+    ModuleString derive_with_ages(std::optional<int> steps, std::vector<std::uint16_t>& ages) const;
     /// A derivation at the axiom (Start block run), to advance step by step.
     Derivation start() const;
     /// The compiled program (productions, decomposition, homomorphism, globals).
@@ -212,6 +217,10 @@ public:
     /// stay unexpanded: geom instances them through is_object_symbol/expand_object.
     ModuleString interpretation_string(const ModuleString& derived,
                                        ObjectHandling objects = ObjectHandling::expand) const;
+    /// The same, and in `origins` for each of its modules the index in `derived` of the
+    /// module whose successor it is (as TurtleString::origins).
+    ModuleString interpretation_string(const ModuleString& derived, ObjectHandling objects,
+                                       std::vector<std::uint32_t>& origins) const;
     /// Whether `symbol` is the predecessor of an object production (-o>, one module, no
     /// context) in a homomorphism: geom may instance its expansion instead of repeating it.
     bool is_object_symbol(int symbol) const;

@@ -42,6 +42,10 @@ struct SurfaceHit {
     std::uint32_t prim_id = 0;
     std::uint32_t inst_id = PrimId::none;  ///< the instance's Embree geometry id
     std::uint32_t instance = PrimId::none;  ///< in Scene::instances (none: own geometry)
+    /// The primitive's index in its Geometry's array of its kind (primitive_kind(shape)):
+    /// the scene's own, or the instance's prototype's; a cap's or joint's is its segment's.
+    /// Pixel-width lines of prototypes are placed in world space: theirs is none.
+    std::uint32_t primitive = PrimId::none;
     std::uint16_t material = 0;  ///< index into Scene::materials (side and instance resolved)
     /// A generalized cylinder's colour blends along its axis: the surface is
     /// (1 - material_blend) `material` + material_blend `end_material` (resolved the same
@@ -75,6 +79,19 @@ struct SurfaceHit {
         return closed() && ((dot(geometric_normal, wi) < 0) != inside);
     }
 };
+
+/// The Geometry array a shape's primitives are in.
+enum class PrimitiveKind : std::uint8_t { lines, curves, spheres, discs, mesh };
+inline PrimitiveKind primitive_kind(Shape s)
+{
+    switch (s) {
+    case Shape::curve: return PrimitiveKind::curves;
+    case Shape::sphere: return PrimitiveKind::spheres;
+    case Shape::disc: return PrimitiveKind::discs;
+    case Shape::triangle: return PrimitiveKind::mesh;
+    default: return PrimitiveKind::lines;  // line, cap, joint
+    }
+}
 
 /// The acceleration structure of one frame: every Geometry part natively in Embree
 /// (round linear and Hermite curves, sphere points, oriented discs, triangles), each

@@ -677,3 +677,17 @@ TEST(SceneAssembly, PlantsOfOneEnvironmentCompete)
     EXPECT_EQ(segments_drawn(f, open, R"([{}, {"translate": [100, 0, 0]}])"), 20u);
     EXPECT_EQ(segments_drawn(f, open, "[{}, {}]"), 0u);
 }
+
+// --light-report: a .json or .csv file, refused before any work otherwise; without -o it
+// renders no image; its value is never taken for a scene file.
+TEST(LightReportOption, ParsedAndChecked)
+{
+    app::Options o = *app::parse_command_line({"--light-report", "r.json", "--light-rays", "5000", "a.l", "a.v"});
+    ASSERT_TRUE(o.light_report);
+    EXPECT_EQ(*o.light_report, "r.json");
+    EXPECT_EQ(o.light_rays, 5000u);
+    EXPECT_FALSE(o.renders());
+    EXPECT_FALSE(o.scene);
+    EXPECT_TRUE(app::parse_command_line({"--light-report", "r.csv", "-o", "x.png", "a.l", "a.v"})->renders());
+    EXPECT_THROW(app::parse_command_line({"--light-report", "r.txt", "a.l", "a.v"}), Error);
+}

@@ -1,0 +1,64 @@
+// SPDX-License-Identifier: Apache-2.0
+// The light each organ absorbs: rays traced from the scene's lights through the plant,
+// scattered by the materials' reflectance and transmittance, tallied per organ (the
+// module that drew the primitive: geom's provenance). docs/light.md.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "geom/scene.h"
+
+namespace cambium::render {
+
+struct LightReportSettings {
+    /// Rays from the lights in all, shared among them by their power.
+    std::uint64_t rays = 1'000'000;
+    std::uint64_t seed = 0;
+    /// Worker threads (0: TBB's default). The numbers do not depend on it.
+    int threads = 0;
+    /// A path ends once its power falls below this fraction of its start (the rest is
+    /// reported as `truncated`) or after max_bounces surfaces.
+    double cutoff = 1e-12;
+    int max_bounces = 4096;
+};
+
+/// One organ: a module that drew primitives, in one plant placement.
+struct OrganLight {
+    std::uint32_t module = geom::no_module;  ///< index in the derived string
+    std::string symbol;
+    std::uint16_t age = geom::unknown_age;
+    std::uint32_t plant = geom::Instance::no_plant;
+    double area = 0;       ///< one-sided: a flat primitive's one side, a closed one's surface
+    double absorbed = 0;   ///< flux absorbed
+    double absorbed_ci95 = 0;  ///< half width of its 95% confidence interval
+    double incident_front = 0, incident_back = 0;  ///< flux arriving on each side
+};
+
+struct LightReport {
+    std::vector<OrganLight> organs;  ///< in order of plant, then string index
+    double emitted = 0;    ///< flux leaving the lights
+    double absorbed = 0;   ///< by every surface, organs or not
+    double unattributed = 0;  ///< of it, by primitives no module drew (background)
+    double escaped = 0;    ///< left the scene
+    double truncated = 0;  ///< in paths cut short (settings.cutoff, max_bounces)
+    std::uint64_t rays = 0;
+    std::vector<std::string> lights;          ///< traced, described
+    std::vector<std::string> skipped_lights;  ///< not traced (and why)
+};
+
+/// Traces the scene's view-file directional lights onto its organs. Irradiance unit: a
+/// directional light of diffuse colour (1, 1, 1) delivers 1 to a surface facing it (the
+/// mean of its colour's channels in general); area unit: the model's; flux: their
+/// product. Reflection and transmission are diffuse (the glossy lobe's albedo reflects
+/// with the diffuse one); transparency passes rays straight on; textures are not read.
+/// The same numbers at any thread count. Throws cambium::Error (Embree).
+LightReport trace_light(const geom::Scene& scene, const LightReportSettings& settings = {});
+
+/// Writes the report as JSON (`.json`) or CSV (`.csv`), atomically. Throws cambium::Error
+/// on another extension or a failed write.
+void write_light_report(const LightReport& report, const std::filesystem::path& file);
+
+}  // namespace cambium::render
