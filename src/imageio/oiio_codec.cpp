@@ -14,6 +14,9 @@ namespace cambium::render {
 
 namespace {
 
+/// The channels a map of the largest size may have: all of its values are decoded.
+constexpr std::size_t max_map_channels = 4;
+
 /// Checks an OpenEXR file's headers before OpenImageIO opens it: OpenEXR allocates each
 /// attribute's declared size before reading its value, so a few hundred bytes could ask
 /// for gigabytes. Every attribute must fit in what the file has left; the walk seeks past
@@ -70,6 +73,13 @@ void check_exr_headers(const std::filesystem::path& file)
 
 MapTexels read_oiio_map(const std::filesystem::path& file, float scale, std::size_t max_texels)
 {
+    // A FIFO would block the open, a folder or device is no map.
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec))
+        throw Error(FileLoc{file.string()},
+                    std::filesystem::exists(file, ec)
+                        ? "cannot read the environment map: not a regular file (a folder, FIFO or device)"
+                        : "cannot read the environment map: no such file");
     check_exr_headers(file);
     auto in = OIIO::ImageInput::open(file.string());
     if (!in)
@@ -79,6 +89,16 @@ MapTexels read_oiio_map(const std::filesystem::path& file, float scale, std::siz
     if (w <= 0 || h <= 0 || std::size_t(w) * std::size_t(h) > max_texels || channels <= 0)
         throw Error(file.string() + ": environment map of " + std::to_string(w) + "x" +
                     std::to_string(h) + " texels is empty or larger than 2^25 texels");
+    // OpenImageIO decodes whole chunks with every channel a file has before it keeps the
+    // ones asked for, so the file's values, not only its texels, are bounded.
+    const std::size_t values = std::size_t(w) * std::size_t(h) * std::size_t(channels);
+    if (values > max_texels * max_map_channels)
+        throw Error(FileLoc{file.string()},
+                    "environment map of " + std::to_string(w) + "x" + std::to_string(h) +
+                        " texels with " + std::to_string(channels) + " channels holds " +
+                        std::to_string(values) + " values, more than the " +
+                        std::to_string(max_texels * max_map_channels) +
+                        " (the texel limit with 4 channels) a map may hold: all are decoded");
     // Only the channels used are decoded (RGB, or the first as grey): a header may
     // declare thousands, which the texel limit alone would multiply.
     const int used = channels >= 3 ? 3 : 1;

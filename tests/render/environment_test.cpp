@@ -5,9 +5,11 @@
 #include <OpenImageIO/imageio.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <numbers>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "base/diagnostics.h"
@@ -228,6 +230,74 @@ TEST(Environment, MapWithManyChannelsUsesItsFirstThree)
     auto env = make_map_environment(file, 1.0f);
     EXPECT_EQ(env.radiance({0, 1, 0}), Vec3f(1, 2, 3));
     EXPECT_EQ(env.radiance({0, -1, 0}), Vec3f(1, 2, 3));
+    std::filesystem::remove_all(dir);
+}
+
+// OpenImageIO decodes every channel of a chunk before it keeps three, so a map's values
+// are bounded, not only its texels: a header declaring 8192x4096 texels (the texel limit)
+// of five channels is refused before a value is read. The file is a small map whose
+// windows are rewritten and zeros appended where the taller window's chunk offsets go.
+TEST(Environment, MapWhoseChannelsExceedTheValueLimitIsRefusedBeforeReading)
+{
+    auto dir = std::filesystem::temp_directory_path() /
+               ("cambium_env_values_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    auto file = dir / "wide.exr";
+    {
+        std::vector<float> values(8 * 4 * 5, 1.0f);
+        auto out = OIIO::ImageOutput::create(file.string());
+        ASSERT_TRUE(out);
+        OIIO::ImageSpec spec(8, 4, 5, OIIO::TypeDesc::FLOAT);
+        ASSERT_TRUE(out->open(file.string(), spec));
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, values.data()));
+        out->close();
+    }
+    std::string bytes;
+    {
+        std::ifstream in(file, std::ios::binary);
+        bytes.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    for (const char* window : {"dataWindow", "displayWindow"}) {
+        const std::string key = std::string(window) + std::string("\0box2i\0\x10\0\0\0", 11);
+        const std::size_t at = bytes.find(key);
+        ASSERT_NE(at, std::string::npos) << window;
+        const std::int32_t box[4] = {0, 0, 8191, 4095};  // little-endian, as on x86
+        std::memcpy(bytes.data() + at + key.size(), box, sizeof box);
+    }
+    bytes.append(std::size_t{1} << 16, '\0');  // room for the taller window's chunk offsets
+    std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes;
+    std::string message;
+    try {
+        make_map_environment(file, 1.0f);
+    } catch (const Error& e) {
+        message = e.what();
+    }
+    EXPECT_NE(message.find("wide.exr: error: environment map of 8192x4096 texels with 5 channels "
+                           "holds 167772160 values, more than the 134217728"),
+              std::string::npos)
+        << message;
+    std::filesystem::remove_all(dir);
+}
+
+// A FIFO named as a map would block the reader for ever: it is refused before opening.
+TEST(Environment, MapThatIsNotARegularFileIsRefused)
+{
+    auto dir = std::filesystem::temp_directory_path() /
+               ("cambium_env_fifo_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir);
+    auto fifo = dir / "sky.exr";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    for (const auto& file : {fifo, dir}) {
+        std::string message;
+        try {
+            make_map_environment(file, 1.0f);
+        } catch (const Error& e) {
+            message = e.what();
+        }
+        EXPECT_NE(message.find("cannot read the environment map: not a regular file"),
+                  std::string::npos)
+            << message;
+    }
     std::filesystem::remove_all(dir);
 }
 
