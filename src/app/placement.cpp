@@ -212,7 +212,7 @@ std::vector<Transform> scatter(const ScatterSpec& spec, const GroundMesh* mesh)
 GroundMesh read_obj_mesh(const std::filesystem::path& file, const SceneLimits& limits)
 {
     const std::size_t max_triangles = limits.max_mesh_triangles;
-    geom::regular_file_size(file, "the mesh", limits.max_mesh_bytes);
+    regular_file_size(file, "the mesh", limits.max_mesh_bytes);
     std::ifstream in(file, std::ios::binary);
     if (!in)
         throw Error(FileLoc{file.string()}, "cannot read the mesh");

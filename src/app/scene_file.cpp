@@ -617,7 +617,7 @@ void check_structure(const std::string& text, const std::string& name, const Sce
 
 json parse_document(const fs::path& file, const std::string& name, const SceneLimits& limits)
 {
-    std::string text = geom::read_file(file, "the scene file", limits.max_file_bytes);
+    std::string text = read_file(file, "the scene file", limits.max_file_bytes);
     check_structure(text, name, limits);
     try {
         // Comments are allowed: scenes are written by hand.

@@ -143,7 +143,7 @@ render::Image assemble_tiles(const fs::path& output, int count, int width, int h
         std::uintmax_t most =
             magic.size() + sizeof(Header) +
             std::uintmax_t(rect.width) * std::uintmax_t(rect.height) * 11 * sizeof(float);
-        std::string bytes = geom::read_file(file, "the tile", most);
+        std::string bytes = read_file(file, "the tile", most);
         Tile tile = decode_tile(bytes, file.string());
         if (tile.index != i || tile.count != count || tile.width != width ||
             tile.height != height || tile.rect != band(i, count, width, height))

@@ -8,31 +8,15 @@
 #include <vector>
 
 #include "base/diagnostics.h"
+#include "base/input_file.h"
 
 namespace cambium::geom {
 
 /// Largest text input file read (view files, surfaces, contours...): 64 MiB.
 constexpr std::uintmax_t max_text_file_bytes = 64u << 20;
 
-/// The whole file, at most `max_bytes`: the one rule for the files a model names.
-/// Only regular files are opened (a FIFO or device would block or never end), and the
-/// size is compared with the limit before anything is read or allocated. Error naming
-/// the file (and `what` it is) when it is missing, not a regular file, unreadable or
-/// too large.
-std::string read_file(const std::filesystem::path& file, const char* what,
-                      std::uintmax_t max_bytes);
-
-/// The size of `file` when it is a regular file of at most `max_bytes` (read_file's
-/// checks, for readers that stream a file instead of holding it); Error otherwise.
-std::uintmax_t regular_file_size(const std::filesystem::path& file, const char* what,
-                                 std::uintmax_t max_bytes);
-
 /// read_file with the text files' limit (max_text_file_bytes).
 std::string read_text_file(const std::filesystem::path& file, const char* what);
-
-/// The whole binary file, at most `max_bytes`; Error naming it otherwise.
-std::vector<unsigned char> read_binary_file(const std::filesystem::path& file, const char* what,
-                                            std::uintmax_t max_bytes);
 
 struct SourceLine {
     int number;        ///< 1-based

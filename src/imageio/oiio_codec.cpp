@@ -9,10 +9,14 @@
 #include <string>
 
 #include "base/diagnostics.h"
+#include "base/input_file.h"
 
 namespace cambium::render {
 
 namespace {
+
+/// A map's file: an 8192 x 4096 RGBA map of 32-bit floats, uncompressed, is 512 MiB.
+constexpr std::uintmax_t max_map_file_bytes = std::uintmax_t{1} << 30;
 
 /// The channels a map of the largest size may have: all of its values are decoded.
 constexpr std::size_t max_map_channels = 4;
@@ -73,13 +77,7 @@ void check_exr_headers(const std::filesystem::path& file)
 
 MapTexels read_oiio_map(const std::filesystem::path& file, float scale, std::size_t max_texels)
 {
-    // A FIFO would block the open, a folder or device is no map.
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(file, ec))
-        throw Error(FileLoc{file.string()},
-                    std::filesystem::exists(file, ec)
-                        ? "cannot read the environment map: not a regular file (a folder, FIFO or device)"
-                        : "cannot read the environment map: no such file");
+    regular_file_size(file, "the environment map", max_map_file_bytes);
     check_exr_headers(file);
     auto in = OIIO::ImageInput::open(file.string());
     if (!in)

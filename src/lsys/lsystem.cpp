@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "base/diagnostics.h"
+#include "base/input_file.h"
 #include "lsys/deriver.h"
 #include "lsys/parser.h"
 #include "lsys/preprocessor.h"
@@ -15,27 +16,6 @@
 namespace cambium::lsys {
 
 namespace {
-
-std::string read_source(const std::filesystem::path& file, std::size_t limit)
-{
-    std::error_code ec;
-    if (std::filesystem::exists(file, ec) && !std::filesystem::is_regular_file(file, ec))
-        throw Error(FileLoc{file.string(), 0, 0},
-                    "cannot read the L-system file: not a regular file");
-    auto size = std::filesystem::file_size(file, ec);
-    if (ec)
-        throw Error(FileLoc{file.string(), 0, 0}, "cannot read the L-system file: " + ec.message());
-    if (size > limit)
-        throw Error(FileLoc{file.string(), 0, 0},
-                    "the file is " + std::to_string(size) + " bytes; at most " +
-                        std::to_string(limit) + " are accepted");
-    std::ifstream in(file, std::ios::binary);
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    if (!in && !in.eof())
-        throw Error(FileLoc{file.string(), 0, 0}, "cannot read the L-system file");
-    return ss.str();
-}
 
 std::unique_ptr<Program> compile(std::string_view source, const std::string& file_name,
                                  const PreprocessOptions& pp)
@@ -95,7 +75,7 @@ LSystem LSystem::load(const std::filesystem::path& file, const LoadOptions& opti
     pp.folder = file.parent_path();
     if (!options.allow_file_access)
         pp.confine_to = std::filesystem::weakly_canonical(std::filesystem::absolute(pp.folder.empty() ? "." : pp.folder));
-    std::string source = read_source(file, pp.max_input_bytes);
+    std::string source = read_file(file, "the L-system file", pp.max_input_bytes);
     return LSystem(compile(source, file.string(), pp), options);
 }
 

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "base/diagnostics.h"
+#include "base/input_file.h"
 #include "lsys/lexer.h"
 
 namespace cambium::lsys {
@@ -132,12 +133,7 @@ std::string read_all(std::istream& in, std::string_view source)
 
 std::ifstream open_input(const std::filesystem::path& file)
 {
-    std::error_code ec;
-    auto size = std::filesystem::file_size(file, ec);
-    if (ec)
-        throw Error(FileLoc{file.string(), 0, 0}, "cannot read the string file: " + ec.message());
-    if (size > max_string_file_bytes)
-        throw Error(FileLoc{file.string(), 0, 0}, "the string file is too large");
+    regular_file_size(file, "the string file", max_string_file_bytes);
     std::ifstream in(file, std::ios::binary);
     if (!in)
         throw Error(FileLoc{file.string(), 0, 0}, "cannot open the string file");

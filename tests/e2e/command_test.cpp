@@ -494,7 +494,7 @@ TEST(Command, LsystemFileMustBeARegularFile)
     ASSERT_EQ(::mkfifo((dir / "p.l").c_str(), 0600), 0);
     Result r = run((dir / "p.l").string() + " " + (dir / "p.v").string() + " < /dev/null");
     EXPECT_NE(r.status, 0);
-    EXPECT_NE(r.output.find("p.l: error: cannot read the L-system file: not a regular file"),
+    EXPECT_NE(r.output.find("p.l: error: cannot open the L-system file: not a regular file"),
               std::string::npos)
         << r.output;
 }

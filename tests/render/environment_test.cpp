@@ -294,7 +294,7 @@ TEST(Environment, MapThatIsNotARegularFileIsRefused)
         } catch (const Error& e) {
             message = e.what();
         }
-        EXPECT_NE(message.find("cannot read the environment map: not a regular file"),
+        EXPECT_NE(message.find("cannot open the environment map: not a regular file"),
                   std::string::npos)
             << message;
     }
