@@ -213,7 +213,7 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     cli.set_version_flag("--version", "cambium " CAMBIUM_VERSION);
     cli.add_option("-o", options.outputs,
                    "Output: an image (.png .exr .tif .jpg .rgb .tga), a video (.mp4 .mov .mkv .webm) "
-                   "or the still's geometry (.obj .ply .gls); may be given more than once")
+                   "or the still's geometry (.obj .ply .gls .glb); may be given more than once")
         ->take_all()
         ->allow_extra_args(false);
     cli.add_option("--spp", options.samples_per_pixel, "Samples per pixel (default 64)")

@@ -10,6 +10,7 @@
 
 #include "base/confinement.h"
 #include "base/diagnostics.h"
+#include "base/output_format.h"
 #include "base/subprocess.h"
 #include "env/environmental_step.h"
 #include "geom/background_scene.h"
@@ -526,9 +527,14 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
     if (scene.shading == geom::Shading::wireframe)
         geom::draw_as_wireframe(scene, wireframe_style(model, scene, options));
     // Small instanced surfaces (petals, leaves) drawn in place: one BVH for rays to
-    // walk instead of two (docs/architecture.md), within a share of the memory budget.
+    // walk instead of two (docs/architecture.md), within a share of the memory budget;
+    // not when a glTF output keeps the organs as shared meshes.
+    const bool keeps_instances = std::any_of(options.outputs.begin(), options.outputs.end(), [](const auto& out) {
+        const OutputFormat* format = find_output_format(out);
+        return format && format->mesh == MeshFormat::glb;
+    });
     geom::FlattenLimits flatten;
-    flatten.max_bytes = options.max_memory_bytes / 8;
+    flatten.max_bytes = keeps_instances ? 0 : options.max_memory_bytes / 8;
     geom::flatten_small_instances(scene, flatten);
     // Non-finite or huge numbers would abort inside Embree: dropped here with a warning.
     geom::drop_unrenderable(scene);

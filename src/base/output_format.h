@@ -15,7 +15,7 @@ namespace cambium {
 enum class ImageFormat { png, jpeg, tiff, exr, sgi, targa };
 
 /// The mesh file formats geom::write_mesh knows.
-enum class MeshFormat { none, obj, ply, gls };
+enum class MeshFormat { none, obj, ply, gls, glb };
 
 /// What one kind of output file holds.
 struct OutputFormat {
@@ -33,7 +33,7 @@ struct OutputFormat {
 // clang-format off
 /// The table. The image I/O module reads it too (it links nothing of render), so it lives
 /// here, whole.
-inline constexpr std::array<OutputFormat, 10> output_formats{{
+inline constexpr std::array<OutputFormat, 11> output_formats{{
     {"PNG",      {".png"},                          false, ImageFormat::png,   MeshFormat::none, false, true},
     {"OpenEXR",  {".exr"},                          false, ImageFormat::exr,   MeshFormat::none, true,  true},
     {"TIFF",     {".tif", ".tiff"},                 false, ImageFormat::tiff,  MeshFormat::none, false, true},
@@ -44,6 +44,7 @@ inline constexpr std::array<OutputFormat, 10> output_formats{{
     {"Wavefront OBJ", {".obj"},                     false, ImageFormat::png,   MeshFormat::obj,  false, false},
     {"PLY",      {".ply"},                          false, ImageFormat::png,   MeshFormat::ply,  false, false},
     {"GLS",      {".gls"},                          false, ImageFormat::png,   MeshFormat::gls,  false, false},
+    {"glTF binary", {".glb"},                       false, ImageFormat::png,   MeshFormat::glb,  false, false},
 }};
 // clang-format on
 

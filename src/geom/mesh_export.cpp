@@ -11,13 +11,14 @@
 
 #include "base/atomic_file.h"
 #include "base/diagnostics.h"
+#include "geom/gltf_export.h"
 
 namespace cambium::geom {
 namespace {
 
 /// What one exported triangle takes while the mesh is held: three vertices of position,
-/// normal and uv, three indices, two materials and a texture.
-constexpr std::uint64_t bytes_per_triangle = 3 * (12 + 12 + 8) + 12 + 6;
+/// normal and uv, three indices, two materials, a texture and a module.
+constexpr std::uint64_t bytes_per_triangle = 3 * (12 + 12 + 8) + 12 + 6 + 4;
 
 const Material& material_of(const Scene& scene, std::uint16_t index)
 {
@@ -216,14 +217,19 @@ void write_gls(const Scene& scene, const TriangleMesh& mesh, const std::filesyst
 void write_mesh(const Scene& scene, const std::filesystem::path& file, MeshFormat format,
                 const MeshExportOptions& options)
 {
-    const std::uint64_t triangles = tessellated_triangles(scene, options.tessellation);
+    const std::uint64_t triangles = format == MeshFormat::glb
+                                        ? gltf_primitives(scene, options.tessellation)
+                                        : tessellated_triangles(scene, options.tessellation);
     if (triangles > options.max_memory_bytes / bytes_per_triangle)
         throw Error(file.string() + ": the plant's " + std::to_string(triangles) +
                     " triangles need " + byte_size_text(triangles * bytes_per_triangle) +
                     ", more than the memory budget of " + byte_size_text(options.max_memory_bytes) +
                     " (--max-memory)");
+    if (format == MeshFormat::glb)
+        return write_glb(scene, file, options);
     const TriangleMesh mesh = tessellate(scene, options.tessellation);
     switch (format) {
+    case MeshFormat::glb: break;
     case MeshFormat::obj: write_obj(scene, mesh, options, file); break;
     case MeshFormat::ply: write_ply(scene, mesh, file); break;
     case MeshFormat::gls: write_gls(scene, mesh, file); break;

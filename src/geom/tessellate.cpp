@@ -19,8 +19,9 @@ Float3 float3(const Vec3& v)
 /// Writes triangles of one material into a mesh.
 class MeshWriter {
 public:
-    MeshWriter(TriangleMesh& out, std::uint16_t material, std::uint16_t back, std::int16_t texture)
-        : m_out(out), m_material(material), m_back(back), m_texture(texture)
+    MeshWriter(TriangleMesh& out, std::uint16_t material, std::uint16_t back, std::int16_t texture,
+               std::uint32_t module)
+        : m_out(out), m_material(material), m_back(back), m_texture(texture), m_module(module)
     {
     }
     std::uint32_t vertex(const Vec3& p, const Vec3& n, Float2 uv = {0, 0})
@@ -36,12 +37,14 @@ public:
         m_out.material.push_back(m_material);
         m_out.back_material.push_back(m_back);
         m_out.texture.push_back(m_texture);
+        m_out.module.push_back(m_module);
     }
 
 private:
     TriangleMesh& m_out;
     std::uint16_t m_material, m_back;
     std::int16_t m_texture;
+    std::uint32_t m_module;
 };
 
 /// Two unit vectors completing `axis` (unit) to a right-handed orthonormal frame.
@@ -163,33 +166,47 @@ std::int16_t texture_of(const std::vector<std::int16_t>& textures, std::size_t i
     return i < textures.size() ? textures[i] : no_texture;
 }
 
+/// The module of primitive `i`: `placed` (an instance's) when there is one, else the
+/// primitive's own entry, else no_module.
+std::uint32_t module_of(const std::vector<std::uint32_t>& modules, std::size_t i, std::uint32_t placed)
+{
+    if (placed != no_module)
+        return placed;
+    return i < modules.size() ? modules[i] : no_module;
+}
+
 void append_geometry(const Geometry& g, const GeometryMark& since, bool lines_in_pixels,
-                     const Tessellation& how, TriangleMesh& out)
+                     const Tessellation& how, std::uint32_t placed, TriangleMesh& out)
 {
     if (!lines_in_pixels)
         for (std::size_t s = since.line_segments; s < g.lines.segments.size(); ++s) {
-            MeshWriter w(out, g.lines.material[s], g.lines.material[s], texture_of(g.lines.texture, s));
+            MeshWriter w(out, g.lines.material[s], g.lines.material[s], texture_of(g.lines.texture, s),
+                         module_of(g.lines.module, s, placed));
             const Float4& a = g.lines.keys[g.lines.segments[s]];
             const Float4& b = g.lines.keys[g.lines.segments[s] + 1];
             frustum(w, point(a), a[3], point(b), b[3], how.sides);
         }
     for (std::size_t s = since.curve_segments; s < g.curves.segments.size(); ++s) {
-        MeshWriter w(out, g.curves.material[s], g.curves.material[s], texture_of(g.curves.texture, s));
+        MeshWriter w(out, g.curves.material[s], g.curves.material[s], texture_of(g.curves.texture, s),
+                     module_of(g.curves.module, s, placed));
         const std::uint32_t i = g.curves.segments[s];
         hermite(w, g.curves.points[i], g.curves.tangents[i], g.curves.points[i + 1],
                 g.curves.tangents[i + 1], how);
     }
     for (std::size_t s = since.spheres; s < g.spheres.centres.size(); ++s) {
-        MeshWriter w(out, g.spheres.material[s], g.spheres.material[s], texture_of(g.spheres.texture, s));
+        MeshWriter w(out, g.spheres.material[s], g.spheres.material[s], texture_of(g.spheres.texture, s),
+                     module_of(g.spheres.module, s, placed));
         sphere(w, g.spheres.centres[s], how.sides);
     }
     for (std::size_t s = since.discs; s < g.discs.centres.size(); ++s) {
-        MeshWriter w(out, g.discs.material[s], g.discs.back_material[s], no_texture);
+        MeshWriter w(out, g.discs.material[s], g.discs.back_material[s], no_texture,
+                     module_of(g.discs.module, s, placed));
         disc(w, g.discs.centres[s], normalize(point(g.discs.normals[s])), how.sides);
     }
     const TriangleMesh& m = g.mesh;
     for (std::size_t t = since.triangles; t < m.triangles.size(); ++t) {
-        MeshWriter w(out, m.material[t], m.back_material[t], texture_of(m.texture, t));
+        MeshWriter w(out, m.material[t], m.back_material[t], texture_of(m.texture, t),
+                     module_of(m.module, t, placed));
         std::uint32_t v[3];
         for (int k = 0; k < 3; ++k) {
             const std::uint32_t i = m.triangles[t][k];
@@ -222,12 +239,12 @@ GeometryMark geometry_mark(const Scene& scene)
 void tessellate_since(const Scene& scene, const GeometryMark& since, const Tessellation& how,
                       TriangleMesh& out)
 {
-    append_geometry(scene.geometry, since, scene.line_radius_in_pixels, how, out);
+    append_geometry(scene.geometry, since, scene.line_radius_in_pixels, how, no_module, out);
     for (std::size_t i = since.instances; i < scene.instances.size(); ++i) {
         const Instance& instance = scene.instances[i];
         Geometry placed = scene.prototypes.at(instance.prototype).geometry;
         place_geometry(placed, instance);
-        append_geometry(placed, GeometryMark{}, scene.line_radius_in_pixels, how, out);
+        append_geometry(placed, GeometryMark{}, scene.line_radius_in_pixels, how, instance.module, out);
     }
 }
 
@@ -236,6 +253,20 @@ TriangleMesh tessellate(const Scene& scene, const Tessellation& how)
     TriangleMesh out;
     tessellate_since(scene, GeometryMark{}, how, out);
     return out;
+}
+
+TriangleMesh tessellate_geometry(const Geometry& geometry, bool lines_in_pixels,
+                                 const Tessellation& how)
+{
+    TriangleMesh out;
+    append_geometry(geometry, GeometryMark{}, lines_in_pixels, how, no_module, out);
+    return out;
+}
+
+std::size_t tessellated_triangles(const Geometry& geometry, bool lines_in_pixels,
+                                  const Tessellation& how)
+{
+    return count_geometry(geometry, lines_in_pixels, how);
 }
 
 std::size_t tessellated_triangles(const Scene& scene, const Tessellation& how)

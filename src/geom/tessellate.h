@@ -24,7 +24,8 @@ struct GeometryMark {
 GeometryMark geometry_mark(const Scene& scene);
 
 /// Appends to `out` (smooth normals; uvs where the scene's mesh has them, else zero;
-/// the front material and texture) every primitive `scene` gained since `since`:
+/// the front material, texture and module: an instance's module for its primitives)
+/// every primitive `scene` gained since `since`:
 /// triangles as they are, line and generalized-cylinder segments as their side walls,
 /// spheres as `sides` meridians and half as many parallels, discs as fans, and the
 /// primitives of placed instances (predefined surfaces, objects) moved into place.
@@ -35,6 +36,15 @@ void tessellate_since(const Scene& scene, const GeometryMark& since, const Tesse
 
 /// The whole scene as triangles.
 TriangleMesh tessellate(const Scene& scene, const Tessellation& how);
+
+/// One Geometry's own primitives as triangles in its own frame (a prototype's before any
+/// instance places it), each with its primitive's module where the geometry records one.
+TriangleMesh tessellate_geometry(const Geometry& geometry, bool lines_in_pixels,
+                                 const Tessellation& how);
+
+/// The triangles tessellate_geometry() makes, counted without making them.
+std::size_t tessellated_triangles(const Geometry& geometry, bool lines_in_pixels,
+                                  const Tessellation& how);
 
 /// The triangles tessellate() makes of `scene`, counted without making them (to check an
 /// export against the memory budget first).
