@@ -13,6 +13,8 @@ packages=(
   # libraries of the renderer and the command
   libembree-dev libtbb-dev libcli11-dev libfmt-dev nlohmann-json3-dev
   libopenimageio-dev libopenexr-dev
+  # glTF exports (.glb): tinygltf (MIT) writes them, the tests read them back
+  libtinygltf-dev
   # @L labels: FreeType draws the glyphs, fontconfig finds a font for cpfg's font names,
   # DejaVu is the font it finds on a bare system
   libfreetype-dev libfontconfig-dev fonts-dejavu-core

@@ -292,6 +292,9 @@ private:
                     static_cast<int>(m_model.textures.size() - 1);
                 if (m_scene.textures[std::size_t(texture)].decal)
                     out.pbrMetallicRoughness.baseColorFactor = {1, 1, 1, 1};
+                // cut-out leaves: the renderer ignores hits where alpha < 0.5 (docs/materials.md)
+                out.alphaMode = "MASK";
+                out.alphaCutoff = 0.5;
             }
         m_model.materials.push_back(std::move(out));
         const int index = static_cast<int>(m_model.materials.size() - 1);

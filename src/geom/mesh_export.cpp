@@ -91,8 +91,11 @@ void write_mtl(const Scene& scene, const TriangleMesh& mesh, const std::vector<s
                       m.specular.r, m.specular.g, m.specular.b, m.emission.r, m.emission.g,
                       m.emission.b, m.shininess, 1.0 - m.transparency);
         out << line;
-        if (mesh.texture[t] != no_texture)
-            out << "map_Kd " << texture_path(scene, mesh.texture[t], options, file) << '\n';
+        if (mesh.texture[t] != no_texture) {
+            const std::string texture = texture_path(scene, mesh.texture[t], options, file);
+            // its alpha cuts leaves out, as the renderer does (docs/materials.md)
+            out << "map_Kd " << texture << "\nmap_d " << texture << '\n';
+        }
     }
 }
 
