@@ -588,14 +588,17 @@ geom::Scene assemble(const SceneFile& file, const std::vector<std::optional<Envi
                 geom::append_geometry(out.geometry, copy);
                 continue;
             }
+            const auto placement = static_cast<std::uint32_t>(r.plant_instances - 1);
             if (v.prototype) {
                 geom::Instance plant_instance;
                 plant_instance.prototype = *v.prototype;
                 plant_instance.transform = t;
+                plant_instance.plant = placement;
                 out.instances.push_back(plant_instance);
             }
             for (geom::Instance organ : v.organs) {
                 organ.transform = compose(t, organ.transform);
+                organ.plant = placement;
                 out.instances.push_back(organ);
                 ++r.organ_instances;
             }

@@ -349,7 +349,7 @@ tinygltf::Node organ_node(const ModuleTable& modules, std::uint32_t module)
 {
     tinygltf::Node node;
     if (module == no_module) {
-        node.name = "unattributed";
+        node.name = "unattributed";  // drawn by no module: a background scene, a scene's ground
         return node;
     }
     tinygltf::Value::Object extras;
@@ -434,6 +434,12 @@ void write_glb(const Scene& scene, const std::filesystem::path& file, const Mesh
         if (it->second < 0)
             continue;
         tinygltf::Node node = organ_node(scene.geometry.modules, instance.module);
+        if (instance.module == no_module && instance.plant != Instance::no_plant) {
+            // a scene file's plant: named by its placement
+            node.name = "plant " + std::to_string(instance.plant) + " " +
+                        scene.prototypes.at(instance.prototype).name;
+            node.extras = tinygltf::Value(tinygltf::Value::Object{{"placement", tinygltf::Value(int(instance.plant))}});
+        }
         node.mesh = it->second;
         node.matrix = matrix_of(instance.transform);
         roots.push_back(builder.add_node(std::move(node)));

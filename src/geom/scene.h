@@ -200,7 +200,8 @@ struct Instance {
     /// prototype's own `module` entries, if any, stand).
     std::uint32_t module = no_module;
     /// In a scene file (docs/scenes.md): the plant placement this instance belongs to
-    /// (an index in the file's placements), or no_plant.
+    /// (its place among all the file's placements, plant by plant in file order), or
+    /// no_plant.
     std::uint32_t plant = no_plant;
     static constexpr std::uint32_t no_plant = 0xffffffffu;
 };

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -464,6 +465,30 @@ TEST(SceneAssembly, EachDistinctVariantIsDerivedOnce)
     // each plant of 3 steps has 3 flowers (objects): composed, one instance each
     EXPECT_EQ(r3.organ_instances, 27u);
     EXPECT_EQ(instances3, 36u);
+}
+
+// Every instance names the placement it belongs to, counted over the file's plants in
+// order: a plant's own instance and its flowers' alike (exports name plants by it).
+TEST(SceneAssembly, EachInstanceNamesItsPlacement)
+{
+    SceneFolder f("placement_ids");
+    f.tiny_model("m");
+    const std::string m = R"("model": "m", "command": "cpfg p.l p.v", )";
+    app::SceneFile s = app::read_scene_file(
+        f.scene(std::string("{\"plants\": [{") + m + R"("placements": [{}, {"translate": [2, 0, 0]}]}, {)" + m +
+                R"("seed": 3, "placements": [{"translate": [4, 0, 0]}]}]})"),
+        app::Options{});
+    geom::Scene scene = app::assemble_scene(s, app::Options{}, {app::OrganPlacement::compose, false});
+    std::map<std::uint32_t, int> per_placement;
+    for (const geom::Instance& i : scene.instances) {
+        ASSERT_NE(i.plant, geom::Instance::no_plant);
+        const float x = i.transform[9];
+        // each placement's instances lie about its translation (flowers a little off it)
+        EXPECT_NEAR(x, 2.0f * float(i.plant), 1.5f) << "placement " << i.plant;
+        ++per_placement[i.plant];
+    }
+    EXPECT_EQ(per_placement.size(), 3u);
+    EXPECT_EQ(per_placement[0], per_placement[1]);  // the same variant: the same instances
 }
 
 TEST(SceneAssembly, SeedOverrideChangesAStochasticPlantReproducibly)
