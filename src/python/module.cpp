@@ -33,6 +33,7 @@
 #include "base/diagnostics.h"
 #include "base/subprocess.h"
 #include "lsys/string_io.h"
+#include "render/framing.h"
 #include "render/render.h"
 
 namespace py = pybind11;
@@ -420,22 +421,47 @@ ModelObject load(const py::object& lsystem, const py::object& view, const py::ob
     return m;
 }
 
-py::object render_model(ModelObject& m, const py::object& string, bool layers,
-                        const py::object& progress, const py::kwargs& keywords)
+/// The string to render: `string` (a String of this model) or none, to derive.
+std::optional<lsys::ModuleString> given_string(const ModelObject& m, const py::object& string)
+{
+    if (string.is_none())
+        return std::nullopt;
+    StringObject& s = string.cast<StringObject&>();
+    if (s.model != m.model)
+        throw Error("the string was derived from another model");
+    return s.string;
+}
+
+/// Derives (unless given a string), interprets and applies the camera options.
+geom::Scene model_scene(const ModelObject& m, std::optional<lsys::ModuleString>& given,
+                        const app::Options& options, Events& events)
+{
+    if (!given) {
+        events.push("derive");
+        given = app::derive(*m.model, options);
+    }
+    events.push("interpret");
+    geom::Scene scene = app::interpret(*m.model, *given, options);
+    given.reset();
+    app::apply_camera_options(scene, options);
+    return scene;
+}
+
+py::dict keyword_dict(const py::kwargs& keywords)
 {
     py::dict more;
     for (const auto& [k, v] : keywords)
         more[k] = v;
-    const app::Options options = m.options_with(more);
+    return more;
+}
+
+py::object render_model(ModelObject& m, const py::object& string, bool layers,
+                        const py::object& progress, const py::kwargs& keywords)
+{
+    const app::Options options = m.options_with(keyword_dict(keywords));
     if (app::is_sequence(options))
-        throw Error("a sequence (-a, --turntable) is not rendered into one image");
-    std::optional<lsys::ModuleString> given;
-    if (!string.is_none()) {
-        StringObject& s = string.cast<StringObject&>();
-        if (s.model != m.model)
-            throw Error("the string was derived from another model");
-        given = s.string;
-    }
+        throw Error("a sequence is not one image: use Model.turntable() (-a is the command's)");
+    std::optional<lsys::ModuleString> given = given_string(m, string);
     render::RenderSettings settings = app::render_settings(options, {});
     settings.aovs = layers;
     const render::WriteOptions write = app::write_options(options);
@@ -443,14 +469,7 @@ py::object render_model(ModelObject& m, const py::object& string, bool layers,
     render::RenderReport report;
     run_released(
         [&](std::atomic<bool>& cancel, Events& events) {
-            if (!given) {
-                events.push("derive");
-                given = app::derive(*m.model, options);
-            }
-            events.push("interpret");
-            geom::Scene scene = app::interpret(*m.model, *given, options);
-            given.reset();
-            app::apply_camera_options(scene, options);
+            geom::Scene scene = model_scene(m, given, options, events);
             settings.cancel = &cancel;
             if (!progress.is_none())
                 settings.on_pass = [&](const render::Image& so_far) {
@@ -461,6 +480,73 @@ py::object render_model(ModelObject& m, const py::object& string, bool layers,
         },
         progress, options.quiet, write);
     return image_object(std::move(image), write);
+}
+
+/// Frames of a sequence, numbered from 1 as the command numbers them.
+struct SequenceObject {
+    py::list frames;
+    int fps = 24;
+};
+
+/// A turntable as the command's --turntable renders it: derived and interpreted once,
+/// `frames` views orbiting the vertical axis through the plant, one BVH for all.
+SequenceObject turntable_model(ModelObject& m, int frames, std::optional<double> elevation,
+                               const py::object& string, bool layers, const py::object& progress,
+                               const py::kwargs& keywords)
+{
+    py::dict more = keyword_dict(keywords);
+    more["turntable"] = frames;
+    if (elevation)
+        more["turntable_elevation"] = *elevation;
+    const app::Options options = m.options_with(more);
+    std::optional<lsys::ModuleString> given = given_string(m, string);
+    render::RenderSettings settings = app::render_settings(options, {});
+    settings.aovs = layers;
+    const render::WriteOptions write = app::write_options(options);
+    std::vector<render::Image> images;
+    run_released(
+        [&](std::atomic<bool>& cancel, Events& events) {
+            geom::Scene scene = model_scene(m, given, options, events);
+            std::vector<render::Camera> cameras = render::turntable_cameras(
+                scene.view, scene.bounds, options.shot.turntable, options.shot.turntable_elevation,
+                settings.width, settings.height);
+            if (settings.aperture_radius > 0)
+                for (render::Camera& c : cameras)
+                    c = c.with_lens(settings.aperture_radius, settings.focus_distance);
+            settings.cancel = &cancel;
+            events.push("render");
+            render::render_views(scene, cameras, settings,
+                                 [&](std::size_t, render::Image& image, const render::RenderReport& r) {
+                                     images.push_back(std::move(image));
+                                     events.push("frame");
+                                     return !r.cancelled;
+                                 });
+        },
+        progress, options.quiet, write);
+    SequenceObject sequence;
+    sequence.fps = options.shot.fps;
+    for (render::Image& image : images)
+        sequence.frames.append(image_object(std::move(image), write));
+    return sequence;
+}
+
+/// The frames as an HTML animation (PNG frames shown in turn by a small script), for
+/// notebooks: no video encoder needed.
+std::string sequence_html(const SequenceObject& s)
+{
+    py::object b64 = py::module_::import("base64").attr("b64encode");
+    std::string id = "cambium" + std::to_string(reinterpret_cast<std::uintptr_t>(&s));
+    std::string frames;
+    for (const auto& f : s.frames) {
+        py::bytes png = png_bytes(f.cast<const ImageObject&>());
+        frames += (frames.empty() ? "\"" : ",\"") + std::string("data:image/png;base64,") +
+                  b64(png).attr("decode")().cast<std::string>() + "\"";
+    }
+    if (frames.empty())
+        return "<p>(no frames)</p>";
+    return "<img id=\"" + id + "\"><script>(function(){var f=[" + frames +
+           "],i=0,e=document.getElementById(\"" + id + "\");function n(){e.src=f[i];i=(i+1)%f.length;}"
+           "n();setInterval(n," + std::to_string(1000 / std::max(1, s.fps)) + ");})();</script>";
 }
 
 }  // namespace
@@ -613,6 +699,39 @@ PYBIND11_MODULE(cambium, m)
             py::arg("module"), py::arg("parameter"), py::arg("value"),
             "Sets parameter k of module i");
 
+    py::class_<SequenceObject>(m, "Sequence",
+                               "Frames of a sequence (Images), numbered from 1 as the command's")
+        .def("__len__", [](const SequenceObject& s) { return py::len(s.frames); })
+        .def("__getitem__", [](const SequenceObject& s, long i) {
+            long n = long(py::len(s.frames));
+            if (i < 0)
+                i += n;
+            if (i < 0 || i >= n)
+                throw py::index_error("frame index out of range");
+            return s.frames[py::size_t(i)];
+        })
+        .def("__iter__", [](const SequenceObject& s) { return py::iter(s.frames); })
+        .def_readwrite("fps", &SequenceObject::fps)
+        .def(
+            "write",
+            [](const SequenceObject& s, const std::string& pattern) {
+                py::list written;
+                int number = 1;
+                for (const auto& f : s.frames) {
+                    std::filesystem::path file = lsys::format_frame_name(pattern, number++);
+                    write_image(f.cast<const ImageObject&>(), file);
+                    written.append(file.string());
+                }
+                return written;
+            },
+            py::arg("pattern"),
+            "Writes frame k to pattern with its number field (e.g. turn%03d.png) given k, from "
+            "1, as the command names a sequence's files; returns the names")
+        .def("_repr_html_", &sequence_html)
+        .def("__repr__", [](const SequenceObject& s) {
+            return "<cambium.Sequence of " + std::to_string(py::len(s.frames)) + " frames>";
+        });
+
     py::class_<ModelObject>(m, "Model", "A cpfg model loaded by cambium.load()")
         .def(
             "derive",
@@ -638,6 +757,11 @@ PYBIND11_MODULE(cambium, m)
             py::arg("progress") = py::none(),
             "Interprets and renders the model (or a given string of it) into an Image; keywords "
             "are the command's options (width=, height=, spp=, ...) over the load's")
+        .def("turntable", &turntable_model, py::arg("frames"), py::arg("elevation") = py::none(),
+             py::arg("string") = py::none(), py::arg("layers") = false,
+             py::arg("progress") = py::none(),
+             "Renders `frames` views orbiting the plant (--turntable, --turntable-elevation) "
+             "into a Sequence; keywords as render()'s")
         .def_property_readonly("view",
                                [](const ModelObject& self) { return view_settings(*self.model->view); })
         .def_property_readonly(
