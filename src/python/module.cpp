@@ -29,6 +29,8 @@
 
 #include "app/command_line.h"
 #include "app/pipeline.h"
+#include "app/scene_assembly.h"
+#include "app/scene_file.h"
 #include "app/sequence.h"
 #include "base/diagnostics.h"
 #include "base/subprocess.h"
@@ -235,13 +237,12 @@ void run_released(const std::function<void(std::atomic<bool>& cancel, Events& ev
 
 // ---- Objects ----
 
-/// A loaded model: its files read once; the options of each call are the load's
-/// keywords with that call's over them, parsed as the command parses them.
-struct ModelObject {
-    std::vector<std::string> files;  // plant.l plant.v [plant.a]
+/// The files and keywords of a load: the options of each call are the load's keywords
+/// with that call's over them, parsed as the command parses them.
+struct Loaded {
+    std::vector<std::string> files;  // plant.l plant.v [plant.a], or scene.json
     py::dict keywords;
     app::Options options;
-    std::shared_ptr<app::Model> model;
 
     app::Options options_with(const py::dict& more) const
     {
@@ -257,6 +258,16 @@ struct ModelObject {
             throw Error("the options asked for help or the version, not a model");
         return *parsed;
     }
+};
+
+/// A loaded model: its files read once.
+struct ModelObject : Loaded {
+    std::shared_ptr<app::Model> model;
+};
+
+/// A loaded scene file of many plants (docs/scenes.md), read and checked once.
+struct SceneObject : Loaded {
+    std::shared_ptr<const app::SceneFile> scene;
 };
 
 /// A derived string: the model's symbols, its modules' parameters editable in place.
@@ -477,6 +488,59 @@ py::object render_model(ModelObject& m, const py::object& string, bool layers,
                 };
             events.push("render");
             image = render::render(scene, settings, &report);
+        },
+        progress, options.quiet, write);
+    return image_object(std::move(image), write);
+}
+
+SceneObject load_scene(const py::object& file, const py::object& progress,
+                       const py::kwargs& keywords)
+{
+    SceneObject o;
+    o.files.push_back(word(file));
+    o.keywords = keyword_dict(keywords);
+    o.options = o.options_with(py::dict());
+    if (!o.options.scene)
+        throw Error(o.files[0] + ": a scene file is a .json file (docs/scenes.md)");
+    run_released(
+        [&](std::atomic<bool>&, Events& events) {
+            events.push("load");
+            o.scene = std::make_shared<const app::SceneFile>(
+                app::read_scene_file(*o.options.scene, o.options));
+        },
+        progress, o.options.quiet);
+    return o;
+}
+
+/// The scene's plants derived, interpreted and placed (each time: a render's options
+/// may change their steps or limits), then rendered as the command renders a still.
+py::object render_scene(SceneObject& o, bool layers, const py::object& progress,
+                        const py::kwargs& keywords)
+{
+    app::Options options = o.options_with(keyword_dict(keywords));
+    if (app::is_sequence(options))
+        throw Error("a sequence is not one image; the command renders a scene's turntable");
+    app::SceneFile file = *o.scene;
+    app::apply_scene_settings(file, options);
+    if (options.steps)  // steps= derives every plant that many steps
+        for (app::ScenePlant& plant : file.plants)
+            plant.steps = {options.steps};
+    render::RenderSettings settings = app::render_settings(options, {});
+    settings.aovs = layers;
+    const render::WriteOptions write = app::write_options(options);
+    render::Image image;
+    run_released(
+        [&](std::atomic<bool>& cancel, Events& events) {
+            events.push("assemble");
+            geom::Scene scene = app::assemble_scene(file, options);
+            app::apply_camera_options(scene, options);
+            settings.cancel = &cancel;
+            if (!progress.is_none())
+                settings.on_pass = [&](const render::Image& so_far) {
+                    events.push("pass", std::make_shared<render::Image>(so_far));
+                };
+            events.push("render");
+            image = render::render(scene, settings);
         },
         progress, options.quiet, write);
     return image_object(std::move(image), write);
@@ -772,6 +836,19 @@ PYBIND11_MODULE(cambium, m)
             return "<cambium.Model " + self.files[0] + ">";
         });
 
+    py::class_<SceneObject>(m, "Scene", "A scene file of many plants loaded by cambium.load_scene()")
+        .def("render", &render_scene, py::arg("layers") = true, py::arg("progress") = py::none(),
+             "Derives, places and renders the scene's plants into an Image; keywords are the "
+             "command's options over the load's, and both over the scene file's settings")
+        .def_property_readonly("files", [](const SceneObject& self) { return self.files; })
+        .def("__repr__", [](const SceneObject& self) {
+            return "<cambium.Scene " + self.files[0] + ">";
+        });
+
+    m.def("load_scene", &load_scene, py::arg("file"), py::kw_only(),
+          py::arg("progress") = py::none(),
+          "Loads a scene file (docs/scenes.md); keywords are the command's options. Raises "
+          "cambium.Error naming the file and the JSON path or line and column.");
     m.def("load", &load, py::arg("lsystem"), py::arg("view") = py::none(),
           py::arg("animation") = py::none(), py::kw_only(), py::arg("progress") = py::none(),
           "Loads a cpfg model: the L-system, the view file (default: the L-system's name with "
