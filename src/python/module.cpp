@@ -36,6 +36,7 @@
 #include "base/subprocess.h"
 #include "lsys/string_io.h"
 #include "render/framing.h"
+#include "render/light_report.h"
 #include "render/render.h"
 
 namespace py = pybind11;
@@ -546,6 +547,80 @@ py::object render_scene(SceneObject& o, bool layers, const py::object& progress,
     return image_object(std::move(image), write);
 }
 
+/// --light-report: the light each organ absorbs (docs/light.md), traced as the command
+/// traces it (the derivation's ages and the modules' provenance included) and written by
+/// its writer to `path` (.json or .csv); returns the JSON report as Python values.
+py::object light_report(ModelObject& m, const py::object& path, const py::object& string,
+                        const py::object& progress, const py::kwargs& keywords)
+{
+    py::dict more = keyword_dict(keywords);
+    // the file is the report's own name (checked by the command line's rules), or a
+    // private temporary one read back
+    std::filesystem::path folder;
+    std::filesystem::path file;
+    if (!path.is_none()) {
+        file = word(path);
+    } else {
+        std::string pattern = (std::filesystem::temp_directory_path() / "cambium-XXXXXX").string();
+        if (!mkdtemp(pattern.data()))
+            throw Error("cannot make a temporary folder for the light report");
+        folder = pattern;
+        file = folder / "light.json";
+    }
+    more["light_report"] = file.string();
+    struct Cleanup {
+        std::filesystem::path folder;
+        ~Cleanup()
+        {
+            std::error_code ec;
+            if (!folder.empty())
+                std::filesystem::remove_all(folder, ec);
+        }
+    } cleanup{folder};
+    const app::Options options = m.options_with(more);
+    if (app::is_sequence(options))
+        throw Error("--light-report measures a still; not with -a, --turntable or --inbetween");
+    std::optional<lsys::ModuleString> given = given_string(m, string);
+    run_released(
+        [&](std::atomic<bool>&, Events& events) {
+            app::StringOrigins provenance;
+            lsys::ModuleString derived;
+            if (given) {
+                derived = std::move(*given);
+            } else {
+                events.push("derive");
+                derived = options.homomorphism_in_string
+                              ? app::derive(*m.model, options)
+                              : m.model->lsystem.derive_with_ages(options.steps, provenance.ages);
+            }
+            events.push("interpret");
+            geom::Scene scene;
+            if (app::turtle_reads_derived_string(*m.model, options)) {
+                scene = app::interpret_turtle_string(*m.model, derived, options, &provenance);
+            } else {
+                provenance.derived = &derived;
+                lsys::ModuleString turtle =
+                    app::turtle_string(*m.model, derived, options, provenance.origins);
+                scene = app::interpret_turtle_string(*m.model, turtle, options, &provenance);
+            }
+            events.push("trace");
+            render::LightReportSettings settings;
+            settings.rays = options.light_rays;
+            settings.threads = options.threads;
+            render::LightReport report = render::trace_light(scene, settings);
+            for (const std::string& skipped : report.skipped_lights)
+                warn("--light-report: " + skipped);
+            render::write_light_report(report, *options.light_report);
+        },
+        progress, options.quiet);
+    if (file.extension() != ".json")
+        return py::none();
+    std::ifstream in(file, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    return py::module_::import("json").attr("loads")(text.str());
+}
+
 /// Frames of a sequence, numbered from 1 as the command numbers them.
 struct SequenceObject {
     py::list frames;
@@ -826,6 +901,11 @@ PYBIND11_MODULE(cambium, m)
              py::arg("progress") = py::none(),
              "Renders `frames` views orbiting the plant (--turntable, --turntable-elevation) "
              "into a Sequence; keywords as render()'s")
+        .def("light_report", &light_report, py::arg("path") = py::none(),
+             py::arg("string") = py::none(), py::arg("progress") = py::none(),
+             "The light each organ absorbs (--light-report; docs/light.md): written to `path` "
+             "(.json or .csv) as the command writes it when given; returns the JSON report "
+             "(None for a .csv path). Keywords as render()'s (light_rays=, ...)")
         .def_property_readonly("view",
                                [](const ModelObject& self) { return view_settings(*self.model->view); })
         .def_property_readonly(
