@@ -621,6 +621,27 @@ py::object light_report(ModelObject& m, const py::object& path, const py::object
     return py::module_::import("json").attr("loads")(text.str());
 }
 
+/// A derivation in progress, one step (or a few) at a time.
+struct DerivationObject {
+    std::shared_ptr<app::Model> model;
+    std::unique_ptr<lsys::Derivation> derivation;
+    bool quiet = false;
+
+    StringObject string() const { return StringObject{model, derivation->string()}; }
+    StringObject advance(int steps, const py::object& progress)
+    {
+        if (steps < 0)
+            throw Error("advance: steps must be 0 or more");
+        run_released(
+            [&](std::atomic<bool>&, Events& events) {
+                events.push("derive");
+                derivation->advance(steps);
+            },
+            progress, quiet);
+        return string();
+    }
+};
+
 /// Frames of a sequence, numbered from 1 as the command numbers them.
 struct SequenceObject {
     py::list frames;
@@ -838,6 +859,25 @@ PYBIND11_MODULE(cambium, m)
             py::arg("module"), py::arg("parameter"), py::arg("value"),
             "Sets parameter k of module i");
 
+    py::class_<DerivationObject>(m, "Derivation",
+                                 "A derivation from the axiom, advanced step by step")
+        .def("advance", &DerivationObject::advance, py::arg("steps") = 1,
+             py::arg("progress") = py::none(),
+             "Derives `steps` more steps (the query pass before each, as derive() does; past "
+             "the derivation length if asked) and returns the string")
+        .def_property_readonly("string", &DerivationObject::string, "The string so far (a copy)")
+        .def_property_readonly("steps_done",
+                               [](const DerivationObject& d) { return d.derivation->steps_done(); })
+        .def_property_readonly(
+            "derivation_length",
+            [](const DerivationObject& d) { return d.derivation->derivation_length(); })
+        .def_property_readonly("stopped",
+                               [](const DerivationObject& d) { return d.derivation->stopped(); },
+                               "stop() was called in a step")
+        .def(
+            "finish", [](DerivationObject& d) { d.derivation->finish(); },
+            "Runs the End block (once)");
+
     py::class_<SequenceObject>(m, "Sequence",
                                "Frames of a sequence (Images), numbered from 1 as the command's")
         .def("__len__", [](const SequenceObject& s) { return py::len(s.frames); })
@@ -896,6 +936,20 @@ PYBIND11_MODULE(cambium, m)
             py::arg("progress") = py::none(),
             "Interprets and renders the model (or a given string of it) into an Image; keywords "
             "are the command's options (width=, height=, spp=, ...) over the load's")
+        .def(
+            "derivation",
+            [](ModelObject& self) {
+                DerivationObject d{self.model, nullptr, self.options.quiet};
+                run_released(
+                    [&](std::atomic<bool>&, Events&) {
+                        d.derivation =
+                            std::make_unique<lsys::Derivation>(self.model->lsystem.start());
+                    },
+                    py::none(), self.options.quiet);
+                return d;
+            },
+            "Starts a derivation from the axiom (the Start block run): advance() it step by "
+            "step")
         .def("turntable", &turntable_model, py::arg("frames"), py::arg("elevation") = py::none(),
              py::arg("string") = py::none(), py::arg("layers") = false,
              py::arg("progress") = py::none(),

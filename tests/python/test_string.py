@@ -85,3 +85,17 @@ def test_view_settings(default_scene):
     assert view["projection"] in ("parallel", "perspective")
     assert ("perspective" in text) == (view["projection"] == "perspective")
     assert len(view["viewpoint"]) == 3
+
+
+def test_a_derivation_advanced_step_by_step_gives_each_steps_string(default_scene):
+    m = cambium.load("plant.l", "plant.v", materials="plant.mat")
+    d = m.derivation()
+    assert d.steps_done == 0 and d.derivation_length == m.derivation_length
+    assert str(d.string) == str(m.derive(steps=0))
+    for step in range(1, 4):
+        s = d.advance()
+        assert d.steps_done == step
+        assert str(s) == str(m.derive(steps=step))
+    # the step's string renders like any other
+    img = m.render(string=d.advance(2), **SMALL)
+    assert np.array_equal(np.asarray(img), np.asarray(m.render(steps=5, **SMALL)))
