@@ -10,7 +10,7 @@ import pytest
 SOURCE = pathlib.Path(__file__).resolve().parents[2]
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def command():
     """The cambium command of the same build (CAMBIUM_EXE, set by ctest)."""
     exe = os.environ.get("CAMBIUM_EXE")
@@ -19,7 +19,7 @@ def command():
     return exe
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")
 def corpus():
     """The model corpus: $CAMBIUM_CORPUS, else the build's default (../shared/corpus)."""
     folder = os.environ.get("CAMBIUM_CORPUS") or os.environ.get("CAMBIUM_CORPUS_DEFAULT")
