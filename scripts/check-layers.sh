@@ -9,6 +9,7 @@
 #           FreeType and fontconfig (labels)
 #   imageio what render may + render + OpenImageIO (libcambium_imageio.so: the only OpenImageIO user)
 #   app     everything
+#   python  + app (the command's pipeline) and pybind11: the Python module
 # Standard and POSIX headers are <name>, <name.h> and <sys/name.h>; any other <dir/...> is a
 # third-party library; "layer/file.h" is the project's own.
 #   scripts/check-layers.sh [SRC]   (default: the src/ beside this script)
@@ -25,9 +26,11 @@ BEGIN {
     project["render"] = "^(base|render)/|^geom/(scene|scene_limits|vec)\\.h$"
     project["imageio"] = "^(base|render|imageio)/|^geom/(scene|scene_limits|vec)\\.h$"
     project["app"] = "."
+    project["python"] = "^(base|lsys|geom|env|render|app)/"
     library["render"] = "^(embree3|tbb|fontconfig)/|^ft2build\\.h$"
     library["imageio"] = "^(tbb|OpenImageIO)/"
     library["app"] = "."
+    library["python"] = "^pybind11/"
     rule["base"] = "the standard library only"
     rule["lsys"] = "the standard library and base only"
     rule["geom"] = "the standard library, base and lsys only"
@@ -35,6 +38,7 @@ BEGIN {
     rule["render"] = "base, geom/scene.h, geom/scene_limits.h, geom/vec.h, Embree, TBB, FreeType and fontconfig only"
     rule["imageio"] = "base, render, the Scene contract, TBB and OpenImageIO only"
     rule["app"] = "anything"
+    rule["python"] = "the project layers and pybind11 only"
 }
 FNR == 1 {
     file = FILENAME; sub(/^\.\//, "", file)

@@ -30,6 +30,11 @@ packages=(
   # Open MPI (BSD licence) for --mpi: the module libcambium_mpi.so links it, the tests
   # run mpirun (docs/distributed.md)
   libopenmpi-dev openmpi-bin
+  # the Python module (docs/python.md): pybind11 and the Python headers build it, numpy
+  # reads its images, pytest runs its tests; nbconvert and the IPython kernel execute the
+  # example notebook (examples/python/plants.ipynb) in the suite
+  pybind11-dev python3-dev python3-numpy python3-pytest
+  jupyter-nbconvert python3-ipykernel
 )
 # Not installed on purpose: python3-imath. Imath's CMake package names its Python binding,
 # which Cambium does not use (CMakeLists.txt keeps the resulting notice quiet).

@@ -53,61 +53,13 @@ std::vector<std::filesystem::path> image_outputs(const Options& options)
     return {(options.scene ? options.scene->stem() : options.lsystem.stem()).string() + ".png"};
 }
 
-render::PixelFilter pixel_filter(const std::string& name)
+/// The render settings of the options, with the terminal's progress line and Ctrl-C.
+render::RenderSettings command_render_settings(const Options& options,
+                                               const std::vector<std::filesystem::path>& images)
 {
-    if (name == "gaussian")
-        return render::PixelFilter::gaussian;
-    if (name == "blackman-harris")
-        return render::PixelFilter::blackman_harris;
-    return render::PixelFilter::box;
-}
-
-render::RenderSettings render_settings(const Options& options,
-                                       const std::vector<std::filesystem::path>& images)
-{
-    render::RenderSettings settings;
-    settings.width = options.width;
-    settings.height = options.height;
-    settings.samples_per_pixel = options.samples_per_pixel;
-    settings.max_depth = options.max_depth;
-    settings.seed = options.seed;
-    settings.sampler = options.sampler == "white" ? render::SampleSequence::white
-                                                  : render::SampleSequence::sobol;
-    settings.threads = options.threads;
-    settings.max_memory_bytes = options.max_memory_bytes;
-    settings.filter = pixel_filter(options.filter);
-    settings.filter_radius = options.filter_radius;
-    settings.noise_target = options.noise_target;
-    settings.time_budget_s = options.time_budget_s;
-    settings.aperture_radius = options.aperture_radius;
-    settings.focus_distance = options.focus_distance;
-    settings.transparent_background = options.transparent;
-    settings.ambient = {options.ambient, options.ambient, options.ambient};
-    settings.view_lights = !options.no_view_lights;
-    std::optional<render::Environment> environment;
-    if (options.sky) {
-        render::SkyParameters sky;
-        if (!options.sun_direction.empty())
-            sky.sun_direction = render::normalize(render::Vec3f(
-                options.sun_direction[0], options.sun_direction[1], options.sun_direction[2]));
-        sky.turbidity = options.turbidity;
-        environment = render::make_sky_environment(sky);
-    } else if (options.environment_map) {
-        environment =
-            render::make_map_environment(*options.environment_map, options.environment_scale);
-    }
-    if (environment)
-        settings.environment = std::make_shared<const render::Environment>(
-            std::move(*environment).rotated(options.environment_rotation));
+    render::RenderSettings settings = render_settings(options, images);
     settings.progress = !options.quiet && isatty(fileno(stderr));
-    // The albedo, normal and depth layers cost a camera-ray intersection: only for a
-    // format that keeps them.
-    settings.aovs = std::any_of(images.begin(), images.end(), [](const auto& f) {
-        const OutputFormat* format = find_output_format(f);
-        return format && format->keeps_layers;
-    });
     settings.cancel = render::install_interrupt_handler();
-    apply_staging(settings, options);
     return settings;
 }
 
@@ -262,7 +214,7 @@ int render_and_write_still(geom::Scene& scene, const Options& options,
         report_stats(stats, options);
         return 0;
     }
-    render::RenderSettings settings = render_settings(options, images);
+    render::RenderSettings settings = command_render_settings(options, images);
     apply_camera_options(scene, options);
     if (options.tile) {
         write_tile(options, images.front(), scene, settings, say);
@@ -350,7 +302,7 @@ int run_scene(Options options, const std::function<void(const std::string&)>& sa
         return scene;
     };
     if (is_sequence(options)) {
-        SequenceOutputs outputs{images, render_settings(options, images), {},     say,
+        SequenceOutputs outputs{images, command_render_settings(options, images), {},     say,
                                 mpi,    make_scene,                       &stats, command_start};
         return run_sequence_with_stats(options, outputs);
     }
@@ -391,7 +343,7 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
         auto strings = [&](const Model& model, const lsys::ModuleString& s, int step) {
             write_strings(model, s, options, step, say);
         };
-        SequenceOutputs outputs{images, render_settings(options, images), strings, say, mpi,
+        SequenceOutputs outputs{images, command_render_settings(options, images), strings, say, mpi,
                                 {},     &stats,                           command_start};
         return run_sequence_with_stats(options, outputs);
     }

@@ -23,6 +23,7 @@
 #include "app/shot_options.h"
 #include "app/video.h"
 #include "base/diagnostics.h"
+#include "base/output_format.h"
 #include "base/subprocess.h"
 #include "geom/view_file.h"
 #include "geom/view_volume.h"
@@ -708,6 +709,66 @@ void apply_staging(render::RenderSettings& settings, const Options& options)
     auto rgb = background_colour(*background);
     settings.backdrop = render::RenderSettings::Backdrop::colour;
     settings.backdrop_colour = {rgb[0], rgb[1], rgb[2]};
+}
+
+namespace {
+
+render::PixelFilter pixel_filter(const std::string& name)
+{
+    if (name == "gaussian")
+        return render::PixelFilter::gaussian;
+    if (name == "blackman-harris")
+        return render::PixelFilter::blackman_harris;
+    return render::PixelFilter::box;
+}
+
+}  // namespace
+
+render::RenderSettings render_settings(const Options& options,
+                                       const std::vector<std::filesystem::path>& images)
+{
+    render::RenderSettings settings;
+    settings.width = options.width;
+    settings.height = options.height;
+    settings.samples_per_pixel = options.samples_per_pixel;
+    settings.max_depth = options.max_depth;
+    settings.seed = options.seed;
+    settings.sampler = options.sampler == "white" ? render::SampleSequence::white
+                                                  : render::SampleSequence::sobol;
+    settings.threads = options.threads;
+    settings.max_memory_bytes = options.max_memory_bytes;
+    settings.filter = pixel_filter(options.filter);
+    settings.filter_radius = options.filter_radius;
+    settings.noise_target = options.noise_target;
+    settings.time_budget_s = options.time_budget_s;
+    settings.aperture_radius = options.aperture_radius;
+    settings.focus_distance = options.focus_distance;
+    settings.transparent_background = options.transparent;
+    settings.ambient = {options.ambient, options.ambient, options.ambient};
+    settings.view_lights = !options.no_view_lights;
+    std::optional<render::Environment> environment;
+    if (options.sky) {
+        render::SkyParameters sky;
+        if (!options.sun_direction.empty())
+            sky.sun_direction = render::normalize(render::Vec3f(
+                options.sun_direction[0], options.sun_direction[1], options.sun_direction[2]));
+        sky.turbidity = options.turbidity;
+        environment = render::make_sky_environment(sky);
+    } else if (options.environment_map) {
+        environment =
+            render::make_map_environment(*options.environment_map, options.environment_scale);
+    }
+    if (environment)
+        settings.environment = std::make_shared<const render::Environment>(
+            std::move(*environment).rotated(options.environment_rotation));
+    // The albedo, normal and depth layers cost a camera-ray intersection: only for a
+    // format that keeps them.
+    settings.aovs = std::any_of(images.begin(), images.end(), [](const auto& f) {
+        const OutputFormat* format = find_output_format(f);
+        return format && format->keeps_layers;
+    });
+    apply_staging(settings, options);
+    return settings;
 }
 
 render::WriteOptions write_options(const Options& options)

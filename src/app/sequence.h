@@ -68,6 +68,12 @@ int derive_frames_with_lineage(const Model& model,
 /// --shadow-catcher.
 void apply_staging(render::RenderSettings& settings, const Options& options);
 
+/// The render settings of the options for `images` (the albedo, normal and depth layers
+/// only when one of them keeps them), staging included; without a progress line or a
+/// cancel flag, which the caller sets (the command: the terminal and Ctrl-C).
+render::RenderSettings render_settings(const Options& options,
+                                       const std::vector<std::filesystem::path>& images);
+
 /// How images are written: --exposure and --tonemap.
 render::WriteOptions write_options(const Options& options);
 

@@ -18,6 +18,14 @@ std::vector<fs::path> module_candidates(const std::string& file_name)
         candidates.push_back(exe.parent_path() / file_name);
         candidates.push_back(exe.parent_path() / CAMBIUM_LIB_FROM_BIN / file_name);
     }
+    // Code loaded as a shared object of its own (the Python module, installed in
+    // P/lib/python3.X/dist-packages): the library folder P/lib two levels above it.
+    Dl_info info{};
+    if (dladdr(reinterpret_cast<void*>(&module_candidates), &info) && info.dli_fname) {
+        fs::path self = fs::absolute(info.dli_fname, error);
+        if (!error && self != exe)
+            candidates.push_back(self.parent_path().parent_path().parent_path() / file_name);
+    }
     candidates.push_back(fs::path(CAMBIUM_INSTALL_LIB_DIR) / file_name);
     candidates.push_back(fs::path(CAMBIUM_BUILD_MODULE_DIR) / file_name);
     return candidates;

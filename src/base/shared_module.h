@@ -11,8 +11,9 @@
 namespace cambium {
 
 /// Where module `file_name` may be, in order: beside the executable (the build tree's
-/// src/app), the install's library folder relative to the executable's bin folder, the
-/// configured install library folder, and the build tree's module folder (for tests and
+/// src/app), the install's library folder relative to the executable's bin folder, for
+/// code loaded as a shared object (the Python module in P/lib/python3.X/dist-packages)
+/// the folder two levels above it, the configured install library folder, and the build tree's module folder (for tests and
 /// benchmarks that live elsewhere in the build tree).
 std::vector<std::filesystem::path> module_candidates(const std::string& file_name);
 
