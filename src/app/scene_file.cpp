@@ -223,10 +223,18 @@ void check_command_options(const Node& n, const std::vector<std::string>& words)
     static const std::set<std::string> no_value = {"-a", "-v", "-V", "-g", "-d", "-mb", "-pm", "-sb"};
     static const std::set<std::string> one_value = {"-wt", "-S", "-C", "-f"};
     static const std::set<std::string> two_values = {"-w", "-wp"};
+    // cpfg keeps the last of a repeated option, where a reviewer of the scene reads the first
+    std::set<std::string> seen;
     for (std::size_t i = 0; i < words.size(); ++i) {
         const std::string& w = words[i];
         if (w.empty() || w[0] != '-')
             continue;
+        std::string key = w == "-m" || w == "-M" ? w + "1" : w;  // no number: colour map 1
+        if (std::regex_match(w, glued))
+            key = w.substr(0, 2);
+        if (!seen.insert(key).second)
+            n.fail("option " + w + " is given twice (cpfg would keep the last, a reader sees "
+                                   "the first)");
         if (std::regex_match(w, takes_file) || one_value.count(w))
             ++i;
         else if (two_values.count(w))

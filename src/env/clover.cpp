@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <numbers>
 
+#include "base/input_file.h"
 #include "env/builtins.h"
 #include "env/spec_values.h"
 
@@ -18,6 +19,7 @@ namespace cambium::env {
 namespace {
 
 constexpr int max_side = 4096;  // cells a side: a model file may not ask for more
+constexpr std::uintmax_t max_image_file_bytes = std::uintmax_t{1} << 30;  // as environment maps
 
 struct Settings {
     std::array<int, 2> size{512, 512};
@@ -25,6 +27,7 @@ struct Settings {
     std::array<float, 2> extent{2, 2};
     float transmittance = 0.6f;
     std::string image;  ///< empty: full light everywhere
+    FileLoc image_loc;  ///< the `input image:` line, for errors about the file it names
     bool remove_old_leaves = false;
     bool z_is_up = true;
 };
@@ -151,6 +154,15 @@ std::vector<Cell> cells_from(const Settings& s, const Context& context)
     if (!context.read_image)
         throw Error("clover: cannot read the input image " + s.image + ": no image reader");
     const std::filesystem::path file = model_file(s.image, context);
+    // a FIFO or device would block the image reader forever: regular files only, sized first
+    try {
+        regular_file_size(file, "the input image", max_image_file_bytes);
+    } catch (const Error& e) {
+        const std::string why = e.what();
+        const std::size_t at = why.find("error: ");
+        throw Error(s.image_loc, "clover: input image " + file.string() + ": " +
+                                     (at == std::string::npos ? why : why.substr(at + 7)));
+    }
     const RgbImage image = context.read_image(file);
     if (image.width < 1 || image.height < 1 ||
         image.rgb.size() != static_cast<std::size_t>(image.width) * static_cast<std::size_t>(image.height) * 3)
@@ -207,6 +219,7 @@ std::unique_ptr<Environment> make_clover(const std::vector<std::string>& args, c
         } else if (k == "input image") {
             // the file name: up to a blank, comma, semicolon or colon ('x' may be in a name)
             s.image = line.value.substr(0, line.value.find_first_of(" \t,;:"));
+            s.image_loc = line.loc;
         } else if (k == "remove old leaves") {
             s.remove_old_leaves = switch_value(line, {"on", "yes"});
         } else if (k == "z is up") {

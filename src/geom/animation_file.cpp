@@ -10,6 +10,8 @@
 
 #include <cctype>
 #include <charconv>
+#include <cmath>
+#include <limits>
 #include <string>
 
 #include "base/diagnostics.h"
@@ -65,7 +67,29 @@ public:
         }
         return n;
     }
-    double real(const char* what) { return number<double>(what); }
+    /// A finite number within single precision, cpfg's type for the frame intervals' values.
+    double real()
+    {
+        skip_blanks();
+        std::size_t at = m_at;
+        double value = number<double>("a number");
+        if (!std::isfinite(value) || std::abs(value) > std::numeric_limits<float>::max()) {
+            std::size_t end = at;
+            while (end < m_text.size() && !std::isspace(static_cast<unsigned char>(m_text[end])) &&
+                   m_text[end] != ',')
+                ++end;
+            m_at = at;
+            fail("expected a number, found '" + std::string(m_text.substr(at, end - at)) + "'");
+        }
+        return value;
+    }
+    FileLoc here()
+    {
+        skip_blanks();
+        FileLoc at = m_line;
+        at.column = static_cast<int>(m_at) + 1;
+        return at;
+    }
     [[noreturn]] void fail(const std::string& message) const
     {
         FileLoc at = m_line;
@@ -128,9 +152,10 @@ FrameInterval read_interval(LineValue& value)
                    interval.change == FrameInterval::Change::none) {
             interval.change = word == "rotate" ? FrameInterval::Change::rotate
                                                : FrameInterval::Change::scale;
-            interval.amount.x = value.real("three numbers");
-            interval.amount.y = value.real("three numbers");
-            interval.amount.z = value.real("three numbers");
+            interval.change_loc = value.here();
+            interval.amount.x = value.real();
+            interval.amount.y = value.real();
+            interval.amount.z = value.real();
         } else {
             value.fail("expected step, rotate or scale (one each) after a frame range, not '" +
                        std::string(word) + "'");
@@ -253,6 +278,16 @@ void advance_to_next_frame(const AnimationFile& a, AnimationFrame& next, std::si
         else if (interval.change == FrameInterval::Change::scale)
             next.scale = {next.scale.x * interval.amount.x, next.scale.y * interval.amount.y,
                           next.scale.z * interval.amount.z};
+        // a sum or product past single precision leaves the camera no finite direction
+        auto beyond = [](const Vec3& v) {
+            const double most = std::numeric_limits<float>::max();
+            return !(std::abs(v.x) <= most && std::abs(v.y) <= most && std::abs(v.z) <= most);
+        };
+        if (beyond(next.rotation_deg) || beyond(next.scale))
+            throw Error(interval.change_loc,
+                        std::string("the accumulated ") +
+                            (interval.change == FrameInterval::Change::rotate ? "rotation" : "scale") +
+                            " exceeds single precision by frame " + std::to_string(n));
         if (interval.step && *interval.step == 0) {
             next.number = current + 1;
             next.derive_steps = 0;

@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "base/diagnostics.h"
 #include "geom/vec.h"
 
 namespace cambium::geom {
@@ -27,6 +28,7 @@ struct FrameInterval {
     std::optional<int> step;  ///< absent: the file's `step:`; 0: frames without derivation
     Change change = Change::none;
     Vec3 amount{0, 0, 0};     ///< degrees about x, y, z (rotate) or factors (scale)
+    FileLoc change_loc;       ///< where the rotate or scale numbers are, for errors
 };
 
 /// The commands of an animation file, with cpfg's defaults.

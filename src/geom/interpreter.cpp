@@ -155,6 +155,15 @@ public:
             bytes += geometry_bytes(p.geometry);
         bytes += m_scene.instances.capacity() * sizeof(Instance);
         bytes += m_label_text_bytes + m_scene.labels.capacity() * sizeof(Label);
+        // a string of nested '[' holds a turtle each without drawing anything
+        const std::size_t stack_bytes = m_stack.capacity() * sizeof(Turtle);
+        if (bytes <= m_options.max_memory_bytes && bytes + stack_bytes > m_options.max_memory_bytes)
+            throw Error("the turtle's branch stack of " + std::to_string(m_stack.size()) +
+                        " nested '[' needs " + byte_size_text(stack_bytes) + " after " +
+                        std::to_string(m_module_index) +
+                        " modules of the string, beside the geometry more than the memory budget of " +
+                        byte_size_text(m_options.max_memory_bytes) +
+                        " (--max-memory); close the branches or raise --max-memory");
         if (bytes > m_options.max_memory_bytes)
             throw Error("the scene's geometry needs " + byte_size_text(bytes) + " after " +
                         std::to_string(m_module_index) +

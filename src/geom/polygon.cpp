@@ -37,7 +37,8 @@ bool same_point(const Point2& a, const Point2& b) { return a.x == b.x && a.y == 
 /// order (consecutive repeats already dropped); `index` maps them back to the outline.
 class EarClipper {
 public:
-    EarClipper(std::vector<Point2> points, std::vector<std::uint32_t> index, double eps)
+    EarClipper(std::vector<Point2> points, std::vector<std::uint32_t> index, double eps,
+               std::size_t max_tests)
         : m_p(std::move(points)), m_index(std::move(index)), m_eps(eps), m_prev(m_p.size()),
           m_next(m_p.size()), m_removed(m_p.size(), 0), m_repeated(m_p.size(), 0),
           m_remaining(m_p.size())
@@ -50,7 +51,7 @@ public:
         mark_repeated_positions();
         index_spoilers();
         // Work beyond near-linear is allowed up to this many tests (seconds at most).
-        m_budget = std::min<std::size_t>(1000 * n + 50'000'000, 300'000'000);
+        m_budget = std::min<std::size_t>(1000 * n + 50'000'000, max_tests);
     }
 
     /// Cuts ears until fewer than three vertices remain.
@@ -59,6 +60,8 @@ public:
         std::uint32_t k = 0;
         std::size_t misses = 0;
         while (m_remaining >= 3) {
+            // every step of the walk counts: rounds of quick misses are the quadratic part
+            ++m_tests;
             std::uint32_t a = m_prev[k], c = m_next[k];
             double turn = cross2(m_p[a], m_p[k], m_p[c]);
             bool collinear = std::abs(turn) <= m_eps;
@@ -271,7 +274,8 @@ Vec3 polygon_normal(std::span<const Vec3> outline)
 }
 
 std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(std::span<const Vec3> outline,
-                                                              bool* cut_short)
+                                                              bool* cut_short,
+                                                              std::size_t max_tests)
 {
     std::vector<std::array<std::uint32_t, 3>> triangles;
     if (cut_short)
@@ -308,7 +312,7 @@ std::vector<std::array<std::uint32_t, 3>> triangulate_polygon(std::span<const Ve
     if (ring.size() < 3)
         return triangles;
     triangles.reserve(ring.size() - 2);
-    EarClipper clipper(std::move(ring), std::move(index), eps);
+    EarClipper clipper(std::move(ring), std::move(index), eps, max_tests);
     clipper.run(triangles);
     if (cut_short)
         *cut_short = clipper.over_budget();

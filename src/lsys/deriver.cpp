@@ -121,6 +121,13 @@ void Deriver::start()
             setting(*main.derivation_length, main.derivation_length_loc, "the derivation length",
                     0, max_derivation_steps));
     }
+    // The value of `seed:` is unused (below) but checked, as the homomorphism's: a number
+    // out of a long's range is an error at its expression, not a silently accepted model.
+    for (const LSystemDefinition& ls : m_program.lsystems)
+        if (ls.seed) {
+            in_block("'seed:'");
+            setting(*ls.seed, ls.seed_loc, "the seed", LONG_MIN, LONG_MAX);
+        }
     // seed: makes the L-system stochastic. The production choice draws from erand48 on
     // a state that starts at 0 and that cpfg (the build the corpus oracle comes from)
     // never seeds: RandomMoss (seed: 2454) matches cpfg only this way.

@@ -97,6 +97,65 @@ std::vector<IncludeDirective> scan_includes(std::string_view text, bool tab_line
     return found;
 }
 
+/// Refuses `__has_include`, `__has_include_next` and `GCC dependency` (a pragma, or the
+/// text of a `_Pragma`) in `text`: cpp would look up the files they name, so a model could
+/// learn which files exist outside its folder. Token pasting in a #define, which could
+/// build the name, is refused too. Line splices are joined first, as cpp does.
+void refuse_file_probes(std::string_view text, const std::string& file_name)
+{
+    // where `text` (one logical line) probes for a file, or npos; the word found in `word`
+    auto find_probe = [](std::string_view text, std::string& word) {
+        std::size_t at = text.find("__has_include");
+        for (std::size_t gcc = text.find("GCC"); gcc != std::string_view::npos && gcc < at;
+             gcc = text.find("GCC", gcc + 1)) {
+            std::size_t next = text.find_first_not_of(" \t", gcc + 3);
+            if (next > gcc + 3 && next != std::string_view::npos &&
+                text.substr(next, 10) == "dependency") {
+                word = "GCC dependency";
+                return gcc;
+            }
+        }
+        if (at != std::string_view::npos) {
+            word = text.substr(at, 18) == "__has_include_next" ? "__has_include_next" : "__has_include";
+            return at;
+        }
+        // a macro that pastes tokens could build __has_include where no scan sees it
+        std::size_t hash = text.find_first_not_of(" \t");
+        if (hash == std::string_view::npos)
+            return hash;
+        std::size_t name = text.substr(hash, 1) == "#" ? hash + 1 : text.substr(hash, 2) == "%:" ? hash + 2 : hash;
+        name = text.find_first_not_of(" \t", name);
+        if (name == hash || name == std::string_view::npos || text.substr(name, 6) != "define")
+            return std::string_view::npos;
+        at = std::min(text.find("##", name), text.find("%:%:", name));
+        if (at != std::string_view::npos)
+            word = "token pasting in a #define";
+        return at;
+    };
+    std::string joined;
+    int line = 0, first = 1;
+    for_each_line(text, [&](std::string_view l) {
+        ++line;
+        if (joined.empty())
+            first = line;
+        if (!l.empty() && l.back() == '\n')
+            l.remove_suffix(1);
+        if (!l.empty() && l.back() == '\r')
+            l.remove_suffix(1);
+        if (!l.empty() && l.back() == '\\') {
+            joined.append(l.substr(0, l.size() - 1));
+            return;
+        }
+        joined.append(l);
+        std::string word;
+        if (std::size_t at = find_probe(joined, word); at != std::string_view::npos)
+            throw Error(FileLoc{file_name, first, int(at) + 1},
+                        "'" + word + "' would tell the model whether a file exists outside its "
+                                     "folder; --allow-file-access lifts this");
+        joined.clear();
+    });
+}
+
 /// Refuses, before cpp opens them, included names that are not regular files (reading
 /// /dev/zero, a FIFO or a terminal never ends) or that lie outside `confine_to`.
 /// Follows the includes it can resolve (as cpp: the including file's folder for quoted
@@ -117,6 +176,8 @@ void check_includes(std::string_view source, const std::string& file_name,
     while (!queue.empty()) {
         Pending current = std::move(queue.back());
         queue.pop_back();
+        if (confine_to)
+            refuse_file_probes(current.text, current.name);
         for (const IncludeDirective& d : scan_includes(current.text, current.protected_tabs)) {
             std::vector<std::filesystem::path> candidates;
             std::filesystem::path named(d.name);

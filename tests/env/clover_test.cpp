@@ -3,7 +3,10 @@
 // answers follow from what vlab's program computes (docs/environment.md).
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <cstdio>
+#include <fstream>
 
 #include "env_fixture.h"
 
@@ -14,11 +17,12 @@ using testing::first_params;
 using testing::model_with;
 using testing::query_at;
 
-/// A model folder with `spec` as enviro.spec and an image reader that returns `image`
-/// for light.rgb.
+/// A model folder with `spec` as enviro.spec, a light.rgb file and an image reader that
+/// returns `image` for it.
 Context clover_model(const std::string& test, const std::string& spec, const RgbImage& image)
 {
     Context context = model_with("clover_" + test, "enviro.spec", spec);
+    std::ofstream(context.folder / "light.rgb") << "image";
     context.read_image = [image](const std::filesystem::path& file) {
         if (file.filename() != "light.rgb")
             throw Error(FileLoc{file.string()}, "no such image");
@@ -211,6 +215,34 @@ TEST(Clover, OversizedGridsAndMissingImagesAreErrors)
     EXPECT_THROW(clover("no_image", "input image: other.rgb\n"), Error);
     Context context = model_with("clover_no_reader", "enviro.spec", "input image: light.rgb\n");
     EXPECT_THROW(make_builtin("clover", {"enviro.spec"}, context), Error);
+}
+
+// A FIFO would block the image reader forever and a device never ends: refused before
+// the reader is called, naming the spec line.
+TEST(Clover, AnImageThatIsNoRegularFileIsRefusedAtItsLine)
+{
+    Context fifo = clover_model("fifo", "grid size: 4x4\ninput image: pipe.rgb\n", two_by_two);
+    ASSERT_EQ(::mkfifo((fifo.folder / "pipe.rgb").c_str(), 0600), 0);
+    bool read = false;
+    fifo.read_image = [&read](const std::filesystem::path&) {
+        read = true;
+        return two_by_two;
+    };
+    try {
+        make_builtin("clover", {"enviro.spec"}, fifo);
+        ADD_FAILURE() << "a FIFO image was accepted";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.loc().file, (fifo.folder / "enviro.spec").string());
+        EXPECT_EQ(e.loc().line, 2);
+        EXPECT_NE(std::string(e.what()).find("not a regular file"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(read);
+
+    Context device = clover_model("device", "input image: /dev/zero\n", two_by_two);
+    device.allow_file_access = true;
+    device.read_image = fifo.read_image;
+    EXPECT_THROW(make_builtin("clover", {"enviro.spec"}, device), Error);
+    EXPECT_FALSE(read);
 }
 
 }  // namespace

@@ -191,6 +191,28 @@ int error_column(const std::string& text, const std::string& words)
     return 0;
 }
 
+// A rotate or scale the camera cannot take is an error at its column before any frame,
+// not a failed camera after some frames were written.
+TEST(AnimationFile, RotateAndScaleAreFiniteNumbers)
+{
+    EXPECT_EQ(error_column("frame intervals: 1-3 rotate nan 0 0\n", "expected a number, found 'nan'"), 29);
+    EXPECT_EQ(error_column("frame intervals: 1-3 scale 1 inf 1\n", "found 'inf'"), 30);
+    EXPECT_EQ(error_column("frame intervals: 1-3 rotate 0 0 1.7e308\n", "found '1.7e308'"), 33);
+    // each value fits, their sum or product after two frames does not
+    AnimationFile a = parse_animation_file("frame intervals: 1-3 rotate 3e38 0 0\n", "t.a");
+    try {
+        select_frames(a, 10);
+        ADD_FAILURE() << "no error";
+    } catch (const Error& e) {
+        EXPECT_EQ(e.loc().file, "t.a");
+        EXPECT_EQ(e.loc().line, 1);
+        EXPECT_EQ(e.loc().column, 29);
+    }
+    EXPECT_THROW(select_frames(parse_animation_file("frame intervals: 1-9 scale 1e30 1 1\n", "t.a"), 10),
+                 Error);
+    EXPECT_NO_THROW(select_frames(parse_animation_file("frame intervals: 1-9 rotate 1e30 0 0\n", "t.a"), 10));
+}
+
 // Frame numbers and steps are derivation steps: past the derivation length's limit
 // they are errors at their column, not billions of steps derived without a word.
 TEST(AnimationFile, FrameNumbersAndStepsAreBounded)

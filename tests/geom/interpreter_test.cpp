@@ -163,6 +163,32 @@ TEST(Interpreter, SceneGeometryPastTheMemoryBudgetIsAnError)
               20000u);
 }
 
+TEST(Interpreter, BranchStackPastTheMemoryBudgetIsAnError)
+{
+    // 20 000 nested '[' draw nothing, but each holds a turtle of some hundred bytes: the
+    // first check, after 4096 modules, finds the stack past a budget of 64 KiB
+    lsys::SymbolTable symbols;
+    lsys::ModuleString s = text_modules(symbols, std::string(20000, '[') + "F");
+    InterpretOptions options;
+    options.max_memory_bytes = 64 << 10;
+    try {
+        interpret(s, symbols, parse_view_file("", "t.v"), options);
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        std::string message = e.what();
+        EXPECT_EQ(message.rfind("error: the turtle's branch stack of 4096 nested '[' needs ", 0), 0u)
+            << message;
+        EXPECT_NE(message.find(" after 4096 modules of the string, beside the geometry more than "
+                               "the memory budget of 64.0 KiB (--max-memory)"),
+                  std::string::npos)
+            << message;
+    }
+    options.max_memory_bytes = 64 << 20;  // the same string within a larger budget
+    EXPECT_EQ(interpret(s, symbols, parse_view_file("", "t.v"), options)
+                  .geometry.lines.segment_count(),
+              1u);
+}
+
 TEST(Interpreter, LabelTextPastTheMemoryBudgetIsAnError)
 {
     // 100 labels of 12 formats padded to 99 characters: about 120 KiB of text, found at

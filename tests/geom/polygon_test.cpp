@@ -206,3 +206,25 @@ TEST(Polygon, LongCombWithDeepTeeth)
     // counter-clockwise from (0,-1): base, then the teeth from the right
     check_xy(p, p.size() - 2);
 }
+
+// A star whose every step turns 137.508° (a golden-angle phyllotaxis outline) crosses
+// itself everywhere: the walk finds no ear for a full round before each cut, quadratic
+// quick misses that the budget must count. 4096 vertices take about 2 million steps.
+TEST(Polygon, SelfIntersectingStarWalkCountsAgainstTheBudget)
+{
+    Outline star;
+    double x = 0, y = 0, angle = 0;
+    for (int i = 0; i < 4096; ++i) {
+        star.push_back({x, y, 0});
+        angle += 137.508 * 3.141592653589793 / 180;
+        x += std::cos(angle);
+        y += std::sin(angle);
+    }
+    bool cut_short = false;
+    auto tris = triangulate_polygon(star, &cut_short, 1'000'000);
+    EXPECT_TRUE(cut_short);
+    EXPECT_EQ(tris.size(), star.size() - 2);  // the rest is still cut, in order
+    tris = triangulate_polygon(star, &cut_short);
+    EXPECT_FALSE(cut_short);
+    EXPECT_EQ(tris.size(), star.size() - 2);
+}

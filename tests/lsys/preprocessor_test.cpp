@@ -259,6 +259,38 @@ TEST(LsysPreprocessor, IncludesStayInTheConfinedFolder)
     EXPECT_NE(preprocess("#include \"../secret.h\"\n", "p.l", options).find("secret_text"), npos);
 }
 
+// __has_include and `#pragma GCC dependency` look files up: a confined model could learn
+// whether a file exists outside its folder, so they are refused where they stand.
+TEST(LsysPreprocessor, FileProbesAreRefusedInTheConfinedFolder)
+{
+    constexpr auto npos = std::string::npos;
+    fs::path dir = scratch("probes");
+    fs::create_directories(dir / "model");
+    std::ofstream(dir / "model" / "probe.h") << "\n#pragma GCC dependency \"/etc/passwd\"\n";
+    PreprocessOptions options;
+    options.folder = dir / "model";
+    options.confine_to = dir / "model";
+    const std::string has = "#if __has_include(\"/etc/passwd\")\nA\n#endif\nB\n";
+    EXPECT_NE(preprocess_error("\n" + has, "p.l", options).find("p.l:2:5: error: '__has_include' would"), npos)
+        << preprocess_error("\n" + has, "p.l", options);
+    EXPECT_NE(preprocess_error("#if __has_include_next(<x>)\n#endif\n", "p.l", options)
+                  .find("p.l:1:5: error: '__has_include_next'"), npos);
+    EXPECT_NE(preprocess_error("#if __has_\\\ninclude(\"/etc/passwd\")\n#endif\n", "p.l", options)
+                  .find("p.l:1:5: error: '__has_include'"), npos);
+    EXPECT_NE(preprocess_error("#pragma GCC dependency \"/etc/passwd\"\n", "p.l", options)
+                  .find("p.l:1:9: error: 'GCC dependency'"), npos);
+    EXPECT_NE(preprocess_error("_Pragma(\"GCC dependency \\\"/etc/passwd\\\"\")\n", "p.l", options)
+                  .find("'GCC dependency'"), npos);
+    EXPECT_NE(preprocess_error("#include \"probe.h\"\n", "p.l", options).find("probe.h:2:9: error:"), npos);
+    EXPECT_NE(preprocess_error("#define C(a, b) a ## b\n#if C(__has_, include)(\"/etc/passwd\")\n#endif\n",
+                               "p.l", options)
+                  .find("p.l:1:19: error: 'token pasting in a #define'"), npos);
+    EXPECT_NE(preprocess_error("#define X\n %: define C(a, b) a%:%:b\n", "p.l", options)
+                  .find("p.l:2:21: error:"), npos);
+    options.confine_to.reset();  // --allow-file-access
+    EXPECT_NE(preprocess(has, "p.l", options).find("A"), npos);
+}
+
 // cpp runs in the model's folder; included files are still named as the user reaches
 // them (the folder they gave), in line markers and in cpp's messages.
 TEST(LsysPreprocessor, IncludedFilesAreNamedFromTheUsersFolder)

@@ -378,6 +378,15 @@ TEST(NumericSettings, HomomorphismSeedOutOfRangeIsAnError)
     EXPECT_EQ(e.substr(0, 60), "test.l:4:7: error: the homomorphism's seed is 1e+300; it mus");
 }
 
+// The value is unused (cpfg never seeds) but a model's seed must still be a long
+TEST(NumericSettings, LsystemSeedOutOfRangeIsAnError)
+{
+    EXPECT_EQ(derive_error("lsystem: 1\nseed: 1e30\naxiom: A\nA --> B\nendlsystem\n").substr(0, 48),
+              "test.l:2:7: error: the seed is 1e+30; it must be");
+    EXPECT_EQ(derive_error("lsystem: 1\nseed: -1e300\naxiom: A\nA --> B\nendlsystem\n").substr(0, 49),
+              "test.l:2:7: error: the seed is -1e+300; it must b");
+}
+
 TEST(NumericSettings, FunctionArgumentsOutOfRangeAreErrorsNamingTheBlock)
 {
     EXPECT_EQ(derive_error(with_start("SetDerivationLength(1e30);")),
