@@ -31,6 +31,7 @@
 #include "lsys/string_io.h"
 #include "base/output_format.h"
 #include "geom/mesh_export.h"
+#include "render/denoise.h"
 #include "render/light_report.h"
 #include "render/render.h"
 
@@ -106,6 +107,8 @@ render::RenderSettings render_settings(const Options& options,
         const OutputFormat* format = find_output_format(f);
         return format && format->keeps_layers;
     });
+    if (options.denoise)
+        settings.denoiser = render::make_default_denoiser();
     settings.cancel = render::install_interrupt_handler();
     apply_staging(settings, options);
     return settings;
