@@ -14,12 +14,15 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <string>
 #include <thread>
 
 #include "base/diagnostics.h"
+#include "render/simd_clones.h"
 
 namespace cambium::render {
 
@@ -57,17 +60,39 @@ float depth_slope(float before, float here, float after)
     return has_a ? a : (has_b ? b : 0.0f);
 }
 
-/// The inputs prepared once per frame, shared read-only by the bands.
+/// exp(-x) for x >= 0, to about 2e-6 relative (at least 2^-100: callers zero what must
+/// weigh nothing): 2^-t as an exponent built from bits times a polynomial of the
+/// fraction. Branch-free, so the row loops below vectorise; the same bits on every thread.
+inline float exp_neg(float x)
+{
+    constexpr float log2e = 1.44269504f, ln2 = 0.69314718f;
+    const float t = std::min(x * log2e, 100.0f);
+    const int whole = static_cast<int>(t);  // t >= 0: truncation is the floor
+    const float g = (static_cast<float>(whole) - t) * ln2;  // in (-ln 2, 0]
+    // e^g by its Taylor series to the 7th power (error below 2e-6 on the interval).
+    float p = 1.0f / 5040;
+    p = p * g + 1.0f / 720;
+    p = p * g + 1.0f / 120;
+    p = p * g + 1.0f / 24;
+    p = p * g + 1.0f / 6;
+    p = p * g + 0.5f;
+    p = p * g + 1.0f;
+    p = p * g + 1.0f;
+    return p * std::bit_cast<float>((127 - whole) << 23);
+}
+
+/// The inputs prepared once per frame, one plane per channel (rows of contiguous floats
+/// for the vectorised row loops), shared read-only by the bands.
 struct Prepared {
     int w = 0, h = 0;
-    std::vector<float> colour;    // RGB, 3 per pixel
-    std::vector<float> variance;  // smoothed, 3 per pixel
-    std::vector<float> slope;     // the depth's gradient (x, y), 2 per pixel
-    std::span<const float> albedo, normal, depth;
-    std::span<const std::uint32_t> organ;
+    bool albedo = false, normal = false, depth = false;
+    std::array<std::vector<float>, 3> colour, variance, albedos, normals;
+    /// Depth: the distance (0 where none), 1 / distance (0 where none) and whether there
+    /// is one (1 or 0), and its gradient along x and y.
+    std::vector<float> z, inv_z, has_z, slope_x, slope_y;
+    std::vector<std::uint32_t> organ;
 
     std::size_t at(int x, int y) const { return std::size_t(y) * std::size_t(w) + std::size_t(x); }
-    std::uint32_t organ_at(std::size_t i) const { return organ.empty() ? 0 : organ[i]; }
 };
 
 void check_input(const DenoiseInput& in)
@@ -90,24 +115,49 @@ void check_input(const DenoiseInput& in)
     check(in.organ.size(), 1, "organ");
 }
 
-/// The colour, the variance smoothed over each pixel's own organ within `radius`, and
-/// the depth's gradient.
+/// The planes; the variance smoothed over each pixel's own organ within `radius`; the
+/// depth's gradient.
 Prepared prepare(const DenoiseInput& in, int radius)
 {
     Prepared p;
     p.w = in.width;
     p.h = in.height;
-    p.albedo = in.albedo;
-    p.normal = in.normal;
-    p.depth = in.depth;
-    p.organ = in.organ;
     const std::size_t n = std::size_t(p.w) * std::size_t(p.h);
-    p.colour.resize(n * 3);
-    p.variance.assign(n * 3, 0.0f);
-    p.slope.assign(n * 2, 0.0f);
-    for (std::size_t i = 0; i < n; ++i)
-        for (int c = 0; c < 3; ++c)
-            p.colour[i * 3 + c] = in.beauty[i * 4 + c];
+    p.albedo = !in.albedo.empty();
+    p.normal = !in.normal.empty();
+    p.depth = !in.depth.empty();
+    p.organ.assign(n, 0);
+    if (!in.organ.empty())
+        std::copy(in.organ.begin(), in.organ.end(), p.organ.begin());
+    for (int c = 0; c < 3; ++c) {
+        p.colour[c].resize(n);
+        p.variance[c].assign(n, 0.0f);
+        for (std::size_t i = 0; i < n; ++i)
+            p.colour[c][i] = in.beauty[i * 4 + std::size_t(c)];
+        if (p.albedo) {
+            p.albedos[c].resize(n);
+            for (std::size_t i = 0; i < n; ++i)
+                p.albedos[c][i] = in.albedo[i * 3 + std::size_t(c)];
+        }
+        if (p.normal) {
+            p.normals[c].resize(n);
+            for (std::size_t i = 0; i < n; ++i)
+                p.normals[c][i] = in.normal[i * 3 + std::size_t(c)];
+        }
+    }
+    if (p.depth) {
+        p.z.assign(n, 0.0f);
+        p.inv_z.assign(n, 0.0f);
+        p.has_z.assign(n, 0.0f);
+        p.slope_x.assign(n, 0.0f);
+        p.slope_y.assign(n, 0.0f);
+        for (std::size_t i = 0; i < n; ++i)
+            if (std::isfinite(in.depth[i]) && in.depth[i] > 0) {
+                p.z[i] = in.depth[i];
+                p.inv_z[i] = 1 / in.depth[i];
+                p.has_z[i] = 1;
+            }
+    }
     tbb::parallel_for(tbb::blocked_range<int>(0, p.h, 8), [&](const tbb::blocked_range<int>& rows) {
         for (int y = rows.begin(); y != rows.end(); ++y)
             for (int x = 0; x < p.w; ++x) {
@@ -116,32 +166,119 @@ Prepared prepare(const DenoiseInput& in, int radius)
                 if (!in.variance.empty()) {
                     double sum[3] = {0, 0, 0};
                     int count = 0;
-                    const std::uint32_t organ = p.organ_at(i);
+                    const std::uint32_t organ = p.organ[i];
                     for (int yy = std::max(0, y - radius); yy <= std::min(p.h - 1, y + radius); ++yy)
                         for (int xx = std::max(0, x - radius); xx <= std::min(p.w - 1, x + radius); ++xx) {
                             const std::size_t j = p.at(xx, yy);
-                            if (p.organ_at(j) != organ)
+                            if (p.organ[j] != organ)
                                 continue;
                             for (int c = 0; c < 3; ++c)
-                                sum[c] += in.variance[j * 3 + c];
+                                sum[c] += in.variance[j * 3 + std::size_t(c)];
                             ++count;
                         }
                     for (int c = 0; c < 3; ++c)
-                        p.variance[i * 3 + c] = static_cast<float>(sum[c] / count);
+                        p.variance[c][i] = static_cast<float>(sum[c] / count);
                 }
                 // Depth gradient, one-sided across discontinuities.
-                if (!in.depth.empty()) {
+                if (p.depth) {
                     constexpr float none = std::numeric_limits<float>::infinity();
                     const float z = in.depth[i];
-                    p.slope[i * 2 + 0] = depth_slope(x > 0 ? in.depth[i - 1] : none, z,
-                                                     x + 1 < p.w ? in.depth[i + 1] : none);
-                    p.slope[i * 2 + 1] = depth_slope(y > 0 ? in.depth[i - std::size_t(p.w)] : none, z,
-                                                     y + 1 < p.h ? in.depth[i + std::size_t(p.w)] : none);
+                    p.slope_x[i] = depth_slope(x > 0 ? in.depth[i - 1] : none, z,
+                                               x + 1 < p.w ? in.depth[i + 1] : none);
+                    p.slope_y[i] = depth_slope(y > 0 ? in.depth[i - std::size_t(p.w)] : none, z,
+                                               y + 1 < p.h ? in.depth[i + std::size_t(p.w)] : none);
                 }
             }
     });
     return p;
 }
+
+/// The row loops, built for each vector width (render/simd_clones.h; denoise.cpp is
+/// compiled without FMA contraction, so every clone gives the same bits).
+struct RowKernels {
+    /// out[x] = the colour distance of pixels p + x and q + x (Rousselle et al. 2012: the
+    /// squared difference less the noise's expected share, over the noise's variance),
+    /// summed over RGB, for x < n.
+    CAMBIUM_SIMD_CLONES
+    static void colour(const Prepared& d, std::size_t p, std::size_t q, int n, float cancel,
+                       float k2, float* out)
+    {
+        for (int x = 0; x < n; ++x)
+            out[x] = 0;
+        for (int c = 0; c < 3; ++c) {
+            const float* up = &d.colour[c][p];
+            const float* uq = &d.colour[c][q];
+            const float* vp = &d.variance[c][p];
+            const float* vq = &d.variance[c][q];
+            for (int x = 0; x < n; ++x) {
+                const float diff = up[x] - uq[x];
+                const float noise = cancel * (vp[x] + std::min(vp[x], vq[x]));
+                out[x] += (diff * diff - noise) / (epsilon + k2 * (vp[x] + vq[x]));
+            }
+        }
+    }
+
+    /// sums[x] (4 planes: R, G, B, weight) += the weight of neighbour q + x for centre
+    /// p + x times its colour, for x < n; `patch` holds the patch distances summed.
+    CAMBIUM_SIMD_CLONES
+    static void accumulate(const Prepared& d, std::size_t p, std::size_t q, int n, float dx,
+                           float dy, const float* patch, float inv_patch, float inv_albedo,
+                           float inv_normal, float inv_depth, float* feature,
+                           std::array<float*, 4> sums)
+    {
+        // The features' distance.
+        for (int x = 0; x < n; ++x)
+            feature[x] = std::max(0.0f, patch[x] * inv_patch);
+        if (d.albedo)
+            for (int c = 0; c < 3; ++c) {
+                const float* ap = &d.albedos[c][p];
+                const float* aq = &d.albedos[c][q];
+                for (int x = 0; x < n; ++x) {
+                    const float e = ap[x] - aq[x];
+                    feature[x] += e * e * inv_albedo;
+                }
+            }
+        if (d.normal)
+            for (int c = 0; c < 3; ++c) {
+                const float* np = &d.normals[c][p];
+                const float* nq = &d.normals[c][q];
+                for (int x = 0; x < n; ++x) {
+                    const float e = np[x] - nq[x];
+                    feature[x] += e * e * inv_normal;
+                }
+            }
+        if (d.depth) {
+            // Against the centre's plane (its depth and gradient), relative to its depth;
+            // 0 where either has no depth (then the organs differ anyway).
+            const float* zp = &d.z[p];
+            const float* zq = &d.z[q];
+            const float* izp = &d.inv_z[p];
+            const float* hq = &d.has_z[q];
+            const float* sx = &d.slope_x[p];
+            const float* sy = &d.slope_y[p];
+            for (int x = 0; x < n; ++x) {
+                const float e = (zq[x] - (zp[x] + sx[x] * dx + sy[x] * dy)) * izp[x] * hq[x];
+                feature[x] += e * e * inv_depth;
+            }
+        }
+        // Pixels of another organ weigh nothing.
+        const std::uint32_t* op = &d.organ[p];
+        const std::uint32_t* oq = &d.organ[q];
+        for (int x = 0; x < n; ++x)
+            feature[x] = exp_neg(feature[x]);
+        for (int x = 0; x < n; ++x)
+            feature[x] = op[x] == oq[x] ? feature[x] : 0.0f;
+        // The weighted neighbours, plane by plane.
+        for (int c = 0; c < 3; ++c) {
+            const float* colour = &d.colour[std::size_t(c)][q];
+            float* sum = sums[std::size_t(c)];
+            for (int x = 0; x < n; ++x)
+                sum[x] += feature[x] * colour[x];
+        }
+        for (int x = 0; x < n; ++x)
+            sums[3][x] += feature[x];
+    }
+};
 
 /// One band's filter: rows y0 .. y1 - 1 of `out`.
 class Band {
@@ -150,12 +287,12 @@ public:
         : m_p(p), m_q(q), m_y0(y0), m_y1(y1), m_ya(std::max(0, y0 - q.patch_radius)),
           m_yb(std::min(p.h, y1 + q.patch_radius)),
           m_distance(std::size_t(m_yb - m_ya) * std::size_t(p.w)),
-          m_row_sum(m_distance.size()),
-          m_sums(std::size_t(y1 - y0) * std::size_t(p.w) * 4, 0.0f)
+          m_row_sum(m_distance.size()), m_patch(std::size_t(p.w)), m_feature(std::size_t(p.w))
     {
-        const float k2 = q.colour_k * q.colour_k;
+        for (auto& plane : m_sums)
+            plane.assign(std::size_t(y1 - y0) * std::size_t(p.w), 0.0f);
         m_inv_patch = 1.0f / float((2 * q.patch_radius + 1) * (2 * q.patch_radius + 1) * 3);
-        m_k2 = k2;
+        m_k2 = q.colour_k * q.colour_k;
         m_inv_albedo = 1.0f / (q.albedo_tolerance * q.albedo_tolerance);
         m_inv_normal = 1.0f / (q.normal_tolerance * q.normal_tolerance);
         m_inv_depth = 1.0f / (q.depth_tolerance * q.depth_tolerance);
@@ -175,38 +312,35 @@ public:
         for (int y = m_y0; y < m_y1; ++y)
             for (int x = 0; x < m_p.w; ++x) {
                 const std::size_t i = m_p.at(x, y);
-                const float* s = &m_sums[(std::size_t(y - m_y0) * std::size_t(m_p.w) + std::size_t(x)) * 4];
-                const float inv = 1.0f / s[3];  // the centre's own weight is 1: never 0
+                const std::size_t k = std::size_t(y - m_y0) * std::size_t(m_p.w) + std::size_t(x);
+                const float inv = 1.0f / m_sums[3][k];  // the centre's own weight is 1: never 0
                 for (int c = 0; c < 3; ++c)
-                    out[i * 4 + c] = s[c] * inv;
+                    out[i * 4 + std::size_t(c)] = m_sums[std::size_t(c)][k] * inv;
                 out[i * 4 + 3] = beauty[i * 4 + 3];
             }
     }
 
 private:
     /// The per-pixel colour distance of (s, s + offset) for the band's rows and the
-    /// patch's margin, neighbours clamped to the image (Rousselle et al. 2012: the
-    /// squared difference less the noise's expected share, over the noise's variance).
+    /// patch's margin, neighbours clamped to the image.
     void colour_distances(int dx, int dy)
     {
         const int w = m_p.w;
+        const float cancel = m_q.variance_cancel;
+        // Columns whose neighbour lies in the image: xa .. xb - 1.
+        const int xa = std::clamp(-dx, 0, w), xb = std::clamp(w - dx, xa, w);
         for (int y = m_ya; y < m_yb; ++y) {
             const int qy = std::clamp(y + dy, 0, m_p.h - 1);
             float* row = &m_distance[std::size_t(y - m_ya) * std::size_t(w)];
-            for (int x = 0; x < w; ++x) {
-                const int qx = std::clamp(x + dx, 0, w - 1);
-                const float* up = &m_p.colour[m_p.at(x, y) * 3];
-                const float* uq = &m_p.colour[m_p.at(qx, qy) * 3];
-                const float* vp = &m_p.variance[m_p.at(x, y) * 3];
-                const float* vq = &m_p.variance[m_p.at(qx, qy) * 3];
-                float d = 0;
-                for (int c = 0; c < 3; ++c) {
-                    const float diff = up[c] - uq[c];
-                    const float noise = m_q.variance_cancel * (vp[c] + std::min(vp[c], vq[c]));
-                    d += (diff * diff - noise) / (epsilon + m_k2 * (vp[c] + vq[c]));
-                }
-                row[x] = d;
-            }
+            for (int x = 0; x < xa; ++x)
+                RowKernels::colour(m_p, m_p.at(x, y), m_p.at(std::clamp(x + dx, 0, w - 1), qy), 1,
+                                   cancel, m_k2, row + x);
+            if (xb > xa)
+                RowKernels::colour(m_p, m_p.at(xa, y), m_p.at(xa + dx, qy), xb - xa, cancel, m_k2,
+                                   row + xa);
+            for (int x = xb; x < w; ++x)
+                RowKernels::colour(m_p, m_p.at(x, y), m_p.at(std::clamp(x + dx, 0, w - 1), qy), 1,
+                                   cancel, m_k2, row + x);
         }
     }
 
@@ -217,87 +351,61 @@ private:
         for (int y = m_ya; y < m_yb; ++y) {
             const float* d = &m_distance[std::size_t(y - m_ya) * std::size_t(w)];
             float* s = &m_row_sum[std::size_t(y - m_ya) * std::size_t(w)];
-            for (int x = 0; x < w; ++x) {
-                float sum = 0;
-                if (x >= r && x + r < w) {
-                    for (int k = -r; k <= r; ++k)
-                        sum += d[x + k];
-                } else {
-                    for (int k = -r; k <= r; ++k)
-                        sum += d[std::clamp(x + k, 0, w - 1)];
-                }
+            // Inside: the 2r + 1 shifted rows added in order (a vectorised loop each);
+            // at the ends, the same order with the columns clamped.
+            const int x0 = std::min(r, w), x1 = std::max(x0, w - r);
+            for (int x = x0; x < x1; ++x)
+                s[x] = d[x - r];
+            for (int k = -r + 1; k <= r; ++k)
+                for (int x = x0; x < x1; ++x)
+                    s[x] += d[x + k];
+            auto clamped = [&](int x) {
+                float sum = d[std::clamp(x - r, 0, w - 1)];
+                for (int k = -r + 1; k <= r; ++k)
+                    sum += d[std::clamp(x + k, 0, w - 1)];
                 s[x] = sum;
-            }
+            };
+            for (int x = 0; x < x0; ++x)
+                clamped(x);
+            for (int x = x1; x < w; ++x)
+                clamped(x);
         }
-    }
-
-    /// The features' distance of the centre p and its neighbour q = p + (dx, dy).
-    float feature_distance(std::size_t p, std::size_t q, int dx, int dy) const
-    {
-        float d = 0;
-        if (!m_p.albedo.empty()) {
-            float s = 0;
-            for (int c = 0; c < 3; ++c) {
-                const float e = m_p.albedo[p * 3 + c] - m_p.albedo[q * 3 + c];
-                s += e * e;
-            }
-            d += s * m_inv_albedo;
-        }
-        if (!m_p.normal.empty()) {
-            float s = 0;
-            for (int c = 0; c < 3; ++c) {
-                const float e = m_p.normal[p * 3 + c] - m_p.normal[q * 3 + c];
-                s += e * e;
-            }
-            d += s * m_inv_normal;
-        }
-        if (!m_p.depth.empty()) {
-            const float zp = m_p.depth[p], zq = m_p.depth[q];
-            if (std::isfinite(zp) && std::isfinite(zq) && zp > 0) {
-                // Against the centre's plane: a slanted surface keeps its neighbours.
-                const float predicted = zp + m_p.slope[p * 2] * float(dx) + m_p.slope[p * 2 + 1] * float(dy);
-                const float e = (zq - predicted) / zp;
-                d += e * e * m_inv_depth;
-            }
-        }
-        return d;
     }
 
     /// The neighbours at (dx, dy) weighted into the band's sums.
     void accumulate(int dx, int dy)
     {
         const int w = m_p.w, r = m_q.patch_radius;
+        const int x0 = std::clamp(-dx, 0, w), x1 = std::clamp(w - dx, x0, w);
+        if (x1 <= x0)
+            return;
         for (int y = m_y0; y < m_y1; ++y) {
             const int qy = y + dy;
             if (qy < 0 || qy >= m_p.h)
                 continue;
-            const int x0 = std::max(0, -dx), x1 = std::min(w, w - dx);
-            float* sums = &m_sums[std::size_t(y - m_y0) * std::size_t(w) * 4];
-            for (int x = x0; x < x1; ++x) {
-                const std::size_t p = m_p.at(x, y), q = m_p.at(x + dx, qy);
-                if (m_p.organ_at(p) != m_p.organ_at(q))
-                    continue;
-                float patch = 0;
-                for (int k = -r; k <= r; ++k) {
-                    const int yy = std::clamp(y + k, 0, m_p.h - 1);
-                    patch += m_row_sum[std::size_t(yy - m_ya) * std::size_t(w) + std::size_t(x)];
-                }
-                const float colour = std::max(0.0f, patch * m_inv_patch);
-                const float weight = std::exp(-(colour + feature_distance(p, q, dx, dy)));
-                const float* uq = &m_p.colour[q * 3];
-                float* s = &sums[std::size_t(x) * 4];
-                s[0] += weight * uq[0];
-                s[1] += weight * uq[1];
-                s[2] += weight * uq[2];
-                s[3] += weight;
+            // The patch distances: the row sums of the rows around y, added in order.
+            float* patch = m_patch.data();
+            for (int x = x0; x < x1; ++x)
+                patch[x] = 0;
+            for (int k = -r; k <= r; ++k) {
+                const int yy = std::clamp(y + k, 0, m_p.h - 1);
+                const float* s = &m_row_sum[std::size_t(yy - m_ya) * std::size_t(w)];
+                for (int x = x0; x < x1; ++x)
+                    patch[x] += s[x];
             }
+            const std::size_t row = std::size_t(y - m_y0) * std::size_t(w) + std::size_t(x0);
+            RowKernels::accumulate(m_p, m_p.at(x0, y), m_p.at(x0 + dx, qy), x1 - x0, float(dx),
+                                   float(dy), patch + x0, m_inv_patch, m_inv_albedo, m_inv_normal,
+                                   m_inv_depth, m_feature.data(),
+                                   {&m_sums[0][row], &m_sums[1][row], &m_sums[2][row], &m_sums[3][row]});
         }
     }
 
     const Prepared& m_p;
     const NlMeansParameters& m_q;
     int m_y0, m_y1, m_ya, m_yb;
-    std::vector<float> m_distance, m_row_sum, m_sums;
+    std::vector<float> m_distance, m_row_sum, m_patch, m_feature;
+    std::array<std::vector<float>, 4> m_sums;
     float m_inv_patch = 0, m_k2 = 0, m_inv_albedo = 0, m_inv_normal = 0, m_inv_depth = 0;
 };
 
@@ -317,14 +425,15 @@ NlMeansDenoiser::NlMeansDenoiser(const NlMeansParameters& parameters) : m_parame
 std::uint64_t NlMeansDenoiser::working_bytes(int width, int height) const
 {
     const std::uint64_t w = std::uint64_t(std::max(width, 0)), h = std::uint64_t(std::max(height, 0));
-    // Prepared: colour, variance, slope (8 floats a pixel); each band in flight: two
-    // distance rows per row with the patch margin, and 4 sums per pixel.
+    // Prepared: colour, variance, albedo, normal planes, depth's five, organ (18 values
+    // a pixel); each band in flight: two distance rows per row with the patch margin,
+    // and 4 sums per pixel.
     const std::uint64_t bands = (h + band_rows - 1) / band_rows;
     const std::uint64_t in_flight = std::min<std::uint64_t>(
         bands, std::max(1u, std::thread::hardware_concurrency()));
     const std::uint64_t band = (2 * (band_rows + 2 * std::uint64_t(m_parameters.patch_radius)) +
                                 4 * band_rows) * w * sizeof(float);
-    return w * h * 8 * sizeof(float) + in_flight * band;
+    return w * h * 18 * sizeof(float) + in_flight * band;
 }
 
 std::vector<float> NlMeansDenoiser::denoise(const DenoiseInput& input) const
