@@ -17,7 +17,8 @@
 // plant.
 //
 //   build/benchmarks/denoise [--plant NAME]... [--size WxH] [--threads N] [--spp N]
-//       [--raw-spp N] [--reference-spp N] [--save FOLDER]
+//       [--raw-spp N] [--reference-spp N] [--search-radius N] [--patch-radius N]
+//       [--save FOLDER]
 //
 // --save writes each plant's images as PNG for a person to look at: NAME-noisy.png (the
 // raw --spp render), NAME-denoised.png, NAME-raw-256.png (the --raw-spp one) and
@@ -62,6 +63,7 @@ const std::map<std::string, std::string> plants = {
 struct Settings {
     std::vector<std::string> plants;
     int width = 640, height = 480, threads = 2, spp = 16, raw_spp = 256, reference_spp = 1024;
+    render::NlMeansParameters denoiser;  ///< --search-radius, --patch-radius
     fs::path save;
 };
 
@@ -108,13 +110,14 @@ struct Run {
     render::RenderReport report;
 };
 
-Run render_at(const Staged& staged, int spp, std::uint64_t seed, bool denoise)
+Run render_at(const Staged& staged, int spp, std::uint64_t seed, bool denoise,
+              const render::NlMeansParameters& parameters = {})
 {
     render::RenderSettings rs = staged.settings;
     rs.samples_per_pixel = spp;
     rs.seed = seed;
     if (denoise)
-        rs.denoiser = render::make_default_denoiser();
+        rs.denoiser = std::make_shared<render::NlMeansDenoiser>(parameters);
     Run run;
     run.image = render::render(staged.scene, rs, &run.report);
     return run;
@@ -274,7 +277,7 @@ void run_plant(const std::string& name, const fs::path& folder, const Settings& 
         reference(staged, s, cache / (name + "-" + std::to_string(s.width) + "x" +
                                       std::to_string(s.height) + "-" +
                                       std::to_string(s.reference_spp) + ".raw"));
-    const Run few = render_at(staged, s.spp, 1, true);
+    const Run few = render_at(staged, s.spp, 1, true, s.denoiser);
     const Run many = render_at(staged, s.raw_spp, 2, false);
     const std::vector<bool> band = silhouette_band(ref.organ, s.width, s.height);
     std::size_t band_pixels = 0, plant_pixels = 0;
@@ -292,6 +295,8 @@ void run_plant(const std::string& name, const fs::path& folder, const Settings& 
     j["image"] = std::to_string(s.width) + "x" + std::to_string(s.height);
     j["threads"] = s.threads;
     j["spp"] = s.spp;
+    j["search_radius"] = s.denoiser.search_radius;
+    j["patch_radius"] = s.denoiser.patch_radius;
     j["raw_spp"] = s.raw_spp;
     j["reference_spp"] = s.reference_spp;
     j["plant_pixels"] = plant_pixels;
@@ -366,6 +371,10 @@ int main(int argc, char** argv)
             s.raw_spp = positive(a, value());
         } else if (a == "--reference-spp") {
             s.reference_spp = positive(a, value());
+        } else if (a == "--search-radius") {
+            s.denoiser.search_radius = positive(a, value());
+        } else if (a == "--patch-radius") {
+            s.denoiser.patch_radius = positive(a, value());
         } else if (a == "--save") {
             s.save = fs::absolute(value());
         } else {

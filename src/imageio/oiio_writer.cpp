@@ -85,6 +85,10 @@ void write_exr(OIIO::ImageOutput& out, const Image& image, const std::filesystem
         names.insert(names.end(), {"variance.R", "variance.G", "variance.B"});
         layers.emplace_back(&image.variance, 3);
     }
+    if (has_layer(image, image.feature_variance, 2)) {
+        names.insert(names.end(), {"variance.albedo", "variance.normal"});
+        layers.emplace_back(&image.feature_variance, 2);
+    }
     const int halves = static_cast<int>(names.size());
     bool depth = has_layer(image, image.depth, 1);
     if (depth) {

@@ -87,6 +87,8 @@ struct Prepared {
     int w = 0, h = 0;
     bool albedo = false, normal = false, depth = false;
     std::array<std::vector<float>, 3> colour, variance, albedos, normals;
+    /// The albedo's and the normal's variance (smoothed as `variance`; zero where unknown).
+    std::vector<float> albedo_variance, normal_variance;
     /// Depth: the distance (0 where none), 1 / distance (0 where none) and whether there
     /// is one (1 or 0), and its gradient along x and y.
     std::vector<float> z, inv_z, has_z, slope_x, slope_y;
@@ -113,6 +115,7 @@ void check_input(const DenoiseInput& in)
     check(in.normal.size(), 3, "normal");
     check(in.depth.size(), 1, "depth");
     check(in.organ.size(), 1, "organ");
+    check(in.feature_variance.size(), 2, "feature variance");
 }
 
 /// The planes; the variance smoothed over each pixel's own organ within `radius`; the
@@ -129,6 +132,8 @@ Prepared prepare(const DenoiseInput& in, int radius)
     p.organ.assign(n, 0);
     if (!in.organ.empty())
         std::copy(in.organ.begin(), in.organ.end(), p.organ.begin());
+    p.albedo_variance.assign(n, 0.0f);
+    p.normal_variance.assign(n, 0.0f);
     for (int c = 0; c < 3; ++c) {
         p.colour[c].resize(n);
         p.variance[c].assign(n, 0.0f);
@@ -179,6 +184,22 @@ Prepared prepare(const DenoiseInput& in, int radius)
                     for (int c = 0; c < 3; ++c)
                         p.variance[c][i] = static_cast<float>(sum[c] / count);
                 }
+                if (!in.feature_variance.empty()) {
+                    double sum[2] = {0, 0};
+                    int count = 0;
+                    const std::uint32_t organ = p.organ[i];
+                    for (int yy = std::max(0, y - radius); yy <= std::min(p.h - 1, y + radius); ++yy)
+                        for (int xx = std::max(0, x - radius); xx <= std::min(p.w - 1, x + radius); ++xx) {
+                            const std::size_t j = p.at(xx, yy);
+                            if (p.organ[j] != organ)
+                                continue;
+                            sum[0] += in.feature_variance[j * 2];
+                            sum[1] += in.feature_variance[j * 2 + 1];
+                            ++count;
+                        }
+                    p.albedo_variance[i] = static_cast<float>(sum[0] / count);
+                    p.normal_variance[i] = static_cast<float>(sum[1] / count);
+                }
                 // Depth gradient, one-sided across discontinuities.
                 if (p.depth) {
                     constexpr float none = std::numeric_limits<float>::infinity();
@@ -222,31 +243,38 @@ struct RowKernels {
     /// p + x times its colour, for x < n; `patch` holds the patch distances summed.
     CAMBIUM_SIMD_CLONES
     static void accumulate(const Prepared& d, std::size_t p, std::size_t q, int n, float dx,
-                           float dy, const float* patch, float inv_patch, float inv_albedo,
-                           float inv_normal, float inv_depth, float* feature,
-                           std::array<float*, 4> sums)
+                           float dy, const float* patch, float inv_patch, float albedo_tolerance2,
+                           float normal_tolerance2, float inv_depth, float* feature,
+                           float* scratch, std::array<float*, 4> sums)
     {
         // The features' distance.
         for (int x = 0; x < n; ++x)
             feature[x] = std::max(0.0f, patch[x] * inv_patch);
+        // Albedo and normal: the squared difference less what the two pixels' noise
+        // explains, over the tolerance squared plus that noise's variance.
+        auto vector_feature = [&](const std::array<std::vector<float>, 3>& f,
+                                  const std::vector<float>& variance, float tolerance2) {
+            for (int x = 0; x < n; ++x)
+                scratch[x] = 0;
+            for (int c = 0; c < 3; ++c) {
+                const float* fp = &f[std::size_t(c)][p];
+                const float* fq = &f[std::size_t(c)][q];
+                for (int x = 0; x < n; ++x) {
+                    const float e = fp[x] - fq[x];
+                    scratch[x] += e * e;
+                }
+            }
+            const float* vp = &variance[p];
+            const float* vq = &variance[q];
+            for (int x = 0; x < n; ++x) {
+                const float excess = std::max(0.0f, scratch[x] - (vp[x] + std::min(vp[x], vq[x])));
+                feature[x] += excess / (tolerance2 + vp[x] + vq[x]);
+            }
+        };
         if (d.albedo)
-            for (int c = 0; c < 3; ++c) {
-                const float* ap = &d.albedos[c][p];
-                const float* aq = &d.albedos[c][q];
-                for (int x = 0; x < n; ++x) {
-                    const float e = ap[x] - aq[x];
-                    feature[x] += e * e * inv_albedo;
-                }
-            }
+            vector_feature(d.albedos, d.albedo_variance, albedo_tolerance2);
         if (d.normal)
-            for (int c = 0; c < 3; ++c) {
-                const float* np = &d.normals[c][p];
-                const float* nq = &d.normals[c][q];
-                for (int x = 0; x < n; ++x) {
-                    const float e = np[x] - nq[x];
-                    feature[x] += e * e * inv_normal;
-                }
-            }
+            vector_feature(d.normals, d.normal_variance, normal_tolerance2);
         if (d.depth) {
             // Against the centre's plane (its depth and gradient), relative to its depth;
             // 0 where either has no depth (then the organs differ anyway).
@@ -287,14 +315,15 @@ public:
         : m_p(p), m_q(q), m_y0(y0), m_y1(y1), m_ya(std::max(0, y0 - q.patch_radius)),
           m_yb(std::min(p.h, y1 + q.patch_radius)),
           m_distance(std::size_t(m_yb - m_ya) * std::size_t(p.w)),
-          m_row_sum(m_distance.size()), m_patch(std::size_t(p.w)), m_feature(std::size_t(p.w))
+          m_row_sum(m_distance.size()), m_patch(std::size_t(p.w)), m_feature(std::size_t(p.w)),
+          m_scratch(std::size_t(p.w))
     {
         for (auto& plane : m_sums)
             plane.assign(std::size_t(y1 - y0) * std::size_t(p.w), 0.0f);
         m_inv_patch = 1.0f / float((2 * q.patch_radius + 1) * (2 * q.patch_radius + 1) * 3);
         m_k2 = q.colour_k * q.colour_k;
-        m_inv_albedo = 1.0f / (q.albedo_tolerance * q.albedo_tolerance);
-        m_inv_normal = 1.0f / (q.normal_tolerance * q.normal_tolerance);
+        m_albedo_tolerance2 = q.albedo_tolerance * q.albedo_tolerance;
+        m_normal_tolerance2 = q.normal_tolerance * q.normal_tolerance;
         m_inv_depth = 1.0f / (q.depth_tolerance * q.depth_tolerance);
     }
 
@@ -395,8 +424,8 @@ private:
             }
             const std::size_t row = std::size_t(y - m_y0) * std::size_t(w) + std::size_t(x0);
             RowKernels::accumulate(m_p, m_p.at(x0, y), m_p.at(x0 + dx, qy), x1 - x0, float(dx),
-                                   float(dy), patch + x0, m_inv_patch, m_inv_albedo, m_inv_normal,
-                                   m_inv_depth, m_feature.data(),
+                                   float(dy), patch + x0, m_inv_patch, m_albedo_tolerance2,
+                                   m_normal_tolerance2, m_inv_depth, m_feature.data(), m_scratch.data(),
                                    {&m_sums[0][row], &m_sums[1][row], &m_sums[2][row], &m_sums[3][row]});
         }
     }
@@ -404,9 +433,10 @@ private:
     const Prepared& m_p;
     const NlMeansParameters& m_q;
     int m_y0, m_y1, m_ya, m_yb;
-    std::vector<float> m_distance, m_row_sum, m_patch, m_feature;
+    std::vector<float> m_distance, m_row_sum, m_patch, m_feature, m_scratch;
     std::array<std::vector<float>, 4> m_sums;
-    float m_inv_patch = 0, m_k2 = 0, m_inv_albedo = 0, m_inv_normal = 0, m_inv_depth = 0;
+    float m_inv_patch = 0, m_k2 = 0, m_albedo_tolerance2 = 0, m_normal_tolerance2 = 0,
+          m_inv_depth = 0;
 };
 
 }  // namespace
@@ -425,15 +455,15 @@ NlMeansDenoiser::NlMeansDenoiser(const NlMeansParameters& parameters) : m_parame
 std::uint64_t NlMeansDenoiser::working_bytes(int width, int height) const
 {
     const std::uint64_t w = std::uint64_t(std::max(width, 0)), h = std::uint64_t(std::max(height, 0));
-    // Prepared: colour, variance, albedo, normal planes, depth's five, organ (18 values
-    // a pixel); each band in flight: two distance rows per row with the patch margin,
+    // Prepared: colour, variance, albedo, normal planes, their variances, depth's five,
+    // organ (20 values a pixel); each band in flight: two distance rows per row with the patch margin,
     // and 4 sums per pixel.
     const std::uint64_t bands = (h + band_rows - 1) / band_rows;
     const std::uint64_t in_flight = std::min<std::uint64_t>(
         bands, std::max(1u, std::thread::hardware_concurrency()));
     const std::uint64_t band = (2 * (band_rows + 2 * std::uint64_t(m_parameters.patch_radius)) +
                                 4 * band_rows) * w * sizeof(float);
-    return w * h * 18 * sizeof(float) + in_flight * band;
+    return w * h * 20 * sizeof(float) + in_flight * band;
 }
 
 std::vector<float> NlMeansDenoiser::denoise(const DenoiseInput& input) const

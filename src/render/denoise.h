@@ -35,6 +35,11 @@ struct DenoiseInput {
     /// organ_ground, organ_unknown), 1 per pixel: pixels of different organs are never
     /// mixed.
     std::span<const std::uint32_t> organ;
+    /// The variance of the albedo's and of the normal's pixel means (2 per pixel, each
+    /// summed over its channels), estimated as `variance` is: large where a pixel's
+    /// samples see different surfaces (its silhouette), so that such pixels may still be
+    /// averaged with their like.
+    std::span<const float> feature_variance;
 };
 
 /// A denoiser of rendered frames: Cambium's own (NlMeansDenoiser) or, where one is
@@ -63,7 +68,9 @@ struct NlMeansParameters {
     /// difference (which noise alone gives) is subtracted first.
     float colour_k = 0.45f;
     float variance_cancel = 1.0f;
-    /// Feature tolerances: the weight falls by e per tolerance squared of difference.
+    /// Feature tolerances: the weight falls by e per tolerance squared of difference
+    /// (beyond what the features' own noise explains, and the noise's variance added to
+    /// the tolerance's square: Rousselle, Manzi & Zwicker 2013).
     float albedo_tolerance = 0.08f;  ///< albedo units (reflectance)
     float normal_tolerance = 0.35f;  ///< length of the normals' difference
     /// Depth: the neighbour's depth against the centre's plane (its depth and depth

@@ -182,7 +182,7 @@ struct PixelExtras {
     std::uint32_t caught = 0;              // samples that met the shadow catcher
     /// Denoising: the odd samples' radiance sum (the even ones' is the rest), and the
     /// organ of the nearest camera-ray hit (the one `depth` is of).
-    Vec3f odd_radiance;
+    Vec3f odd_radiance, odd_albedo, odd_normal;
     std::uint32_t organ = organ_background;
 };
 
@@ -458,8 +458,14 @@ void take_sample(const RenderState& f, const PixelReplicas& replicas, double tne
         ex->albedo += first.albedo;
         ex->normal += first.normal;
         const float t = static_cast<float>(first.t + tnear);
-        if (f.organs && t < ex->depth)
-            ex->organ = organ_of(*f.organs, first);
+        if (f.organs) {  // denoising
+            if (t < ex->depth)
+                ex->organ = organ_of(*f.organs, first);
+            if (i & 1u) {
+                ex->odd_albedo += first.albedo;
+                ex->odd_normal += first.normal;
+            }
+        }
         ex->depth = std::min(ex->depth, t);
     }
     if ((s.transparent_background || s.ground.shadow_catcher) && !r.hit)
@@ -777,6 +783,7 @@ Image resolve(const Film& film, const PixelRect& sampled, const PixelRect& out,
     }
     if (denoise) {
         img.variance.assign(count * 3, 0.0f);
+        img.feature_variance.assign(count * 2, 0.0f);
         img.organ.assign(count, organ_background);
     }
     const bool extras = !film.extras.empty();  // (without them no pixel has a catcher's light)
@@ -805,6 +812,13 @@ Image resolve(const Film& film, const PixelRect& sampled, const PixelRect& out,
                     img.variance[i * 3 + 0] = 0.25f * d.x * d.x;
                     img.variance[i * 3 + 1] = 0.25f * d.y * d.y;
                     img.variance[i * 3 + 2] = 0.25f * d.z * d.z;
+                    // The same for the albedo and the normal, summed over their channels.
+                    auto half_variance = [&](const Vec3f& sum, const Vec3f& odd_sum) {
+                        const Vec3f e = (sum - odd_sum) * (1.0f / float(even)) - odd_sum * (1.0f / float(odd));
+                        return 0.25f * (e.x * e.x + e.y * e.y + e.z * e.z);
+                    };
+                    img.feature_variance[i * 2 + 0] = half_variance(ex.albedo, ex.odd_albedo);
+                    img.feature_variance[i * 2 + 1] = half_variance(ex.normal, ex.odd_normal);
                 }
                 img.organ[i] = ex.organ;
             }
@@ -905,8 +919,16 @@ GroundPlane make_ground(const geom::Scene& scene, const RenderSettings& settings
 /// The image denoised in place: RGBA the denoiser's, the raw frame kept in `noisy`.
 void denoise(const Denoiser& denoiser, Image& image)
 {
-    DenoiseInput in{image.width, image.height, image.rgba, image.variance, image.albedo,
-                    image.normal, image.depth, image.organ};
+    DenoiseInput in;
+    in.width = image.width;
+    in.height = image.height;
+    in.beauty = image.rgba;
+    in.variance = image.variance;
+    in.albedo = image.albedo;
+    in.normal = image.normal;
+    in.depth = image.depth;
+    in.organ = image.organ;
+    in.feature_variance = image.feature_variance;
     std::vector<float> clean = denoiser.denoise(in);
     image.noisy = std::move(image.rgba);
     image.rgba = std::move(clean);
@@ -921,7 +943,7 @@ void check_denoise_memory(const RenderSettings& s)
     const std::uint64_t pixels = std::uint64_t(s.width) * std::uint64_t(s.height);
     // Film extras (odd radiance, organ, albedo, normal, depth, ...), then the image's
     // noisy, variance, organ, albedo, normal, depth and denoised layers.
-    const std::uint64_t per_pixel = sizeof(PixelExtras) + (4 + 3 + 1 + 3 + 3 + 1 + 4) * 4;
+    const std::uint64_t per_pixel = sizeof(PixelExtras) + (4 + 3 + 2 + 1 + 3 + 3 + 1 + 4) * 4;
     const std::uint64_t bytes = pixels * per_pixel + s.denoiser->working_bytes(s.width, s.height);
     if (bytes > s.max_memory_bytes)
         throw Error("render: denoising a " + std::to_string(s.width) + "x" +
