@@ -3,7 +3,6 @@
 // JPEG).
 #include "imageio/oiio_codec.h"
 
-#include <Imath/half.h>
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -144,8 +143,8 @@ void write_exr(OIIO::ImageOutput& out, const Image& image, const std::filesystem
             if (spec.channelformat(c) == OIIO::TypeDesc::FLOAT) {
                 std::memcpy(p + offset[std::size_t(c)], &v, sizeof v);
             } else {
-                const Imath::half h(v);
-                std::memcpy(p + offset[std::size_t(c)], &h, sizeof h);
+                OIIO::convert_pixel_values(OIIO::TypeDesc::FLOAT, &v, OIIO::TypeDesc::HALF,
+                                           p + offset[std::size_t(c)]);
             }
             ++c;
         };
