@@ -182,6 +182,9 @@ void check_distributed_options(const Options& options)
     if ((options.tile || options.assemble) && sequence)
         throw Error("--tile and --assemble split a still; split a sequence with --frames A-B "
                     "(docs/distributed.md)");
+    if (options.denoise && (options.tile || options.assemble || (options.mpi && !sequence)))
+        throw Error("--denoise needs the whole image: it cannot denoise the bands of --tile, "
+                    "--assemble or an --mpi still (an --mpi sequence is denoised frame by frame)");
     int count = options.tile ? options.tile->second : options.assemble.value_or(1);
     if (count > options.height)
         throw Error(std::string(options.tile ? "--tile: " : "--assemble: ") +
@@ -280,6 +283,9 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     cli.add_option("--focus-distance", options.focus_distance,
                    "Depth of field: distance in focus (default: to the view reference point)")
         ->check(CLI::Range(0.0, 1e12));
+    cli.add_flag("--denoise", options.denoise,
+                 "Denoise each frame from its albedo, normal, depth, organ and variance "
+                 "(docs/denoise.md); an EXR keeps the raw frame as the noisy layer");
     cli.add_option("--exposure", options.exposure, "Exposure in stops for PNG/TIFF/JPEG")
         ->check(CLI::Range(-20.0f, 20.0f));
     cli.add_flag("--transparent", options.transparent,

@@ -31,6 +31,7 @@
 #include "lsys/string_io.h"
 #include "base/output_format.h"
 #include "geom/mesh_export.h"
+#include "render/denoise.h"
 #include "render/light_report.h"
 #include "render/render.h"
 

@@ -29,6 +29,7 @@
 #include "geom/view_volume.h"
 #include "lsys/inbetween.h"
 #include "lsys/string_io.h"
+#include "render/denoise.h"
 #include "render/framing.h"
 #include "render/ground.h"
 
@@ -767,6 +768,8 @@ render::RenderSettings render_settings(const Options& options,
         const OutputFormat* format = find_output_format(f);
         return format && format->keeps_layers;
     });
+    if (options.denoise)
+        settings.denoiser = render::make_default_denoiser();
     apply_staging(settings, options);
     return settings;
 }

@@ -72,6 +72,7 @@ void RunStats::add_render(const render::RenderReport& report, double render_star
     build_s = report.build_seconds;
     first_pixel_s = render_start_s + report.setup_seconds;
     render_s = report.seconds - report.setup_seconds;
+    denoise_s = report.denoise_seconds;
     width = w;
     height = h;
     samples = report.samples;
@@ -112,6 +113,7 @@ void RunStats::add_frame(FrameStats f, const geom::Scene& scene,
     interpret_s += f.interpret_s;
     build_s += f.build_s;
     render_s += f.render_s;
+    denoise_s += report.denoise_seconds;
     samples += f.samples;
     rays += f.rays;
     background_only_samples += f.background_only_samples;
@@ -251,8 +253,10 @@ std::string format_stats(const RunStats& s)
                        "build {:.3f} s\n",
                        s.load_s, s.derive_s, s.interpret_s, s.assemble_s, s.build_s);
     if (s.rendered)
-        out += fmt::format("  time to first pixel {:.3f} s, rendering {:.3f} s\n", s.first_pixel_s,
-                           s.render_s);
+        out += fmt::format("  time to first pixel {:.3f} s, rendering {:.3f} s{}\n", s.first_pixel_s,
+                           s.render_s,
+                           s.denoise_s > 0 ? fmt::format(" (denoising {:.3f} s)", s.denoise_s)
+                                           : std::string());
     if (s.interpreted) {
         out += std::string(s.sequence ? "  largest frame: " : "  ") + "primitives " +
                counts_line(s.primitives) + "\n";
@@ -294,7 +298,8 @@ nlohmann::json stats_json(const RunStats& s)
                     {"assemble", s.assemble_s},
                     {"build", s.build_s},
                     {"first_pixel", s.rendered ? nlohmann::json(s.first_pixel_s) : nullptr},
-                    {"render", s.render_s}};
+                    {"render", s.render_s},
+                    {"denoise", s.denoise_s}};
     j["primitives"] = counts_json(s.primitives);
     j["placed_primitives"] = counts_json(s.placed_primitives);
     j["instances"] = s.instances;

@@ -59,7 +59,8 @@ struct RunStats {
     /// time of the whole; for one model, `assemble_s` is their sum.
     double load_s = 0, derive_s = 0, interpret_s = 0, assemble_s = 0, build_s = 0;
     double first_pixel_s = 0;
-    double render_s = 0;  ///< sampling, after the first pixel
+    double render_s = 0;  ///< sampling, after the first pixel (denoising included)
+    double denoise_s = 0;  ///< of render_s, the denoiser's (--denoise)
     bool interpreted = false, rendered = false;
 
     /// Built once: the scene's own geometry and its prototypes'.

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 #include <string>
 #include <utility>
@@ -74,35 +75,88 @@ void write_exr(OIIO::ImageOutput& out, const Image& image, const std::filesystem
         names.insert(names.end(), {"normal.X", "normal.Y", "normal.Z"});
         layers.emplace_back(&image.normal, 3);
     }
+    // A denoised image: the raw frame and the variance the denoiser was given.
+    if (has_layer(image, image.noisy, 4)) {
+        names.insert(names.end(), {"noisy.R", "noisy.G", "noisy.B", "noisy.A"});
+        layers.emplace_back(&image.noisy, 4);
+    }
+    if (has_layer(image, image.variance, 3)) {
+        names.insert(names.end(), {"variance.R", "variance.G", "variance.B"});
+        layers.emplace_back(&image.variance, 3);
+    }
+    if (has_layer(image, image.feature_variance, 2)) {
+        names.insert(names.end(), {"variance.albedo", "variance.normal"});
+        layers.emplace_back(&image.feature_variance, 2);
+    }
+    const int halves = static_cast<int>(names.size());
     bool depth = has_layer(image, image.depth, 1);
     if (depth) {
         names.emplace_back("Z");
         layers.emplace_back(&image.depth, 1);
     }
+    // The organ id, as a 32-bit unsigned channel (exact, unlike a float's 24 bits).
+    const bool organ = image.organ.size() == std::size_t(image.width) * image.height;
+    if (organ)
+        names.emplace_back("organ.id");
     int channels = static_cast<int>(names.size());
     OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::HALF);
     spec.channelnames = names;
     spec.alpha_channel = 3;
-    if (depth) {
+    if (depth || organ) {
         // Distances need more than half's 11 bits.
         spec.channelformats.assign(std::size_t(channels), OIIO::TypeDesc::HALF);
-        spec.channelformats.back() = OIIO::TypeDesc::FLOAT;
-        spec.z_channel = channels - 1;
+        if (depth) {
+            spec.channelformats[std::size_t(halves)] = OIIO::TypeDesc::FLOAT;
+            spec.z_channel = halves;
+        }
+        if (organ)
+            spec.channelformats.back() = OIIO::TypeDesc::UINT;
     }
     spec.attribute("oiio:ColorSpace", "Linear");
     spec.attribute("compression", "zip");
     without_time_stamp(spec);
     std::size_t n = std::size_t(image.width) * image.height;
-    std::vector<float> pixels(n * std::size_t(channels));
-    for (std::size_t i = 0; i < n; ++i) {
-        float* p = &pixels[i * channels];
-        for (int c = 0; c < 4; ++c)
-            *p++ = image.rgba[i * 4 + c];
-        for (const auto& [layer, count] : layers)
-            for (int c = 0; c < count; ++c)
-                *p++ = (*layer)[i * count + c];
+    if (!organ) {
+        std::vector<float> pixels(n * std::size_t(channels));
+        for (std::size_t i = 0; i < n; ++i) {
+            float* p = &pixels[i * channels];
+            for (int c = 0; c < 4; ++c)
+                *p++ = image.rgba[i * 4 + c];
+            for (const auto& [layer, count] : layers)
+                for (int c = 0; c < count; ++c)
+                    *p++ = (*layer)[i * count + c];
+        }
+        ok = out.open(temp.string(), spec) && out.write_image(OIIO::TypeDesc::FLOAT, pixels.data());
+        return;
     }
-    ok = out.open(temp.string(), spec) && out.write_image(OIIO::TypeDesc::FLOAT, pixels.data());
+    // With the organ id the channels differ in type: written in the file's own types
+    // (TypeDesc::UNKNOWN), each pixel's bytes packed as the channel formats say.
+    std::vector<std::size_t> offset(std::size_t(channels) + 1, 0);
+    for (int c = 0; c < channels; ++c)
+        offset[std::size_t(c) + 1] = offset[std::size_t(c)] + spec.channelformat(c).size();
+    const std::size_t stride = offset.back();
+    std::vector<unsigned char> pixels(n * stride);
+    for (std::size_t i = 0; i < n; ++i) {
+        unsigned char* p = &pixels[i * stride];
+        int c = 0;
+        auto put = [&](float v) {
+            if (spec.channelformat(c) == OIIO::TypeDesc::FLOAT) {
+                std::memcpy(p + offset[std::size_t(c)], &v, sizeof v);
+            } else {
+                OIIO::convert_pixel_values(OIIO::TypeDesc::FLOAT, &v, OIIO::TypeDesc::HALF,
+                                           p + offset[std::size_t(c)]);
+            }
+            ++c;
+        };
+        for (int k = 0; k < 4; ++k)
+            put(image.rgba[i * 4 + k]);
+        for (const auto& [layer, count] : layers)
+            for (int k = 0; k < count; ++k)
+                put((*layer)[i * count + k]);
+        std::memcpy(p + offset[std::size_t(c)], &image.organ[i], sizeof(std::uint32_t));
+    }
+    ok = out.open(temp.string(), spec) &&
+         out.write_image(OIIO::TypeDesc::UNKNOWN, pixels.data());
 }
 
 }  // namespace

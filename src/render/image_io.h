@@ -2,6 +2,7 @@
 // The rendered image and its output through OpenImageIO (render/output_format.h).
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <vector>
 
@@ -24,6 +25,15 @@ struct Image {
     /// nearest hit distance along the camera ray (1; infinity where every sample missed;
     /// perspective: from the eye, parallel: from the plane the rays start on).
     std::vector<float> albedo{}, normal{}, depth{};
+    /// Where the frame was denoised (RenderSettings::denoiser), empty otherwise: the raw
+    /// frame (RGBA, 4 floats per pixel; `rgba` holds the denoised one), the variance of
+    /// each RGB channel's pixel mean that the denoiser was given (3), and the organ of
+    /// each pixel's nearest camera-ray hit (1: the module that drew it, or
+    /// render/denoise.h's organ_background, organ_ground, organ_unknown).
+    /// The same variance of the albedo's and the normal's pixel means, each summed over
+    /// its 3 channels (2 per pixel).
+    std::vector<float> noisy{}, variance{}, feature_variance{};
+    std::vector<std::uint32_t> organ{};
 
     float& at(int x, int y, int c) { return rgba[(std::size_t(y) * width + x) * 4 + c]; }
     float at(int x, int y, int c) const { return rgba[(std::size_t(y) * width + x) * 4 + c]; }
@@ -43,7 +53,8 @@ struct WriteOptions {
 /// .jpg/.jpeg (8-bit sRGB RGB; a transparent image comes out over black), .tif/.tiff
 /// (16-bit sRGB RGBA, associated alpha), .exr (half-float linear RGBA with A = coverage,
 /// plus layers albedo.{R,G,B}, normal.{X,Y,Z} and a float Z for the depth when the image
-/// has them). The image is written to a temporary name in the same
+/// has them, and for a denoised image noisy.{R,G,B,A} (the raw frame), variance.{R,G,B},
+/// variance.{albedo,normal} and a 32-bit unsigned organ.id). The image is written to a temporary name in the same
 /// folder and renamed, so a failure never leaves a partial file. Throws cambium::Error
 /// naming the file on failure.
 void write_image(const Image& image, const std::filesystem::path& file,

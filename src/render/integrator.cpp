@@ -638,7 +638,10 @@ namespace {
 VisibleSurface visible_surface(const SurfaceHit& hit, const SurfaceMaterial& material,
                                const Vec3f& diffuse)
 {
-    return {true, hit.unlit ? flat_colour(material) : diffuse, hit.normal, hit.t};
+    return {true,          hit.unlit ? flat_colour(material) : diffuse,
+            hit.normal,    hit.t,
+            hit.geom_id,   hit.primitive,
+            hit.instance,  hit.shape};
 }
 
 }  // namespace

@@ -123,6 +123,9 @@ struct VisibleSurface {
     Vec3f albedo;  ///< the (textured) diffuse albedo, or an unlit line's flat colour
     Vec3f normal;  ///< unit shading normal, facing the camera
     float t = 0;   ///< distance along the camera ray
+    /// What was hit, to find its organ (SurfaceHit's fields of the same names).
+    std::uint32_t geom_id = 0, primitive = 0, instance = 0;
+    Shape shape = Shape::line;
 };
 
 /// Throws std::logic_error: `caller` was given a context prepare_path_context() did not fill.

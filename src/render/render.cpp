@@ -33,6 +33,7 @@
 #include "base/diagnostics.h"
 #include "render/accel.h"
 #include "render/color.h"
+#include "render/denoise.h"
 #include "render/float_mode.h"
 #include "render/integrator.h"
 #include "render/labels.h"
@@ -76,6 +77,9 @@ void check_settings(const RenderSettings& s)
     if (!(s.aperture_radius >= 0) || !(s.focus_distance >= 0))
         throw Error("render: the aperture and the focus distance must not be negative");
     const PixelRect& c = s.crop;
+    if (s.denoiser && !c.empty())
+        throw Error("render: --denoise needs the whole image; it cannot denoise a crop "
+                    "(--tile, --mpi)");
     if (!c.empty() && (c.x < 0 || c.y < 0 || c.x > s.width - c.width || c.y > s.height - c.height))
         throw Error("render: the crop " + std::to_string(c.width) + "x" + std::to_string(c.height) +
                     "+" + std::to_string(c.x) + "+" + std::to_string(c.y) +
@@ -176,7 +180,48 @@ struct PixelExtras {
     double luminance_sq = 0;
     double lit_with = 0, lit_without = 0;  // shadow-catcher samples' light (PathResult)
     std::uint32_t caught = 0;              // samples that met the shadow catcher
+    /// Denoising: the odd samples' radiance sum (the even ones' is the rest), and the
+    /// organ of the nearest camera-ray hit (the one `depth` is of).
+    Vec3f odd_radiance, odd_albedo, odd_normal;
+    std::uint32_t organ = organ_background;
 };
+
+const std::vector<std::uint32_t>& modules_of(const geom::Geometry& g, PrimitiveKind k)
+{
+    switch (k) {
+    case PrimitiveKind::lines: return g.lines.module;
+    case PrimitiveKind::curves: return g.curves.module;
+    case PrimitiveKind::spheres: return g.spheres.module;
+    case PrimitiveKind::discs: return g.discs.module;
+    default: return g.mesh.module;
+    }
+}
+
+/// The organ a camera ray's first hit shows (provenance, docs/architecture.md): the
+/// module that drew it, or placed its instance; for a primitive of a prototype whose
+/// instance names no module, its module in the prototype mixed with the instance.
+std::uint32_t organ_of(const geom::Scene& scene, const VisibleSurface& v)
+{
+    if (v.geom_id == ground_geom_id)
+        return organ_ground;
+    if (v.primitive == PrimId::none)
+        return organ_unknown;
+    const PrimitiveKind kind = primitive_kind(v.shape);
+    std::uint32_t module = geom::no_module;
+    if (v.instance == PrimId::none || v.instance >= scene.instances.size()) {
+        const auto& m = modules_of(scene.geometry, kind);
+        module = v.primitive < m.size() ? m[v.primitive] : geom::no_module;
+    } else {
+        const geom::Instance& in = scene.instances[v.instance];
+        if (in.module != geom::no_module)
+            return std::min(in.module, organ_unknown - 1);
+        const auto& m = modules_of(scene.prototypes[in.prototype].geometry, kind);
+        if (v.primitive >= m.size() || m[v.primitive] == geom::no_module)
+            return organ_unknown;
+        module = static_cast<std::uint32_t>(mix64((std::uint64_t(v.instance) << 32) | m[v.primitive]));
+    }
+    return module == geom::no_module ? organ_unknown : std::min(module, organ_unknown - 1);
+}
 
 /// The sampled pixels' sums, row by row.
 struct Film {
@@ -234,6 +279,11 @@ struct RenderState {
     /// plane moves them out of it.
     bool rays_in_reach = float_rays || (parallel_rays && camera.parallel_rays_in_reach());
     bool adaptive = settings.noise_target > 0;
+    /// Samples from two replicas (see replica_index): adaptive sampling and denoising.
+    bool split = adaptive || settings.denoiser != nullptr;
+    bool aovs = settings.aovs || settings.denoiser != nullptr;
+    /// The scene, for the organ of each pixel's nearest hit (denoising only; else null).
+    const geom::Scene* organs = nullptr;
     std::optional<FlatMiss> miss = flat_miss(ctx, settings);
     /// The pixels that may meet the scene (screen_mask); the others take
     /// take_background_samples. Null: every pixel is traced.
@@ -285,7 +335,7 @@ struct PixelReplicas {
 /// The sampler of sample i of a pixel: its replica's sequence at its index there.
 Sampler sampler_of(const RenderState& f, const PixelReplicas& replicas, std::uint32_t i)
 {
-    return Sampler(replicas.seeds(f.adaptive ? (i & 1u) : 0), f.adaptive ? replica_index(i) : i,
+    return Sampler(replicas.seeds(f.split ? (i & 1u) : 0), f.split ? replica_index(i) : i,
                    f.settings.sampler);
 }
 
@@ -329,7 +379,7 @@ void film_pairs(const RenderState& f, const PixelReplicas& replicas, std::uint32
         }
         return;
     }
-    if (!f.adaptive) {
+    if (!f.split) {
         sobol_pairs(replicas.even, sample_dimension::film, i0, n, b.jx.data(), b.jy.data());
         return;
     }
@@ -403,11 +453,20 @@ void take_sample(const RenderState& f, const PixelReplicas& replicas, double tne
     PathResult r = camera_hit && !*camera_hit
                        ? camera_miss(f.ctx, ray.dir)
                        : trace_path(f.ctx, ray.org, ray.dir, sampler_of(f, replicas, i), ray.tfar,
-                                    s.aovs ? &first : nullptr, camera_hit);
+                                    f.aovs ? &first : nullptr, camera_hit);
     if (first.hit) {  // (asked for with AOVs only, which keep extras)
         ex->albedo += first.albedo;
         ex->normal += first.normal;
-        ex->depth = std::min(ex->depth, static_cast<float>(first.t + tnear));
+        const float t = static_cast<float>(first.t + tnear);
+        if (f.organs) {  // denoising
+            if (t < ex->depth)
+                ex->organ = organ_of(*f.organs, first);
+            if (i & 1u) {
+                ex->odd_albedo += first.albedo;
+                ex->odd_normal += first.normal;
+            }
+        }
+        ex->depth = std::min(ex->depth, t);
     }
     if ((s.transparent_background || s.ground.shadow_catcher) && !r.hit)
         r.radiance = Vec3f();
@@ -425,6 +484,8 @@ void take_sample(const RenderState& f, const PixelReplicas& replicas, double tne
     ex->caught += r.catcher ? 1 : 0;
     ex->lit_with += r.lit_with;
     ex->lit_without += r.lit_without;
+    if (f.split && (i & 1u))
+        ex->odd_radiance += r.radiance;
     if (!f.adaptive)
         return;  // only adaptive sampling reads the luminance sums (relative_error_squared)
     // Adaptive sampling watches a shadow catcher's light estimate (its colour is 0).
@@ -441,6 +502,8 @@ void take_flat_miss(const RenderState& f, const FlatMiss& miss, std::uint32_t i,
 {
     radiance += miss.radiance;
     st.samples += 1;
+    if (f.split && (i & 1u))
+        ex->odd_radiance += miss.radiance;
     if (!f.adaptive)
         return;
     ex->replica_luminance[i & 1u] += miss.luminance;
@@ -504,7 +567,7 @@ void take_background_samples(const RenderState& f, std::uint32_t i0, std::uint32
                              PixelState& st, PixelExtras* ex, BackgroundRun& last)
 {
     const BackgroundRun::Bits from = BackgroundRun::bits(st.radiance);
-    if (!f.adaptive && i1 - i0 == last.count && from == last.from) {
+    if (!f.split && i1 - i0 == last.count && from == last.from) {
         st.radiance = {std::bit_cast<float>(last.to[0]), std::bit_cast<float>(last.to[1]),
                        std::bit_cast<float>(last.to[2])};
         st.samples += i1 - i0;
@@ -582,7 +645,7 @@ RowSamples take_row(const RenderState& f, const PixelRect& region, int y, int x0
                                     row.background);
         } else {
             row.replicas[std::size_t(x - x0)].emplace(region.x + x, region.y + y, f.settings.seed,
-                                                      f.adaptive);
+                                                      f.split);
             traced[count++] = static_cast<std::uint8_t>(x - x0);
         }
     }
@@ -712,10 +775,16 @@ Image resolve(const Film& film, const PixelRect& sampled, const PixelRect& out,
     const std::size_t width = std::size_t(out.width), count = width * std::size_t(out.height);
     Image img{out.width, out.height, std::vector<float>(count * 4)};
     img.transparent = s.transparent_background || s.ground.shadow_catcher;
-    if (s.aovs) {
+    const bool aovs = s.aovs || s.denoiser, denoise = s.denoiser != nullptr;
+    if (aovs) {
         img.albedo.assign(count * 3, 0.0f);
         img.normal.assign(count * 3, 0.0f);
         img.depth.assign(count, infinity);
+    }
+    if (denoise) {
+        img.variance.assign(count * 3, 0.0f);
+        img.feature_variance.assign(count * 2, 0.0f);
+        img.organ.assign(count, organ_background);
     }
     const bool extras = !film.extras.empty();  // (without them no pixel has a catcher's light)
     for (std::size_t row = 0; row < std::size_t(out.height); ++row) {
@@ -731,7 +800,29 @@ Image resolve(const Film& film, const PixelRect& sampled, const PixelRect& out,
             img.rgba[i * 4 + 1] = st.radiance.y * inv;
             img.rgba[i * 4 + 2] = st.radiance.z * inv;
             img.rgba[i * 4 + 3] = (static_cast<float>(st.hits) + coverage) * inv;
-            if (s.aovs) {
+            if (denoise) {
+                // A quarter of the squared difference of the two replicas' means: the
+                // variance of the pixel's mean, without bias (1 degree of freedom).
+                const PixelExtras& ex = film.extras[from + x];
+                const std::uint32_t odd = st.samples / 2, even = st.samples - odd;
+                if (odd > 0) {
+                    const Vec3f a = (st.radiance - ex.odd_radiance) * (1.0f / float(even));
+                    const Vec3f b = ex.odd_radiance * (1.0f / float(odd));
+                    const Vec3f d = a - b;
+                    img.variance[i * 3 + 0] = 0.25f * d.x * d.x;
+                    img.variance[i * 3 + 1] = 0.25f * d.y * d.y;
+                    img.variance[i * 3 + 2] = 0.25f * d.z * d.z;
+                    // The same for the albedo and the normal, summed over their channels.
+                    auto half_variance = [&](const Vec3f& sum, const Vec3f& odd_sum) {
+                        const Vec3f e = (sum - odd_sum) * (1.0f / float(even)) - odd_sum * (1.0f / float(odd));
+                        return 0.25f * (e.x * e.x + e.y * e.y + e.z * e.z);
+                    };
+                    img.feature_variance[i * 2 + 0] = half_variance(ex.albedo, ex.odd_albedo);
+                    img.feature_variance[i * 2 + 1] = half_variance(ex.normal, ex.odd_normal);
+                }
+                img.organ[i] = ex.organ;
+            }
+            if (aovs) {
                 const PixelExtras& ex = film.extras[from + x];
                 Vec3f a = ex.albedo * inv, n = ex.normal * inv;
                 img.albedo[i * 3 + 0] = a.x;
@@ -825,6 +916,42 @@ GroundPlane make_ground(const geom::Scene& scene, const RenderSettings& settings
     return plane;
 }
 
+/// The image denoised in place: RGBA the denoiser's, the raw frame kept in `noisy`.
+void denoise(const Denoiser& denoiser, Image& image)
+{
+    DenoiseInput in;
+    in.width = image.width;
+    in.height = image.height;
+    in.beauty = image.rgba;
+    in.variance = image.variance;
+    in.albedo = image.albedo;
+    in.normal = image.normal;
+    in.depth = image.depth;
+    in.organ = image.organ;
+    in.feature_variance = image.feature_variance;
+    std::vector<float> clean = denoiser.denoise(in);
+    image.noisy = std::move(image.rgba);
+    image.rgba = std::move(clean);
+}
+
+/// Throws when denoising would take more memory than --max-memory allows: the layers it
+/// adds to the film and the image, and the denoiser's own working memory.
+void check_denoise_memory(const RenderSettings& s)
+{
+    if (!s.denoiser)
+        return;
+    const std::uint64_t pixels = std::uint64_t(s.width) * std::uint64_t(s.height);
+    // Film extras (odd radiance, organ, albedo, normal, depth, ...), then the image's
+    // noisy, variance, organ, albedo, normal, depth and denoised layers.
+    const std::uint64_t per_pixel = sizeof(PixelExtras) + (4 + 3 + 2 + 1 + 3 + 3 + 1 + 4) * 4;
+    const std::uint64_t bytes = pixels * per_pixel + s.denoiser->working_bytes(s.width, s.height);
+    if (bytes > s.max_memory_bytes)
+        throw Error("render: denoising a " + std::to_string(s.width) + "x" +
+                    std::to_string(s.height) + " image takes " + byte_size_text(bytes) +
+                    ", more than the memory budget of " + byte_size_text(s.max_memory_bytes) +
+                    " (--max-memory)");
+}
+
 std::string clock_time(double seconds)
 {
     long s = std::lround(std::max(0.0, seconds));
@@ -901,6 +1028,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                   const RenderSettings& settings, const ViewCallback& on_view)
 {
     check_settings(settings);
+    check_denoise_memory(settings);
     for (const Camera& camera : cameras) {
         if (camera.width() != settings.width || camera.height() != settings.height)
             throw Error("render: the camera's image size differs from the settings'");
@@ -989,8 +1117,9 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                     camera.aperture_radius() > 0 &&
                         camera.projection() == Camera::Projection::perspective,
                     &nonfinite};
+        state.organs = settings.denoiser ? &scene : nullptr;
         Film film(std::size_t(w) * h,
-                  settings.aovs || state.adaptive || (ctx.ground && ctx.ground->shadow_catcher));
+                  state.aovs || state.adaptive || (ctx.ground && ctx.ground->shadow_catcher));
         std::vector<PixelState>& pixels = film.px;
         // Each thread's camera batches, made on its first tile (not once per tile: their
         // members' initialisers, ~60 kB of stores a tile, were a tenth of the pixel loop).
@@ -1107,6 +1236,12 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         for (const PixelState& st : pixels)
             rep.samples += st.samples;
         Image image = resolve(film, region, out_rect, settings);
+        if (settings.denoiser) {
+            auto denoise_start = Clock::now();
+            denoise(*settings.denoiser, image);
+            rep.denoise_seconds =
+                std::chrono::duration<double>(Clock::now() - denoise_start).count();
+        }
         // Labels over the image, as cpfg's window draws them (on the crop's pixels).
         draw_labels(image, scene, camera, *accel,
                     LabelCanvas{out_rect.x, out_rect.y, settings.width, settings.height},

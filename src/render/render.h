@@ -20,6 +20,7 @@
 
 namespace cambium::render {
 
+class Denoiser;
 class TextureSet;
 
 /// The pixel reconstruction filter. Filters are importance sampled: each sample's
@@ -159,6 +160,14 @@ struct RenderSettings {
     /// to check that (tests) or to trace every ray (benchmarks).
     bool skip_empty_pixels = true;
 
+    /// Denoise each frame (--denoise; render/denoise.h) with this denoiser, null: not.
+    /// The samples are then drawn from two independently scrambled replicas (even and
+    /// odd samples, as adaptive sampling draws them), whose difference gives each
+    /// pixel's variance; the AOVs are computed whatever `aovs` says, with the organ id
+    /// beside them. The Image's RGBA is the denoised frame, Image::noisy the raw one.
+    /// Needs the whole image (no crop). Labels are drawn after denoising.
+    std::shared_ptr<const Denoiser> denoiser;
+
     /// Print progress to stderr as one updating line (percentage, elapsed, remaining).
     bool progress = false;
     /// Checked every tile row: when it becomes true, render() stops and returns the image
@@ -182,7 +191,8 @@ struct RenderReport {
     /// skip_empty_pixels): taken without a ray. And those pixels' share of the image.
     std::uint64_t background_only_samples = 0;
     double empty_pixel_share = 0;
-    double seconds = 0;         ///< wall time, including the Embree build
+    double seconds = 0;         ///< wall time, including the Embree build and denoising
+    double denoise_seconds = 0; ///< of it, the denoiser's (RenderSettings::denoiser)
     /// --stats: from the call to the first sample (textures, the Embree build, lights),
     /// and of it the Embree build alone (the first view's; 0 for later views).
     double setup_seconds = 0;

@@ -148,6 +148,50 @@ TEST(Command, RendersAPlantToPngAndExr)
     EXPECT_GT(differ, covered / 2);
 }
 
+// --denoise: the EXR's RGBA is the denoised frame, the raw one the noisy layer beside the
+// organ ids, which name the F modules that drew the plant (its provenance); the PNG is
+// written from the denoised frame. A tile cannot be denoised: an error before rendering.
+TEST(Command, DenoiseWritesTheRawFrameBesideTheDenoisedOne)
+{
+    fs::path dir = scratch("denoise");
+    write(dir / "p.l", "lsystem: 1\nderivation length: 1\naxiom: F\nF --> F[+F]F\nendlsystem\n");
+    write(dir / "p.v", "line style: cylinder\ninitial line width: 0.2\n");
+    const std::string files = (dir / "p.l").string() + " " + (dir / "p.v").string();
+    Result r = run("-q -w 48 36 --spp 4 --ground --denoise -o " + (dir / "p.png").string() +
+                   " -o " + (dir / "p.exr").string() + " " + files);
+    ASSERT_EQ(r.status, 0) << r.output;
+    Picture exr = read_picture(dir / "p.exr");
+    for (const char* name : {"R", "A", "noisy.R", "noisy.G", "noisy.B", "noisy.A", "variance.R",
+                             "variance.albedo", "organ.id", "albedo.R", "normal.X", "Z"})
+        EXPECT_GE(exr.channel(name), 0) << name;
+    const int noisy = exr.channel("noisy.R"), organ = exr.channel("organ.id");
+    ASSERT_GE(organ, 0);
+    double differ = 0;
+    for (int y = 0; y < exr.height; ++y)
+        for (int x = 0; x < exr.width; ++x)
+            for (int c = 0; c < 3; ++c)
+                differ += std::fabs(exr.at(x, y, c) - exr.at(x, y, noisy + c));
+    EXPECT_GT(differ, 0.01) << "the denoised frame equals the raw one";
+    // The organ ids as stored (32-bit unsigned): module indices of the derived string
+    // F[+F]F (0 .. 5) on the plant, the ground's or the background's elsewhere (the
+    // parallel view sees the ground edge-on); none unknown (every cylinder has its module).
+    auto in = OIIO::ImageInput::open((dir / "p.exr").string());
+    ASSERT_TRUE(in);
+    std::vector<std::uint32_t> ids(std::size_t(exr.width) * exr.height);
+    ASSERT_TRUE(in->read_image(0, 0, organ, organ + 1, OIIO::TypeDesc::UINT, ids.data()));
+    in->close();
+    const auto plant = std::count_if(ids.begin(), ids.end(), [](std::uint32_t id) { return id < 6; });
+    EXPECT_GT(plant, 4) << "no pixel names an F module";
+    EXPECT_LT(plant, std::ptrdiff_t(ids.size() / 2));
+    EXPECT_EQ(std::count(ids.begin(), ids.end(), 0xfffffffdu), 0) << "an unknown module";
+    EXPECT_TRUE(fs::exists(dir / "p.png"));
+
+    Result tile = run("-q -w 48 36 --spp 1 --denoise --tile 0/2 -o " + (dir / "t.png").string() +
+                      " " + files);
+    EXPECT_NE(tile.status, 0);
+    EXPECT_NE(tile.output.find("--denoise needs the whole image"), std::string::npos) << tile.output;
+}
+
 // `render mode: wireframe` draws a polygon as its outline of 1-pixel lines in its colour
 // (cpfg's grey without a colour file) and leaves the inside, diagonal included, to the
 // background; `filled` fills it. The square spans most of the 64 x 64 image.
