@@ -320,7 +320,16 @@ void Deriver::decompose()
         return;
     int depth = decomposition_depth();
     std::size_t applied = 0;
+    std::uint64_t work = 0;
     for (int pass = 0; pass < depth; ++pass) {
+        work += m_string.size();
+        if (work > m_limits.max_decomposition_work)
+            throw Error(set.max_depth_loc,
+                        "the decomposition went through " + std::to_string(work) +
+                            " modules in " + std::to_string(pass + 1) + " passes of one step (maximum depth " +
+                            std::to_string(depth) + "), more than the " +
+                            std::to_string(m_limits.max_decomposition_work) +
+                            " a step may take; lower the maximum depth");
         index(m_string, m_indexed);
         m_next.clear();
         applied = rewrite(m_indexed, m_next, true);

@@ -32,6 +32,10 @@ struct DeriveLimits {
     bool start = true;
     /// A scene's seed override of every random stream (LoadOptions::seed)
     std::optional<long> seed;
+    /// Modules the decomposition's passes of one step may go through together: each pass
+    /// reads the whole string, so a deep decomposition that keeps growing is quadratic
+    /// (`A --> FA` at depth 10^6 is 5·10^11 modules, minutes; 2^32 take a few seconds).
+    std::uint64_t max_decomposition_work = std::uint64_t{1} << 32;
 };
 
 /// A fragment start that the turtle pass reached before a step (manual 5.1.9 `%(par)`):

@@ -505,6 +505,37 @@ TEST(MemoryBudget, ParameterValuesPastTheLimitStopTheDerivation)
     EXPECT_EQ(within.string().param_total(), std::size_t{200} << 8);
 }
 
+// Each decomposition pass reads the whole string: a deep decomposition that keeps
+// growing is quadratic, so the modules its passes go through in one step are bounded
+// (here 10^4: `A --> FA` passes over 1, 2, 3 ... modules, past 10^4 at pass 141).
+TEST(DecompositionWork, DeepGrowingDecompositionStopsAtItsMaximumDepthLine)
+{
+    LSystem ls = LSystem::from_source("Lsystem: 1\nderivation length: 1\nAxiom: A\n"
+                                      "decomposition\nmaximum depth: 1000000\nA --> FA\nendlsystem\n",
+                                      "deep.l");
+    DeriveLimits limits;
+    limits.max_decomposition_work = 10000;
+    Deriver deriver(ls.program(), limits);
+    std::string e;
+    try {
+        deriver.step();
+    } catch (const Error& error) {
+        e = error.what();
+    }
+    EXPECT_EQ(e, "deep.l:5:16: error: the decomposition went through 10011 modules in 141 passes of "
+                 "one step (maximum depth 1000000), more than the 10000 a step may take; lower the "
+                 "maximum depth");
+    // a depth whose passes stay within the bound derives as before
+    DeriveLimits roomy;
+    roomy.max_decomposition_work = 10000;
+    LSystem shallow = LSystem::from_source("Lsystem: 1\nderivation length: 1\nAxiom: A\n"
+                                           "decomposition\nmaximum depth: 100\nA --> FA\nendlsystem\n",
+                                           "shallow.l");
+    Deriver within(shallow.program(), roomy);
+    within.step();
+    EXPECT_EQ(within.string().size(), 101u);
+}
+
 // The system refusing memory within the budget (here an address-space limit makes
 // mmap and mremap fail) is an error naming the file and the step, and it does not claim
 // that the budget was exceeded.
