@@ -273,8 +273,8 @@ std::optional<Beam> make_beam(const geom::Light& light, const geom::Bounds3& b)
         return std::nullopt;
     Beam beam;
     beam.to_light = unit(d);
-    Vec3d helper = std::abs(beam.to_light.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0};
-    beam.u = unit(cross(helper, beam.to_light));
+    Vec3d other = std::abs(beam.to_light.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0};
+    beam.u = unit(cross(other, beam.to_light));
     beam.v = cross(beam.to_light, beam.u);
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
     for (int c = 0; c < 8; ++c) {
@@ -313,8 +313,8 @@ Vec3d cosine_direction(Vec3d n, RayRandom& rng)
 {
     const double u1 = rng.next(), u2 = rng.next();
     const double r = std::sqrt(u1), phi = 2 * std::numbers::pi * u2;
-    Vec3d helper = std::abs(n.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0};
-    Vec3d t = unit(cross(helper, n));
+    Vec3d other = std::abs(n.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0};
+    Vec3d t = unit(cross(other, n));
     Vec3d s = cross(n, t);
     return unit(t * (r * std::cos(phi)) + s * (r * std::sin(phi)) + n * std::sqrt(std::max(0.0, 1 - u1)));
 }
