@@ -80,7 +80,7 @@ double median(std::vector<double> v)
 
 }  // namespace
 
-PlantImage read_cpfg_image(const std::string& file)
+PlantImage read_cpfg_image(const std::string& file, const std::array<float, 3>& window_background)
 {
     auto in = OIIO::ImageInput::open(file);
     if (!in)
@@ -108,6 +108,11 @@ PlantImage read_cpfg_image(const std::string& file)
     int background = std::max_element(border.begin(), border.end(), [](auto& a, auto& b) {
                          return a.second < b.second;
                      })->first;
+    bool window_shows_background = true;
+    for (int c = 0; c < 3; ++c) {
+        int bg = (background >> (16 - 8 * c)) & 0xff;
+        window_shows_background = window_shows_background && std::abs(bg - window_background[c] * 255) <= 3;
+    }
     img.rgb.resize(bytes.size());
     img.plant.resize(bytes.size() / 3);
     for (std::size_t i = 0; i < img.plant.size(); ++i) {
@@ -117,7 +122,7 @@ PlantImage read_cpfg_image(const std::string& file)
             int bg = (background >> (16 - 8 * c)) & 0xff;
             differs = differs || std::abs(int(bytes[3 * i + c]) - bg) > 3;
         }
-        img.plant[i] = differs;
+        img.plant[i] = differs || !window_shows_background;
     }
     return img;
 }

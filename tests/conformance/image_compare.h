@@ -3,6 +3,7 @@
 // where the plant is (silhouettes within a few pixels) and what colour it is.
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -17,7 +18,9 @@ struct PlantImage {
 
 /// cpfg's window image: the plant is every pixel whose colour differs from the
 /// background (the most common colour of the border) by more than 3/255 in a channel.
-PlantImage read_cpfg_image(const std::string& file);
+/// When that colour is not the window's `background` (display values in [0, 1]) either,
+/// geometry fills the window and hides the background: every pixel is the plant.
+PlantImage read_cpfg_image(const std::string& file, const std::array<float, 3>& background);
 
 struct ImageAgreement {
     /// Silhouettes: the fraction of our plant pixels within `tolerance_px` of cpfg's
