@@ -3,7 +3,7 @@
 // (`./obcheck`, whose source is not in the corpus), run as an external program through
 // cpfg's pipe protocol: a stand-in written from FACTS-environment.md's description of
 // obcheck (tests/env/test_program.cpp, started under the name obcheck) must give cpfg's
-// string, 174 steps of answers later.
+// string, 174 steps of answers later, and cpfg's box.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -11,6 +11,7 @@
 #include "app/pipeline.h"
 #include "base/diagnostics.h"
 #include "corpus_model.h"
+#include "geom/view_volume.h"
 #include "lsys/string_io.h"
 
 namespace cambium::test {
@@ -44,8 +45,18 @@ TEST(ExternalProgramConformance, CelticKnotWithAnObcheckStandInMatchesCpfg)
     Diagnostics quiet(Diagnostics::Output::quiet);
     ScopedDiagnostics scope(quiet);
     app::Model loaded = app::load_model(options);
-    const std::string ours = lsys::to_text(app::derive(loaded, options), loaded.lsystem.symbols());
+    const lsys::ModuleString derived = app::derive(loaded, options);
+    const std::string ours = lsys::to_text(derived, loaded.lsystem.symbols());
     EXPECT_EQ(string_difference(ours, without_newlines(read_text(found->oracle / "string.str"))), "");
+    // the box, within 1e-3 of its diagonal as the view-volume conformance test asks
+    const geom::Bounds3 box = app::view_volume(loaded, derived, options);
+    const geom::Bounds3 ref =
+        geom::parse_view_volume(read_text(found->oracle / "view.vv"), (found->oracle / "view.vv").string());
+    const double tolerance = 1e-3 * geom::length(ref.extent());
+    for (int axis = 0; axis < 3; ++axis) {
+        EXPECT_NEAR(box.lo[axis], ref.lo[axis], tolerance) << "axis " << axis;
+        EXPECT_NEAR(box.hi[axis], ref.hi[axis], tolerance) << "axis " << axis;
+    }
     fs::remove_all(copy);
 }
 
