@@ -92,7 +92,29 @@ struct Timing {
     }
 };
 
-void derive_group(Group& g, const SceneFile& file, const Options& options, Timing& t)
+/// The interpreted variants every group holds until the scene is combined, counted
+/// together against the memory budget: each derivation checks its own string, but a
+/// thousand variants that each fit can still exhaust memory side by side.
+class HeldVariants {
+public:
+    explicit HeldVariants(std::uint64_t max_bytes) : m_max_bytes(max_bytes) {}
+    void hold(const geom::Scene& variant)
+    {
+        std::uint64_t now = m_bytes += geom::scene_buffer_bytes(variant);
+        std::uint64_t count = ++m_count;
+        if (now > m_max_bytes)
+            throw Error("the plants interpreted so far (" + std::to_string(count) + " variants) hold " +
+                        byte_size_text(now) + ", more than the memory budget of " +
+                        byte_size_text(m_max_bytes) + " (--max-memory)");
+    }
+
+private:
+    const std::uint64_t m_max_bytes;
+    std::atomic<std::uint64_t> m_bytes{0};
+    std::atomic<std::uint64_t> m_count{0};
+};
+
+void derive_group(Group& g, const SceneFile& file, const Options& options, Timing& t, HeldVariants& held)
 {
     // A seated plant leaves its shared environment once derived, or when it fails, so
     // that the others' steps never wait for it.
@@ -118,6 +140,7 @@ void derive_group(Group& g, const SceneFile& file, const Options& options, Timin
             leave.now();  // a seated plant has one variant
             auto begin = Clock::now();
             g.variants[k] = interpret(model, s, o);
+            held.hold(g.variants[k]);
             interpret_us += std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - begin).count();
         });
         t.derive_us += std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - start).count() -
@@ -140,7 +163,8 @@ void derive_group(Group& g, const SceneFile& file, const Options& options, Timin
 /// step of their shared environments, so none may wait for a thread pool's free worker.
 /// The first failure is thrown (the others it caused are not).
 void derive_seated_groups(std::vector<Group>& groups, const std::vector<std::size_t>& seated,
-                          const SceneFile& file, const Options& options, Timing& timing)
+                          const SceneFile& file, const Options& options, Timing& timing,
+                          HeldVariants& held)
 {
     std::vector<std::exception_ptr> errors(seated.size());
     std::atomic<int> first{-1};
@@ -150,7 +174,7 @@ void derive_seated_groups(std::vector<Group>& groups, const std::vector<std::siz
         for (std::size_t k = 0; k < seated.size(); ++k)
             threads.emplace_back([&, k] {
                 try {
-                    derive_group(groups[seated[k]], file, options, timing);
+                    derive_group(groups[seated[k]], file, options, timing, held);
                 } catch (...) {
                     errors[k] = std::current_exception();
                     int none = -1;
@@ -529,13 +553,14 @@ geom::Scene assemble(const SceneFile& file, const std::vector<std::optional<Envi
     }
 
     Timing timing;
+    HeldVariants held(options.max_memory_bytes);
     std::vector<std::size_t> closed, seated;
     for (std::size_t i = 0; i < groups.size(); ++i)
         (groups[i].seat ? seated : closed).push_back(i);
     tbb::parallel_for(std::size_t{0}, closed.size(), [&](std::size_t i) {
-        derive_group(groups[closed[i]], file, options, timing);
+        derive_group(groups[closed[i]], file, options, timing, held);
     });
-    derive_seated_groups(groups, seated, file, options, timing);
+    derive_seated_groups(groups, seated, file, options, timing, held);
 
     geom::Scene out;
     out.materials.clear();

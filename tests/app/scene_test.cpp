@@ -16,9 +16,11 @@
 #include <string>
 #include <vector>
 
+#include "app/pipeline.h"
 #include "app/scene_assembly.h"
 #include "app/scene_file.h"
 #include "base/diagnostics.h"
+#include "geom/scene_limits.h"
 #include "render/camera.h"
 #include "render/render.h"
 
@@ -607,6 +609,38 @@ TEST(SceneAssembly, PlacementsTimesOrgansAreWithinTheMemoryBudget)
     // drawn inline, every copy's primitives count (7 a plant: 100 B each)
     budget.max_memory_bytes = 400'000;
     EXPECT_THROW(app::assemble_scene(s, budget, {app::OrganPlacement::compose, true}), Error);
+}
+
+// Each variant's derivation and interpretation keeps to the budget on its own; the
+// variants held together until the scene is combined must too.
+TEST(SceneAssembly, VariantsHeldTogetherAreWithinTheMemoryBudget)
+{
+    SceneFolder f("variants_budget");
+    f.tiny_model("m");
+    app::Options one;
+    one.lsystem = f.dir() / "m/p.l";
+    one.view = f.dir() / "m/p.v";
+    app::Model model = app::load_model(one);
+    const std::uint64_t variant_bytes = geom::scene_buffer_bytes(app::interpret(model, app::derive(model, one), one));
+    ASSERT_GT(variant_bytes, 0u);
+    std::string plants;  // 10 seeds: 10 groups, each one variant held until combined
+    for (int seed = 0; seed < 10; ++seed)
+        plants += std::string(seed ? ", " : "") + R"({"model": "m", "command": "cpfg p.l p.v", "seed": )" +
+                  std::to_string(seed) + R"(, "placements": [{}]})";
+    app::SceneFile s = app::read_scene_file(f.scene("{\"plants\": [" + plants + "]}"), app::Options{});
+    app::Options budget;
+    budget.max_memory_bytes = 5 * variant_bytes;
+    try {
+        app::assemble_scene(s, budget, {app::OrganPlacement::compose, false});
+        ADD_FAILURE() << "10 variants of " << variant_bytes << " B passed a budget of 5 of them";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("variants) hold"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("(--max-memory)"), std::string::npos) << e.what();
+    }
+    budget.max_memory_bytes = 15 * variant_bytes;
+    app::AssemblyReport report;
+    app::assemble_scene(s, budget, {app::OrganPlacement::compose, false}, &report);
+    EXPECT_EQ(report.variants, 10u);
 }
 
 TEST(SceneAssembly, InstancedFieldRendersAsTheSamePlantsInline)
