@@ -458,9 +458,16 @@ int main(int argc, char** argv)
         return cambium::app::run(*options, mpi.get(), command_start);
     } catch (const cambium::Interrupted& e) {
         fail(e.what());
-        return 128 + e.signal();  // a helper program was running; it is stopped
+        return 128 + e.signal();  // a child program was running; it is stopped
     } catch (const cambium::Error& e) {
         return fail(e.what());
+    } catch (const std::bad_alloc&) {
+        // The stages that hold most check --max-memory and name their input; what is
+        // left is the system refusing memory within the budget (ulimit -v, memory in use).
+        return fail("error: out of memory: the system refused an allocation within the memory budget "
+                    "(--max-memory); an address-space limit (ulimit -v) or other programs hold the "
+                    "rest: lower --max-memory to have the step that needs it named, or lower the "
+                    "image size, samples or derivation length");
     } catch (const std::exception& e) {
         return fail(std::string("error: ") + e.what());
     }

@@ -675,6 +675,34 @@ TEST(Command, HugeGeometryIsRefusedWithAMessageNeverAnEmbreeAbort)
     EXPECT_FALSE(fs::exists(dir / "out.png"));
 }
 
+// Memory the system refuses within --max-memory (here an address-space limit on a
+// film of 8192 x 8192) is a message that says so, never a bare "std::bad_alloc".
+TEST(Command, MemoryTheSystemRefusesIsAMessageNotABareBadAlloc)
+{
+#if defined(__SANITIZE_ADDRESS__)
+    GTEST_SKIP() << "AddressSanitizer reserves its shadow memory past any address-space limit";
+#else
+    fs::path dir = scratch("refused");
+    write(dir / "p.l", "lsystem: 1\nderivation length: 2\naxiom: A\nA --> F[+A][-A]\nendlsystem\n");
+    write(dir / "p.v", "line style: cylinder\n");
+    auto under_limit = [&](const std::string& size, const std::string& out) {
+        return cambium::test::run_shell("ulimit -v 1500000 && exec " + std::string(CAMBIUM_EXE) + " --threads 2 -w " +
+                                        size + " --spp 1 -o " + (dir / out).string() + " p.l p.v", dir);
+    };
+    Result small = under_limit("64 48", "small.png");  // the limit alone does not stop a run
+    ASSERT_TRUE(WIFEXITED(small.status)) << small.output;
+    ASSERT_EQ(WEXITSTATUS(small.status), 0) << small.output;
+    Result r = under_limit("8192 8192", "big.png");
+    ASSERT_TRUE(WIFEXITED(r.status)) << r.output;
+    EXPECT_EQ(WEXITSTATUS(r.status), 1) << r.output;
+    EXPECT_NE(r.output.find("error: out of memory: the system refused an allocation within the memory budget"),
+              std::string::npos)
+        << r.output;
+    EXPECT_EQ(r.output.find("std::bad_alloc"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "big.png"));
+#endif
+}
+
 TEST(Command, NotANumberGeometryIsDroppedAndTheRestRenders)
 {
     fs::path dir = scratch("nan");
