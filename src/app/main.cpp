@@ -17,6 +17,7 @@
 
 #include "app/command_line.h"
 #include "app/distributed.h"
+#include "app/light_report.h"
 #include "app/tiles.h"
 #include "app/pipeline.h"
 #include "app/scene_assembly.h"
@@ -32,7 +33,6 @@
 #include "base/output_format.h"
 #include "geom/mesh_export.h"
 #include "render/denoise.h"
-#include "render/light_report.h"
 #include "render/render.h"
 
 namespace cambium::app {
@@ -255,13 +255,7 @@ void write_light_report(const geom::Scene& scene, const Options& options,
                         const std::function<void(const std::string&)>& say)
 {
     auto start = Clock::now();
-    render::LightReportSettings settings;
-    settings.rays = options.light_rays;
-    settings.threads = options.threads;
-    render::LightReport report = render::trace_light(scene, settings);
-    for (const std::string& skipped : report.skipped_lights)
-        warn("--light-report: " + skipped);
-    render::write_light_report(report, *options.light_report);
+    render::LightReport report = app::write_light_report(scene, options);
     say(fmt::format("wrote {}: {} organs, {} rays, absorbed {:.6g} of {:.6g} in {:.2f} s",
                     options.light_report->string(), report.organs.size(), report.rays,
                     report.absorbed, report.emitted, seconds_since(start)));
@@ -356,10 +350,7 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
     auto lap = Clock::now();
     // the light report names each organ's age: the derivation's lineage gives it
     StringOrigins provenance;
-    lsys::ModuleString string =
-        options.light_report && !options.homomorphism_in_string
-            ? model.lsystem.derive_with_ages(options.steps, provenance.ages)
-            : derive(model, options);
+    lsys::ModuleString string = derive(model, options, options.light_report.has_value(), provenance.ages);
     stats.derive_s = seconds_since(lap);
     say(fmt::format("derived {} modules in {:.3f} s", string.size(), seconds_since(start)));
     if (writes)
@@ -381,15 +372,7 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
     }
 
     lap = Clock::now();
-    geom::Scene scene;
-    if (turtle_reads_derived_string(model, options)) {
-        scene = interpret_turtle_string(model, string, options, &provenance);
-    } else {
-        // the derived string is kept while the turtle reads: its modules name the organs
-        provenance.derived = &string;
-        lsys::ModuleString turtle = turtle_string(model, string, options, provenance.origins);
-        scene = interpret_turtle_string(model, turtle, options, &provenance);
-    }
+    geom::Scene scene = interpret_with_provenance(model, string, options, provenance);
     string = lsys::ModuleString();  // freed before the geometry's BVH is built
     provenance = StringOrigins();
     stats.interpret_s = seconds_since(lap);

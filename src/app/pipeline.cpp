@@ -265,6 +265,24 @@ lsys::ModuleString derive(const Model& model, const Options& options)
     return derived;
 }
 
+lsys::ModuleString derive(const Model& model, const Options& options, bool with_ages,
+                          std::vector<std::uint16_t>& ages)
+{
+    if (!with_ages || options.homomorphism_in_string)
+        return derive(model, options);
+    return model.lsystem.derive_with_ages(options.steps, ages);
+}
+
+geom::Scene interpret_with_provenance(const Model& model, const lsys::ModuleString& derived,
+                                      const Options& options, StringOrigins& provenance)
+{
+    if (turtle_reads_derived_string(model, options))
+        return interpret_turtle_string(model, derived, options, &provenance);
+    provenance.derived = &derived;  // the turtle string's modules name the derived ones
+    lsys::ModuleString turtle = turtle_string(model, derived, options, provenance.origins);
+    return interpret_turtle_string(model, turtle, options, &provenance);
+}
+
 namespace {
 /// Whether the view's last `render mode:` / `shade mode:` is cpfg's interpolated fill,
 /// which Cambium shades but cpfg draws without any lighting.

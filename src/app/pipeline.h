@@ -94,6 +94,17 @@ lsys::ModuleString turtle_string(const Model& model, const lsys::ModuleString& d
 geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString& string,
                                     const Options& options, const StringOrigins* origins = nullptr);
 
+/// derive(), with each derived module's age in `ages` when `with_ages` and the string is
+/// not asked for with its homomorphism applied (-homo has no ages to give): the lineage
+/// costs 4 bytes a module while deriving, so only what reports ages asks for them.
+lsys::ModuleString derive(const Model& model, const Options& options, bool with_ages,
+                          std::vector<std::uint16_t>& ages);
+/// interpret() with every primitive's module: through the turtle string's origins in
+/// `derived` when a homomorphism rewrites it, directly otherwise. `provenance.ages` as
+/// derive() gave them; `provenance` points into `derived` until both are dropped.
+geom::Scene interpret_with_provenance(const Model& model, const lsys::ModuleString& derived,
+                                      const Options& options, StringOrigins& provenance);
+
 /// What -vv writes: the view volume of a derived string (the view file's `box:` wins, as
 /// in cpfg, unless not `box_wins`). The turtle walks the string without storing geometry, so a
 /// -vv without an image costs the walk alone; the bounds equal interpret()'s.

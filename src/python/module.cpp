@@ -28,6 +28,7 @@
 #include <unistd.h>
 
 #include "app/command_line.h"
+#include "app/light_report.h"
 #include "app/pipeline.h"
 #include "app/scene_assembly.h"
 #include "app/scene_file.h"
@@ -36,7 +37,6 @@
 #include "base/subprocess.h"
 #include "lsys/string_io.h"
 #include "render/framing.h"
-#include "render/light_report.h"
 #include "render/render.h"
 
 namespace py = pybind11;
@@ -453,7 +453,8 @@ geom::Scene model_scene(const ModelObject& m, std::optional<lsys::ModuleString>&
         given = app::derive(*m.model, options);
     }
     events.push("interpret");
-    geom::Scene scene = app::interpret(*m.model, *given, options);
+    app::StringOrigins provenance;  // organs named by the derived string's modules, as the command's
+    geom::Scene scene = app::interpret_with_provenance(*m.model, *given, options, provenance);
     given.reset();
     app::apply_camera_options(scene, options);
     return scene;
@@ -589,28 +590,12 @@ py::object light_report(ModelObject& m, const py::object& path, const py::object
                 derived = std::move(*given);
             } else {
                 events.push("derive");
-                derived = options.homomorphism_in_string
-                              ? app::derive(*m.model, options)
-                              : m.model->lsystem.derive_with_ages(options.steps, provenance.ages);
+                derived = app::derive(*m.model, options, true, provenance.ages);
             }
             events.push("interpret");
-            geom::Scene scene;
-            if (app::turtle_reads_derived_string(*m.model, options)) {
-                scene = app::interpret_turtle_string(*m.model, derived, options, &provenance);
-            } else {
-                provenance.derived = &derived;
-                lsys::ModuleString turtle =
-                    app::turtle_string(*m.model, derived, options, provenance.origins);
-                scene = app::interpret_turtle_string(*m.model, turtle, options, &provenance);
-            }
+            geom::Scene scene = app::interpret_with_provenance(*m.model, derived, options, provenance);
             events.push("trace");
-            render::LightReportSettings settings;
-            settings.rays = options.light_rays;
-            settings.threads = options.threads;
-            render::LightReport report = render::trace_light(scene, settings);
-            for (const std::string& skipped : report.skipped_lights)
-                warn("--light-report: " + skipped);
-            render::write_light_report(report, *options.light_report);
+            app::write_light_report(scene, options);
         },
         progress, options.quiet);
     if (file.extension() != ".json")

@@ -1,0 +1,20 @@
+// SPDX-License-Identifier: Apache-2.0
+#include "app/light_report.h"
+
+#include "base/diagnostics.h"
+
+namespace cambium::app {
+
+render::LightReport write_light_report(const geom::Scene& scene, const Options& options)
+{
+    render::LightReportSettings settings;
+    settings.rays = options.light_rays;
+    settings.threads = options.threads;
+    render::LightReport report = render::trace_light(scene, settings);
+    for (const std::string& skipped : report.skipped_lights)
+        warn("--light-report: " + skipped);
+    render::write_light_report(report, *options.light_report);
+    return report;
+}
+
+}  // namespace cambium::app
