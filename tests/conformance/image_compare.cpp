@@ -11,8 +11,29 @@
 
 #include <fmt/format.h>
 
+#include "app/pipeline.h"
+#include "render/color.h"
+#include "render/render.h"
+
 namespace cambium::test {
 namespace {
+
+/// Pixels apart that still count as the same place (cpfg's lines and polygon edges are
+/// rasterised differently from ray-traced ones).
+constexpr int tolerance_px = 2;
+constexpr double min_agreement = 0.95;
+/// How far (of 255) a pixel may lie from the background colour and still count as
+/// background: the tolerance read_cpfg_image gives cpfg's picture.
+constexpr float background_tolerance = 3;
+constexpr double max_hue_difference_deg = 15;
+/// Hue is compared only where enough pixels of both images have one.
+constexpr std::size_t min_hue_pixels = 200;
+/// Our HSV value over cpfg's, median over the plant. cpfg's window adds a flat ambient
+/// term and lights with OpenGL's unnormalised Lambert term; the path tracer's light is
+/// physical (directional light of radiance pi, sRGB-decoded albedo, soft ambient from
+/// the environment), so shaded parts come out within about 2x of cpfg's either way.
+constexpr double min_value_ratio = 0.5, max_value_ratio = 2.0;
+
 
 /// The square dilation of `mask` by `radius` pixels (separable: rows, then columns).
 std::vector<bool> dilate(const std::vector<bool>& mask, int width, int height, int radius)
@@ -127,7 +148,7 @@ PlantImage read_cpfg_image(const std::string& file, const std::array<float, 3>& 
     return img;
 }
 
-ImageAgreement compare_images(const PlantImage& ours, const PlantImage& cpfg, int tolerance_px)
+ImageAgreement compare_images(const PlantImage& ours, const PlantImage& cpfg)
 {
     if (ours.width != cpfg.width || ours.height != cpfg.height)
         throw std::runtime_error(fmt::format("image sizes differ: {}x{} and cpfg's {}x{}", ours.width,
@@ -151,6 +172,51 @@ ImageAgreement compare_images(const PlantImage& ours, const PlantImage& cpfg, in
     a.median_hue_difference = median(hue);
     a.median_value_ratio = value.empty() ? 1 : median(value);
     return a;
+}
+
+PlantImage render_for_comparison(const app::Options& options)
+{
+    app::Model loaded = app::load_model(options);
+    geom::Scene scene = app::interpret(loaded, app::derive(loaded, options), options);
+    render::RenderSettings settings;
+    settings.width = options.width;
+    settings.height = options.height;
+    settings.samples_per_pixel = 2;
+    settings.max_depth = 3;
+    settings.threads = 2;
+    settings.transparent_background = true;
+    render::Image image = render::render(scene, settings);
+    PlantImage out;
+    out.background = {scene.background.r, scene.background.g, scene.background.b};
+    const std::array<float, 3>& background = out.background;
+    out.width = image.width;
+    out.height = image.height;
+    out.rgb.resize(std::size_t(image.width) * image.height * 3);
+    out.plant.resize(std::size_t(image.width) * image.height);
+    for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x) {
+            std::size_t i = std::size_t(y) * image.width + x;
+            float alpha = image.at(x, y, 3);
+            bool shows_background = true;
+            for (int c = 0; c < 3; ++c) {  // straight colour from the premultiplied
+                out.rgb[3 * i + c] = alpha > 0 ? render::linear_to_srgb(image.at(x, y, c) / alpha) : 0;
+                shows_background = shows_background &&
+                                   std::abs(out.rgb[3 * i + c] - background[c]) * 255 <= background_tolerance;
+            }
+            out.plant[i] = alpha >= 0.5f && !shows_background;
+        }
+    return out;
+}
+
+bool ImageAgreement::silhouettes_agree() const
+{
+    return precision >= min_agreement && recall >= min_agreement;
+}
+
+bool ImageAgreement::colours_agree() const
+{
+    return (hue_pixels < min_hue_pixels || median_hue_difference <= max_hue_difference_deg) &&
+           median_value_ratio >= min_value_ratio && median_value_ratio <= max_value_ratio;
 }
 
 std::string ImageAgreement::describe() const
