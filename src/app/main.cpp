@@ -272,8 +272,6 @@ int run_scene(Options options, const std::function<void(const std::string&)>& sa
     if (!options.colour_files.empty())
         throw Error("-m and -M name one model's colours; each plant of a scene names its own "
                     "in its command");
-    if (options.light_report)
-        throw Error("--light-report measures one plant's organs; not yet with a scene file");
     SceneFile file = read_scene_file(*options.scene, options);
     apply_scene_settings(file, options);
     if (options.steps)  // --steps derives every plant that many steps
@@ -281,6 +279,8 @@ int run_scene(Options options, const std::function<void(const std::string&)>& sa
             plant.steps = {options.steps};
     std::vector<std::filesystem::path> images = image_outputs(options);
     check_outputs(options, images);  // fail before the work, not after
+    if (options.light_report && is_sequence(options))
+        throw Error("--light-report measures a still; not with --turntable");
     RunStats stats;
     auto make_scene = [&]() {
         AssemblyReport report;
@@ -306,6 +306,8 @@ int run_scene(Options options, const std::function<void(const std::string&)>& sa
         geom::write_view_volume(scene.bounds, *options.view_volume);
         say("wrote " + options.view_volume->string());
     }
+    if (options.light_report && (!mpi || mpi->rank() == 0))  // each organ of each placement
+        write_light_report(scene, options, say);
     if (images.empty()) {
         report_stats(stats, options);
         return 0;

@@ -139,7 +139,8 @@ void derive_group(Group& g, const SceneFile& file, const Options& options, Timin
         VariantRuns runs = derive_variants(model, g.steps, [&](std::size_t k, const lsys::ModuleString& s) {
             leave.now();  // a seated plant has one variant
             auto begin = Clock::now();
-            g.variants[k] = interpret(model, s, o);
+            StringOrigins provenance;  // organs named by the derived string's modules
+            g.variants[k] = interpret_with_provenance(model, s, o, provenance);
             held.hold(g.variants[k]);
             interpret_us += std::chrono::duration_cast<std::chrono::microseconds>(Clock::now() - begin).count();
         });

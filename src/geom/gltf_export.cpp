@@ -413,6 +413,7 @@ void write_glb(const Scene& scene, const std::filesystem::path& file, const Mesh
     }
     // placed prototypes: one mesh per prototype and look, a node per instance
     std::map<std::tuple<std::uint32_t, std::uint16_t, std::uint16_t, std::int16_t>, int> shared;
+    const OrganModules organ_modules(scene);
     for (const Instance& instance : scene.instances) {
         const auto look = std::tuple(instance.prototype, instance.material, instance.back_material,
                                      instance.texture);
@@ -433,7 +434,7 @@ void write_glb(const Scene& scene, const std::filesystem::path& file, const Mesh
         }
         if (it->second < 0)
             continue;
-        tinygltf::Node node = organ_node(scene.geometry.modules, instance.module);
+        tinygltf::Node node = organ_node(organ_modules.of(instance), instance.module);
         if (instance.module == no_module && instance.plant != Instance::no_plant) {
             // a scene file's plant: named by its placement
             node.name = "plant " + std::to_string(instance.plant) + " " +

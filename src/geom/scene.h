@@ -331,4 +331,35 @@ struct Scene {
     Bounds3 bounds;
 };
 
+/// Where each organ placed whole (an instance with a module) has its module recorded:
+/// the scene's own table, or, in a field of plants, its plant's geometry (the prototype
+/// that the placement's own instance places), where the plant's interpretation put it.
+class OrganModules {
+public:
+    explicit OrganModules(const Scene& scene) : m_scene(scene)
+    {
+        for (const Instance& in : scene.instances)
+            if (in.plant != Instance::no_plant && in.module == no_module && in.prototype < scene.prototypes.size() &&
+                m_plant_prototype.size() <= in.plant)
+                m_plant_prototype.resize(std::size_t(in.plant) + 1, no_prototype);
+        for (const Instance& in : scene.instances)
+            if (in.plant != Instance::no_plant && in.module == no_module && in.prototype < scene.prototypes.size() &&
+                m_plant_prototype[in.plant] == no_prototype)
+                m_plant_prototype[in.plant] = in.prototype;
+    }
+    const ModuleTable& of(const Instance& organ) const
+    {
+        const ModuleTable& own = m_scene.geometry.modules;
+        if (own.find(organ.module) || organ.plant >= m_plant_prototype.size() ||
+            m_plant_prototype[organ.plant] == no_prototype)
+            return own;
+        return m_scene.prototypes[m_plant_prototype[organ.plant]].geometry.modules;
+    }
+
+private:
+    static constexpr std::uint32_t no_prototype = 0xffffffffu;
+    const Scene& m_scene;
+    std::vector<std::uint32_t> m_plant_prototype;  ///< per placement
+};
+
 }  // namespace cambium::geom

@@ -197,6 +197,7 @@ Organs find_organs(const geom::Scene& scene)
         if (organ != no_organ)
             o.list[organ].area += area;
     });
+    const geom::OrganModules organ_modules(scene);
     o.instance.assign(scene.instances.size(), no_organ);
     for (std::size_t i = 0; i < scene.instances.size(); ++i) {
         const geom::Instance& in = scene.instances[i];
@@ -205,7 +206,7 @@ Organs find_organs(const geom::Scene& scene)
         const geom::Prototype& p = scene.prototypes[in.prototype];
         Affine t{in.transform};
         if (in.module != geom::no_module) {
-            std::uint32_t organ = o.instance[i] = o.organ(in.plant, in.module, scene.geometry.modules);
+            std::uint32_t organ = o.instance[i] = o.organ(in.plant, in.module, organ_modules.of(in));
             each_area(p.geometry, t, pixels, [&](PrimitiveKind, std::size_t, double area) {
                 o.list[organ].area += area;
             });

@@ -93,3 +93,30 @@ TEST(SceneCommand, ABadSceneNamesThePathAndWritesNothing)
     EXPECT_TRUE(fs::exists(dir / "sun.png"));
     fs::remove_all(dir);
 }
+
+// --light-report with a scene file: one report, each organ with its placement.
+TEST(SceneCommand, LightReportOfAField)
+{
+    fs::path dir = scratch();
+    std::ofstream(dir / "field.json") << R"({
+      "plants": [{"model": "m", "command": "cpfg p.l p.v",
+                  "placements": [{"translate": [-1, 0, 0]}, {"translate": [1, 0, 0]}]}]
+    })";
+    Result r = run("field.json --light-report light.csv --light-rays 20000", dir);
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::ifstream in(dir / "light.csv");
+    std::string line;
+    int plant0 = 0, plant1 = 0;
+    while (std::getline(in, line)) {
+        std::size_t a = line.find(','), b = line.find(',', a + 1), c = line.find(',', b + 1);
+        if (a == std::string::npos || c == std::string::npos || line.rfind("module,", 0) == 0)
+            continue;
+        const std::string plant = line.substr(b + 1, c - b - 1);
+        plant0 += plant == "0";
+        plant1 += plant == "1";
+    }
+    EXPECT_GT(plant0, 0) << r.output;
+    EXPECT_EQ(plant0, plant1);
+    EXPECT_FALSE(fs::exists(dir / "field.png"));  // a report alone renders nothing
+    fs::remove_all(dir);
+}

@@ -7,6 +7,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <set>
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -22,6 +24,7 @@
 #include "base/diagnostics.h"
 #include "geom/scene_limits.h"
 #include "render/camera.h"
+#include "render/light_report.h"
 #include "render/render.h"
 
 using namespace cambium;
@@ -747,6 +750,45 @@ TEST(SceneAssembly, PlantsOfOneEnvironmentCompete)
 
 // --light-report: a .json or .csv file, refused before any work otherwise; without -o it
 // renders no image; its value is never taken for a scene file.
+// A scene's light report names each organ by its placement and by the derived string's
+// module (a K the homomorphism draws as F and @O is one organ, K): two equal plants far
+// apart under one sun absorb the same.
+TEST(SceneAssembly, LightReportCountsEachPlacementsOrgans)
+{
+    SceneFolder f("light");
+    f.tiny_model("m");
+    app::SceneFile s = app::read_scene_file(
+        f.scene(with_plant(R"("steps": 3, "placements": [{}, {"translate": [100, 0, 0]}])")), app::Options{});
+    geom::Scene scene = app::assemble_scene(s, app::Options{}, {app::OrganPlacement::compose, false});
+    render::LightReportSettings settings;
+    settings.rays = 200'000;
+    settings.threads = 2;
+    const render::LightReport report = render::trace_light(scene, settings);
+    std::map<std::uint32_t, double> absorbed;
+    std::map<std::uint32_t, std::set<std::pair<std::uint32_t, std::string>>> organs;
+    for (const render::OrganLight& o : report.organs) {
+        absorbed[o.plant] += o.absorbed;
+        organs[o.plant].insert({o.module, o.symbol});
+    }
+    ASSERT_EQ(absorbed.size(), 2u);
+    ASSERT_TRUE(absorbed.count(0) && absorbed.count(1));
+    EXPECT_EQ(organs[0], organs[1]);
+    EXPECT_TRUE(std::any_of(organs[0].begin(), organs[0].end(), [](const auto& o) { return o.second == "K"; }));
+    EXPECT_GT(absorbed[0], 0);
+    EXPECT_NEAR(absorbed[0], absorbed[1], 0.05 * absorbed[0]);
+    // the exports name organs placed whole by the same table: every flower is a K
+    const geom::OrganModules organ_modules(scene);
+    std::size_t flowers = 0;
+    for (const geom::Instance& in : scene.instances)
+        if (in.module != geom::no_module) {
+            const geom::ModuleRecord* r = organ_modules.of(in).find(in.module);
+            ASSERT_TRUE(r) << "module " << in.module << " of plant " << in.plant;
+            EXPECT_EQ(organ_modules.of(in).name(*r), "K");
+            ++flowers;
+        }
+    EXPECT_EQ(flowers, 6u);
+}
+
 TEST(LightReportOption, ParsedAndChecked)
 {
     app::Options o = *app::parse_command_line({"--light-report", "r.json", "--light-rays", "5000", "a.l", "a.v"});
