@@ -524,7 +524,7 @@ def _turn_to_map_frame():
 def _build_ground(scene):
     """Cambium's --ground: the plane y = height, infinite there; here a square 2000 scene
     radii wide under the plant (its far edge lies well under a pixel from the horizon),
-    diffuse of the decoded ground colour, seen from both sides."""
+    diffuse of the decoded ground colour (unlit views: that colour), seen from both sides."""
     ground = scene["stage"]["ground"]
     if ground is None:
         return
@@ -540,9 +540,12 @@ def _build_ground(scene):
     mat.use_nodes = True
     nt = mat.node_tree
     nt.nodes.clear()
-    diffuse = nt.nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.inputs["Color"].default_value = list(ground["diffuse"]) + [1.0]
-    nt.links.new(diffuse.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs["Surface"])
+    # An unlit view (`render mode: filled`) draws the ground in its flat colour too.
+    unlit = scene["shading"] == "unlit"
+    surface = nt.nodes.new("ShaderNodeEmission" if unlit else "ShaderNodeBsdfDiffuse")
+    surface.inputs["Color"].default_value = list(ground["diffuse"]) + [1.0]
+    nt.links.new(surface.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs["Surface"])
+    mat.cycles.sample_as_light = False
     me.materials.append(mat)
     obj = bpy.data.objects.new("ground", me)
     bpy.context.scene.collection.objects.link(obj)
