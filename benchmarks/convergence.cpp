@@ -12,7 +12,7 @@
 //   build/benchmarks/convergence [--plant NAME]... [--sampler sobol|white|both]
 //       [--size WxH] [--threads N] [--max-spp N] [--reference-spp N] [--target NOISE]
 //       [--adaptive NOISE] [--export-scene FOLDER] [--raw-embree-only | --no-raw-embree]
-//       [--trace-empty-pixels] [--record-slots N]
+//       [--trace-empty-pixels] [--record-slots N] [--stage "WORDS" [--ground-target NOISE]]
 //
 // Defaults: the five plants below, both samplers, 320x240, 2 threads, up to 64 spp, a
 // 1024-spp Sobol reference. The noise target (time_to_target_s) is, unless given, white
@@ -62,6 +62,15 @@
 //
 // --export-scene FOLDER renders nothing: it writes each plant's interpreted scene as
 // FOLDER/NAME.json (scene_export.h), which benchmarks/cycles/ builds in Blender.
+//
+// --stage "WORDS" stages each plant as a still: the words (--ground, --env, --perspective,
+// --fit, --orbit, --no-view-lights, --background ...) are appended to its command line,
+// and the renders take the app's render settings from it. Noise is then measured apart
+// on the plant's pixels (relative_rmse, the noise target) and on the ground's
+// (ground_relative_rmse, with --ground-target NOISE its spp and time to that noise); the
+// reference is cached per staging; there is no raw-Embree measurement. With
+// --export-scene the JSON gains the staging and FOLDER/NAME.region the two sets of pixels
+// (make_staging), so that Cycles is measured on the same ones.
 
 #include <sys/resource.h>
 
