@@ -12,7 +12,7 @@
 //   build/benchmarks/convergence [--plant NAME]... [--sampler sobol|white|both]
 //       [--size WxH] [--threads N] [--max-spp N] [--reference-spp N] [--target NOISE]
 //       [--adaptive NOISE] [--export-scene FOLDER] [--raw-embree-only | --no-raw-embree]
-//       [--trace-empty-pixels] [--record-slots N]
+//       [--trace-empty-pixels] [--record-slots N] [--stage "WORDS" [--ground-target NOISE]]
 //
 // Defaults: the five plants below, both samplers, 320x240, 2 threads, up to 64 spp, a
 // 1024-spp Sobol reference. The noise target (time_to_target_s) is, unless given, white
@@ -62,6 +62,15 @@
 //
 // --export-scene FOLDER renders nothing: it writes each plant's interpreted scene as
 // FOLDER/NAME.json (scene_export.h), which benchmarks/cycles/ builds in Blender.
+//
+// --stage "WORDS" stages each plant as a still: the words (--ground, --env, --perspective,
+// --fit, --orbit, --no-view-lights, --background ...) are appended to its command line,
+// and the renders take the app's render settings from it. Noise is then measured apart
+// on the plant's pixels (relative_rmse, the noise target) and on the ground's
+// (ground_relative_rmse, with --ground-target NOISE its spp and time to that noise); the
+// reference is cached per staging; there is no raw-Embree measurement. With
+// --export-scene the JSON gains the staging and FOLDER/NAME.region the two sets of pixels
+// (make_staging), so that Cycles is measured on the same ones.
 
 #include <sys/resource.h>
 
@@ -75,6 +84,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -83,7 +93,10 @@
 
 #include "app/command_line.h"
 #include "app/pipeline.h"
+#include "app/sequence.h"
 #include "render/render.h"
+#include "render/ground.h"
+#include "render/material.h"
 #include "ray_replay.h"
 #include "scene_export.h"
 
@@ -133,6 +146,18 @@ struct Settings {
     /// --record-slots: the raw-Embree measurement's log slots per kind of ray, for a
     /// subsample (about 3/4 of them are aimed at); 0 (the default): every ray.
     std::size_t record_slots = 0;
+    /// --stage WORDS: Cambium options appended to each plant's command line (--ground,
+    /// --env, --perspective, --fit, --orbit, --no-view-lights, --background ...): a staged
+    /// still. Noise is then measured apart on the plant's pixels and the ground's.
+    std::string stage;
+    double ground_target = 0;  ///< --ground-target: the ground's noise target
+};
+
+/// A staged plant's render settings (the app's, from the staged command line) and which
+/// pixels are the plant's (1) and the ground's (2), rows from the top.
+struct Staging {
+    render::RenderSettings base;
+    std::vector<std::uint8_t> region;
 };
 
 /// The process's CPU time so far, user + sys, in seconds.
@@ -158,7 +183,9 @@ const char* name(render::SampleSequence s)
 
 /// The plant's scene, through the same path as `cambium <model.json's command>`; the
 /// current folder becomes the model's (its files are named relative to it).
-cambium::geom::Scene load_plant(const fs::path& folder, std::string command)
+cambium::geom::Scene load_plant(const fs::path& folder, std::string command,
+                                const std::string& stage = "",
+                                cambium::app::Options* staged_options = nullptr)
 {
     if (command.empty()) {
         std::ifstream in(folder / "model.json");
@@ -170,11 +197,20 @@ cambium::geom::Scene load_plant(const fs::path& folder, std::string command)
     words >> word;  // "cpfg"
     while (words >> word)
         args.push_back(word);
+    std::istringstream stage_words(stage);
+    while (stage_words >> word)
+        args.push_back(word);
     args.push_back("-q");
     fs::current_path(folder);
     cambium::app::Options options = *cambium::app::parse_command_line(args);
     cambium::app::Model model = cambium::app::load_model(options);
-    return cambium::app::interpret(model, cambium::app::derive(model, options), options);
+    cambium::geom::Scene scene =
+        cambium::app::interpret(model, cambium::app::derive(model, options), options);
+    if (!stage.empty())
+        cambium::app::apply_camera_options(scene, options);  // as a staged still frames it
+    if (staged_options)
+        *staged_options = options;
+    return scene;
 }
 
 struct Run {
@@ -185,9 +221,10 @@ struct Run {
 
 /// The measured renders' settings.
 render::RenderSettings render_settings(const Settings& s, int spp, render::SampleSequence sampler,
-                                       std::uint64_t seed, double noise_target = 0)
+                                       std::uint64_t seed, double noise_target = 0,
+                                       const Staging* staging = nullptr)
 {
-    render::RenderSettings rs;
+    render::RenderSettings rs = staging ? staging->base : render::RenderSettings{};
     rs.width = s.width;
     rs.height = s.height;
     rs.threads = s.threads;
@@ -203,9 +240,10 @@ render::RenderSettings render_settings(const Settings& s, int spp, render::Sampl
 }
 
 Run render_at(const cambium::geom::Scene& scene, const Settings& s, int spp,
-              render::SampleSequence sampler, std::uint64_t seed, double noise_target = 0)
+              render::SampleSequence sampler, std::uint64_t seed, double noise_target = 0,
+              const Staging* staging = nullptr)
 {
-    render::RenderSettings rs = render_settings(s, spp, sampler, seed, noise_target);
+    render::RenderSettings rs = render_settings(s, spp, sampler, seed, noise_target, staging);
     auto start = Clock::now();
     double cpu_start = cpu_seconds();
     render::RenderReport report;
@@ -221,7 +259,7 @@ Run render_at(const cambium::geom::Scene& scene, const Settings& s, int spp,
 
 /// The reference image, cached as raw floats in `cache` (it costs most of the run).
 std::vector<float> reference(const cambium::geom::Scene& scene, const Settings& s,
-                             const fs::path& file)
+                             const fs::path& file, const Staging* staging = nullptr)
 {
     std::size_t n = std::size_t(s.width) * s.height * 4;
     std::vector<float> rgba(n);
@@ -230,20 +268,23 @@ std::vector<float> reference(const cambium::geom::Scene& scene, const Settings& 
         in.peek() == std::char_traits<char>::eof())
         return rgba;
     // A seed of its own: the reference's noise is independent of the measured renders'.
-    rgba = render_at(scene, s, s.reference_spp, render::SampleSequence::sobol, 0x5eed).image.rgba;
+    rgba = render_at(scene, s, s.reference_spp, render::SampleSequence::sobol, 0x5eed, 0, staging)
+               .image.rgba;
     fs::create_directories(file.parent_path());
     std::ofstream out(file, std::ios::binary | std::ios::trunc);
     out.write(reinterpret_cast<const char*>(rgba.data()), std::streamsize(n * sizeof(float)));
     return rgba;
 }
 
-/// Relative RMSE over the plant's pixels (see the top of the file).
-double relative_rmse(const std::vector<float>& image, const std::vector<float>& ref)
+/// Relative RMSE over the plant's pixels (see the top of the file); staged, over the
+/// pixels of `region` that are `which` (1: the plant's, 2: the ground's).
+double relative_rmse(const std::vector<float>& image, const std::vector<float>& ref,
+                     const std::vector<std::uint8_t>& region = {}, std::uint8_t which = 1)
 {
     double sq = 0, sum = 0;
     std::size_t values = 0;
     for (std::size_t p = 0; p + 3 < ref.size(); p += 4) {
-        if (ref[p + 3] < 0.5f)
+        if (region.empty() ? ref[p + 3] < 0.5f : region[p / 4] != which)
             continue;
         for (std::size_t c = 0; c < 3; ++c) {
             double d = double(image[p + c]) - ref[p + c];
@@ -253,6 +294,69 @@ double relative_rmse(const std::vector<float>& image, const std::vector<float>& 
         }
     }
     return values > 0 && sum > 0 ? std::sqrt(sq / double(values)) / (sum / double(values)) : 0;
+}
+
+/// The staged settings of a plant and its regions: the plant's pixels are those its
+/// camera rays hit at least half the time with neither ground nor environment (a
+/// transparent film's coverage); the ground's, the others where the staged camera rays
+/// hit something (a finite depth). 16 spp, one path segment: only the first hits count.
+Staging make_staging(const cambium::geom::Scene& scene, const Settings& s,
+                     const cambium::app::Options& options)
+{
+    Staging staging;
+    staging.base = cambium::app::render_settings(options, {});
+    render::RenderSettings cover = render_settings(s, 16, render::SampleSequence::sobol, 1, 0,
+                                                   &staging);
+    cover.max_depth = 1;
+    render::RenderSettings depth = cover;
+    cover.ground.enabled = false;
+    cover.environment = nullptr;
+    cover.transparent_background = true;
+    depth.aovs = true;
+    const render::Image plant = render::render(scene, cover);
+    const render::Image hits = render::render(scene, depth);
+    staging.region.assign(std::size_t(s.width) * s.height, 0);
+    for (std::size_t i = 0; i < staging.region.size(); ++i)
+        staging.region[i] = plant.rgba[4 * i + 3] >= 0.5f      ? 1
+                            : std::isfinite(hits.depth[i]) ? 2
+                                                           : 0;
+    return staging;
+}
+
+/// What the scene export adds for a staged plant; its regions (make_staging) written to
+/// `region_file` as one byte per pixel (0 neither, 1 plant, 2 ground), rows from the top,
+/// so that the other renderer measures its noise on the same pixels.
+cambium::bench::StageExport export_staging(const cambium::geom::Scene& scene, const Settings& s,
+                                           const cambium::app::Options& options,
+                                           const fs::path& region_file)
+{
+    const Staging staging = make_staging(scene, s, options);
+    std::ofstream region(region_file, std::ios::binary | std::ios::trunc);
+    region.write(reinterpret_cast<const char*>(staging.region.data()),
+                 std::streamsize(staging.region.size()));
+    if (!region)
+        throw std::runtime_error("cannot write " + region_file.string());
+    const render::RenderSettings& rs = staging.base;
+    cambium::bench::StageExport e;
+    e.view_lights = rs.view_lights;
+    if (rs.ground.enabled) {
+        if (!rs.ground.texture.empty() || rs.ground.shadow_catcher)
+            throw std::runtime_error("--stage: only a plain --ground is exported");
+        e.ground_height = rs.ground.height.value_or(render::lowest_point(scene));
+        cambium::geom::Material soil;
+        soil.diffuse = rs.ground.colour;  // as render.cpp's make_ground decodes it
+        const render::Vec3f d = render::make_materials({soil}).front().diffuse;
+        e.ground_diffuse = {d.x, d.y, d.z};
+    }
+    if (options.sky)
+        throw std::runtime_error("--stage: the --sky is not exported (Cycles' skies differ)");
+    if (options.environment_map) {
+        e.environment_map = fs::absolute(*options.environment_map);
+        e.environment_scale = options.environment_scale;
+        e.environment_rotation_deg = options.environment_rotation;
+    }
+    e.backdrop_environment = rs.backdrop == render::RenderSettings::Backdrop::environment;
+    return e;
 }
 
 /// Least-squares line y = a + b x.
@@ -302,8 +406,33 @@ std::string json_array(const std::vector<double>& v, const char* format)
     return out + "]";
 }
 
+/// A staged series' figures on the ground's pixels: its noise per render, the slope,
+/// and the spp and times (set-up included and not) to the ground's noise target.
+std::string ground_figures(const Curve& c, const std::vector<double>& rmse, double target)
+{
+    std::vector<double> log_spp, log_rmse, render_only, render_only_cpu;
+    for (std::size_t i = 0; i < c.spp.size(); ++i) {
+        log_spp.push_back(std::log(c.spp[i]));
+        log_rmse.push_back(std::log(rmse[i]));
+        render_only.push_back(c.seconds[i] - c.setup_seconds[i]);
+        render_only_cpu.push_back(c.cpu_seconds[i] - c.setup_cpu_seconds[i]);
+    }
+    auto [a, slope] = fit_line(log_spp, log_rmse);
+    double spp = target > 0 ? std::exp((std::log(target) - a) / slope) : 0;
+    char buffer[512];
+    std::snprintf(buffer, sizeof buffer,
+                  ",\"ground_relative_rmse\":%s,\"ground_slope\":%.3f,"
+                  "\"ground_target_noise\":%.5f,\"ground_spp_to_target\":%.1f,"
+                  "\"ground_time_to_target_render_s\":%.3f,"
+                  "\"ground_time_to_target_render_cpu_s\":%.3f",
+                  json_array(rmse, "%.5f").c_str(), slope, target, spp,
+                  target > 0 ? seconds_at(c, render_only, spp) : 0.0,
+                  target > 0 ? seconds_at(c, render_only_cpu, spp) : 0.0);
+    return buffer;
+}
+
 void report(const std::string& plant, const Settings& s, render::SampleSequence sampler,
-            const Curve& c, double target)
+            const Curve& c, double target, const std::string& extra = "")
 {
     std::vector<double> log_spp, log_rmse;
     for (std::size_t i = 0; i < c.spp.size(); ++i) {
@@ -327,7 +456,7 @@ void report(const std::string& plant, const Settings& s, render::SampleSequence 
                 "\"time_to_target_s\":%.3f,\"time_to_target_cpu_s\":%.3f,"
                 "\"time_to_target_render_s\":%.3f,\"time_to_target_render_cpu_s\":%.3f,"
                 "\"samples_per_s\":%.0f,"
-                "\"rays_per_s\":%.0f,\"peak_rss_mb\":%.0f}\n",
+                "\"rays_per_s\":%.0f,\"peak_rss_mb\":%.0f%s}\n",
                 plant.c_str(), name(sampler), s.width, s.height, s.threads, s.reference_spp,
                 json_array(c.spp, "%.0f").c_str(), json_array(c.rmse, "%.5f").c_str(),
                 json_array(c.seconds, "%.3f").c_str(), json_array(c.cpu_seconds, "%.3f").c_str(),
@@ -338,7 +467,7 @@ void report(const std::string& plant, const Settings& s, render::SampleSequence 
                 seconds_at(c, render_only, spp_to_target),
                 seconds_at(c, render_only_cpu, spp_to_target),
                 double(s.width) * s.height * total_spp / c.render_seconds,
-                double(c.rays) / c.render_seconds, peak_rss_mb());
+                double(c.rays) / c.render_seconds, peak_rss_mb(), extra.c_str());
     std::fflush(stdout);
 }
 
@@ -490,26 +619,47 @@ void run_plant(const std::string& plant, const fs::path& folder, const std::stri
                const Settings& s,
                const fs::path& cache)
 {
-    cambium::geom::Scene scene = load_plant(folder, command);
+    cambium::app::Options options;
+    cambium::geom::Scene scene = load_plant(folder, command, s.stage, &options);
+    std::optional<Staging> staging;
+    std::string stage_tag;
+    if (!s.stage.empty()) {
+        staging = make_staging(scene, s, options);
+        // The staged reference is cached per staging (an FNV-1a hash of its words).
+        std::uint64_t h = 0xcbf29ce484222325ull;
+        for (unsigned char ch : s.stage)
+            h = (h ^ ch) * 0x100000001b3ull;
+        char hex[24];
+        std::snprintf(hex, sizeof hex, "-stage%016llx", static_cast<unsigned long long>(h));
+        stage_tag = hex;
+    }
+    const Staging* st = staging ? &*staging : nullptr;
     std::vector<float> ref = reference(
         scene, s,
         cache / (plant + "-" + std::to_string(s.width) + "x" + std::to_string(s.height) + "-" +
                  std::to_string(s.reference_spp) +
-                 (s.max_depth > 0 ? "-depth" + std::to_string(s.max_depth) : "") + ".f32"));
+                 (s.max_depth > 0 ? "-depth" + std::to_string(s.max_depth) : "") + stage_tag +
+                 ".f32"),
+        st);
     save_image(s, plant + "-reference", ref);
     if (s.adaptive > 0) {
         run_adaptive(plant, scene, ref, s);
         return;
     }
+    const std::vector<std::uint8_t> no_region;
+    const std::vector<std::uint8_t>& region = st ? st->region : no_region;
     std::map<render::SampleSequence, Curve> curves;
+    std::map<render::SampleSequence, std::vector<double>> ground_rmse;
     for (render::SampleSequence sampler : s.samplers) {
         Curve& c = curves[sampler];
         for (int spp = 1; spp <= s.max_spp; spp *= 2) {
-            Run run = render_at(scene, s, spp, sampler, 0);
+            Run run = render_at(scene, s, spp, sampler, 0, 0, st);
             save_image(s, plant + "-" + name(sampler) + "-" + std::to_string(spp),
                        run.image.rgba);
             c.spp.push_back(spp);
-            c.rmse.push_back(relative_rmse(run.image.rgba, ref));
+            c.rmse.push_back(relative_rmse(run.image.rgba, ref, region, 1));
+            if (st)
+                ground_rmse[sampler].push_back(relative_rmse(run.image.rgba, ref, region, 2));
             c.seconds.push_back(run.seconds);
             c.cpu_seconds.push_back(run.cpu_seconds);
             c.setup_seconds.push_back(run.setup_seconds);
@@ -526,7 +676,8 @@ void run_plant(const std::string& plant, const fs::path& folder, const std::stri
         target = basis.rmse.back();
     }
     for (const auto& [sampler, curve] : curves)
-        report(plant, s, sampler, curve, target);
+        report(plant, s, sampler, curve, target,
+               st ? ground_figures(curve, ground_rmse[sampler], s.ground_target) : "");
 }
 
 /// The plant's folder: under the corpus, or the project's own.
@@ -586,6 +737,10 @@ Settings parse(int argc, char** argv)
                 throw std::runtime_error("--record-slots: 0 (every ray) or at least 4096");
         } else if (arg == "--trace-empty-pixels") {
             s.skip_empty_pixels = false;
+        } else if (arg == "--stage") {
+            s.stage = value();
+        } else if (arg == "--ground-target") {
+            s.ground_target = std::stod(value());
         } else if (arg == "--export-scene") {
             s.export_folder = fs::absolute(value());
         } else {
@@ -595,6 +750,8 @@ Settings parse(int argc, char** argv)
     if (s.plants.empty())
         for (const auto& [plant, folder] : plants)
             s.plants.push_back(plant);
+    if (!s.stage.empty() && s.series)
+        s.raw_embree = false;  // the raw-Embree measurement renders the plants unstaged
     if (!s.series && !s.raw_embree)
         throw std::runtime_error("--raw-embree-only and --no-raw-embree leave nothing to do");
     return s;
@@ -622,8 +779,13 @@ int main(int argc, char** argv)
             if (!s.export_folder.empty()) {
                 fs::create_directories(s.export_folder);
                 std::ofstream out(s.export_folder / (plant + ".json"));
-                cambium::bench::write_scene_json(load_plant(folder, source.command), s.width,
-                                                 s.height, folder, out);
+                cambium::app::Options options;
+                cambium::geom::Scene scene = load_plant(folder, source.command, s.stage, &options);
+                std::optional<cambium::bench::StageExport> stage;
+                if (!s.stage.empty())
+                    stage = export_staging(scene, s, options,
+                                           s.export_folder / (plant + ".region"));
+                cambium::bench::write_scene_json(scene, s.width, s.height, folder, out, stage);
                 if (!out)
                     throw std::runtime_error("cannot write " +
                                              (s.export_folder / plant).string());

@@ -96,11 +96,13 @@ json lights_json(const std::vector<geom::Light>& lights)
     return out;
 }
 
-json materials_json(const geom::Scene& scene)
+json materials_json(const geom::Scene& scene, bool view_lights)
 {
     json out = json::array();
+    // Without the view's lights the renderer drops their OpenGL ambient term too.
     for (const render::SurfaceMaterial& m : render::make_materials(
-             scene.materials, render::opengl_ambient_light(scene.lights)))
+             scene.materials,
+             view_lights ? render::opengl_ambient_light(scene.lights) : geom::Rgb{0, 0, 0}))
         out.push_back({{"diffuse", vec(m.diffuse)},
                        {"translucency", m.translucency},
                        {"specular", vec(m.specular)},
@@ -114,8 +116,10 @@ json materials_json(const geom::Scene& scene)
 }  // namespace
 
 void write_scene_json(const geom::Scene& scene, int width, int height,
-                      const std::filesystem::path& model_folder, std::ostream& out)
+                      const std::filesystem::path& model_folder, std::ostream& out,
+                      const std::optional<StageExport>& stage)
 {
+    const bool view_lights = !stage || stage->view_lights;
     render::RenderSettings defaults;  // the ambient environment render() uses
     json j;
     j["format"] = "cambium-scene-1";
@@ -127,8 +131,23 @@ void write_scene_json(const geom::Scene& scene, int width, int height,
     j["line_radius_in_pixels"] = scene.line_radius_in_pixels;
     j["camera"] = camera_json(render::make_camera(scene.view, scene.bounds, width, height),
                               scene.bounds);
-    j["lights"] = lights_json(scene.lights);
-    j["materials"] = materials_json(scene);
+    j["lights"] = view_lights ? lights_json(scene.lights) : json::array();
+    j["materials"] = materials_json(scene, view_lights);
+    if (stage) {
+        json st;
+        st["view_lights"] = stage->view_lights;
+        st["ground"] = stage->ground_height
+                           ? json{{"height", *stage->ground_height},
+                                  {"diffuse", stage->ground_diffuse}}
+                           : json();
+        st["environment"] = stage->environment_map.empty()
+                                ? json()
+                                : json{{"map", stage->environment_map.string()},
+                                       {"scale", stage->environment_scale},
+                                       {"rotation_deg", stage->environment_rotation_deg}};
+        st["backdrop"] = stage->backdrop_environment ? "environment" : "view";
+        j["stage"] = st;
+    }
     j["background"] = vec(render::decode_display(scene.background));
     j["ambient_radiance"] = {defaults.ambient.r, defaults.ambient.g, defaults.ambient.b};
     j["max_depth"] = defaults.max_depth;

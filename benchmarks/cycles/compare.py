@@ -21,6 +21,14 @@ and times at 64 spp), then Cambium's (build/benchmarks/convergence --sampler sob
 Below 1: Cambium is faster. The rounds interleave the two renderers; the last line is
 each plant's median ratios over the rounds. Both renderers cache their references
 (build/convergence-cache/, build/cycles/cache/), so only the first round renders them.
+
+--staged env | env-without-view-lights: the plant staged (convergence --stage) on a
+ground of albedo 0.2 (`--ground`, the plane at the plant's lowest point), seen in
+perspective (`--perspective --fit --orbit 30 10`), lit by the lat-long map sky_map.py
+writes (`--env`, seen behind the plant: `--background env`), with the view file's lights
+kept or dropped (`--no-view-lights`). Noise is then measured apart on the plant's pixels
+and the ground's; the JSON adds the noise at 16 and 64 spp of both renderers on both, and
+`ground_cpu_ratio` / `ground_wall_ratio`: Cambium's time to Cycles' 64-spp ground noise.
 """
 import argparse
 import json
@@ -28,6 +36,11 @@ import os
 import statistics
 import subprocess
 import sys
+
+# A ground of albedo 0.2: --ground takes a display (sRGB) value.
+STAGE = ("--ground 0.4845,0.4845,0.4845 --perspective --fit --orbit 30 10 "
+         "--env {map} --background env")
+STAGINGS = {"env": STAGE, "env-without-view-lights": STAGE + " --no-view-lights"}
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PLANTS = ["FernLeaf", "WeepingBirch", "Lilac", "GeneralizedCylinder", "TranslucentTree"]
@@ -67,14 +80,26 @@ def main():
                         help="Cycles does not sample emissive primitives as lights")
     parser.add_argument("--cycles-tilt", type=float, default=0.0,
                         help="turn Cycles' camera by this many radians (cycles_convergence.py)")
+    parser.add_argument("--staged", choices=sorted(STAGINGS),
+                        help="the plant staged on a ground under an HDR map (see the top)")
     args = parser.parse_args()
     convergence = os.path.join(args.build, "benchmarks", "convergence")
     scenes = os.path.join(args.build, "cycles", "scenes")
     cache = os.path.join(args.build, "cycles", "cache")
+    stage = []
+    if args.staged:
+        sky = os.path.abspath(os.path.join(args.build, "cycles", "staged", "sky.exr"))
+        if not os.path.exists(sky):
+            os.makedirs(os.path.dirname(sky), exist_ok=True)
+            subprocess.run([sys.executable, os.path.join(HERE, "sky_map.py"), sky], check=True)
+        stage = ["--stage", STAGINGS[args.staged].format(map=sky)]
+        scenes = os.path.join(args.build, "cycles", "staged", args.staged, "scenes")
+        cache = os.path.join(args.build, "cycles", "staged", args.staged, "cache")
     ratios = {}
     for round_index in range(args.rounds):
         for plant in args.plant or PLANTS:
-            common = ["--plant", plant, "--size", args.size, "--threads", str(args.threads)]
+            common = ["--plant", plant, "--size", args.size, "--threads", str(args.threads),
+                      *stage]
             if round_index == 0:
                 json_lines([convergence, *common, "--export-scene", scenes])
             cycles = json_lines([args.blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python",
@@ -87,7 +112,9 @@ def main():
                                 ["--tilt", str(args.cycles_tilt)])[0]
             cambium = json_lines([convergence, *common, "--sampler", "sobol",
                                   "--reference-spp", str(args.reference_spp),
-                                  "--target", str(cycles["noise_at_max_spp"])])[0]
+                                  "--target", str(cycles["noise_at_max_spp"])] +
+                                 (["--ground-target", str(cycles["ground_noise_at_max_spp"])]
+                                  if args.staged else []))[0]
             result = {
                 "plant": plant, "round": round_index + 1, "image": args.size,
                 "threads": args.threads, "reference_spp": args.reference_spp,
@@ -111,9 +138,31 @@ def main():
                 (result["cambium_cpu_s"] + result["cambium_setup_cpu_s"]) /
                 (result["cycles_cpu_s"] + result["cycles_setup_cpu_s"]), 3)
             result["wall_ratio"] = round(result["cambium_s"] / result["cycles_s"], 3)
+            if args.staged:
+                at16 = cycles["spp"].index(16)
+                result.update({
+                    "staged": args.staged,
+                    "cycles_noise_16": cycles["relative_rmse"][at16],
+                    "cambium_rmse_16": cambium["relative_rmse"][at16],
+                    "cycles_ground_noise_16": cycles["ground_relative_rmse"][at16],
+                    "cycles_ground_noise_64": cycles["ground_noise_at_max_spp"],
+                    "cambium_ground_rmse_16": cambium["ground_relative_rmse"][at16],
+                    "cambium_ground_rmse_64": cambium["ground_relative_rmse"][-1],
+                    "cambium_ground_spp_to_target": cambium["ground_spp_to_target"],
+                    "cambium_ground_cpu_s": cambium["ground_time_to_target_render_cpu_s"],
+                    "cambium_ground_s": cambium["ground_time_to_target_render_s"],
+                })
+                result["ground_cpu_ratio"] = round(
+                    result["cambium_ground_cpu_s"] / result["cycles_cpu_s"], 3)
+                result["ground_wall_ratio"] = round(
+                    result["cambium_ground_s"] / result["cycles_s"], 3)
             ratios.setdefault(plant, []).append(result)
             print(json.dumps(result), flush=True)
+    def median(runs, key):
+        return round(statistics.median(r[key] for r in runs), 3) if key in runs[0] else None
+
     summary = {plant: {"cpu_ratio": round(statistics.median(r["cpu_ratio"] for r in runs), 3),
+                       "ground_cpu_ratio": median(runs, "ground_cpu_ratio"),
                        "cpu_ratio_with_setup": round(statistics.median(
                            r["cpu_ratio_with_setup"] for r in runs), 3),
                        "wall_ratio": round(statistics.median(r["wall_ratio"] for r in runs), 3),

@@ -14,7 +14,9 @@ seed, cached as EXR), then renders at 1, 2, 4, ... max spp and prints one JSON l
 computed as benchmarks/convergence does for Cambium: sqrt(mean over plant pixels and RGB
 of (value - reference)^2) / mean(reference), over the view's background, plant pixels
 being those whose reference alpha is at least 0.5; its wall and CPU seconds (the process's user + sys); the slope
-of log RMSE against log spp; and the noise and times at the highest spp.
+of log RMSE against log spp; and the noise and times at the highest spp. A staged scene
+(convergence --stage) is measured on the plant's pixels and, apart, on the ground's
+(`ground_relative_rmse`, ...), the pixels its export wrote beside it (SCENE.region).
 """
 import argparse
 import json
@@ -51,8 +53,8 @@ def over_background(rgba, background):
     return out
 
 
-def relative_rmse(image, reference):
-    plant = reference[:, 3] >= 0.5
+def relative_rmse(image, reference, pixels=None):
+    plant = reference[:, 3] >= 0.5 if pixels is None else pixels
     diff = image[plant, :3] - reference[plant, :3]
     mean = reference[plant, :3].mean()
     return float(math.sqrt((diff * diff).mean()) / mean) if mean > 0 else 0.0
@@ -112,14 +114,23 @@ def main():
         reference_seconds = timed_render(reference_file, args.reference_spp, 0x5eed)
     background = scene["background"]
     reference = over_background(import_scene.read_exr(reference_file), background)
+    plant_pixels, ground_pixels = None, None
+    if "stage" in scene:
+        # A staged scene's pixels of the plant (1) and of the ground (2), as Cambium's
+        # export measured them (rows from the top; Blender's from the bottom).
+        region = np.fromfile(os.path.splitext(args.scene)[0] + ".region", dtype=np.uint8)
+        region = region.reshape(scene["height"], scene["width"])[::-1].ravel()
+        plant_pixels, ground_pixels = region == 1, region == 2
 
-    spps, rmse, seconds, cpu_s = [], [], [], []
+    spps, rmse, ground_rmse, seconds, cpu_s = [], [], [], [], []
     spp = 1
     while spp <= args.max_spp:
         w, c = timed_render(scratch, spp, 0)
         spps.append(spp)
-        rmse.append(relative_rmse(over_background(import_scene.read_exr(scratch), background),
-                                  reference))
+        image = over_background(import_scene.read_exr(scratch), background)
+        rmse.append(relative_rmse(image, reference, plant_pixels))
+        if ground_pixels is not None:
+            ground_rmse.append(relative_rmse(image, reference, ground_pixels))
         seconds.append(w)
         cpu_s.append(c)
         spp *= 2
@@ -140,6 +151,10 @@ def main():
         "sync_s": round(sync[0], 3), "sync_cpu_s": round(sync[1], 3),
         "reference_s": round(reference_seconds[0], 3) if reference_seconds else None,
     }
+    if ground_rmse:
+        result["ground_relative_rmse"] = [round(r, 5) for r in ground_rmse]
+        result["ground_slope"] = round(float(np.polyfit(x, np.log(ground_rmse), 1)[0]), 3)
+        result["ground_noise_at_max_spp"] = round(ground_rmse[-1], 5)
     print(json.dumps(result), flush=True)
 
 

@@ -407,6 +407,8 @@ def _build_camera(scene):
         back = 0.0
     near = cam["clip_near"] if cam["clip_near"] is not None else -back
     far = cam["clip_far"] if cam["clip_far"] is not None else back + 4 * cam["scene_radius"]
+    if scene.get("stage", {}).get("ground"):
+        far = back + 4000 * cam["scene_radius"]  # the ground reaches the horizon in Cambium
     data.clip_start = max(1e-4 * size, back + near)
     data.clip_end = back + far
     obj = bpy.data.objects.new("camera", data)
@@ -463,6 +465,90 @@ def _build_world(scene):
     # Cambium leaves a uniform environment to BSDF sampling alone.
     world.cycles.sampling_method = "NONE"
     bpy.context.scene.world = world
+
+
+def _build_staged_world(scene):
+    """A staged still's environment: the lat-long map of `stage.environment` (Cambium's
+    --env: nearest texel; the scene is turned to the map's frame, _turn_to_map_frame),
+    importance-sampled as Cambium samples it;
+    camera rays see it too where Cambium shows it (--background env, or any perspective
+    view), else the view's background. Without a map, the uniform ambient (_build_world)."""
+    stage = scene["stage"]
+    env = stage["environment"]
+    if env is None:
+        _build_world(scene)
+        return
+    if env["rotation_deg"]:
+        raise SystemExit("import_scene: a rotated --env map is not supported yet")
+    world = bpy.data.worlds.new("environment")
+    world.use_nodes = True
+    nt = world.node_tree
+    nt.nodes.clear()
+    n, link = nt.nodes.new, nt.links.new
+    texture = n("ShaderNodeTexEnvironment")
+    texture.image = bpy.data.images.load(env["map"], check_existing=True)
+    texture.image.colorspace_settings.name = "Linear"
+    texture.interpolation = "Closest"
+    texture.projection = "EQUIRECTANGULAR"
+    colour = texture.outputs["Color"]
+    if not (stage["backdrop"] == "environment" or scene["camera"]["projection"] == "perspective"):
+        mix = n("ShaderNodeMixRGB")
+        link(colour, mix.inputs[1])
+        mix.inputs[2].default_value = list(scene["background"]) + [1.0]
+        link(n("ShaderNodeLightPath").outputs["Is Camera Ray"], mix.inputs[0])
+        colour = mix.outputs[0]
+    background = n("ShaderNodeBackground")
+    background.inputs["Strength"].default_value = env["scale"]
+    link(colour, background.inputs["Color"])
+    link(background.outputs[0], n("ShaderNodeOutputWorld").inputs["Surface"])
+    world.cycles.sampling_method = "MANUAL"  # one importance cell per texel, as Cambium
+    world.cycles.sample_map_resolution = texture.image.size[0]
+    bpy.context.scene.world = world
+
+
+# Cambium's frame is +y up and its map's u = 0 along +z, a quarter turn along -x
+# (render/environment.h); Blender's equirectangular lookup is +z up, u = 0 along -x, a
+# quarter turn along +y: Cambium's (x, y, z) is Blender's (-z, -x, y).
+CAMBIUM_TO_MAP_FRAME = Matrix(((0, 0, -1, 0), (-1, 0, 0, 0), (0, 1, 0, 0), (0, 0, 0, 1)))
+
+
+def _turn_to_map_frame():
+    """Turns the whole scene (geometry, camera, lights) into Blender's map frame rather
+    than turning the map's lookup: Cycles tabulates the world for importance sampling
+    in its own lat-long frame, which then lines up with the map's texels (a turned lookup
+    splits the small sun among the table's cells, and the sun then comes as fireflies)."""
+    for obj in bpy.context.scene.collection.objects:
+        obj.matrix_world = CAMBIUM_TO_MAP_FRAME @ obj.matrix_world
+
+
+def _build_ground(scene):
+    """Cambium's --ground: the plane y = height, infinite there; here a square 2000 scene
+    radii wide under the plant (its far edge lies well under a pixel from the horizon),
+    diffuse of the decoded ground colour (unlit views: that colour), seen from both sides."""
+    ground = scene["stage"]["ground"]
+    if ground is None:
+        return
+    cx, _, cz = scene["camera"]["scene_centre"]
+    half = 1000.0 * max(scene["camera"]["scene_radius"], 1e-3)
+    y = ground["height"]
+    me = bpy.data.meshes.new("ground")
+    me.from_pydata([(cx - half, y, cz - half), (cx + half, y, cz - half),
+                    (cx + half, y, cz + half), (cx - half, y, cz + half)], [],
+                   [(0, 3, 2, 1)])  # counter-clockwise seen from +y: the normal is +y
+    me.update()
+    mat = bpy.data.materials.new("ground")
+    mat.use_nodes = True
+    nt = mat.node_tree
+    nt.nodes.clear()
+    # An unlit view (`render mode: filled`) draws the ground in its flat colour too.
+    unlit = scene["shading"] == "unlit"
+    surface = nt.nodes.new("ShaderNodeEmission" if unlit else "ShaderNodeBsdfDiffuse")
+    surface.inputs["Color"].default_value = list(ground["diffuse"]) + [1.0]
+    nt.links.new(surface.outputs[0], nt.nodes.new("ShaderNodeOutputMaterial").inputs["Surface"])
+    mat.cycles.sample_as_light = False
+    me.materials.append(mat)
+    obj = bpy.data.objects.new("ground", me)
+    bpy.context.scene.collection.objects.link(obj)
 
 
 def configure(scene, threads=2):
@@ -524,8 +610,16 @@ def build_scene(path, threads=2, emitters_as_lights=True):
     _build_curves(scene, table, shaders)
     _build_camera(scene)
     _build_lights(scene)
-    _build_world(scene)
+    if "stage" in scene:
+        _build_ground(scene)
+        _build_staged_world(scene)
+        if scene["stage"]["environment"] is not None:
+            _turn_to_map_frame()
+    else:
+        _build_world(scene)
     configure(scene, threads)
+    if "stage" in scene:  # the ground and the map fill the frame: an opaque film
+        bpy.context.scene.render.film_transparent = False
     return scene
 
 
