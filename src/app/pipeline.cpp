@@ -543,4 +543,21 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
     return scene;
 }
 
+geom::RayshadeOptions rayshade_options(const Options& options, const std::filesystem::path& file,
+                                       const Model* model)
+{
+    geom::RayshadeOptions ray;
+    ray.object_name = file.filename().string();
+    ray.colormap = std::none_of(options.colour_files.begin(), options.colour_files.end(),
+                                [](const ColourFile& c) { return c.materials; });
+    ray.width = options.width;
+    ray.height = options.height;
+    if (model) {
+        ray.scale = geom::rayshade_scale(*model->view);
+        for (const geom::Material& m : model->palette.entries(options.colour_block))
+            ray.transparency.push_back(m.transparency);
+    }
+    return ray;
+}
+
 }  // namespace cambium::app
