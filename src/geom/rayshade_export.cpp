@@ -133,9 +133,51 @@ private:
     std::map<std::size_t, std::uint16_t> m_used;
 };
 
+/// Text appended to a stream as it is made: a scene's body can be larger than memory
+/// should hold twice.
+class Sink {
+public:
+    explicit Sink(std::ostream& out) : m_out(out) {}
+    Sink& operator+=(const std::string& text)
+    {
+        m_out << text;
+        return *this;
+    }
+    Sink& operator+=(char c)
+    {
+        m_out << c;
+        return *this;
+    }
+
+private:
+    std::ostream& m_out;
+};
+
+/// The surfaces every primitive and instance of the scene uses, registered before any
+/// is written so that the definitions can come first.
+void register_surfaces(const Scene& scene, SurfaceNames& surfaces)
+{
+    auto each = [&](const std::vector<std::uint16_t>& materials) {
+        for (std::uint16_t m : materials)
+            surfaces.use(m);
+    };
+    auto geometry = [&](const Geometry& g) {
+        each(g.lines.material);
+        each(g.curves.material);
+        each(g.spheres.material);
+        each(g.discs.material);
+        each(g.mesh.material);
+    };
+    geometry(scene.geometry);
+    for (const Prototype& p : scene.prototypes)
+        geometry(p.geometry);
+    for (const Instance& in : scene.instances)
+        surfaces.use(in.material);
+}
+
 /// The primitives of one Geometry, each naming its surface (none where it inherits the
 /// instance's).
-void write_geometry(std::string& out, const Geometry& g, SurfaceNames& surfaces, double shortest_segment)
+void write_geometry(Sink& out, const Geometry& g, SurfaceNames& surfaces, double shortest_segment)
 {
     const LinearCurves& lines = g.lines;
     for (std::size_t i = 0; i < lines.segments.size(); ++i) {
@@ -174,8 +216,12 @@ void write_geometry(std::string& out, const Geometry& g, SurfaceNames& surfaces,
             out += '\n';
             for (std::uint32_t v : t) {
                 out += point(mesh.positions[v]) + " " + point(mesh.normals[v]);
-                if (uv)
-                    out.append(" ").append(num(mesh.uvs[v][0])).append(" ").append(num(mesh.uvs[v][1]));
+                if (uv) {
+                    out += ' ';
+                    out += num(mesh.uvs[v][0]);
+                    out += ' ';
+                    out += num(mesh.uvs[v][1]);
+                }
                 out += '\n';
             }
         }
@@ -319,42 +365,15 @@ double rayshade_scale(const ViewFile& view)
     return scale;
 }
 
-std::string rayshade_text(const Scene& scene, const RayshadeOptions& options)
+void write_rayshade(std::ostream& stream, const Scene& scene, const RayshadeOptions& options)
 {
     SurfaceNames surfaces(scene, options);
-    // the body first: only the surfaces it uses are defined
-    std::string body;
-    std::unordered_set<std::string> taken{options.object_name};
-    std::vector<std::string> names;
-    for (std::size_t i = 0; i < scene.prototypes.size(); ++i) {
-        names.push_back(object_name(scene.prototypes[i], i, taken));
-        body += "name " + names.back() + " grid 20 20 20\n";
-        write_geometry(body, scene.prototypes[i].geometry, surfaces, options.shortest_segment);
-        body += "end\n\n";
-    }
-    body += "name " + options.object_name + "\ngrid 40 40 40\n";
-    write_geometry(body, scene.geometry, surfaces, options.shortest_segment);
-    for (const Instance& in : scene.instances) {
-        if (in.prototype >= names.size())
-            continue;
-        std::string s = surfaces.use(in.material);
-        if (!s.empty())
-            body += "applysurf " + s + "\n";
-        // rayshade multiplies row vectors: the rows are the images of the axes, which
-        // are the columns of the Instance's column-major matrix
-        const auto& m = in.transform;
-        body += "object " + names[in.prototype] + "\n transform\n  " + num(m[0]) + " " + num(m[1]) +
-                " " + num(m[2]) + "  " + num(m[3]) + " " + num(m[4]) + " " + num(m[5]) + "  " +
-                num(m[6]) + " " + num(m[7]) + " " + num(m[8]) + "\n translate " + num(m[9]) + " " +
-                num(m[10]) + " " + num(m[11]) + "\n";
-    }
-    body += "end\n";
-
+    register_surfaces(scene, surfaces);
     const ViewLines view = view_lines(scene, options);
     Bounds3 box = scene.view.box.value_or(scene.bounds);
     if (box.empty())
         box.extend(Vec3{0, 0, 0});
-    std::string out;
+    Sink out(stream);
     out += "/* rayshade 4.0 scene written by cambium */\n";
     out += "#ifndef NOSURFACES\n" + surfaces.definitions() + "#endif\n";
     out += "#ifndef NOHEADERS\n";
@@ -367,20 +386,49 @@ std::string rayshade_text(const Scene& scene, const RayshadeOptions& options)
     out += "#endif\n\n";
     out += "#ifdef BBOX\nname " + options.object_name + "\nbox " + point(box.lo) + " " + point(box.hi) +
            "\n#else\n";
-    out += body;
+    std::unordered_set<std::string> taken{options.object_name};
+    std::vector<std::string> names;
+    for (std::size_t i = 0; i < scene.prototypes.size(); ++i) {
+        names.push_back(object_name(scene.prototypes[i], i, taken));
+        out += "name " + names.back() + " grid 20 20 20\n";
+        write_geometry(out, scene.prototypes[i].geometry, surfaces, options.shortest_segment);
+        out += "end\n\n";
+    }
+    out += "name " + options.object_name + "\ngrid 40 40 40\n";
+    write_geometry(out, scene.geometry, surfaces, options.shortest_segment);
+    for (const Instance& in : scene.instances) {
+        if (in.prototype >= names.size())
+            continue;
+        std::string s = surfaces.use(in.material);
+        if (!s.empty())
+            out += "applysurf " + s + "\n";
+        // rayshade multiplies row vectors: the rows are the images of the axes, which
+        // are the columns of the Instance's column-major matrix
+        const auto& m = in.transform;
+        out += "object " + names[in.prototype] + "\n transform\n  " + num(m[0]) + " " + num(m[1]) +
+                " " + num(m[2]) + "  " + num(m[3]) + " " + num(m[4]) + " " + num(m[5]) + "  " +
+                num(m[6]) + " " + num(m[7]) + " " + num(m[8]) + "\n translate " + num(m[9]) + " " +
+                num(m[10]) + " " + num(m[11]) + "\n";
+    }
+    out += "end\n";
     out += "#endif\n\n#ifndef NOHEADERS\nobject " + options.object_name;
     if (options.scale != 1)
         out += " scale " + num(options.scale) + " " + num(options.scale) + " " + num(options.scale);
     out += "\n#endif\n";
-    return out;
+}
+
+std::string rayshade_text(const Scene& scene, const RayshadeOptions& options)
+{
+    std::ostringstream out;
+    write_rayshade(out, scene, options);
+    return out.str();
 }
 
 void write_rayshade(const Scene& scene, const std::filesystem::path& file, const RayshadeOptions& options)
 {
-    std::string text = rayshade_text(scene, options);
     write_file_atomically(file, [&](const std::filesystem::path& temporary) {
         std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-        out << text;
+        write_rayshade(out, scene, options);
         out.close();
         if (!out)
             throw Error(FileLoc{file.string()}, "cannot write the rayshade file");

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,9 @@ double rayshade_scale(const ViewFile& view);
 /// changes), spheres and discs stay themselves, triangles stay triangles, generalized
 /// cylinders become triangles, prototypes become named objects placed by `object`.
 std::string rayshade_text(const Scene& scene, const RayshadeOptions& options);
+
+/// Writes rayshade_text() to `out` as it is made.
+void write_rayshade(std::ostream& out, const Scene& scene, const RayshadeOptions& options);
 
 /// Writes rayshade_text() as `file`, whole or not at all; throws cambium::Error naming it.
 void write_rayshade(const Scene& scene, const std::filesystem::path& file,
