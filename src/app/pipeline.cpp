@@ -4,6 +4,7 @@
 #include "app/pipeline.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -548,6 +549,9 @@ geom::RayshadeOptions rayshade_options(const Options& options, const std::filesy
 {
     geom::RayshadeOptions ray;
     ray.object_name = file.filename().string();
+    // a rayshade name is one word
+    std::replace_if(ray.object_name.begin(), ray.object_name.end(),
+                    [](unsigned char c) { return std::isspace(c) != 0; }, '_');
     ray.colormap = std::none_of(options.colour_files.begin(), options.colour_files.end(),
                                 [](const ColourFile& c) { return c.materials; });
     ray.width = options.width;
