@@ -83,7 +83,7 @@ const std::map<std::string, CpfgOption>& cpfg_options()
         {"-tga", {1, [](Options& o, auto& a) { o.outputs.emplace_back(a[0]); }}},
         {"-ras", {1, unsupported_output("colour-index SGI raster")}},
         {"-rle", {1, unsupported_output("Utah RLE")}},
-        {"-ray", {1, unsupported_output("rayshade")}},
+        {"-ray", {1, [](Options& o, auto& a) { o.rayshade = a[0]; }}},
         {"-ps", {1, unsupported_output("PostScript")}},
         {"-iv", {1, unsupported_output("Inventor")}},
         {"-gls", {1, gls_output}},
@@ -207,7 +207,7 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
 
     CLI::App cli{"cambium: renders cpfg plant models physically.\n"
                  "cpfg options: -w W H (image size, default 640 480), -m[n] file.map, -M[n] file.mat, -c<n>, -str file,\n"
-                 "-strb file, -homo, -vv file, -rgb file, -tga file, -gls file, -v, -V, -P cpp, -e file,\n"
+                 "-strb file, -homo, -vv file, -ray file, -rgb file, -tga file, -gls file, -v, -V, -P cpp, -e file,\n"
                  "-a (every frame of the animation file); window options (-g -wp -wt -mb -pm -sb -s<n>)\n"
                  "are accepted and ignored.\n"
                  "--ground [COLOUR|FILE]: a ground plane under the plant, grey (default), a colour\n"

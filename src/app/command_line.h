@@ -78,6 +78,7 @@ struct Options {
     std::optional<std::filesystem::path> string_binary;  ///< -strb
     bool homomorphism_in_string = false;                  ///< -homo
     std::optional<std::filesystem::path> view_volume;    ///< -vv
+    std::optional<std::filesystem::path> rayshade;       ///< -ray: rayshade 4.0 scene
     // Statistics (app/stats.h): a readable block on stderr, and JSON
     bool stats = false;                                   ///< --stats
     std::optional<std::filesystem::path> stats_json;     ///< --stats-json FILE
@@ -138,7 +139,7 @@ struct Options {
     bool renders() const
     {
         return !outputs.empty() ||
-               (!string_text && !string_binary && !view_volume && !light_report);
+               (!string_text && !string_binary && !view_volume && !rayshade && !light_report);
     }
 };
 

@@ -28,6 +28,7 @@
 #include "app/video.h"
 #include "base/diagnostics.h"
 #include "base/subprocess.h"
+#include "geom/rayshade_export.h"
 #include "geom/view_volume.h"
 #include "lsys/string_io.h"
 #include "base/output_format.h"
@@ -179,6 +180,16 @@ void check_outputs(const Options& options, const std::vector<std::filesystem::pa
     }
 }
 
+/// -ray FILE: the scene as cpfg's rayshade file (`model`, when there is one, gives
+/// `rayshade scale:` and the materials' transparency).
+void write_rayshade_output(const geom::Scene& scene, const Options& options,
+                           const std::filesystem::path& file, const Model* model,
+                           const std::function<void(const std::string&)>& say)
+{
+    geom::write_rayshade(scene, file, rayshade_options(options, file, model));
+    say("wrote " + file.string());
+}
+
 /// Writes the mesh outputs among `outputs` from `scene` (rank 0 alone under --mpi) and
 /// returns the others, the pictures to render.
 std::vector<std::filesystem::path> write_meshes(const geom::Scene& scene, const Options& options,
@@ -308,6 +319,8 @@ int run_scene(Options options, const std::function<void(const std::string&)>& sa
     }
     if (options.light_report && (!mpi || mpi->rank() == 0))  // each organ of each placement
         write_light_report(scene, options, say);
+    if (options.rayshade)
+        write_rayshade_output(scene, options, *options.rayshade, nullptr, say);
     if (images.empty()) {
         report_stats(stats, options);
         return 0;
@@ -358,7 +371,7 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
     if (writes)
         write_strings(model, string, options,
                       options.steps.value_or(model.lsystem.derivation_length()), say);
-    if (images.empty() && !options.light_report) {
+    if (images.empty() && !options.light_report && !options.rayshade) {
         // Only strings and the view volume are written: the turtle walks the string for
         // -vv without building geometry, and has nothing to do otherwise.
         if (options.view_volume && writes) {
@@ -392,6 +405,8 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
         geom::write_view_volume(scene.view.box.value_or(scene.bounds), *options.view_volume);
         say("wrote " + options.view_volume->string());
     }
+    if (options.rayshade && writes)
+        write_rayshade_output(scene, options, *options.rayshade, &model, say);
     if (options.light_report && writes)
         write_light_report(scene, options, say);
     if (images.empty()) {

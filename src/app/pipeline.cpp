@@ -4,6 +4,7 @@
 #include "app/pipeline.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -559,6 +560,26 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
     release_unused_line_buffers(scene.geometry.lines);
     geom::fit_scene_buffers(scene);
     return scene;
+}
+
+geom::RayshadeOptions rayshade_options(const Options& options, const std::filesystem::path& file,
+                                       const Model* model)
+{
+    geom::RayshadeOptions ray;
+    ray.object_name = file.filename().string();
+    // a rayshade name is one word
+    std::replace_if(ray.object_name.begin(), ray.object_name.end(),
+                    [](unsigned char c) { return std::isspace(c) != 0; }, '_');
+    ray.colormap = std::none_of(options.colour_files.begin(), options.colour_files.end(),
+                                [](const ColourFile& c) { return c.materials; });
+    ray.width = options.width;
+    ray.height = options.height;
+    if (model) {
+        ray.scale = geom::rayshade_scale(*model->view);
+        for (const geom::Material& m : model->palette.entries(options.colour_block))
+            ray.transparency.push_back(m.transparency);
+    }
+    return ray;
 }
 
 }  // namespace cambium::app

@@ -12,6 +12,7 @@
 #include "env/shared_environment.h"
 #include "geom/function.h"
 #include "geom/palette.h"
+#include "geom/rayshade_export.h"
 #include "geom/scene.h"
 #include "geom/turtle.h"
 #include "geom/view_file.h"
@@ -110,5 +111,12 @@ geom::Scene interpret_with_provenance(const Model& model, const lsys::ModuleStri
 /// -vv without an image costs the walk alone; the bounds equal interpret()'s.
 geom::Bounds3 view_volume(const Model& model, const lsys::ModuleString& derived,
                           const Options& options, bool box_wins = true);
+
+/// -ray FILE's settings: the main object named by the file (as cpfg names it), colormap or
+/// material surfaces by the command's colour files, framed for its image size, and the
+/// view file's `rayshade scale:` and the colour files' transparencies (none without a
+/// model: a scene file's field).
+geom::RayshadeOptions rayshade_options(const Options& options, const std::filesystem::path& file,
+                                       const Model* model);
 
 }  // namespace cambium::app

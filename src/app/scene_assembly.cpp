@@ -78,6 +78,7 @@ Options plant_options(const Options& options, const ScenePlant& plant)
     o.string_text.reset();
     o.string_binary.reset();
     o.view_volume.reset();
+    o.rayshade.reset();
     o.verbosity = Verbosity::normal;
     return o;
 }

@@ -121,6 +121,8 @@ void require_numbered_names(const Options& options, const std::vector<fs::path>&
         check(*options.string_binary, "-strb");
     if (options.view_volume)
         check(*options.view_volume, "-vv");
+    if (options.rayshade)
+        check(*options.rayshade, "-ray");
 }
 
 render::ViewOverrides view_overrides(const ShotOptions& shot)
@@ -492,7 +494,7 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         const lsys::ModuleString& written = homo ? *homo : string;
         if (writes)
             out.write_strings(model, written, f.number);
-        if (!options.view_volume && !filter.to_render(number))
+        if (!options.view_volume && !options.rayshade && !filter.to_render(number))
             return;
         if (refit && animation->new_view_between_frames)
             model.view = read_view(options);
@@ -503,6 +505,14 @@ int run_animation(const Options& options, const SequenceOutputs& out)
             ledger.shared(0, seconds_since(vv_start));
             fs::path file = frame_file(*options.view_volume, f.number);
             geom::write_view_volume(volume, file);
+            out.say("wrote " + file.string());
+        }
+        if (options.rayshade && writes) {
+            // the frame's own geometry, as the turtle draws it for the picture
+            fs::path file = frame_file(*options.rayshade, f.number);
+            geom::Scene frame = interpret_turtle_string(
+                model, homo ? *homo : turtle_string(model, string, options), options);
+            geom::write_rayshade(frame, file, rayshade_options(options, file, &model));
             out.say("wrote " + file.string());
         }
         if (!filter.to_render(number))

@@ -64,6 +64,7 @@ const char* cpfg_flag(const std::string& key)
         {"animate", "-a"},       {"homomorphism", "-homo"}, {"warnings", "-v"},
         {"verbose", "-V"},       {"environment", "-e"},     {"preprocessor", "-P"},
         {"string_text", "-str"}, {"string_binary", "-strb"}, {"view_volume", "-vv"},
+        {"rayshade", "-ray"},
     };
     for (const auto& [name, flag] : table)
         if (key == name)

@@ -796,6 +796,35 @@ TEST(Sequence, AnimationFileSelectsFrames)
     EXPECT_FALSE(fs::exists(dir / "s3.str"));
 }
 
+// -ray writes cpfg's rayshade scene: a still's alone (nothing rendered), and one per frame
+// through the name's number field, each with that frame's segments.
+TEST(Command, RayshadeSceneOfAStillAndOfEveryFrame)
+{
+    fs::path dir = growing_plant(scratch("ray"));
+    Result still = run("-q -ray " + (dir / "p.ray").string() + " " + plant_files(dir));
+    ASSERT_EQ(still.status, 0) << still.output;
+    std::string text = bytes_of(dir / "p.ray");
+    EXPECT_NE(text.find("\nname p.ray\ngrid 40 40 40\n"), std::string::npos) << text;
+    EXPECT_NE(text.find("\nobject p.ray\n"), std::string::npos) << text;
+    EXPECT_FALSE(fs::exists(dir / "g.png"));  // only the scene was asked for
+
+    Result frames = run("-a -q -ray " + (dir / "r%d.ray").string() + " " + plant_files(dir));
+    ASSERT_EQ(frames.status, 0) << frames.output;
+    auto cylinders = [](const std::string& t) {
+        std::size_t n = 0;
+        for (std::size_t at = t.find("\ncylinder "); at != std::string::npos; at = t.find("\ncylinder ", at + 1))
+            ++n;
+        return n;
+    };
+    ASSERT_TRUE(fs::exists(dir / "r1.ray") && fs::exists(dir / "r3.ray"));
+    EXPECT_LT(cylinders(bytes_of(dir / "r1.ray")), cylinders(bytes_of(dir / "r3.ray")));
+    EXPECT_EQ(cylinders(bytes_of(dir / "r3.ray")), cylinders(text));
+
+    Result one = run("-a -q -ray " + (dir / "one.ray").string() + " " + plant_files(dir));
+    EXPECT_NE(one.status, 0);
+    EXPECT_NE(one.output.find("-ray names one file for"), std::string::npos) << one.output;
+}
+
 TEST(Sequence, SeveralFramesIntoOneNameIsAnErrorBeforeAnyWork)
 {
     fs::path dir = growing_plant(scratch("anim_name"));
