@@ -509,10 +509,12 @@ std::filesystem::path confined_path(const std::string& base_dir, const std::stri
 
 /// Opens a confined file without following a link in its last component (a link that
 /// points nowhere yet would create its target) and only if it is a regular file, so a
-/// device or a FIFO is neither read nor waited on.
+/// device or a FIFO is neither read nor waited on. A file to write must have one name:
+/// a hard link shipped in the model's folder may share its data with a file outside, so
+/// it is checked before anything is truncated.
 std::FILE* open_regular(const std::filesystem::path& path, const std::string& mode)
 {
-    int flags = mode == "r" ? O_RDONLY : O_WRONLY | O_CREAT | (mode == "a" ? O_APPEND : O_TRUNC);
+    int flags = mode == "r" ? O_RDONLY : O_WRONLY | O_CREAT | (mode == "a" ? O_APPEND : 0);
     int fd = ::open(path.c_str(), flags | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC, 0666);
     if (fd < 0)
         return nullptr;
@@ -520,6 +522,17 @@ std::FILE* open_regular(const std::filesystem::path& path, const std::string& mo
     if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
         ::close(fd);
         throw EvaluationError("fopen: '" + path.string() + "' is not a regular file");
+    }
+    if (mode != "r" && st.st_nlink > 1) {
+        ::close(fd);
+        throw EvaluationError("fopen: '" + path.string() + "' has " + std::to_string(st.st_nlink) +
+                              " hard links, so writing it could change a file outside the model's "
+                              "folder; an L-system writes only files of one name "
+                              "(--allow-file-access lifts this)");
+    }
+    if (mode == "w" && ::ftruncate(fd, 0) != 0) {
+        ::close(fd);
+        return nullptr;
     }
     ::fcntl(fd, F_SETFL, ::fcntl(fd, F_GETFL) & ~O_NONBLOCK);
     std::FILE* f = ::fdopen(fd, mode.c_str());

@@ -234,6 +234,26 @@ TEST(FileAccess, SymbolicLinksPointingOutsideAreRefused)
     EXPECT_FALSE(fs::exists(m.root / "not-yet.txt"));
 }
 
+// A hard link in the model's folder shares its data with a file outside: writing through
+// it (or truncating it) would change that file, so a file to write must have one name.
+TEST(FileAccess, HardLinksAreNotWritten)
+{
+    ModelFolder m;
+    std::ofstream(m.outside) << "secret\n";
+    ASSERT_EQ(::link(m.outside.c_str(), (m.model / "shared.txt").c_str()), 0);
+    for (std::string mode : {"w", "a"}) {
+        std::string e = derive_error(with_start("f = fopen(\"shared.txt\", \"" + mode + "\"); fprintf(f, \"x\");"),
+                                     m.l_file());
+        EXPECT_NE(e.find("has 2 hard links, so writing it could change a file outside"), std::string::npos) << e;
+    }
+    EXPECT_EQ(read_file(m.outside), "secret\n");
+    // reading it is harmless, and a file of one name is written as before
+    EXPECT_EQ(derive_error(with_start(R"(f = fopen("shared.txt", "r"); fclose(f);)"), m.l_file()), "");
+    std::ofstream(m.model / "own.txt") << "old text\n";
+    EXPECT_EQ(derive_error(with_start(R"(f = fopen("own.txt", "w"); fprintf(f, "new\n"); fclose(f);)"), m.l_file()), "");
+    EXPECT_EQ(read_file(m.model / "own.txt"), "new\n");
+}
+
 TEST(FileAccess, FifosAndFoldersInsideAreNotOpened)
 {
     ModelFolder m;
