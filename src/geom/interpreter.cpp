@@ -1245,6 +1245,13 @@ private:
             t.names.emplace_back(m_tables->symbols->name(symbol));
         }
         const std::uint16_t age = module < m_options.ages.size() ? m_options.ages[module] : unknown_age;
+        if (m_options.branch_orders) {
+            const std::size_t depth = std::min<std::size_t>(m_stack.size(), ModuleTable::no_branch_order - 1);
+            t.orders.insert(t.orders.begin() + (at - t.records.begin()), static_cast<std::uint16_t>(depth));
+        }
+        if (!m_options.births.empty())
+            t.births.insert(t.births.begin() + (at - t.records.begin()),
+                            module < m_options.births.size() ? m_options.births[module] : module);
         t.records.insert(at, {module, static_cast<std::uint16_t>(m_name_of_symbol[symbol]), age});
     }
     std::size_t m_instances_attributed = 0;

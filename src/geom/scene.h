@@ -43,6 +43,15 @@ struct ModuleRecord {
 struct ModuleTable {
     std::vector<ModuleRecord> records;  ///< sorted by index, each index once
     std::vector<std::string> names;     ///< symbol names, each once
+    /// Each record's branch order (the `[` open around the module where the turtle drew
+    /// it; no_branch_order where unknown), parallel to `records` where asked for
+    /// (InterpretOptions::branch_orders: organ masks), else empty.
+    std::vector<std::uint16_t> orders;
+    static constexpr std::uint16_t no_branch_order = 0xffff;
+    /// In an animation with organ masks (InterpretOptions::births): each record's index in
+    /// the string of the frame where its module appeared (with the record's age, its
+    /// identity across frames), parallel to `records`; else empty.
+    std::vector<std::uint32_t> births;
 
     /// The record of module `index`, or null.
     const ModuleRecord* find(std::uint32_t index) const
