@@ -80,7 +80,7 @@ struct InterpretOptions {
     /// empty: ages are unknown_age.
     std::span<const std::uint16_t> ages;
     /// Record each organ's branch order (ModuleTable::orders: the turtle's open `[` where
-    /// the module drew): 2 bytes a record, for organ masks.
+    /// the module's successor begins): 2 bytes a record, for organ masks.
     bool branch_orders = false;
     /// Per module of the derived string, its index where it appeared (ModuleTable::births;
     /// an animation's organ masks); empty: not recorded.

@@ -43,8 +43,8 @@ struct ModuleRecord {
 struct ModuleTable {
     std::vector<ModuleRecord> records;  ///< sorted by index, each index once
     std::vector<std::string> names;     ///< symbol names, each once
-    /// Each record's branch order (the `[` open around the module where the turtle drew
-    /// it; no_branch_order where unknown), parallel to `records` where asked for
+    /// Each record's branch order (the `[` open where the turtle begins the module's
+    /// successor; no_branch_order where unknown), parallel to `records` where asked for
     /// (InterpretOptions::branch_orders: organ masks), else empty.
     std::vector<std::uint16_t> orders;
     static constexpr std::uint16_t no_branch_order = 0xffff;

@@ -188,3 +188,23 @@ TEST(Provenance, BranchOrdersWhenAskedFor)
         EXPECT_EQ(t.orders[i], expected[i].second) << "module " << expected[i].first;
     }
 }
+
+// Through a homomorphism the order is the derived module's: a successor that opens its
+// own bracket (K --> [F]) does not raise its module's order.
+TEST(Provenance, BranchOrderOfAModuleWhoseSuccessorOpensABracket)
+{
+    lsys::SymbolTable symbols;
+    // turtle string F [ F ] from the derived string F K: K's successor is [ F ]
+    lsys::ModuleString s = text_modules(symbols, "F(1) [ F(1) ]");
+    ViewFile view = surface_view();
+    InterpretOptions options;
+    options.branch_orders = true;
+    const std::vector<std::uint32_t> origins{0, 1, 1, 1};
+    options.origins = origins;
+    Scene scene = interpret(s, symbols, view, options);
+    const ModuleTable& t = scene.geometry.modules;
+    ASSERT_EQ(t.records.size(), 2u);
+    ASSERT_EQ(t.orders.size(), 2u);
+    EXPECT_EQ(t.records[1].index, 1u);
+    EXPECT_EQ(t.orders[1], 0u) << "K itself is in no branch";
+}
