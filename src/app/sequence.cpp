@@ -414,6 +414,8 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         lsys::ModuleString turtle;
         std::optional<geom::View> own_view;  ///< refitted per frame (else the fixed camera)
         StringOrigins origins;  ///< organ masks: ages and births (else empty)
+        /// Organ masks: the frame's derived string, whose symbols name the organs.
+        std::shared_ptr<const lsys::ModuleString> derived;
     };
     std::vector<Kept> kept;
     geom::Bounds3 all_bounds, fixed_bounds;
@@ -423,6 +425,7 @@ int run_animation(const Options& options, const SequenceOutputs& out)
     auto take = [&](lsys::ModuleString turtle, const geom::AnimationFrame& frame,
                     StringOrigins origins = {}) {
         auto interpret_start = Clock::now();
+        // (origins.derived, when set, lives only as long as this call)
         geom::Scene scene = interpret_turtle_string(model, turtle, options,
                                                     origins.ages.empty() ? nullptr : &origins);
         ledger.interpreted(frame.number, seconds_since(interpret_start));
@@ -439,9 +442,14 @@ int run_animation(const Options& options, const SequenceOutputs& out)
             fixed_view = scene.view;
             fixed_bounds.extend(scene.bounds);
         }
+        std::shared_ptr<const lsys::ModuleString> derived;
+        if (origins.derived) {  // copied: the derivation goes on before the frame is rendered
+            derived = std::make_shared<const lsys::ModuleString>(*origins.derived);
+            origins.derived = derived.get();
+        }
         kept.push_back({frame, std::move(turtle),
                         own_camera ? std::optional<geom::View>(scene.view) : std::nullopt,
-                        std::move(origins)});
+                        std::move(origins), std::move(derived)});
     };
     // -homo: the strings written are the homomorphism's output, which the turtle then
     // reads as it is; otherwise the derived string is written as it stands (not copied)
@@ -540,6 +548,7 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         anchor.number = number;
         if (options.organ_masks && !homo) {
             StringOrigins origins;
+            origins.derived = &string;
             origins.ages = ages;
             origins.births = births;
             lsys::ModuleString turtle = turtle_string(model, string, options, origins.origins);

@@ -852,6 +852,16 @@ TEST(Sequence, OrganMaskNamesAreStableAcrossFrames)
     }
     EXPECT_NE(third.find("\"F 10@3\""), std::string::npos) << third;
     EXPECT_EQ(first.find("@2"), std::string::npos) << first;
+
+    // through a homomorphism the organs keep the derived string's symbols (I, not F)
+    write(dir / "h.l", "lsystem: 1\nderivation length: 2\naxiom: A\nA --> I[+I]A\n"
+                       "homomorphism\nI --> F\nendlsystem\n");
+    r = run("-a -q -w 48 36 --spp 2 --organ-masks -o " + (dir / "h%02d.exr").string() + " " +
+            (dir / "h.l").string() + " " + (dir / "g.v").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    const std::string h2 = manifest("h02.exr");
+    EXPECT_NE(h2.find("\"I 0@1\""), std::string::npos) << h2;
+    EXPECT_EQ(h2.find("\"F "), std::string::npos) << h2;
 }
 
 TEST(Sequence, SeveralFramesIntoOneNameIsAnErrorBeforeAnyWork)
