@@ -185,6 +185,9 @@ void check_distributed_options(const Options& options)
     if (options.denoise && (options.tile || options.assemble || (options.mpi && !sequence)))
         throw Error("--denoise needs the whole image: it cannot denoise the bands of --tile, "
                     "--assemble or an --mpi still (an --mpi sequence is denoised frame by frame)");
+    if (options.organ_masks && (options.tile || options.assemble || options.mpi))
+        throw Error("--organ-masks needs the whole image in one process: not with --tile, "
+                    "--assemble or --mpi");
     int count = options.tile ? options.tile->second : options.assemble.value_or(1);
     if (count > options.height)
         throw Error(std::string(options.tile ? "--tile: " : "--assemble: ") +
@@ -283,6 +286,10 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     cli.add_option("--focus-distance", options.focus_distance,
                    "Depth of field: distance in focus (default: to the view reference point)")
         ->check(CLI::Range(0.0, 1e12));
+    cli.add_flag("--organ-masks", options.organ_masks,
+                 "Add organ masks to EXR outputs: Cryptomatte layers CryptoOrgan (each organ) "
+                 "and CryptoSymbol (each module symbol), and organ.index, .age, .order, "
+                 ".plant channels (docs/masks.md)");
     cli.add_flag("--denoise", options.denoise,
                  "Denoise each frame from its albedo, normal, depth, organ and variance "
                  "(docs/denoise.md); an EXR keeps the raw frame as the noisy layer");

@@ -103,6 +103,8 @@ struct Options {
     float filter_radius = 0;           ///< --filter-radius (0: the filter's default)
     float noise_target = 0;            ///< --noise-target: adaptive sampling (0 = off)
     bool denoise = false;              ///< --denoise: each frame denoised (docs/denoise.md)
+    /// --organ-masks: EXR outputs get Cryptomatte layers and organ channels (docs/masks.md)
+    bool organ_masks = false;
     double time_budget_s = 0;          ///< --time-budget seconds (0 = none)
     double aperture_radius = 0;        ///< --aperture: thin-lens radius (0 = pinhole)
     double focus_distance = 0;         ///< --focus-distance (0 = view reference point)

@@ -163,6 +163,12 @@ int run_sequence_with_stats(const Options& options, const SequenceOutputs& outpu
 /// videos by ffmpeg's, meshes (a still's geometry only) by their folder.
 void check_outputs(const Options& options, const std::vector<std::filesystem::path>& outputs)
 {
+    if (options.organ_masks &&
+        std::none_of(outputs.begin(), outputs.end(), [](const std::filesystem::path& out) {
+            const OutputFormat* format = find_output_format(out);
+            return format && format->keeps_layers;
+        }))
+        throw Error("--organ-masks writes its layers into EXR images: give an -o file.exr");
     for (const auto& out : outputs) {
         const OutputFormat* format = find_output_format(out);
         if (format && format->mesh != MeshFormat::none) {
@@ -363,9 +369,10 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
     Model model = load_model(options);
     stats.load_s = seconds_since(start);
     auto lap = Clock::now();
-    // the light report names each organ's age: the derivation's lineage gives it
+    // the light report and organ masks name each organ's age: the lineage gives it
     StringOrigins provenance;
-    lsys::ModuleString string = derive(model, options, options.light_report.has_value(), provenance.ages);
+    lsys::ModuleString string =
+        derive(model, options, options.light_report || options.organ_masks, provenance.ages);
     stats.derive_s = seconds_since(lap);
     say(fmt::format("derived {} modules in {:.3f} s", string.size(), seconds_since(start)));
     if (writes)

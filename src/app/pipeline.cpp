@@ -468,6 +468,7 @@ geom::InterpretOptions interpret_options(const Model& model, const Options& opti
         turtle.next_colormap_material_offset = 2 * geom::colour_indices;
     }
     turtle.max_memory_bytes = options.max_memory_bytes;
+    turtle.branch_orders = options.organ_masks;
     if (model.fragment_turtles)
         turtle.fragment_turtles = *model.fragment_turtles;
     std::vector<char> objects = instanced_objects(model, options);
@@ -512,6 +513,7 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
         turtle.derived = origins->derived;
         turtle.origins = origins->origins;
         turtle.ages = origins->ages;
+        turtle.births = origins->births;
     }
     geom::Scene scene = geom::interpret(string, model.lsystem.symbols(), *model.view, turtle);
     const bool index_lit = lit_by_colour_index(model);

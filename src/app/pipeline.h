@@ -87,6 +87,9 @@ struct StringOrigins {
     const lsys::ModuleString* derived = nullptr;  ///< the derived string
     std::vector<std::uint32_t> origins;  ///< per turtle-string module, its index in *derived
     std::vector<std::uint16_t> ages;     ///< per derived module (empty: unknown)
+    /// Per derived module, its index in the string where it appeared (an animation's
+    /// organ masks: ModuleTable::births); empty: not recorded.
+    std::vector<std::uint32_t> births;
 };
 /// turtle_string(), its modules' origins in `derived` written to `origins`.
 lsys::ModuleString turtle_string(const Model& model, const lsys::ModuleString& derived,

@@ -30,6 +30,7 @@
 #include "lsys/inbetween.h"
 #include "lsys/string_io.h"
 #include "render/denoise.h"
+#include "render/organ_masks.h"
 #include "render/framing.h"
 #include "render/ground.h"
 
@@ -414,15 +415,21 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         geom::AnimationFrame frame;  ///< numbered as its images
         lsys::ModuleString turtle;
         std::optional<geom::View> own_view;  ///< refitted per frame (else the fixed camera)
+        StringOrigins origins;  ///< organ masks: ages and births (else empty)
+        /// Organ masks: the frame's derived string, whose symbols name the organs.
+        std::shared_ptr<const lsys::ModuleString> derived;
     };
     std::vector<Kept> kept;
     geom::Bounds3 all_bounds, fixed_bounds;
     double lowest = std::numeric_limits<double>::infinity();
     std::optional<geom::View> fixed_view;
     // One frame's turtle string (and image number in `frame`): rendered or kept.
-    auto take = [&](lsys::ModuleString turtle, const geom::AnimationFrame& frame) {
+    auto take = [&](lsys::ModuleString turtle, const geom::AnimationFrame& frame,
+                    StringOrigins origins = {}) {
         auto interpret_start = Clock::now();
-        geom::Scene scene = interpret_turtle_string(model, turtle, options);
+        // (origins.derived, when set, lives only as long as this call)
+        geom::Scene scene = interpret_turtle_string(model, turtle, options,
+                                                    origins.ages.empty() ? nullptr : &origins);
         ledger.interpreted(frame.number, seconds_since(interpret_start));
         scene.view = render::apply_overrides(scene.view, overrides, scene.bounds);
         bool own_camera = refit || scene.view.perspective;
@@ -437,8 +444,14 @@ int run_animation(const Options& options, const SequenceOutputs& out)
             fixed_view = scene.view;
             fixed_bounds.extend(scene.bounds);
         }
+        std::shared_ptr<const lsys::ModuleString> derived;
+        if (origins.derived) {  // copied: the derivation goes on before the frame is rendered
+            derived = std::make_shared<const lsys::ModuleString>(*origins.derived);
+            origins.derived = derived.get();
+        }
         kept.push_back({frame, std::move(turtle),
-                        own_camera ? std::optional<geom::View>(scene.view) : std::nullopt});
+                        own_camera ? std::optional<geom::View>(scene.view) : std::nullopt,
+                        std::move(origins), std::move(derived)});
     };
     // -homo: the strings written are the homomorphism's output, which the turtle then
     // reads as it is; otherwise the derived string is written as it stands (not copied)
@@ -452,11 +465,35 @@ int run_animation(const Options& options, const SequenceOutputs& out)
     lsys::ModuleString before;  // the previous frame's string (--inbetween)
     const geom::AnimationFrame* previous = nullptr;
     auto derivation_start = Clock::now();  // of this frame's steps: since the last frame
+    // Organ masks: each module's age (the derivation step of the frame where it appeared)
+    // and its index in that frame's string, followed along the lineage from frame to
+    // frame: together its name in every frame it lives in (docs/masks.md).
+    std::vector<std::uint16_t> ages;
+    std::vector<std::uint32_t> births;
+    int steps_so_far = 0;
     int derived = derive_frames_with_lineage(
-        model, frames, numbering.inbetween > 0,
+        model, frames, numbering.inbetween > 0 || options.organ_masks,
         [&](const geom::AnimationFrame& f, const lsys::ModuleString& string,
             const std::vector<std::uint32_t>& lineage) {
         std::size_t index = std::size_t(&f - frames.data());
+        steps_so_far += f.derive_steps;
+        if (options.organ_masks) {
+            constexpr std::uint16_t oldest = 0xfffe;
+            const auto step = static_cast<std::uint16_t>(std::min(steps_so_far, int(oldest)));
+            std::vector<std::uint16_t> next_ages(string.size(), step);
+            std::vector<std::uint32_t> next_births(string.size());
+            for (std::size_t i = 0; i < string.size(); ++i) {
+                const std::uint32_t parent = i < lineage.size() ? lineage[i] : lsys::no_parent;
+                next_births[i] = static_cast<std::uint32_t>(i);
+                if (parent == lsys::no_parent)
+                    continue;
+                // the first frame's parents are the axiom's modules, born at step 0
+                next_ages[i] = parent < ages.size() ? ages[parent] : 0;
+                next_births[i] = parent < births.size() ? births[parent] : parent;
+            }
+            ages = std::move(next_ages);
+            births = std::move(next_births);
+        }
         int number = numbering.anchor(f, index);
         struct Restart {  // the next frame's derivation starts when this call returns
             Clock::time_point& start;
@@ -519,6 +556,15 @@ int run_animation(const Options& options, const SequenceOutputs& out)
             return;
         geom::AnimationFrame anchor = f;
         anchor.number = number;
+        if (options.organ_masks && !homo) {
+            StringOrigins origins;
+            origins.derived = &string;
+            origins.ages = ages;
+            origins.births = births;
+            lsys::ModuleString turtle = turtle_string(model, string, options, origins.origins);
+            take(std::move(turtle), anchor, std::move(origins));
+            return;
+        }
         take(homo ? std::move(*homo) : turtle_string(model, string, options), anchor);
     });
     out.say(fmt::format("derived {} steps once for {} frames", derived, images_total));
@@ -538,7 +584,8 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         if (status != 0)
             break;
         auto interpret_start = Clock::now();
-        geom::Scene scene = interpret_turtle_string(model, k.turtle, options);
+        geom::Scene scene = interpret_turtle_string(model, k.turtle, options,
+                                                    k.origins.ages.empty() ? nullptr : &k.origins);
         ledger.interpreted(k.frame.number, seconds_since(interpret_start));
         scene.view = k.own_view.value_or(*fixed_view);
         render_frame(scene, k.own_view ? std::nullopt : camera, k.frame);
@@ -780,6 +827,8 @@ render::RenderSettings render_settings(const Options& options,
     });
     if (options.denoise)
         settings.denoiser = render::make_default_denoiser();
+    if (options.organ_masks)
+        settings.organ_mask_depth = render::default_organ_mask_depth;
     apply_staging(settings, options);
     return settings;
 }

@@ -662,16 +662,36 @@ void append_module_table(ModuleTable& into, const ModuleTable& from)
     }
     std::vector<ModuleRecord> merged;
     merged.reserve(into.records.size() + from.records.size());
+    // branch orders and births kept parallel where either table has them
+    const bool orders = !into.orders.empty() || !from.orders.empty();
+    const bool births = !into.births.empty() || !from.births.empty();
+    std::vector<std::uint16_t> merged_orders;
+    std::vector<std::uint32_t> merged_births;
+    auto parallel = [&](const ModuleTable& t, std::size_t i) {
+        if (orders)
+            merged_orders.push_back(i < t.orders.size() ? t.orders[i] : ModuleTable::no_branch_order);
+        if (births)
+            merged_births.push_back(i < t.births.size() ? t.births[i] : t.records[i].index);
+    };
     auto a = into.records.begin();
-    for (const ModuleRecord& r : from.records) {
+    auto keep_into = [&] {
+        parallel(into, std::size_t(a - into.records.begin()));
+        merged.push_back(*a++);
+    };
+    for (std::size_t f = 0; f < from.records.size(); ++f) {
+        const ModuleRecord& r = from.records[f];
         while (a != into.records.end() && a->index < r.index)
-            merged.push_back(*a++);
+            keep_into();
         if (a != into.records.end() && a->index == r.index)
             continue;
+        parallel(from, f);
         merged.push_back({r.index, name[r.name], r.age});
     }
-    merged.insert(merged.end(), a, into.records.end());
+    while (a != into.records.end())
+        keep_into();
     into.records = std::move(merged);
+    into.orders = std::move(merged_orders);
+    into.births = std::move(merged_births);
 }
 
 }  // namespace

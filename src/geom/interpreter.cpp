@@ -130,6 +130,8 @@ public:
             } else {
                 if (m_capture)
                     begin_captures();
+                if (m_provenance && m_options.branch_orders)
+                    note_module_depth();
                 interpret_module(m, m_root == this);
             }
             if (m_provenance)
@@ -1245,8 +1247,31 @@ private:
             t.names.emplace_back(m_tables->symbols->name(symbol));
         }
         const std::uint16_t age = module < m_options.ages.size() ? m_options.ages[module] : unknown_age;
+        if (m_options.branch_orders) {
+            // the brackets open where the module's successor began, not the successor's own
+            const std::size_t open = module == m_depth_module ? m_module_depth : m_stack.size();
+            const std::size_t depth = std::min<std::size_t>(open, ModuleTable::no_branch_order - 1);
+            t.orders.insert(t.orders.begin() + (at - t.records.begin()), static_cast<std::uint16_t>(depth));
+        }
+        if (!m_options.births.empty())
+            t.births.insert(t.births.begin() + (at - t.records.begin()),
+                            module < m_options.births.size() ? m_options.births[module] : module);
         t.records.insert(at, {module, static_cast<std::uint16_t>(m_name_of_symbol[symbol]), age});
     }
+    /// Branch orders: the turtle's open brackets before the first turtle module of
+    /// derived module m_depth_module (a homomorphism may open brackets of its own).
+    void note_module_depth()
+    {
+        const std::uint32_t module = m_options.origins.empty()
+                                         ? static_cast<std::uint32_t>(m_module_index)
+                                         : m_options.origins[m_module_index];
+        if (module != m_depth_module) {
+            m_depth_module = module;
+            m_module_depth = m_stack.size();
+        }
+    }
+    std::uint32_t m_depth_module = no_module;
+    std::size_t m_module_depth = 0;
     std::size_t m_instances_attributed = 0;
     const lsys::ModuleString* m_string = nullptr;  ///< the string run() interprets
     bool m_warned_system = false, m_warned_include = false, m_warned_grid = false;

@@ -79,6 +79,12 @@ struct InterpretOptions {
     /// Per module of the derived string, the step at which it appeared (lsys::module_ages);
     /// empty: ages are unknown_age.
     std::span<const std::uint16_t> ages;
+    /// Record each organ's branch order (ModuleTable::orders: the turtle's open `[` where
+    /// the module's successor begins): 2 bytes a record, for organ masks.
+    bool branch_orders = false;
+    /// Per module of the derived string, its index where it appeared (ModuleTable::births;
+    /// an animation's organ masks); empty: not recorded.
+    std::span<const std::uint32_t> births;
 };
 
 Scene interpret(const lsys::ModuleString& string, const lsys::SymbolTable& symbols,

@@ -43,6 +43,15 @@ struct ModuleRecord {
 struct ModuleTable {
     std::vector<ModuleRecord> records;  ///< sorted by index, each index once
     std::vector<std::string> names;     ///< symbol names, each once
+    /// Each record's branch order (the `[` open where the turtle begins the module's
+    /// successor; no_branch_order where unknown), parallel to `records` where asked for
+    /// (InterpretOptions::branch_orders: organ masks), else empty.
+    std::vector<std::uint16_t> orders;
+    static constexpr std::uint16_t no_branch_order = 0xffff;
+    /// In an animation with organ masks (InterpretOptions::births): each record's index in
+    /// the string of the frame where its module appeared (with the record's age, its
+    /// identity across frames), parallel to `records`; else empty.
+    std::vector<std::uint32_t> births;
 
     /// The record of module `index`, or null.
     const ModuleRecord* find(std::uint32_t index) const
@@ -331,29 +340,35 @@ struct Scene {
     Bounds3 bounds;
 };
 
-/// Where each organ placed whole (an instance with a module) has its module recorded:
-/// the scene's own table, or, in a field of plants, its plant's geometry (the prototype
-/// that the placement's own instance places), where the plant's interpretation put it.
+/// Where an organ's module is recorded: the scene's own table, or, in a field of plants,
+/// its plant's geometry (the prototype that the placement's own instance places), where
+/// the plant's interpretation put it. Organs placed whole (an instance with a module) and
+/// a plant's own primitives alike are named through it.
 class OrganModules {
 public:
     explicit OrganModules(const Scene& scene) : m_scene(scene)
     {
         for (const Instance& in : scene.instances)
-            if (in.plant != Instance::no_plant && in.module == no_module && in.prototype < scene.prototypes.size() &&
-                m_plant_prototype.size() <= in.plant)
-                m_plant_prototype.resize(std::size_t(in.plant) + 1, no_prototype);
-        for (const Instance& in : scene.instances)
-            if (in.plant != Instance::no_plant && in.module == no_module && in.prototype < scene.prototypes.size() &&
-                m_plant_prototype[in.plant] == no_prototype)
-                m_plant_prototype[in.plant] = in.prototype;
+            if (in.plant != Instance::no_plant && in.module == no_module && in.prototype < scene.prototypes.size()) {
+                if (m_plant_prototype.size() <= in.plant)
+                    m_plant_prototype.resize(std::size_t(in.plant) + 1, no_prototype);
+                if (m_plant_prototype[in.plant] == no_prototype)
+                    m_plant_prototype[in.plant] = in.prototype;
+            }
     }
-    const ModuleTable& of(const Instance& organ) const
+    /// The table recording `module` of placement `plant` (Instance::no_plant: a still's).
+    const ModuleTable& of(std::uint32_t plant, std::uint32_t module) const
     {
-        const ModuleTable& own = m_scene.geometry.modules;
-        if (own.find(organ.module) || organ.plant >= m_plant_prototype.size() ||
-            m_plant_prototype[organ.plant] == no_prototype)
-            return own;
-        return m_scene.prototypes[m_plant_prototype[organ.plant]].geometry.modules;
+        const Prototype* p = plant_prototype(plant);
+        return p && !m_scene.geometry.modules.find(module) ? p->geometry.modules : m_scene.geometry.modules;
+    }
+    const ModuleTable& of(const Instance& organ) const { return of(organ.plant, organ.module); }
+    /// The prototype that placement `plant` places (its variant), or null.
+    const Prototype* plant_prototype(std::uint32_t plant) const
+    {
+        return plant < m_plant_prototype.size() && m_plant_prototype[plant] != no_prototype
+                   ? &m_scene.prototypes[m_plant_prototype[plant]]
+                   : nullptr;
     }
 
 private:

@@ -294,7 +294,9 @@ std::size_t geometry_bytes(const Geometry& g)
                         g.discs.back_material, g.discs.module) +
            vector_bytes(m.positions, m.normals, m.uvs, m.triangles, m.material,
                         m.back_material, m.texture, m.module) +
-           g.modules.records.capacity() * sizeof(ModuleRecord);
+           g.modules.records.capacity() * sizeof(ModuleRecord) +
+           g.modules.orders.capacity() * sizeof(std::uint16_t) +
+           g.modules.births.capacity() * sizeof(std::uint32_t);
 }
 
 void fit_mesh_buffers(TriangleMesh& mesh, bool textured_by_instances)
@@ -330,6 +332,8 @@ void fit_scene_buffers(Scene& scene)
         fit_mesh_buffers(scene.prototypes[p].geometry.mesh, textured[p]);
     fit_buffer(scene.instances);
     fit_buffer(scene.geometry.modules.records);  // one record per organ: millions in a tree
+    fit_buffer(scene.geometry.modules.orders);
+    fit_buffer(scene.geometry.modules.births);
     fit_buffer(scene.geometry.curves.module);
     fit_buffer(scene.geometry.spheres.module);
     fit_buffer(scene.geometry.discs.module);

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <string>
@@ -94,6 +95,24 @@ void write_exr(OIIO::ImageOutput& out, const Image& image, const std::filesystem
         names.emplace_back("Z");
         layers.emplace_back(&image.depth, 1);
     }
+    // Organ masks (docs/masks.md): Cryptomatte ids are float bit patterns and organ
+    // indices whole numbers past half's range, so all in 32-bit float.
+    const OrganLayers& masks = image.organ_masks;
+    const bool with_masks = !masks.empty();
+    if (with_masks) {
+        for (const CryptomatteLayer& layer : masks.cryptomatte) {
+            for (int group = 0; group < masks.depth / 2; ++group) {
+                char prefix[16];
+                std::snprintf(prefix, sizeof prefix, "%02d.", group);
+                for (const char* c : {"R", "G", "B", "A"})
+                    names.push_back(layer.name + prefix + c);
+            }
+            layers.emplace_back(&layer.ranks, 2 * masks.depth);
+        }
+        names.insert(names.end(), {"organ.index", "organ.age", "organ.order", "organ.plant"});
+        for (const auto* channel : {&masks.index, &masks.age, &masks.order, &masks.plant})
+            layers.emplace_back(channel, 1);
+    }
     // The organ id, as a 32-bit unsigned channel (exact, unlike a float's 24 bits).
     const bool organ = image.organ.size() == std::size_t(image.width) * image.height;
     if (organ)
@@ -102,21 +121,25 @@ void write_exr(OIIO::ImageOutput& out, const Image& image, const std::filesystem
     OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::HALF);
     spec.channelnames = names;
     spec.alpha_channel = 3;
-    if (depth || organ) {
+    if (depth || organ || with_masks) {
         // Distances need more than half's 11 bits.
         spec.channelformats.assign(std::size_t(channels), OIIO::TypeDesc::HALF);
         if (depth) {
             spec.channelformats[std::size_t(halves)] = OIIO::TypeDesc::FLOAT;
             spec.z_channel = halves;
         }
+        for (int c = halves + (depth ? 1 : 0); c < channels; ++c)
+            spec.channelformats[std::size_t(c)] = OIIO::TypeDesc::FLOAT;
         if (organ)
             spec.channelformats.back() = OIIO::TypeDesc::UINT;
     }
     spec.attribute("oiio:ColorSpace", "Linear");
     spec.attribute("compression", "zip");
+    for (const auto& [name, value] : masks.attributes)
+        spec.attribute(name, value);
     without_time_stamp(spec);
     std::size_t n = std::size_t(image.width) * image.height;
-    if (!organ) {
+    if (!organ && !with_masks) {
         std::vector<float> pixels(n * std::size_t(channels));
         for (std::size_t i = 0; i < n; ++i) {
             float* p = &pixels[i * channels];
@@ -129,7 +152,7 @@ void write_exr(OIIO::ImageOutput& out, const Image& image, const std::filesystem
         ok = out.open(temp.string(), spec) && out.write_image(OIIO::TypeDesc::FLOAT, pixels.data());
         return;
     }
-    // With the organ id the channels differ in type: written in the file's own types
+    // With the organ id or masks the channels differ in type: written in the file's own types
     // (TypeDesc::UNKNOWN), each pixel's bytes packed as the channel formats say.
     std::vector<std::size_t> offset(std::size_t(channels) + 1, 0);
     for (int c = 0; c < channels; ++c)
@@ -153,7 +176,8 @@ void write_exr(OIIO::ImageOutput& out, const Image& image, const std::filesystem
         for (const auto& [layer, count] : layers)
             for (int k = 0; k < count; ++k)
                 put((*layer)[i * count + k]);
-        std::memcpy(p + offset[std::size_t(c)], &image.organ[i], sizeof(std::uint32_t));
+        if (organ)
+            std::memcpy(p + offset[std::size_t(c)], &image.organ[i], sizeof(std::uint32_t));
     }
     ok = out.open(temp.string(), spec) &&
          out.write_image(OIIO::TypeDesc::UNKNOWN, pixels.data());

@@ -51,7 +51,7 @@ public:
 const ImageCodec& image_codec();
 
 /// The interface's version: the loader refuses a module of another version.
-inline constexpr int image_codec_version = 2;
+inline constexpr int image_codec_version = 3;
 
 }  // namespace cambium::render
 

@@ -4,11 +4,32 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "render/tonemap.h"
 
 namespace cambium::render {
+
+/// One Cryptomatte layer (render/organ_masks.h): per pixel `depth` (id, coverage) pairs,
+/// the largest coverage first (ids 0 and coverage 0 past the organs the pixel shows).
+struct CryptomatteLayer {
+    std::string name;  ///< the channels' prefix: name00.R, .G, .B, .A, name01.R, ...
+    std::vector<float> ranks;
+};
+
+/// Organ masks (--organ-masks; docs/masks.md), empty when not asked for.
+struct OrganLayers {
+    int depth = 0;  ///< (id, coverage) pairs per pixel and layer; even
+    std::vector<CryptomatteLayer> cryptomatte;
+    /// The header's cryptomatte/<key>/name, hash, conversion and manifest attributes.
+    std::vector<std::pair<std::string, std::string>> attributes;
+    /// The organ covering most of each pixel: its module's index in the derived string,
+    /// its age, its branch order and its plant placement; -1 where unknown or no organ.
+    std::vector<float> index, age, order, plant;
+    bool empty() const { return cryptomatte.empty(); }
+};
 
 /// A rendered frame: rows top to bottom, 4 floats per pixel. RGB is linear; A is the
 /// coverage, the fraction of the pixel's samples whose camera ray hit geometry.
@@ -34,6 +55,8 @@ struct Image {
     /// its 3 channels (2 per pixel).
     std::vector<float> noisy{}, variance{}, feature_variance{};
     std::vector<std::uint32_t> organ{};
+    /// RenderSettings::organ_mask_depth > 0: the Cryptomatte layers and organ channels.
+    OrganLayers organ_masks{};
 
     float& at(int x, int y, int c) { return rgba[(std::size_t(y) * width + x) * 4 + c]; }
     float at(int x, int y, int c) const { return rgba[(std::size_t(y) * width + x) * 4 + c]; }
@@ -54,7 +77,9 @@ struct WriteOptions {
 /// (16-bit sRGB RGBA, associated alpha), .exr (half-float linear RGBA with A = coverage,
 /// plus layers albedo.{R,G,B}, normal.{X,Y,Z} and a float Z for the depth when the image
 /// has them, and for a denoised image noisy.{R,G,B,A} (the raw frame), variance.{R,G,B},
-/// variance.{albedo,normal} and a 32-bit unsigned organ.id). The image is written to a temporary name in the same
+/// variance.{albedo,normal} and a 32-bit unsigned organ.id; with organ masks the
+/// 32-bit float Cryptomatte layers, their header attributes and the organ.index, .age,
+/// .order, .plant channels: docs/masks.md). The image is written to a temporary name in the same
 /// folder and renamed, so a failure never leaves a partial file. Throws cambium::Error
 /// naming the file on failure.
 void write_image(const Image& image, const std::filesystem::path& file,

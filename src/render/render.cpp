@@ -37,6 +37,7 @@
 #include "render/float_mode.h"
 #include "render/integrator.h"
 #include "render/labels.h"
+#include "render/organ_masks.h"
 #include "render/screen_mask.h"
 #include "render/texture.h"
 
@@ -198,29 +199,44 @@ const std::vector<std::uint32_t>& modules_of(const geom::Geometry& g, PrimitiveK
 }
 
 /// The organ a camera ray's first hit shows (provenance, docs/architecture.md): the
-/// module that drew it, or placed its instance; for a primitive of a prototype whose
-/// instance names no module, its module in the prototype mixed with the instance.
-std::uint32_t organ_of(const geom::Scene& scene, const VisibleSurface& v)
+/// module that drew it, or placed its instance, in its plant placement (a scene file's;
+/// no_plant for a single plant).
+OrganKey organ_key_of(const geom::Scene& scene, const VisibleSurface& v)
 {
     if (v.geom_id == ground_geom_id)
-        return organ_ground;
+        return ground_organ;
     if (v.primitive == PrimId::none)
-        return organ_unknown;
+        return unattributed_organ;
     const PrimitiveKind kind = primitive_kind(v.shape);
-    std::uint32_t module = geom::no_module;
+    std::uint32_t module = geom::no_module, plant = geom::Instance::no_plant;
     if (v.instance == PrimId::none || v.instance >= scene.instances.size()) {
         const auto& m = modules_of(scene.geometry, kind);
         module = v.primitive < m.size() ? m[v.primitive] : geom::no_module;
     } else {
         const geom::Instance& in = scene.instances[v.instance];
-        if (in.module != geom::no_module)
-            return std::min(in.module, organ_unknown - 1);
-        const auto& m = modules_of(scene.prototypes[in.prototype].geometry, kind);
-        if (v.primitive >= m.size() || m[v.primitive] == geom::no_module)
-            return organ_unknown;
-        module = static_cast<std::uint32_t>(mix64((std::uint64_t(v.instance) << 32) | m[v.primitive]));
+        plant = in.plant;
+        if (in.module != geom::no_module) {
+            module = in.module;
+        } else {
+            const auto& m = modules_of(scene.prototypes[in.prototype].geometry, kind);
+            module = v.primitive < m.size() ? m[v.primitive] : geom::no_module;
+        }
     }
-    return module == geom::no_module ? organ_unknown : std::min(module, organ_unknown - 1);
+    return module == geom::no_module ? unattributed_organ : organ_key(plant, module);
+}
+
+/// The denoiser's organ id of a hit (render/denoise.h): the module for a single plant's
+/// organ, a scene file's (plant, module) hashed into the ids below the reserved ones.
+std::uint32_t organ_of(const geom::Scene& scene, const VisibleSurface& v)
+{
+    const OrganKey key = organ_key_of(scene, v);
+    if (key == ground_organ)
+        return organ_ground;
+    if (key == unattributed_organ)
+        return organ_unknown;
+    if ((key >> 32) == geom::Instance::no_plant)
+        return std::min(static_cast<std::uint32_t>(key), organ_unknown - 1);
+    return std::min(static_cast<std::uint32_t>(mix64(key)), organ_unknown - 1);
 }
 
 /// The sampled pixels' sums, row by row.
@@ -230,7 +246,13 @@ struct Film {
     /// only renders whose samples add to them); else empty.
     std::vector<PixelExtras> extras;
 
-    Film(std::size_t pixels, bool with_extras) : px(pixels), extras(with_extras ? pixels : 0) {}
+    /// Organ masks: the organs each pixel's samples met; else empty.
+    std::vector<OrganSamples> organs;
+
+    Film(std::size_t pixels, bool with_extras, bool with_organs)
+        : px(pixels), extras(with_extras ? pixels : 0), organs(with_organs ? pixels : 0)
+    {
+    }
     PixelExtras* extra(std::size_t i) { return extras.empty() ? nullptr : &extras[i]; }
 };
 
@@ -281,9 +303,14 @@ struct RenderState {
     bool adaptive = settings.noise_target > 0;
     /// Samples from two replicas (see replica_index): adaptive sampling and denoising.
     bool split = adaptive || settings.denoiser != nullptr;
-    bool aovs = settings.aovs || settings.denoiser != nullptr;
+    bool aovs = settings.aovs || settings.denoiser != nullptr || settings.organ_mask_depth > 0;
     /// The scene, for the organ of each pixel's nearest hit (denoising only; else null).
     const geom::Scene* organs = nullptr;
+    /// Organ masks (RenderSettings::organ_mask_depth): the scene, and the film's organ
+    /// counts, a pixel's at its extras' offset from `extras` (null: no masks).
+    const geom::Scene* mask_scene = nullptr;
+    OrganSamples* organ_samples = nullptr;
+    const PixelExtras* extras = nullptr;
     std::optional<FlatMiss> miss = flat_miss(ctx, settings);
     /// The pixels that may meet the scene (screen_mask); the others take
     /// take_background_samples. Null: every pixel is traced.
@@ -467,6 +494,8 @@ void take_sample(const RenderState& f, const PixelReplicas& replicas, double tne
             }
         }
         ex->depth = std::min(ex->depth, t);
+        if (f.organ_samples && r.hit)  // a sample counted in the pixel's alpha
+            f.organ_samples[ex - f.extras].add(organ_key_of(*f.mask_scene, first));
     }
     if ((s.transparent_background || s.ground.shadow_catcher) && !r.hit)
         r.radiance = Vec3f();
@@ -770,7 +799,7 @@ float shadow_coverage(const PixelExtras& ex)
 /// The image of the sums so far over `out`, from the sums over `sampled` (which holds it),
 /// row by row (each output row is a run of a sampled row).
 Image resolve(const Film& film, const PixelRect& sampled, const PixelRect& out,
-              const RenderSettings& s)
+              const RenderSettings& s, const geom::Scene& scene)
 {
     const std::size_t width = std::size_t(out.width), count = width * std::size_t(out.height);
     Image img{out.width, out.height, std::vector<float>(count * 4)};
@@ -787,6 +816,9 @@ Image resolve(const Film& film, const PixelRect& sampled, const PixelRect& out,
         img.organ.assign(count, organ_background);
     }
     const bool extras = !film.extras.empty();  // (without them no pixel has a catcher's light)
+    std::optional<OrganMaskBuilder> masks;
+    if (!film.organs.empty())
+        masks.emplace(scene, count, s.organ_mask_depth);
     for (std::size_t row = 0; row < std::size_t(out.height); ++row) {
         const std::size_t from = (std::size_t(out.y - sampled.y) + row) * std::size_t(sampled.width) +
                                  std::size_t(out.x - sampled.x);
@@ -800,6 +832,8 @@ Image resolve(const Film& film, const PixelRect& sampled, const PixelRect& out,
             img.rgba[i * 4 + 1] = st.radiance.y * inv;
             img.rgba[i * 4 + 2] = st.radiance.z * inv;
             img.rgba[i * 4 + 3] = (static_cast<float>(st.hits) + coverage) * inv;
+            if (masks)
+                masks->pixel(i, film.organs[from + x], st.samples);
             if (denoise) {
                 // A quarter of the squared difference of the two replicas' means: the
                 // variance of the pixel's mean, without bias (1 degree of freedom).
@@ -835,6 +869,8 @@ Image resolve(const Film& film, const PixelRect& sampled, const PixelRect& out,
             }
         }
     }
+    if (masks)
+        img.organ_masks = masks->finish();
     return img;
 }
 
@@ -952,6 +988,26 @@ void check_denoise_memory(const RenderSettings& s)
                     " (--max-memory)");
 }
 
+/// Throws when organ masks would take more memory than --max-memory allows: their film
+/// counts and image layers, beside the film's extras they need.
+void check_organ_mask_memory(const RenderSettings& s)
+{
+    if (s.organ_mask_depth <= 0)
+        return;
+    if (s.organ_mask_depth % 2 != 0 || std::size_t(s.organ_mask_depth) > OrganSamples::slots)
+        throw Error("render: the organ masks' rank depth must be even, from 2 to " +
+                    std::to_string(OrganSamples::slots) + ", not " +
+                    std::to_string(s.organ_mask_depth));
+    const std::uint64_t pixels = std::uint64_t(s.width) * std::uint64_t(s.height);
+    const std::uint64_t bytes =
+        pixels * (organ_mask_bytes_per_pixel(s.organ_mask_depth) + sizeof(PixelExtras));
+    if (bytes > s.max_memory_bytes)
+        throw Error("render: organ masks of a " + std::to_string(s.width) + "x" +
+                    std::to_string(s.height) + " image take " + byte_size_text(bytes) +
+                    ", more than the memory budget of " + byte_size_text(s.max_memory_bytes) +
+                    " (--max-memory)");
+}
+
 std::string clock_time(double seconds)
 {
     long s = std::lround(std::max(0.0, seconds));
@@ -1029,6 +1085,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
 {
     check_settings(settings);
     check_denoise_memory(settings);
+    check_organ_mask_memory(settings);
     for (const Camera& camera : cameras) {
         if (camera.width() != settings.width || camera.height() != settings.height)
             throw Error("render: the camera's image size differs from the settings'");
@@ -1119,7 +1176,13 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                     &nonfinite};
         state.organs = settings.denoiser ? &scene : nullptr;
         Film film(std::size_t(w) * h,
-                  state.aovs || state.adaptive || (ctx.ground && ctx.ground->shadow_catcher));
+                  state.aovs || state.adaptive || (ctx.ground && ctx.ground->shadow_catcher),
+                  settings.organ_mask_depth > 0);
+        if (!film.organs.empty()) {
+            state.mask_scene = &scene;
+            state.organ_samples = film.organs.data();
+            state.extras = film.extras.data();
+        }
         std::vector<PixelState>& pixels = film.px;
         // Each thread's camera batches, made on its first tile (not once per tile: their
         // members' initialisers, ~60 kB of stores a tile, were a tenth of the pixel loop).
@@ -1211,7 +1274,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
             if (settings.noise_target > 0)
                 mark_converged(film, w, h, settings.noise_target);
             if (settings.on_pass)
-                settings.on_pass(resolve(film, region, out_rect, settings));
+                settings.on_pass(resolve(film, region, out_rect, settings, scene));
         }
         progress.finish();
         rep.cancelled = cancelled;
@@ -1235,7 +1298,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                  " ray(s) not finite or starting too far from the origin were skipped");
         for (const PixelState& st : pixels)
             rep.samples += st.samples;
-        Image image = resolve(film, region, out_rect, settings);
+        Image image = resolve(film, region, out_rect, settings, scene);
         if (settings.denoiser) {
             auto denoise_start = Clock::now();
             denoise(*settings.denoiser, image);

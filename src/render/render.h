@@ -167,6 +167,11 @@ struct RenderSettings {
     /// beside them. The Image's RGBA is the denoised frame, Image::noisy the raw one.
     /// Needs the whole image (no crop). Labels are drawn after denoising.
     std::shared_ptr<const Denoiser> denoiser;
+    /// Organ masks (--organ-masks; render/organ_masks.h, docs/masks.md): 0, none; else
+    /// the (id, coverage) pairs per pixel of each Cryptomatte layer (even, at most
+    /// OrganSamples::slots), in Image::organ_masks. The film keeps 96 bytes a pixel more
+    /// (counted against max_memory_bytes) and the AOVs' first hits are traced.
+    int organ_mask_depth = 0;
 
     /// Print progress to stderr as one updating line (percentage, elapsed, remaining).
     bool progress = false;

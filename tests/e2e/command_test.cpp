@@ -192,6 +192,61 @@ TEST(Command, DenoiseWritesTheRawFrameBesideTheDenoisedOne)
     EXPECT_NE(tile.output.find("--denoise needs the whole image"), std::string::npos) << tile.output;
 }
 
+// --organ-masks: the EXR gets Cryptomatte layers whose manifest names the visible F
+// modules of F[+F]F by index and the symbol F, organ channels with the branched F's
+// order 1 and every covered pixel's age known; without the option none of it, and
+// without an EXR output, or split into tiles, an error before rendering.
+TEST(Command, OrganMasksNameTheModulesInTheExr)
+{
+    fs::path dir = scratch("organ_masks");
+    write(dir / "p.l", "lsystem: 1\nderivation length: 1\naxiom: F\nF --> F[+F]F\nendlsystem\n");
+    write(dir / "p.v", "angle increment: 45\nline style: cylinder\ninitial line width: 0.3\n");
+    const std::string files = (dir / "p.l").string() + " " + (dir / "p.v").string();
+    Result r = run("-q -w 48 36 --spp 4 --organ-masks -o " + (dir / "m.exr").string() + " " + files);
+    ASSERT_EQ(r.status, 0) << r.output;
+    Picture exr = read_picture(dir / "m.exr");
+    for (const char* name : {"CryptoOrgan00.R", "CryptoOrgan02.A", "CryptoSymbol00.R", "CryptoSymbol02.A",
+                             "organ.index", "organ.age", "organ.order", "organ.plant"})
+        EXPECT_GE(exr.channel(name), 0) << name;
+    auto in = OIIO::ImageInput::open((dir / "m.exr").string());
+    ASSERT_TRUE(in);
+    const std::string organs = in->spec().get_string_attribute("cryptomatte/e72bb61/manifest");
+    const std::string symbols = in->spec().get_string_attribute("cryptomatte/0f85aed/manifest");
+    in->close();
+    for (const char* name : {"\"F 0\"", "\"F 3\"", "\"F 5\""})
+        EXPECT_NE(organs.find(name), std::string::npos) << organs;
+    EXPECT_EQ(symbols, "{\"F\":\"982b1106\"}");
+    const int order = exr.channel("organ.order"), index = exr.channel("organ.index"),
+              age = exr.channel("organ.age");
+    int branched = 0;
+    for (int y = 0; y < exr.height; ++y)
+        for (int x = 0; x < exr.width; ++x) {
+            if (exr.at(x, y, index) < 0)
+                continue;
+            EXPECT_GE(exr.at(x, y, age), 0) << x << "," << y;
+            if (exr.at(x, y, index) == 3) {
+                EXPECT_EQ(exr.at(x, y, order), 1) << x << "," << y;
+                ++branched;
+            } else {
+                EXPECT_EQ(exr.at(x, y, order), 0) << x << "," << y;
+            }
+        }
+    EXPECT_GT(branched, 0);
+
+    r = run("-q -w 48 36 --spp 4 -o " + (dir / "plain.exr").string() + " " + files);
+    ASSERT_EQ(r.status, 0) << r.output;
+    Picture plain = read_picture(dir / "plain.exr");
+    EXPECT_LT(plain.channel("CryptoOrgan00.R"), 0);
+    EXPECT_LT(plain.channel("organ.index"), 0);
+
+    Result png = run("-q -w 48 36 --organ-masks -o " + (dir / "m.png").string() + " " + files);
+    EXPECT_NE(png.status, 0);
+    EXPECT_NE(png.output.find("give an -o file.exr"), std::string::npos) << png.output;
+    Result tile = run("-q -w 48 36 --organ-masks --tile 0/2 -o " + (dir / "t.exr").string() + " " + files);
+    EXPECT_NE(tile.status, 0);
+    EXPECT_NE(tile.output.find("--organ-masks needs the whole image"), std::string::npos) << tile.output;
+}
+
 // `render mode: wireframe` draws a polygon as its outline of 1-pixel lines in its colour
 // (cpfg's grey without a colour file) and leaves the inside, diagonal included, to the
 // background; `filled` fills it. The square spans most of the 64 x 64 image.
@@ -823,6 +878,47 @@ TEST(Command, RayshadeSceneOfAStillAndOfEveryFrame)
     Result one = run("-a -q -ray " + (dir / "one.ray").string() + " " + plant_files(dir));
     EXPECT_NE(one.status, 0);
     EXPECT_NE(one.output.find("-ray names one file for"), std::string::npos) << one.output;
+}
+
+// --organ-masks in an animation: an organ keeps its name from frame to frame (its index
+// where it appeared @ that frame's step), though new modules shift string indices.
+TEST(Sequence, OrganMaskNamesAreStableAcrossFrames)
+{
+    fs::path dir = growing_plant(scratch("anim_masks"));
+    Result r = run("-a -q -w 48 36 --spp 2 --organ-masks -o " + (dir / "f%02d.exr").string() + " " +
+                   plant_files(dir));
+    ASSERT_EQ(r.status, 0) << r.output;
+    auto manifest = [&](const char* file) {
+        auto in = OIIO::ImageInput::open((dir / file).string());
+        EXPECT_TRUE(in) << file;
+        if (!in)
+            return std::string();
+        std::string m = in->spec().get_string_attribute("cryptomatte/e72bb61/manifest");
+        in->close();
+        return m;
+    };
+    // F[+F]A, then F[+F]F[+F]A: the first frame's F modules keep their names
+    const std::string first = manifest("f01.exr"), second = manifest("f02.exr"), third = manifest("f03.exr");
+    for (const std::string& m : {first, second, third}) {
+        EXPECT_NE(m.find("\"F 0@1\""), std::string::npos) << m;
+        EXPECT_NE(m.find("\"F 3@1\""), std::string::npos) << m;
+    }
+    for (const std::string& m : {second, third}) {
+        EXPECT_NE(m.find("\"F 5@2\""), std::string::npos) << m;
+        EXPECT_NE(m.find("\"F 8@2\""), std::string::npos) << m;
+    }
+    EXPECT_NE(third.find("\"F 10@3\""), std::string::npos) << third;
+    EXPECT_EQ(first.find("@2"), std::string::npos) << first;
+
+    // through a homomorphism the organs keep the derived string's symbols (I, not F)
+    write(dir / "h.l", "lsystem: 1\nderivation length: 2\naxiom: A\nA --> I[+I]A\n"
+                       "homomorphism\nI --> F\nendlsystem\n");
+    r = run("-a -q -w 48 36 --spp 2 --organ-masks -o " + (dir / "h%02d.exr").string() + " " +
+            (dir / "h.l").string() + " " + (dir / "g.v").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    const std::string h2 = manifest("h02.exr");
+    EXPECT_NE(h2.find("\"I 0@1\""), std::string::npos) << h2;
+    EXPECT_EQ(h2.find("\"F "), std::string::npos) << h2;
 }
 
 TEST(Sequence, SeveralFramesIntoOneNameIsAnErrorBeforeAnyWork)

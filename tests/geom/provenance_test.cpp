@@ -165,3 +165,46 @@ TEST(Provenance, Off)
     EXPECT_TRUE(scene.geometry.lines.module.empty());
     EXPECT_TRUE(scene.geometry.modules.records.empty());
 }
+
+// Organ masks' branch order: the brackets open around each drawing module where the
+// turtle meets it; recorded only when asked for, parallel to the records.
+TEST(Provenance, BranchOrdersWhenAskedFor)
+{
+    lsys::SymbolTable symbols;
+    // modules: 0 F, 1 [, 2 F, 3 [, 4 F, 5 ], 6 ], 7 F, 8 [, 9 F, 10 ]
+    lsys::ModuleString s = text_modules(symbols, "F(1) [ F(1) [ F(1) ] ] F(1) [ F(1) ]");
+    ViewFile view = surface_view();
+    InterpretOptions options;
+    EXPECT_TRUE(interpret(s, symbols, view, options).geometry.modules.orders.empty());
+    options.branch_orders = true;
+    Scene scene = interpret(s, symbols, view, options);
+    const ModuleTable& t = scene.geometry.modules;
+    ASSERT_EQ(t.records.size(), 5u);
+    ASSERT_EQ(t.orders.size(), t.records.size());
+    const std::vector<std::pair<std::uint32_t, std::uint16_t>> expected{
+        {0, 0}, {2, 1}, {4, 2}, {7, 0}, {9, 1}};
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+        EXPECT_EQ(t.records[i].index, expected[i].first);
+        EXPECT_EQ(t.orders[i], expected[i].second) << "module " << expected[i].first;
+    }
+}
+
+// Through a homomorphism the order is the derived module's: a successor that opens its
+// own bracket (K --> [F]) does not raise its module's order.
+TEST(Provenance, BranchOrderOfAModuleWhoseSuccessorOpensABracket)
+{
+    lsys::SymbolTable symbols;
+    // turtle string F [ F ] from the derived string F K: K's successor is [ F ]
+    lsys::ModuleString s = text_modules(symbols, "F(1) [ F(1) ]");
+    ViewFile view = surface_view();
+    InterpretOptions options;
+    options.branch_orders = true;
+    const std::vector<std::uint32_t> origins{0, 1, 1, 1};
+    options.origins = origins;
+    Scene scene = interpret(s, symbols, view, options);
+    const ModuleTable& t = scene.geometry.modules;
+    ASSERT_EQ(t.records.size(), 2u);
+    ASSERT_EQ(t.orders.size(), 2u);
+    EXPECT_EQ(t.records[1].index, 1u);
+    EXPECT_EQ(t.orders[1], 0u) << "K itself is in no branch";
+}
