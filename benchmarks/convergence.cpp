@@ -348,8 +348,15 @@ cambium::bench::StageExport export_staging(const cambium::geom::Scene& scene, co
         const render::Vec3f d = render::make_materials({soil}).front().diffuse;
         e.ground_diffuse = {d.x, d.y, d.z};
     }
-    if (options.sky)
-        throw std::runtime_error("--stage: the --sky is not exported (Cycles' skies differ)");
+    if (options.sky) {
+        // Cycles' skies are other models: it gets this one's dome as a map and its sun
+        // as a lamp of the same solid angle and radiance.
+        const render::environment_kind::Sky* sky = rs.environment ? rs.environment->sky() : nullptr;
+        if (sky == nullptr || rs.environment->rotation_degrees() != 0)
+            throw std::runtime_error("--stage: only an unturned --sky is exported");
+        e.environment_map = fs::absolute(region_file).replace_extension(".sky.exr");
+        e.sun = cambium::bench::write_sky_dome_map(*sky, 1024, e.environment_map);
+    }
     if (options.environment_map) {
         e.environment_map = fs::absolute(*options.environment_map);
         e.environment_scale = options.environment_scale;

@@ -7,6 +7,7 @@
 
 #include "render/camera.h"
 #include "render/color.h"
+#include "render/image_io.h"
 #include "render/light.h"
 #include "render/material.h"
 #include "render/render.h"
@@ -115,6 +116,42 @@ json materials_json(const geom::Scene& scene, bool view_lights)
 
 }  // namespace
 
+std::optional<StageExport::Sun> write_sky_dome_map(const render::environment_kind::Sky& sky,
+                                                   int width, const std::filesystem::path& file)
+{
+    constexpr int sub = 4;
+    constexpr float pi = 3.14159265358979f;
+    render::Image map;
+    map.width = width;
+    map.height = width / 2;
+    map.rgba.resize(std::size_t(map.width) * std::size_t(map.height) * 4);
+    for (int j = 0; j < map.height; ++j)
+        for (int i = 0; i < map.width; ++i) {
+            render::Vec3f sum;
+            for (int a = 0; a < sub; ++a)
+                for (int b = 0; b < sub; ++b) {
+                    // Uniform in the texel's polar angle, as the map's lookup is by angle.
+                    float t = pi * (float(j) + (float(a) + 0.5f) / sub) / float(map.height);
+                    float u = (float(i) + (float(b) + 0.5f) / sub) / float(map.width);
+                    sum += sky.without_sun(render::environment_kind::LatLongTable::direction(
+                        u, std::cos(t)));
+                }
+            sum = sum * (1.0f / (sub * sub));
+            float* texel = &map.at(i, j, 0);
+            texel[0] = sum.x;
+            texel[1] = sum.y;
+            texel[2] = sum.z;
+            texel[3] = 1;
+        }
+    render::write_image(map, file);
+    const render::environment_kind::Sky::SunDisk sun = sky.sun_disk();
+    if (!(sun.solid_angle > 0) || !(sun.radiance.x > 0 || sun.radiance.y > 0 || sun.radiance.z > 0))
+        return std::nullopt;
+    return StageExport::Sun{{sun.direction.x, sun.direction.y, sun.direction.z},
+                            sun.solid_angle,
+                            {sun.radiance.x, sun.radiance.y, sun.radiance.z}};
+}
+
 void write_scene_json(const geom::Scene& scene, int width, int height,
                       const std::filesystem::path& model_folder, std::ostream& out,
                       const std::optional<StageExport>& stage)
@@ -145,6 +182,10 @@ void write_scene_json(const geom::Scene& scene, int width, int height,
                                 : json{{"map", stage->environment_map.string()},
                                        {"scale", stage->environment_scale},
                                        {"rotation_deg", stage->environment_rotation_deg}};
+        if (stage->sun)
+            st["sun"] = {{"toward_sun", stage->sun->toward_sun},
+                         {"solid_angle", stage->sun->solid_angle},
+                         {"radiance", stage->sun->radiance}};
         st["backdrop"] = stage->backdrop_environment ? "environment" : "view";
         j["stage"] = st;
     }

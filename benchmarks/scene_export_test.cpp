@@ -1,7 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 // The scene export's staging (convergence --stage --export-scene): what another renderer
 // is told to light a staged still with.
+#include <cmath>
+#include <filesystem>
 #include <sstream>
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -84,6 +87,47 @@ TEST(SceneExport, KeptViewLightsAndNoGroundOrMap)
     EXPECT_TRUE(j["stage"]["ground"].is_null());
     EXPECT_TRUE(j["stage"]["environment"].is_null());
     EXPECT_EQ(j["stage"]["backdrop"], "view");
+}
+
+/// The exported sky is the map plus the sun lamp: together they give back the sky's
+/// radiance in every direction, and the map alone holds no sun.
+TEST(SceneExport, SkyIsItsDomeMapPlusTheSunLamp)
+{
+    namespace render = cambium::render;
+    render::SkyParameters p;
+    p.sun_direction = {0.3f, 0.6f, -0.5f};
+    const render::environment_kind::Sky sky(p);
+    const std::filesystem::path file = std::filesystem::temp_directory_path() /
+                                       ("cambium-sky-" + std::to_string(getpid()) + ".exr");
+    const auto sun = cambium::bench::write_sky_dome_map(sky, 512, file);
+    const render::Environment map = render::make_map_environment(file);
+    std::filesystem::remove(file);
+    ASSERT_TRUE(sun.has_value());
+    const render::Vec3f toward = normalize(p.sun_direction);
+    EXPECT_NEAR(sun->toward_sun[0], toward.x, 1e-6);
+    const float sun_cos = 1 - sun->solid_angle / (2 * 3.14159265f);
+
+    // Away from the sun's aureole the dome varies slowly: the map's texel (a 4 x 4 mean,
+    // stored as half floats) is within 3% of the sky there.
+    int checked = 0;
+    for (int k = 0; k < 200; ++k) {
+        float c = 0.98f - 1.96f * float(k) / 199, phi = 2.39996f * float(k);
+        float s = std::sqrt(1 - c * c);
+        render::Vec3f d{s * std::cos(phi), c, s * std::sin(phi)};
+        if (dot(d, toward) > 0.9f || std::abs(c) < 0.05f)
+            continue;
+        const render::Vec3f want = sky.radiance(d), got = map.radiance(d);
+        EXPECT_NEAR(got.y, want.y, 0.03f * want.y + 1e-6f) << "direction " << k;
+        ++checked;
+    }
+    EXPECT_GT(checked, 150);
+
+    // At the sun: the map has only the dome there, the lamp the rest.
+    const render::Vec3f at_sun = sky.radiance(toward), dome = map.radiance(toward);
+    render::Vec3f lamp{sun->radiance[0], sun->radiance[1], sun->radiance[2]};
+    EXPECT_LT(dome.y, 1e-3f * at_sun.y);
+    EXPECT_NEAR(dome.y + lamp.y, at_sun.y, 2e-3f * at_sun.y);
+    EXPECT_GT(sun_cos, std::cos(0.3f * 3.14159265f / 180));
 }
 
 }  // namespace

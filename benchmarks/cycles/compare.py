@@ -22,13 +22,18 @@ Below 1: Cambium is faster. The rounds interleave the two renderers; the last li
 each plant's median ratios over the rounds. Both renderers cache their references
 (build/convergence-cache/, build/cycles/cache/), so only the first round renders them.
 
---staged env | env-without-view-lights: the plant staged (convergence --stage) on a
-ground of albedo 0.2 (`--ground`, the plane at the plant's lowest point), seen in
+--staged env | env-without-view-lights | sky | sky-without-view-lights: the plant staged
+(convergence --stage) on a ground of albedo 0.2 (`--ground`, the plane at the plant's
+lowest point), seen in
 perspective (`--perspective --fit --orbit 30 10`), lit by the lat-long map sky_map.py
 writes (`--env`, seen behind the plant: `--background env`), with the view file's lights
 kept or dropped (`--no-view-lights`). Noise is then measured apart on the plant's pixels
 and the ground's; the JSON adds the noise at 16 and 64 spp of both renderers on both, and
 `ground_cpu_ratio` / `ground_wall_ratio`: Cambium's time to Cycles' 64-spp ground noise.
+The sky stagings light it with Cambium's `--sky` instead (seen behind it: `--background
+sky`); Cycles' own skies are other models, so the scene export hands it this sky's dome
+(and ground) as a 1024 x 512 lat-long map and its sun as a sun lamp of the same solid
+angle and radiance (scene_export.h, write_sky_dome_map).
 """
 import argparse
 import json
@@ -38,9 +43,11 @@ import subprocess
 import sys
 
 # A ground of albedo 0.2: --ground takes a display (sRGB) value.
-STAGE = ("--ground 0.4845,0.4845,0.4845 --perspective --fit --orbit 30 10 "
-         "--env {map} --background env")
-STAGINGS = {"env": STAGE, "env-without-view-lights": STAGE + " --no-view-lights"}
+GROUND_AND_CAMERA = "--ground 0.4845,0.4845,0.4845 --perspective --fit --orbit 30 10 "
+STAGE = GROUND_AND_CAMERA + "--env {map} --background env"
+SKY = GROUND_AND_CAMERA + "--sky --background sky"
+STAGINGS = {"env": STAGE, "env-without-view-lights": STAGE + " --no-view-lights",
+            "sky": SKY, "sky-without-view-lights": SKY + " --no-view-lights"}
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 PLANTS = ["FernLeaf", "WeepingBirch", "Lilac", "GeneralizedCylinder", "TranslucentTree"]
@@ -89,7 +96,7 @@ def main():
     stage = []
     if args.staged:
         sky = os.path.abspath(os.path.join(args.build, "cycles", "staged", "sky.exr"))
-        if not os.path.exists(sky):
+        if args.staged.startswith("env") and not os.path.exists(sky):
             os.makedirs(os.path.dirname(sky), exist_ok=True)
             subprocess.run([sys.executable, os.path.join(HERE, "sky_map.py"), sky], check=True)
         stage = ["--stage", STAGINGS[args.staged].format(map=sky)]

@@ -427,26 +427,44 @@ def _build_camera(scene):
 SUN_STRENGTH_PER_COLOUR = math.pi
 
 
+def _add_sun(name, toward_light, irradiance, angle=0.0):
+    """A Cycles sun giving `irradiance` (RGB) to a surface facing it, shining from
+    `toward_light`, its disk `angle` radians across."""
+    data = bpy.data.lights.new(name, "SUN")
+    data.angle = angle
+    peak = max(irradiance)
+    data.color = [c / peak for c in irradiance] if peak > 0 else (0, 0, 0)
+    data.energy = peak
+    data.cycles.cast_shadow = True
+    obj = bpy.data.objects.new(name, data)
+    bpy.context.scene.collection.objects.link(obj)
+    z = np.asarray(toward_light, dtype=np.float64)  # the sun shines along -z
+    z /= np.linalg.norm(z)
+    x = np.cross([0.0, 1.0, 0.0] if abs(z[1]) < 0.9 else [1.0, 0.0, 0.0], z)
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)
+    matrix = np.eye(4)
+    matrix[:3, :3] = np.column_stack([x, y, z])
+    obj.matrix_world = Matrix(matrix.tolist())
+
+
 def _build_lights(scene):
     for i, light in enumerate(scene["lights"]):
         if light["kind"] != "directional":
             raise SystemExit("import_scene: only directional lights are supported yet")
-        data = bpy.data.lights.new(f"sun{i}", "SUN")
-        data.angle = 0.0
-        colour = light["colour"]
-        peak = max(colour)
-        data.color = [c / peak for c in colour] if peak > 0 else (0, 0, 0)
-        data.energy = SUN_STRENGTH_PER_COLOUR * peak
-        data.cycles.cast_shadow = True
-        obj = bpy.data.objects.new(f"sun{i}", data)
-        bpy.context.scene.collection.objects.link(obj)
-        z = np.asarray(light["toward_light"], dtype=np.float64)  # the sun shines along -z
-        x = np.cross([0.0, 1.0, 0.0] if abs(z[1]) < 0.9 else [1.0, 0.0, 0.0], z)
-        x /= np.linalg.norm(x)
-        y = np.cross(z, x)
-        matrix = np.eye(4)
-        matrix[:3, :3] = np.column_stack([x, y, z])
-        obj.matrix_world = Matrix(matrix.tolist())
+        _add_sun(f"sun{i}", light["toward_light"],
+                 [SUN_STRENGTH_PER_COLOUR * c for c in light["colour"]])
+
+
+def _build_sky_sun(scene):
+    """The --sky's sun (its dome is the stage's map): a lamp of the disk's solid angle
+    whose irradiance at normal incidence is the disk's radiance times that solid angle."""
+    sun = scene["stage"].get("sun")
+    if sun is None:
+        return
+    omega = sun["solid_angle"]
+    angle = 2 * math.acos(1 - omega / (2 * math.pi))
+    _add_sun("sky_sun", sun["toward_sun"], [omega * r for r in sun["radiance"]], angle)
 
 
 def _build_world(scene):
@@ -614,6 +632,7 @@ def build_scene(path, threads=2, emitters_as_lights=True):
         _build_ground(scene)
         _build_staged_world(scene)
         if scene["stage"]["environment"] is not None:
+            _build_sky_sun(scene)
             _turn_to_map_frame()
     else:
         _build_world(scene)

@@ -128,6 +128,17 @@ public:
     void hide_below_horizon() { tabulate(true); }
     /// The probability of the sun's strategy (0 when the sun is down).
     float sun_probability() const { return m_sun_probability; }
+    /// The sky without its sun disk: the dome, and the ground's radiance below the
+    /// horizon (what another renderer's map holds when it gets the sun as a lamp).
+    Vec3f without_sun(const Vec3f& d) const { return d.y < 0 ? m_ground : dome(d); }
+    /// The sun disk: unit direction toward it, its solid angle and its radiance, constant
+    /// over the disk (0 when the sun is down).
+    struct SunDisk {
+        Vec3f direction;
+        float solid_angle = 0;
+        Vec3f radiance;
+    };
+    SunDisk sun_disk() const { return {m_sun, m_sun_solid_angle, m_sun_radiance}; }
 
 private:
     /// The Perez luminance distribution's five coefficients.
@@ -214,6 +225,9 @@ public:
     /// a BSDF ray that finds it takes full weight). A uniform environment is unchanged
     /// (it is never sampled for next-event estimation). Shares a map's texels.
     Environment hidden_below_horizon() const;
+    /// The sky this environment is, unturned (nullptr for other kinds); with
+    /// rotation_degrees() about +y it is what radiance() returns.
+    const environment_kind::Sky* sky() const { return std::get_if<environment_kind::Sky>(&m_kind); }
 
 private:
     using Kinds = std::variant<environment_kind::Uniform, environment_kind::Sky,
