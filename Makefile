@@ -5,6 +5,10 @@ JOBS ?= $(shell nproc)
 CAMBIUM = $(BUILD)/src/app/cambium
 MAKEFLAGS += --no-print-directory
 DEFAULT = scenes/default
+# The default scene staged as a still: on a soil-coloured ground under the daylight sky,
+# seen in perspective from a little below the view file's viewpoint, denoised.
+STAGE = --sky --background sky --ground 0.42,0.38,0.3 --perspective --fit --orbit 25 -12 \
+	--denoise
 # ccache, when a developer has it, makes rebuilds in fresh clones cheap (optional; the
 # paths it hashes are made relative to this folder so clones share the cache).
 CCACHE := $(shell command -v ccache 2>/dev/null)
@@ -31,7 +35,7 @@ render: configure
 	@cmake --build $(BUILD) --parallel $(JOBS) --target cambium
 	@mkdir -p out
 	@echo "render: $(DEFAULT) -> out/default.png, out/default.exr"
-	@cd $(DEFAULT) && $(CURDIR)/$(CAMBIUM) -M plant.mat -o $(CURDIR)/out/default.png \
+	@cd $(DEFAULT) && $(CURDIR)/$(CAMBIUM) -M plant.mat $(STAGE) -o $(CURDIR)/out/default.png \
 		-o $(CURDIR)/out/default.exr plant.l plant.v
 
 # The README's second command does what the first does (the default scene rendered too),
