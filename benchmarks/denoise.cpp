@@ -18,7 +18,18 @@
 //
 //   build/benchmarks/denoise [--plant NAME]... [--size WxH] [--threads N] [--spp N]
 //       [--raw-spp N] [--reference-spp N] [--search-radius N] [--patch-radius N]
-//       [--save FOLDER]
+//       [--save FOLDER] [--turntable N]
+//
+// --turntable N measures flicker instead: an N-frame turntable of the staged plant (10
+// degrees above the horizontal, as `--turntable N --turntable-elevation 10`) at --spp
+// denoised and raw, and at --raw-spp raw; for each renderer and each pair of consecutive
+// frames, the mean absolute difference over RGB relative to the open ground's level, on
+// the ground's pixels that the plant does not shade (below). The sun stays put while the
+// camera turns, so the plant's shadow moves across the image: a pixel counts only where
+// both frames' --raw-spp renders see the ground (organ ground, and no other organ within
+// 3 pixels) within 5% of that frame's median ground luminance. Ground that is neither
+// shaded nor hidden has the same radiance in every frame, so what differs there is noise
+// that moves from frame to frame: flicker.
 //
 // --save writes each plant's images as PNG for a person to look at: NAME-noisy.png (the
 // raw --spp render), NAME-denoised.png, NAME-raw-256.png (the --raw-spp one) and
@@ -34,6 +45,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <span>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -46,6 +58,7 @@
 #include "render/color.h"
 #include "render/denoise.h"
 #include "render/environment.h"
+#include "render/framing.h"
 #include "render/render.h"
 
 namespace fs = std::filesystem;
@@ -65,6 +78,7 @@ struct Settings {
     int width = 640, height = 480, threads = 2, spp = 16, raw_spp = 256, reference_spp = 1024;
     render::NlMeansParameters denoiser;  ///< --search-radius, --patch-radius
     fs::path save;
+    int turntable = 0;  ///< --turntable N: measure flicker over N frames
 };
 
 /// The plant staged: its scene (camera options applied) and its render settings.
@@ -261,6 +275,134 @@ double ssim(const std::vector<float>& image, const std::vector<float>& ref, int 
     return total / double(count);
 }
 
+void save_png(const std::vector<float>& rgba, int w, int h, const fs::path& file);
+
+/// The turntable's frames: RGBA (denoised when the run denoises), the raw RGBA beside
+/// them when denoised, and each frame's organ ids.
+struct Frames {
+    std::vector<std::vector<float>> rgba, noisy;
+    std::vector<std::vector<std::uint32_t>> organ;
+};
+
+Frames render_turntable(const Staged& staged, std::span<const render::Camera> cameras, int spp,
+                        bool denoise, const render::NlMeansParameters& parameters = {})
+{
+    render::RenderSettings rs = staged.settings;
+    rs.samples_per_pixel = spp;
+    rs.seed = 1;
+    // The organ layer comes with the denoiser; the raw runs need it for the ground mask.
+    rs.denoiser = std::make_shared<render::NlMeansDenoiser>(parameters);
+    Frames f;
+    render::render_views(staged.scene, cameras, rs,
+                         [&](std::size_t, render::Image& image, const render::RenderReport&) {
+                             f.rgba.push_back(denoise ? std::move(image.rgba) : std::move(image.noisy));
+                             if (denoise)
+                                 f.noisy.push_back(std::move(image.noisy));
+                             f.organ.push_back(std::move(image.organ));
+                             return true;
+                         });
+    return f;
+}
+
+/// Open, unshaded ground in a frame (see the top of the file), from a clean render of it.
+std::vector<bool> open_ground(const std::vector<float>& rgba, const std::vector<std::uint32_t>& organ,
+                              int w, int h)
+{
+    std::vector<float> ground;
+    for (std::size_t i = 0; i < organ.size(); ++i)
+        if (organ[i] == render::organ_ground)
+            ground.push_back(render::luminance(render::Vec3f(rgba[i * 4], rgba[i * 4 + 1], rgba[i * 4 + 2])));
+    std::vector<bool> open(organ.size(), false);
+    if (ground.empty())
+        return open;
+    std::nth_element(ground.begin(), ground.begin() + std::ptrdiff_t(ground.size() / 2), ground.end());
+    const float median = ground[ground.size() / 2];
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const std::size_t i = std::size_t(y) * w + x;
+            bool ok = organ[i] == render::organ_ground &&
+                      std::abs(render::luminance(render::Vec3f(rgba[i * 4], rgba[i * 4 + 1],
+                                                               rgba[i * 4 + 2])) - median) <= 0.05f * median;
+            for (int dy = -3; ok && dy <= 3; ++dy)
+                for (int dx = -3; ok && dx <= 3; ++dx) {
+                    const int nx = std::clamp(x + dx, 0, w - 1), ny = std::clamp(y + dy, 0, h - 1);
+                    ok = organ[std::size_t(ny) * w + nx] == render::organ_ground;
+                }
+            open[i] = ok;
+        }
+    return open;
+}
+
+/// Mean over consecutive frame pairs of the mean |a - b| over RGB and the pairs' open
+/// ground, relative to the clean frames' mean ground level there.
+double flicker(const std::vector<std::vector<float>>& frames, const Frames& clean,
+               const std::vector<std::vector<bool>>& open)
+{
+    double total = 0;
+    std::size_t pairs = 0;
+    for (std::size_t k = 0; k + 1 < frames.size(); ++k) {
+        double diff = 0, level = 0;
+        std::size_t n = 0;
+        for (std::size_t i = 0; i < open[k].size(); ++i) {
+            if (!open[k][i] || !open[k + 1][i])
+                continue;
+            for (std::size_t c = 0; c < 3; ++c) {
+                diff += std::abs(double(frames[k][i * 4 + c]) - frames[k + 1][i * 4 + c]);
+                level += 0.5 * (double(clean.rgba[k][i * 4 + c]) + clean.rgba[k + 1][i * 4 + c]);
+            }
+            ++n;
+        }
+        if (n > 0 && level > 0) {
+            total += diff / level;
+            ++pairs;
+        }
+    }
+    return pairs > 0 ? total / double(pairs) : 0;
+}
+
+void run_turntable(const std::string& name, const fs::path& folder, const Settings& s)
+{
+    const fs::path start = fs::current_path();
+    Staged staged = load_staged(folder, s);
+    fs::current_path(start);
+    const std::vector<render::Camera> cameras = render::turntable_cameras(
+        staged.scene.view, staged.scene.bounds, s.turntable, 10.0, s.width, s.height);
+    const auto t0 = std::chrono::steady_clock::now();
+    const Frames few = render_turntable(staged, cameras, s.spp, true, s.denoiser);
+    const auto t1 = std::chrono::steady_clock::now();
+    const Frames many = render_turntable(staged, cameras, s.raw_spp, false);
+    const auto t2 = std::chrono::steady_clock::now();
+    std::vector<std::vector<bool>> open;
+    std::size_t open_pixels = 0;
+    for (std::size_t k = 0; k < many.rgba.size(); ++k) {
+        open.push_back(open_ground(many.rgba[k], many.organ[k], s.width, s.height));
+        open_pixels += std::size_t(std::count(open.back().begin(), open.back().end(), true));
+    }
+    nlohmann::json j;
+    j["plant"] = name;
+    j["image"] = std::to_string(s.width) + "x" + std::to_string(s.height);
+    j["threads"] = s.threads;
+    j["frames"] = s.turntable;
+    j["spp"] = s.spp;
+    j["raw_spp"] = s.raw_spp;
+    j["open_ground_pixels_per_frame"] = open_pixels / std::max<std::size_t>(1, open.size());
+    j["flicker"] = {{"noisy", flicker(few.noisy, many, open)},
+                    {"denoised", flicker(few.rgba, many, open)},
+                    {"raw_many", flicker(many.rgba, many, open)}};
+    j["seconds"] = {{"denoised_turntable", std::chrono::duration<double>(t1 - t0).count()},
+                    {"raw_many_turntable", std::chrono::duration<double>(t2 - t1).count()}};
+    std::printf("%s\n", j.dump().c_str());
+    std::fflush(stdout);
+    if (!s.save.empty()) {
+        fs::create_directories(s.save);
+        for (std::size_t k : {std::size_t(0), few.rgba.size() / 2}) {
+            const std::string tag = name + "-turntable-" + std::to_string(k + 1);
+            save_png(few.rgba[k], s.width, s.height, s.save / (tag + "-denoised.png"));
+            save_png(few.noisy[k], s.width, s.height, s.save / (tag + "-noisy.png"));
+        }
+    }
+}
+
 void save_png(const std::vector<float>& rgba, int w, int h, const fs::path& file)
 {
     render::Image image{w, h, rgba};
@@ -377,6 +519,8 @@ int main(int argc, char** argv)
             s.denoiser.patch_radius = positive(a, value());
         } else if (a == "--save") {
             s.save = fs::absolute(value());
+        } else if (a == "--turntable") {
+            s.turntable = positive(a, value());
         } else {
             std::fprintf(stderr, "unknown option '%s'\n", a.c_str());
             return 2;
@@ -394,7 +538,10 @@ int main(int argc, char** argv)
     const fs::path cache = fs::absolute("denoise-references");
     try {
         for (const std::string& name : s.plants)
-            run_plant(name, corpus / plants.at(name), s, cache);
+            if (s.turntable > 0)
+                run_turntable(name, corpus / plants.at(name), s);
+            else
+                run_plant(name, corpus / plants.at(name), s, cache);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "denoise: %s\n", e.what());
         return 1;

@@ -36,8 +36,6 @@ namespace {
 
 constexpr float pi = std::numbers::pi_v<float>;
 
-float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
-
 Vec3f vec(const geom::Float3& a) { return {a[0], a[1], a[2]}; }
 Vec3f vec(const geom::Float4& a) { return {a[0], a[1], a[2]}; }
 

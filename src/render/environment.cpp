@@ -47,8 +47,6 @@ Vec3f uniform_sphere(float u1, float u2)
     return {r * std::cos(phi), r * std::sin(phi), z};
 }
 
-float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
-
 Vec3f exp(const Vec3f& v) { return {std::exp(v.x), std::exp(v.y), std::exp(v.z)}; }
 
 /// Linear sRGB (D65) of CIE xyY.

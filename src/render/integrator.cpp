@@ -237,8 +237,6 @@ Vec3f unshadowed(const Vertex& v, const LightLiSample& ls)
     return f * ls.li * cos;
 }
 
-float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
-
 /// Room for a vector per delta light, each made in place as its light is met: a
 /// std::array<Vec3f> would be zeroed whole (Vec3f's members are initialised), a
 /// `rep stos` at every vertex.

@@ -16,8 +16,6 @@ namespace {
 
 constexpr float pi = std::numbers::pi_v<float>;
 
-float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
-
 float attenuation(const RenderLight& l, float d)
 {
     float a = l.att_constant + l.att_linear * d + l.att_quadratic * d * d;

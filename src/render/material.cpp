@@ -67,8 +67,6 @@ namespace {
 
 constexpr int index_block = 64;  // cpfg's surface rule works within blocks of 64 entries
 
-float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
-
 /// The albedo of display colour `entry` at the brightness of display colour `own`,
 /// scaled down where a channel would pass 1. Scaled in display values, where colormap
 /// ramps are made: a ramp of one colour in several brightnesses gives `own` exactly.

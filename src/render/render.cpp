@@ -256,8 +256,6 @@ struct Film {
     PixelExtras* extra(std::size_t i) { return extras.empty() ? nullptr : &extras[i]; }
 };
 
-float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
-
 /// What a camera ray that meets nothing adds to its pixel when that is the same in every
 /// direction (no visible environment) and finite: take_sample's sums for camera_miss's
 /// result, made once per view instead of once per sample (most samples of a plant miss).

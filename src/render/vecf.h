@@ -40,6 +40,8 @@ constexpr Vec3f cross(const Vec3f& a, const Vec3f& b)
     return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
 inline float length(const Vec3f& v) { return std::sqrt(dot(v, v)); }
+/// Relative luminance of linear Rec. 709 RGB (the weights of ITU-R BT.709).
+inline float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 inline Vec3f normalize(const Vec3f& v)
 {
     float l = length(v);

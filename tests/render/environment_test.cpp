@@ -409,8 +409,6 @@ TEST(SkyEnvironment, SunDiskDeliversTheStatedIrradiance)
     EXPECT_TRUE(night.black());  // 90 degrees down: past civil twilight
 }
 
-float luminance(const Vec3f& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
-
 /// CIE xy of linear sRGB (D65 matrix of IEC 61966-2-1).
 std::pair<double, double> chromaticity(const Vec3f& c)
 {
