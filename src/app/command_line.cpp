@@ -316,6 +316,11 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     cli.add_flag("--infinite-canopy", options.infinite_canopy,
                  "--light-report repeats the scene sideways: rays leaving its x-z bounds "
                  "through a side come back through the opposite side (a stand)");
+    cli.add_option("--canopy-tile", options.canopy_tile,
+                   "The --infinite-canopy's tile X0 Z0 X1 Z1 (it must hold the scene's x-z "
+                   "bounds) instead of those bounds: plants spaced wider than they are")
+        ->expected(4)
+        ->allow_extra_args(false);
     cli.add_option("--light-rays", options.light_rays,
                    "Rays from the lights for --light-report (default 1e6)")
         ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{10'000'000'000}));
@@ -452,8 +457,16 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
             throw Error("--sun-at places the --sky's sun; give --sky too");
         options.sun_direction = sun_at_option(options.sun_at);
     }
+    if (!options.canopy_tile.empty()) {
+        const auto& t = options.canopy_tile;
+        const bool finite = std::all_of(t.begin(), t.end(), [](double v) { return std::isfinite(v); });
+        if (!finite || !(t[0] < t[2] && t[1] < t[3]))
+            throw Error("--canopy-tile X0 Z0 X1 Z1: expected X0 < X1 and Z0 < Z1");
+        options.infinite_canopy = true;
+    }
     if (options.infinite_canopy && !options.light_report)
-        throw Error("--infinite-canopy repeats the scene for --light-report; give --light-report too");
+        throw Error("--infinite-canopy (--canopy-tile) repeats the scene for --light-report; give "
+                    "--light-report too");
     if (cli.count("--turbidity") > 0 && !options.sky)
         throw Error("--turbidity sets the haze of the --sky; give --sky too");
     if (cli.count("--env-rotate") > 0 && !options.sky && !options.environment_map)

@@ -86,6 +86,8 @@ struct Options {
     std::optional<std::filesystem::path> light_report;
     /// --infinite-canopy: the light report repeats the scene sideways over its x-z bounds
     bool infinite_canopy = false;
+    /// --canopy-tile X0 Z0 X1 Z1: the canopy's tile instead of those bounds (it implies it)
+    std::vector<double> canopy_tile;
     std::uint64_t light_rays = 1'000'000;  ///< --light-rays N
 
     // Rendering

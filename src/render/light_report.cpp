@@ -291,15 +291,29 @@ struct Extent {
     double depth() const { return hi.z - lo.z; }
 };
 
-Extent make_extent(const geom::Bounds3& b, bool canopy)
+Extent make_extent(const geom::Bounds3& b, const LightReportSettings& settings)
 {
     Extent e;
     e.lo = {b.lo.x, b.lo.y, b.lo.z};
     e.hi = {b.hi.x, b.hi.y, b.hi.z};
+    e.canopy = settings.infinite_canopy || settings.canopy_tile;
+    if (settings.canopy_tile && !b.empty()) {
+        const auto& t = *settings.canopy_tile;
+        if (!(t[0] < t[2] && t[1] < t[3]) || t[0] > e.lo.x || t[2] < e.hi.x || t[1] > e.lo.z || t[3] < e.hi.z) {
+            char text[256];
+            std::snprintf(text, sizeof text,
+                          "--canopy-tile %g %g %g %g must hold the scene's x-z bounds, x %g .. %g, z %g .. %g",
+                          t[0], t[1], t[2], t[3], e.lo.x, e.hi.x, e.lo.z, e.hi.z);
+            throw Error(text);
+        }
+        e.lo.x = t[0];
+        e.lo.z = t[1];
+        e.hi.x = t[2];
+        e.hi.z = t[3];
+    }
     e.centre = (e.lo + e.hi) * 0.5;
     // a margin, so that no primitive touches the sphere
     e.radius = length(e.hi - e.lo) * 0.5 * (1 + 1e-3) + 1e-6;
-    e.canopy = canopy;
     return e;
 }
 
@@ -672,7 +686,7 @@ LightReport trace_light(const geom::Scene& scene, const LightReportSettings& set
     LightReport report;
     Organs organs = find_organs(scene);
     const geom::Bounds3 bounds = world_bounds(scene);
-    const Extent extent = make_extent(bounds, settings.infinite_canopy);
+    const Extent extent = make_extent(bounds, settings);
     const Environment* env = settings.environment.get();
     std::vector<Source> sources;
     if (settings.view_lights && !bounds.empty())

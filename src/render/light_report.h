@@ -4,9 +4,11 @@
 // module that drew the primitive: geom's provenance). docs/light.md.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -32,6 +34,9 @@ struct LightReportSettings {
     /// Repeat the scene sideways: a ray leaving the x-z bounds of every primitive through
     /// a side comes back through the opposite side (a stand of infinite extent).
     bool infinite_canopy = false;
+    /// The canopy's tile, x0 z0 x1 z1, when not those bounds: it must hold them (a stand
+    /// of plants spaced wider than they are).
+    std::optional<std::array<double, 4>> canopy_tile;
 };
 
 /// One organ: a module that drew primitives, in one plant placement.

@@ -837,4 +837,10 @@ TEST(InfiniteCanopyOption, NeedsTheLightReport)
 {
     EXPECT_TRUE(app::parse_command_line({"--light-report", "r.json", "--infinite-canopy", "a.l", "a.v"})->infinite_canopy);
     EXPECT_THROW(app::parse_command_line({"--infinite-canopy", "a.l", "a.v"}), Error);
+    app::Options o = *app::parse_command_line(
+        {"--light-report", "r.json", "--canopy-tile", "-1", "-2", "3", "4", "a.l", "a.v"});
+    EXPECT_TRUE(o.infinite_canopy);
+    EXPECT_EQ(o.canopy_tile, (std::vector<double>{-1, -2, 3, 4}));
+    EXPECT_THROW(app::parse_command_line({"--light-report", "r.json", "--canopy-tile", "3", "0", "1", "4", "a.l", "a.v"}),
+                 Error);
 }

@@ -4,12 +4,14 @@
 // canopy against Beer-Lambert's law.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <random>
 #include <string>
 #include <vector>
 
+#include "base/diagnostics.h"
 #include "render/environment.h"
 #include "render/light.h"
 #include "render/light_report.h"
@@ -274,6 +276,41 @@ TEST(LightSources, InfiniteCanopyFollowsBeerLambert)
     EXPECT_GT(without, 2 * expected);
     EXPECT_NEAR(stand.absorbed + stand.escaped + stand.truncated, stand.emitted,
                 1e-9 * stand.emitted);
+}
+
+// A stated tile twice as wide as the leaves' bounds: half of it bare. A beam whose
+// horizontal travel across the leaves' unit-high layer is one tile width spends the same
+// share of its path among leaves wherever it enters, so Beer-Lambert holds with the leaf
+// area index of the whole tile. A tile that does not hold the bounds is an error.
+TEST(LightSources, CanopyTileSetsTheSpacing)
+{
+    geom::Scene scene = dark_scene();
+    const int count = 3000;
+    const double leaf_area = 2.0 / count;
+    random_canopy(scene, count, leaf_area, 12);
+    double lo[2] = {1e9, 1e9}, hi[2] = {-1e9, -1e9};
+    for (const Float3& q : scene.geometry.mesh.positions) {
+        lo[0] = std::min(lo[0], double(q[0]));
+        hi[0] = std::max(hi[0], double(q[0]));
+        lo[1] = std::min(lo[1], double(q[2]));
+        hi[1] = std::max(hi[1], double(q[2]));
+    }
+    const double period = 2 * (hi[0] - lo[0]);
+    const double lai = count * leaf_area / (period * (hi[1] - lo[1]));
+    geom::Light light;
+    light.kind = geom::Light::Kind::directional;
+    light.direction = {period, 1, 0};  // tan(zenith angle) = period / the layer's height
+    scene.lights = {light};
+    LightReportSettings s;
+    s.rays = 200'000;
+    s.canopy_tile = std::array<double, 4>{lo[0], lo[1], lo[0] + period, hi[1]};
+    const LightReport r = trace_light(scene, s);
+    const double expected = std::exp(-0.5 * lai * std::sqrt(1 + period * period));
+    RecordProperty("expected", std::to_string(expected));
+    RecordProperty("measured", std::to_string(r.escaped_down / r.emitted));
+    EXPECT_NEAR(r.escaped_down / r.emitted, expected, 0.06 * expected);
+    s.canopy_tile = std::array<double, 4>{lo[0] + 0.1, lo[1], lo[0] + period, hi[1]};
+    EXPECT_THROW(trace_light(scene, s), cambium::Error);
 }
 
 // The sky, a point light and the canopy together: the same numbers, bit for bit, on one
