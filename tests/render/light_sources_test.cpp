@@ -87,6 +87,29 @@ TEST(LightSources, UniformEnvironmentGivesItsRadianceOnEachSide)
     EXPECT_NEAR(r.absorbed + r.escaped + r.truncated, r.emitted, 1e-9 * r.emitted);
 }
 
+// An --env map bright above the horizon and black below, turned (a turn about +y changes
+// nothing here): the rectangle's upper side gets the radiance, its lower side nothing.
+TEST(LightSources, MapLightsTheUpperSideOnly)
+{
+    geom::Scene scene = dark_scene();
+    add_floor(scene, 2, 3);
+    // 8 x 2 texels: the top row (the upper hemisphere) radiance 0.5 in grey, 1.5 in red
+    std::vector<float> rgb(8 * 2 * 3, 0.0f);
+    for (int i = 0; i < 8; ++i)
+        for (int c = 0; c < 3; ++c)
+            rgb[3 * i + c] = i == 3 && c == 0 ? 1.5f : 0.5f;
+    const double mean_up = (7 * 0.5 + (1.5 + 0.5 + 0.5) / 3) / 8;
+    auto map = std::make_shared<Environment>(make_map_environment(8, 2, rgb).rotated(30));
+    LightReport r = trace_light(scene, lit_by(map, 200'000));
+    ASSERT_EQ(r.organs.size(), 1u);
+    const OrganLight& o = r.organs[0];
+    RecordProperty("absorbed", std::to_string(o.absorbed));
+    RecordProperty("expected", std::to_string(6 * mean_up));
+    EXPECT_NEAR(o.absorbed, 6 * mean_up, o.absorbed_ci95);
+    EXPECT_LT(o.absorbed_ci95, 0.01 * 6 * mean_up);
+    EXPECT_EQ(o.incident_back, 0);
+}
+
 // The sky with its sun at the zenith over a black rectangle: what it absorbs is the sky's
 // radiance times |cos| integrated over the sphere (over pi), the sun's disk taken whole:
 // the sun's stated irradiance (SkyEnvironment.SunDiskDeliversTheStatedIrradiance) plus
