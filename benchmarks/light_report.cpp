@@ -5,6 +5,8 @@
 //   build/benchmarks/light_report plant.l plant.v [rays] [--allow-file-access]
 //   build/benchmarks/light_report --synthetic ORGANS [rays]
 //
+// Either may end with --sky (the default sky and sun too) and --infinite-canopy.
+//
 // The synthetic plant: ORGANS / 2 grey translucent leaves and as many internodes
 // (cylinders) at random in a crown of radius 1, each its own module.
 #include <sys/resource.h>
@@ -14,6 +16,7 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <memory>
 #include <random>
 #include <string>
 #include <vector>
@@ -117,6 +120,12 @@ int main(int argc, char** argv)
         geom::Scene scene;
         double interpret_s = 0;
         auto t = Clock::now();
+        bool sky = false, canopy = false;
+        while (argc > 3 && (std::strcmp(argv[argc - 1], "--sky") == 0 ||
+                            std::strcmp(argv[argc - 1], "--infinite-canopy") == 0)) {
+            (std::strcmp(argv[argc - 1], "--sky") == 0 ? sky : canopy) = true;
+            --argc;
+        }
         if (std::strcmp(argv[1], "--synthetic") == 0) {
             const auto organs = static_cast<std::uint32_t>(std::stoul(argv[2]));
             if (argc > 3)
@@ -148,6 +157,9 @@ int main(int argc, char** argv)
         interpret_s = seconds_since(t);
         render::LightReportSettings settings;
         settings.rays = rays;
+        if (sky)
+            settings.environment = std::make_shared<const render::Environment>(render::make_sky_environment());
+        settings.infinite_canopy = canopy;
         auto cpu_seconds = [] {
             struct rusage u {};
             getrusage(RUSAGE_SELF, &u);

@@ -5,14 +5,17 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 #include <regex>
 
 #include "app/shot_options.h"
 #include "base/diagnostics.h"
 #include "render/render.h"
+#include "render/sun_position.h"
 
 namespace cambium::app {
 namespace {
@@ -154,6 +157,61 @@ std::optional<Options> parse_command_line(int argc, char** argv)
 namespace {
 
 /// --tile I/N: band I (from 0) of N.
+/// A number of the whole word, or nullopt.
+std::optional<double> number_of(const std::string& text)
+{
+    double v = 0;
+    const char* end = text.data() + text.size();
+    auto [p, ec] = std::from_chars(text.data(), end, v);
+    if (ec != std::errc() || p != end || !std::isfinite(v))
+        return std::nullopt;
+    return v;
+}
+
+/// --sun-at's local time: YYYY-MM-DDTHH:MM[:SS] then Z or an offset +HH:MM / -HH:MM.
+std::optional<render::LocalTime> local_time_of(const std::string& text)
+{
+    static const std::regex form(
+        R"((\d{4})-(\d{2})-(\d{2})[T ](\d{2}):(\d{2})(?::(\d{2}(?:\.\d+)?))?(Z|([+-])(\d{2})(?::?(\d{2}))?))");
+    std::smatch m;
+    if (!std::regex_match(text, m, form))
+        return std::nullopt;
+    render::LocalTime t;
+    t.year = std::stoi(m[1]);
+    t.month = std::stoi(m[2]);
+    t.day = std::stoi(m[3]);
+    t.hour = std::stoi(m[4]);
+    t.minute = std::stoi(m[5]);
+    t.second = m[6].matched ? std::stod(m[6]) : 0;
+    if (m[7] != "Z") {
+        const int minutes = m[10].matched ? std::stoi(m[10]) : 0;
+        if (minutes > 59)
+            return std::nullopt;
+        t.utc_offset_hours = (m[8] == "-" ? -1 : 1) * (std::stoi(m[9]) + minutes / 60.0);
+    }
+    if (!render::valid_local_time(t))
+        return std::nullopt;
+    return t;
+}
+
+/// The direction toward the sun of --sun-at LAT LON TIME.
+std::vector<float> sun_at_option(const std::vector<std::string>& words)
+{
+    const std::optional<double> lat = number_of(words[0]), lon = number_of(words[1]);
+    if (!lat || *lat < -90 || *lat > 90)
+        throw Error("--sun-at: latitude '" + words[0] + "' is not a number of degrees in -90 .. 90");
+    if (!lon || *lon < -180 || *lon > 180)
+        throw Error("--sun-at: longitude '" + words[1] +
+                    "' is not a number of degrees in -180 .. 180 (east positive)");
+    const std::optional<render::LocalTime> t = local_time_of(words[2]);
+    if (!t)
+        throw Error("--sun-at: '" + words[2] +
+                    "' is not a date and local time with its UTC offset such as "
+                    "2024-06-21T14:30+02:00 (or Z for UTC)");
+    const render::Vec3f d = render::sun_direction(render::sun_position(*lat, *lon, *t));
+    return {d.x, d.y, d.z};
+}
+
 std::pair<int, int> tile_option(const std::string& text)
 {
     std::size_t slash = text.find('/');
@@ -248,13 +306,21 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
                  "peak memory, rays/s and samples/s");
     cli.add_option("--stats-json", options.stats_json, "Write the --stats figures as JSON to FILE");
     cli.add_option("--light-report", options.light_report,
-                   "Trace the view file's directional lights onto every organ and write the "
+                   "Trace the lights (the view file's, the --sky or --env) onto every organ and write the "
                    "light each absorbs to FILE (.json or .csv; docs/light.md)")
         ->check([](const std::string& file) {  // refused before the work, not after
             const auto ext = std::filesystem::path(file).extension();
             return ext == ".json" || ext == ".csv" ? std::string()
                                                    : std::string("expected a .json or .csv file");
         });
+    cli.add_flag("--infinite-canopy", options.infinite_canopy,
+                 "--light-report repeats the scene sideways: rays leaving its x-z bounds "
+                 "through a side come back through the opposite side (a stand)");
+    cli.add_option("--canopy-tile", options.canopy_tile,
+                   "The --infinite-canopy's tile X0 Z0 X1 Z1 (it must hold the scene's x-z "
+                   "bounds) instead of those bounds: plants spaced wider than they are")
+        ->expected(4)
+        ->allow_extra_args(false);
     cli.add_option("--light-rays", options.light_rays,
                    "Rays from the lights for --light-report (default 1e6)")
         ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{10'000'000'000}));
@@ -306,6 +372,12 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     cli.add_option("--sun", options.sun_direction, "Direction toward the sun (with --sky)")
         ->expected(3)
         ->allow_extra_args(false);  // with a lone scene file allowed, files must not feed it
+    cli.add_option("--sun-at", options.sun_at,
+                   "The --sky's sun for a place and time: LAT LON (degrees, north and east "
+                   "positive) and local time with UTC offset, e.g. 52.0 5.2 2024-06-21T14:30+02:00 "
+                   "(north along -z, east along +x)")
+        ->expected(3)
+        ->allow_extra_args(false);
     cli.add_option("--turbidity", options.turbidity,
                    "Haze of the --sky, 1.7 (very clear) .. 10 (hazy); default 3")
         ->check(CLI::Range(1.7f, 10.0f));
@@ -378,6 +450,23 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
         options.sky = true;
     if (options.sky && options.environment_map)
         throw Error("--sky and --env both set what surrounds the plant; give one");
+    if (!options.sun_at.empty()) {
+        if (!options.sun_direction.empty())
+            throw Error("--sun and --sun-at both place the sun; give one");
+        if (!options.sky)
+            throw Error("--sun-at places the --sky's sun; give --sky too");
+        options.sun_direction = sun_at_option(options.sun_at);
+    }
+    if (!options.canopy_tile.empty()) {
+        const auto& t = options.canopy_tile;
+        const bool finite = std::all_of(t.begin(), t.end(), [](double v) { return std::isfinite(v); });
+        if (!finite || !(t[0] < t[2] && t[1] < t[3]))
+            throw Error("--canopy-tile X0 Z0 X1 Z1: expected X0 < X1 and Z0 < Z1");
+        options.infinite_canopy = true;
+    }
+    if (options.infinite_canopy && !options.light_report)
+        throw Error("--infinite-canopy (--canopy-tile) repeats the scene for --light-report; give "
+                    "--light-report too");
     if (cli.count("--turbidity") > 0 && !options.sky)
         throw Error("--turbidity sets the haze of the --sky; give --sky too");
     if (cli.count("--env-rotate") > 0 && !options.sky && !options.environment_map)

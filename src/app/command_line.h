@@ -84,6 +84,10 @@ struct Options {
     std::optional<std::filesystem::path> stats_json;     ///< --stats-json FILE
     /// --light-report FILE: the light each organ absorbs (docs/light.md), .json or .csv
     std::optional<std::filesystem::path> light_report;
+    /// --infinite-canopy: the light report repeats the scene sideways over its x-z bounds
+    bool infinite_canopy = false;
+    /// --canopy-tile X0 Z0 X1 Z1: the canopy's tile instead of those bounds (it implies it)
+    std::vector<double> canopy_tile;
     std::uint64_t light_rays = 1'000'000;  ///< --light-rays N
 
     // Rendering
@@ -115,7 +119,9 @@ struct Options {
     bool material_transparency = false;
     float ambient = 0.05f;             ///< --ambient: uniform environment radiance
     bool sky = false;                  ///< --sky: analytic sun and sky
-    std::vector<float> sun_direction;  ///< --sun X Y Z (with --sky)
+    std::vector<float> sun_direction;  ///< --sun X Y Z (with --sky), or from --sun-at
+    /// --sun-at LAT LON TIME: the place and local time the --sky's sun is computed for
+    std::vector<std::string> sun_at;
     float turbidity = 3;               ///< --turbidity: sky haze, 1.7 .. 10 (with --sky)
     std::optional<std::filesystem::path> environment_map;  ///< --env file.exr|.hdr
     float environment_scale = 1;       ///< --env-scale

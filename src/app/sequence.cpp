@@ -782,6 +782,26 @@ render::PixelFilter pixel_filter(const std::string& name)
 
 }  // namespace
 
+std::shared_ptr<const render::Environment> make_environment(const Options& options)
+{
+    std::optional<render::Environment> environment;
+    if (options.sky) {
+        render::SkyParameters sky;
+        if (!options.sun_direction.empty())
+            sky.sun_direction = render::normalize(render::Vec3f(
+                options.sun_direction[0], options.sun_direction[1], options.sun_direction[2]));
+        sky.turbidity = options.turbidity;
+        environment = render::make_sky_environment(sky);
+    } else if (options.environment_map) {
+        environment =
+            render::make_map_environment(*options.environment_map, options.environment_scale);
+    }
+    if (!environment)
+        return nullptr;
+    return std::make_shared<const render::Environment>(
+        std::move(*environment).rotated(options.environment_rotation));
+}
+
 render::RenderSettings render_settings(const Options& options,
                                        const std::vector<std::filesystem::path>& images)
 {
@@ -804,21 +824,7 @@ render::RenderSettings render_settings(const Options& options,
     settings.transparent_background = options.transparent;
     settings.ambient = {options.ambient, options.ambient, options.ambient};
     settings.view_lights = !options.no_view_lights;
-    std::optional<render::Environment> environment;
-    if (options.sky) {
-        render::SkyParameters sky;
-        if (!options.sun_direction.empty())
-            sky.sun_direction = render::normalize(render::Vec3f(
-                options.sun_direction[0], options.sun_direction[1], options.sun_direction[2]));
-        sky.turbidity = options.turbidity;
-        environment = render::make_sky_environment(sky);
-    } else if (options.environment_map) {
-        environment =
-            render::make_map_environment(*options.environment_map, options.environment_scale);
-    }
-    if (environment)
-        settings.environment = std::make_shared<const render::Environment>(
-            std::move(*environment).rotated(options.environment_rotation));
+    settings.environment = make_environment(options);
     // The albedo, normal and depth layers cost a camera-ray intersection: only for a
     // format that keeps them.
     settings.aovs = std::any_of(images.begin(), images.end(), [](const auto& f) {

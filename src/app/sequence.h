@@ -68,6 +68,10 @@ int derive_frames_with_lineage(const Model& model,
 /// --shadow-catcher.
 void apply_staging(render::RenderSettings& settings, const Options& options);
 
+/// The --sky (its sun from --sun or --sun-at) or --env map around the scene, turned by
+/// --env-rotate; none without either. Throws cambium::Error for a map it cannot read.
+std::shared_ptr<const render::Environment> make_environment(const Options& options);
+
 /// The render settings of the options for `images` (the albedo, normal and depth layers
 /// only when one of them keeps them), staging included; without a progress line or a
 /// cancel flag, which the caller sets (the command: the terminal and Ctrl-C).

@@ -17,6 +17,7 @@
 #include "base/diagnostics.h"
 #include "render/accel.h"
 #include "render/camera.h"
+#include "render/light.h"
 #include "render/material.h"
 
 namespace cambium::render {
@@ -257,48 +258,6 @@ geom::Bounds3 world_bounds(const geom::Scene& scene)
     return b;
 }
 
-/// A directional light's parallel rays: from a rectangle beyond the scene, across the
-/// scene's projection onto it.
-struct Beam {
-    Vec3d to_light, u, v, corner;  ///< corner: the rectangle's origin, beyond the scene
-    double width = 0, height = 0;
-    Rgb3 colour{};
-    std::uint64_t nx = 0, ny = 0;
-    double power() const { return mean(colour) * width * height; }
-};
-
-std::optional<Beam> make_beam(const geom::Light& light, const geom::Bounds3& b)
-{
-    Vec3d d{light.direction.x, light.direction.y, light.direction.z};
-    if (!(length(d) > 0))
-        return std::nullopt;
-    Beam beam;
-    beam.to_light = unit(d);
-    Vec3d other = std::abs(beam.to_light.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0};
-    beam.u = unit(cross(other, beam.to_light));
-    beam.v = cross(beam.to_light, beam.u);
-    double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
-    for (int c = 0; c < 8; ++c) {
-        Vec3d p{c & 1 ? b.hi.x : b.lo.x, c & 2 ? b.hi.y : b.lo.y, c & 4 ? b.hi.z : b.lo.z};
-        double q[3] = {dot(p, beam.u), dot(p, beam.v), dot(p, beam.to_light)};
-        for (int k = 0; k < 3; ++k) {
-            lo[k] = std::min(lo[k], q[k]);
-            hi[k] = std::max(hi[k], q[k]);
-        }
-    }
-    // a margin, so that nothing lies on the rectangle's edge
-    const double margin = 1e-3 * std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-6});
-    for (int k = 0; k < 3; ++k) {
-        lo[k] -= margin;
-        hi[k] += margin;
-    }
-    beam.width = hi[0] - lo[0];
-    beam.height = hi[1] - lo[1];
-    beam.corner = beam.u * lo[0] + beam.v * lo[1] + beam.to_light * (hi[2] + margin);
-    beam.colour = {light.diffuse.r, light.diffuse.g, light.diffuse.b};
-    return beam;
-}
-
 struct Tally {
     double absorbed = 0, front = 0, back = 0;
 };
@@ -306,7 +265,7 @@ struct Tally {
 /// A block's tallies, by organ (sorted), and its totals.
 struct BlockResult {
     std::vector<std::pair<std::uint32_t, Tally>> organs;
-    double absorbed = 0, unattributed = 0, escaped = 0, truncated = 0, emitted = 0;
+    double absorbed = 0, unattributed = 0, escaped = 0, escaped_down = 0, truncated = 0, emitted = 0;
 };
 
 /// A cosine-distributed direction about n.
@@ -323,33 +282,332 @@ Vec3d cosine_direction(Vec3d n, RayRandom& rng)
 Vec3f f3(Vec3d a) { return {float(a.x), float(a.y), float(a.z)}; }
 Vec3d d3(const Vec3f& a) { return {a.x, a.y, a.z}; }
 
+/// The slab the rays live in: the bounds of every primitive, and their bounding sphere.
+struct Extent {
+    Vec3d lo, hi, centre;
+    double radius = 0;
+    bool canopy = false;  ///< rays wrap across the x and z sides
+    double width() const { return hi.x - lo.x; }
+    double depth() const { return hi.z - lo.z; }
+};
+
+Extent make_extent(const geom::Bounds3& b, const LightReportSettings& settings)
+{
+    Extent e;
+    e.lo = {b.lo.x, b.lo.y, b.lo.z};
+    e.hi = {b.hi.x, b.hi.y, b.hi.z};
+    e.canopy = settings.infinite_canopy || settings.canopy_tile;
+    if (settings.canopy_tile && !b.empty()) {
+        const auto& t = *settings.canopy_tile;
+        if (!(t[0] < t[2] && t[1] < t[3]) || t[0] > e.lo.x || t[2] < e.hi.x || t[1] > e.lo.z || t[3] < e.hi.z) {
+            char text[256];
+            std::snprintf(text, sizeof text,
+                          "--canopy-tile %g %g %g %g must hold the scene's x-z bounds, x %g .. %g, z %g .. %g",
+                          t[0], t[1], t[2], t[3], e.lo.x, e.hi.x, e.lo.z, e.hi.z);
+            throw Error(text);
+        }
+        e.lo.x = t[0];
+        e.lo.z = t[1];
+        e.hi.x = t[2];
+        e.hi.z = t[3];
+    }
+    e.centre = (e.lo + e.hi) * 0.5;
+    // a margin, so that no primitive touches the sphere
+    e.radius = length(e.hi - e.lo) * 0.5 * (1 + 1e-3) + 1e-6;
+    return e;
+}
+
+/// Two unit vectors across the unit vector d.
+std::pair<Vec3d, Vec3d> frame(Vec3d d)
+{
+    Vec3d other = std::abs(d.x) < 0.9 ? Vec3d{1, 0, 0} : Vec3d{0, 1, 0};
+    Vec3d u = unit(cross(other, d));
+    return {u, cross(d, u)};
+}
+
+/// One light as the report emits it: a directional light's parallel beam, the
+/// environment's directions, or a point (spot) light's rays. Each ray stands for a cell
+/// of an nx x ny grid over the unit square of the two numbers that place it
+/// (stratified).
+struct Source {
+    enum class Kind { beam, environment, point };
+    Kind kind = Kind::beam;
+    Rgb3 colour{};  ///< beam: irradiance; point: intensity at unit falloff
+    double power = 0;  ///< what it sends into the scene, roughly: shares the rays
+    std::uint64_t nx = 1, ny = 1;
+    std::string text;
+    // beam: rays along -to_light from corner + x u + y v, over `area` across the beam
+    Vec3d to_light, corner, u, v;
+    double area = 0;
+    // point: rays from `position` within the cone about `axis` of cosine `cos_cone`
+    RenderLight light;
+    Vec3d position, axis;
+    double cos_cone = -1;
+    double solid_angle() const { return 2 * std::numbers::pi * (1 - cos_cone); }
+};
+
+/// A ray as emitted: its power per channel, and for a point light the falloff by the
+/// distance it travels to its first surface.
+struct Emitted {
+    Vec3d org, dir;
+    Rgb3 w{};
+    const RenderLight* falloff = nullptr;
+};
+
+/// A directional light's beam: over the rectangle the scene's bounds project onto across
+/// its direction, or with the canopy over the bounds' top.
+std::optional<Source> make_beam(const RenderLight& light, const Extent& e)
+{
+    Source s;
+    s.to_light = unit(d3(light.toward_light));
+    s.colour = {light.colour.x, light.colour.y, light.colour.z};
+    if (e.canopy) {
+        if (!(s.to_light.y > 0))
+            return std::nullopt;  // below the horizon: nothing enters the stand from above
+        const double margin = 1e-3 * std::max({e.hi.y - e.lo.y, e.width(), e.depth(), 1e-6});
+        s.corner = {e.lo.x, e.hi.y + margin, e.lo.z};
+        s.u = {e.width(), 0, 0};
+        s.v = {0, 0, e.depth()};
+        s.area = e.width() * e.depth() * s.to_light.y;
+    } else {
+        auto [u, v] = frame(s.to_light);
+        double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+        for (int c = 0; c < 8; ++c) {
+            Vec3d p{c & 1 ? e.hi.x : e.lo.x, c & 2 ? e.hi.y : e.lo.y, c & 4 ? e.hi.z : e.lo.z};
+            double q[3] = {dot(p, u), dot(p, v), dot(p, s.to_light)};
+            for (int k = 0; k < 3; ++k) {
+                lo[k] = std::min(lo[k], q[k]);
+                hi[k] = std::max(hi[k], q[k]);
+            }
+        }
+        // a margin, so that nothing lies on the rectangle's edge
+        const double margin = 1e-3 * std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-6});
+        for (int k = 0; k < 3; ++k) {
+            lo[k] -= margin;
+            hi[k] += margin;
+        }
+        s.corner = u * lo[0] + v * lo[1] + s.to_light * (hi[2] + margin);
+        s.u = u * (hi[0] - lo[0]);
+        s.v = v * (hi[1] - lo[1]);
+        s.area = (hi[0] - lo[0]) * (hi[1] - lo[1]);
+    }
+    s.power = mean(s.colour) * s.area;
+    return s;
+}
+
+/// A point or spot light: rays from it within the narrower of the cone that holds the
+/// scene's bounding sphere (the light outside it, no canopy) and the spot's cutoff cone.
+Source make_point(const RenderLight& light, const Extent& e)
+{
+    Source s;
+    s.kind = Source::Kind::point;
+    s.light = light;
+    s.position = d3(light.position);
+    s.colour = {light.colour.x, light.colour.y, light.colour.z};
+    s.axis = {0, 1, 0};
+    const Vec3d to_centre = e.centre - s.position;
+    const double d = length(to_centre);
+    if (!e.canopy && d > e.radius) {
+        s.axis = to_centre * (1 / d);
+        s.cos_cone = std::sqrt(1 - (e.radius / d) * (e.radius / d));
+    }
+    if (light.kind == RenderLight::Kind::spot && light.spot_cos_cutoff > s.cos_cone) {
+        s.axis = unit(d3(light.spot_axis));
+        s.cos_cone = light.spot_cos_cutoff;
+    }
+    // roughly the flux its nearest reach of the scene receives
+    const double reach = std::max(e.radius, d - e.radius);
+    const float a = light.att_constant + light.att_linear * float(reach) +
+                    light.att_quadratic * float(reach * reach);
+    s.power = a > 0 ? mean(s.colour) * s.solid_angle() * reach * reach / a : 0;
+    return s;
+}
+
+/// The environment: directions drawn from its own sampling, each ray from a point drawn
+/// uniformly over the disc across that direction that covers the bounding sphere (with
+/// the canopy, over the bounds' top or bottom face).
+Source make_environment_source(const Environment& env, const Extent& e, std::uint64_t seed)
+{
+    Source s;
+    s.kind = Source::Kind::environment;
+    // its power from a few of its own samples (only shares the rays out)
+    RayRandom rng(seed, 0xe4, 0);
+    double sum = 0;
+    constexpr int n = 1024;
+    for (int i = 0; i < n; ++i) {
+        EnvironmentSample es = env.sample(float(rng.next()), float(rng.next()));
+        if (es.pdf > 0)
+            sum += mean({es.radiance.x, es.radiance.y, es.radiance.z}) / es.pdf *
+                   (e.canopy ? std::abs(es.direction.y) * e.width() * e.depth() / std::numbers::pi
+                             : e.radius * e.radius);
+    }
+    s.power = sum / n;
+    return s;
+}
+
+std::optional<Emitted> emit(const Source& s, const Extent& e, const Environment* env,
+                            std::uint64_t j, std::uint64_t count, RayRandom& rng)
+{
+    const double x = (double(j % s.nx) + rng.next()) / double(s.nx);
+    const double y = (double(j / s.nx) + rng.next()) / double(s.ny);
+    Emitted out;
+    switch (s.kind) {
+    case Source::Kind::beam: {
+        out.org = s.corner + s.u * x + s.v * y;
+        out.dir = s.to_light * -1.0;
+        const double flux = s.area / double(count);
+        out.w = {s.colour[0] * flux, s.colour[1] * flux, s.colour[2] * flux};
+        return out;
+    }
+    case Source::Kind::environment: {
+        const EnvironmentSample es = env->sample(float(x), float(y));
+        if (!(es.pdf > 0))
+            return std::nullopt;
+        const Vec3d w = unit(d3(es.direction));  // toward the sky
+        // radiance / pdf over the area rays start from, in units where irradiance pi
+        // (the renderer's) is 1
+        double area = 0;
+        if (e.canopy) {
+            if (w.y == 0)
+                return std::nullopt;
+            const double margin = 1e-3 * std::max({e.hi.y - e.lo.y, e.width(), e.depth(), 1e-6});
+            out.org = {e.lo.x + rng.next() * e.width(), w.y > 0 ? e.hi.y + margin : e.lo.y - margin,
+                       e.lo.z + rng.next() * e.depth()};
+            area = e.width() * e.depth() * std::abs(w.y);
+        } else {
+            auto [t, b] = frame(w);
+            const double r = e.radius * std::sqrt(rng.next()), phi = 2 * std::numbers::pi * rng.next();
+            out.org = e.centre + w * e.radius + t * (r * std::cos(phi)) + b * (r * std::sin(phi));
+            area = std::numbers::pi * e.radius * e.radius;
+        }
+        out.dir = w * -1.0;
+        const double k = area / (std::numbers::pi * double(es.pdf) * double(count));
+        out.w = {es.radiance.x * k, es.radiance.y * k, es.radiance.z * k};
+        return out;
+    }
+    case Source::Kind::point: {
+        const double c = 1 - x * (1 - s.cos_cone), sine = std::sqrt(std::max(0.0, 1 - c * c));
+        const double phi = 2 * std::numbers::pi * y;
+        auto [t, b] = frame(s.axis);
+        out.org = s.position;
+        out.dir = unit(s.axis * c + t * (sine * std::cos(phi)) + b * (sine * std::sin(phi)));
+        double k = s.solid_angle() / double(count);
+        const RenderLight& l = s.light;
+        if (l.kind == RenderLight::Kind::spot) {  // OpenGL's spot factor, as the renderer's
+            const double along = dot(out.dir, d3(l.spot_axis));
+            if (along < l.spot_cos_cutoff)
+                return std::nullopt;
+            if (l.spot_exponent > 0)
+                k *= std::pow(std::max(along, 0.0), double(l.spot_exponent));
+        }
+        out.w = {s.colour[0] * k, s.colour[1] * k, s.colour[2] * k};
+        out.falloff = &s.light;
+        return out;
+    }
+    }
+    return std::nullopt;
+}
+
 struct Tracer {
     const geom::Scene& scene;
     const EmbreeScene& accel;
     const Organs& organs;
     const std::vector<SurfaceMaterial>& materials;
     const LightReportSettings& settings;
+    /// Wraps across the canopy's sides before a path is cut short (a ray level with the
+    /// ground could wrap for ever).
+    static constexpr std::uint32_t wrap_limit = 1u << 16;
 
-    /// One path: `w` its power per channel; tallies into `t` (by organ, dense) and `r`.
-    void trace(Vec3d org, Vec3d dir, Rgb3 w, RayRandom& rng, std::vector<Tally>& t,
-               std::vector<std::uint32_t>& touched, BlockResult& r) const
+    const Extent& extent;
+
+    /// The distance from org along dir to where the ray leaves the slab of the bounds
+    /// (the canopy) or their bounding sphere.
+    double exit_distance(Vec3d org, Vec3d dir) const
     {
-        const double start = mean(w);
+        const Extent& e = extent;
+        if (e.canopy)
+            return dir.y > 0 ? std::max(0.0, (e.hi.y - org.y) / dir.y)
+                 : dir.y < 0 ? std::max(0.0, (e.lo.y - org.y) / dir.y)
+                             : 0.0;
+        const Vec3d c = e.centre - org;
+        const double b = dot(c, dir), disc = b * b - (dot(c, c) - e.radius * e.radius);
+        return std::max(0.0, disc > 0 ? b + std::sqrt(disc) : b);
+    }
+
+    /// One path: `w` its power per channel (for a point light, at unit distance: its
+    /// falloff by the distance to the first surface still to come); tallies into `t` (by
+    /// organ, dense) and `r`.
+    void trace(Vec3d org, Vec3d dir, Rgb3 w, const RenderLight* falloff, RayRandom& rng,
+               std::vector<Tally>& t, std::vector<std::uint32_t>& touched, BlockResult& r) const
+    {
+        const Extent& e = extent;
+        double travelled = 0;  // from a point light, until its first surface
+        // a point light's ray has its power once its distance is known
+        auto arrive = [&](double d) {
+            const double a = falloff->att_constant + falloff->att_linear * d + falloff->att_quadratic * d * d;
+            const double k = a > 0 ? d * d / a : 0;
+            for (double& c : w)
+                c *= k;
+            falloff = nullptr;
+            r.emitted += mean(w);
+        };
+        if (!falloff)
+            r.emitted += mean(w);
+        double start = mean(w);
         PrimId skip{};
+        std::uint32_t wraps = 0;
         for (int bounce = 0;; ++bounce) {
-            if (bounce >= settings.max_bounces || mean(w) < settings.cutoff * start) {
+            if (!falloff && (bounce >= settings.max_bounces || mean(w) < settings.cutoff * start)) {
                 r.truncated += mean(w);
                 return;
             }
+            // with the canopy, up to the side the ray leaves the bounds by
+            double wall = std::numeric_limits<double>::infinity();
+            int axis = -1;
+            if (e.canopy) {
+                auto to_wall = [&](double o, double d, double lo, double hi) {
+                    return d > 0 ? (hi - o) / d : d < 0 ? (lo - o) / d : wall;
+                };
+                const double tx = to_wall(org.x, dir.x, e.lo.x, e.hi.x);
+                const double tz = to_wall(org.z, dir.z, e.lo.z, e.hi.z);
+                wall = std::max(0.0, std::min(tx, tz));
+                axis = tx <= tz ? 0 : 2;
+            }
             std::optional<SurfaceHit> hit =
-                accel.intersect(f3(org), f3(dir), 0, std::numeric_limits<float>::infinity(), skip);
+                accel.intersect(f3(org), f3(dir), 0, float(wall), skip);
+            if (!hit && axis >= 0) {
+                Vec3d q = org + dir * wall;
+                const bool leaving = (q.y >= e.hi.y && dir.y >= 0) || (q.y <= e.lo.y && dir.y <= 0);
+                if (!leaving) {  // in through the opposite side
+                    if (++wraps > wrap_limit) {
+                        if (falloff)
+                            arrive(travelled + wall);
+                        r.truncated += mean(w);
+                        return;
+                    }
+                    if (axis == 0)
+                        q.x = dir.x > 0 ? e.lo.x : e.hi.x;
+                    else
+                        q.z = dir.z > 0 ? e.lo.z : e.hi.z;
+                    travelled += wall;
+                    org = q;
+                    skip = {};
+                    --bounce;  // a wrap meets no surface
+                    continue;
+                }
+            }
             if (!hit) {
+                if (falloff)
+                    arrive(travelled + exit_distance(org, dir));
                 r.escaped += mean(w);
+                if (dir.y < 0)
+                    r.escaped_down += mean(w);
                 return;
             }
             const Vec3d p = d3(hit->position);
             const Vec3d n = d3(hit->geometric_normal);  // toward the incoming ray
             if (hit->unlit) {  // pixel-width lines have no area: light passes
+                travelled += length(p - org);
                 org = p;
                 skip = hit->prim();
                 continue;
@@ -358,9 +616,14 @@ struct Tracer {
             if (hit->material_blend > 0 && hit->end_material < materials.size())
                 m = mix(m, materials[hit->end_material], hit->material_blend);
             if (m.opacity < 1 && rng.next() >= m.opacity) {  // passes straight through
+                travelled += length(p - org);
                 org = hit->closed() ? p : p - n * hit->spawn_offset;
                 skip = hit->prim();
                 continue;
+            }
+            if (falloff) {
+                arrive(travelled + length(p - org));
+                start = mean(w);
             }
             const std::uint32_t organ = organs.of(scene, *hit);
             const Bsdf b = make_bsdf(m);
@@ -423,33 +686,68 @@ LightReport trace_light(const geom::Scene& scene, const LightReportSettings& set
     LightReport report;
     Organs organs = find_organs(scene);
     const geom::Bounds3 bounds = world_bounds(scene);
-    std::vector<Beam> beams;
-    for (const geom::Light& l : scene.lights) {
-        if (l.kind != geom::Light::Kind::directional) {
-            report.skipped_lights.push_back(std::string(l.kind == geom::Light::Kind::point ? "point" : "spot") +
-                                            " light at " + format_vec({l.position.x, l.position.y, l.position.z}) +
-                                            ": only directional lights are traced");
-            continue;
+    const Extent extent = make_extent(bounds, settings);
+    const Environment* env = settings.environment.get();
+    std::vector<Source> sources;
+    if (settings.view_lights && !bounds.empty())
+        for (const RenderLight& l : make_lights(scene.lights)) {
+            if (l.kind == RenderLight::Kind::directional) {
+                if (auto b = make_beam(l, extent))
+                    sources.push_back(std::move(*b));
+                else
+                    report.skipped_lights.push_back("directional light toward " + format_vec(d3(l.toward_light)) +
+                                                    ": below the horizon of the infinite canopy");
+                continue;
+            }
+            const char* kind = l.kind == RenderLight::Kind::point ? "point" : "spot";
+            const Vec3d p = d3(l.position);
+            const bool outside = p.x < extent.lo.x || p.x > extent.hi.x || p.z < extent.lo.z || p.z > extent.hi.z;
+            if (extent.canopy && outside) {
+                report.skipped_lights.push_back(std::string(kind) + " light at " + format_vec(p) +
+                                                ": outside the infinite canopy's tile");
+                continue;
+            }
+            Source s = make_point(l, extent);
+            char text[256];
+            std::snprintf(text, sizeof text, "%s light at %s, intensity %g, attenuation 1/(%g + %g d + %g d^2)",
+                          kind, format_vec(p).c_str(), mean(s.colour), l.att_constant, l.att_linear,
+                          l.att_quadratic);
+            s.text = text;
+            sources.push_back(std::move(s));
         }
-        if (bounds.empty())
-            continue;
-        if (auto b = make_beam(l, bounds); b && b->power() > 0)
-            beams.push_back(*b);
+    if (env && !env->black() && !bounds.empty()) {
+        Source s = make_environment_source(*env, extent, settings.seed);
+        s.text = env->kind() == Environment::Kind::sky   ? "sky and sun"
+                 : env->kind() == Environment::Kind::map ? "environment map"
+                                                          : "uniform environment";
+        s.text += " (radiance L gives irradiance L to a surface under all of it)";
+        sources.push_back(std::move(s));
     }
-    double total_power = 0;
-    for (const Beam& b : beams)
-        total_power += b.power();
-    std::vector<std::uint64_t> first{0};  // each beam's first ray
-    for (Beam& b : beams) {
-        const double n = std::max(1.0, std::round(double(settings.rays) * b.power() / total_power));
-        b.nx = std::max<std::uint64_t>(1, std::llround(std::sqrt(n * b.width / b.height)));
-        b.ny = std::max<std::uint64_t>(1, std::llround(n / double(b.nx)));
-        first.push_back(first.back() + b.nx * b.ny);
+    if (extent.canopy) {
         char text[256];
-        std::snprintf(text, sizeof text, "directional toward %s, irradiance %g, %llu x %llu rays",
-                      format_vec(b.to_light).c_str(), mean(b.colour), (unsigned long long)b.nx,
-                      (unsigned long long)b.ny);
+        std::snprintf(text, sizeof text, "infinite canopy: the tile x %g .. %g, z %g .. %g repeats sideways",
+                      extent.lo.x, extent.hi.x, extent.lo.z, extent.hi.z);
         report.lights.emplace_back(text);
+    }
+    std::erase_if(sources, [](const Source& s) { return !(s.power > 0); });
+    double total_power = 0;
+    for (const Source& s : sources)
+        total_power += s.power;
+    std::vector<std::uint64_t> first{0};  // each source's first ray
+    for (Source& s : sources) {
+        const double n = std::max(1.0, std::round(double(settings.rays) * s.power / total_power));
+        const double aspect = s.kind == Source::Kind::beam ? length(s.u) / length(s.v) : 1.0;
+        s.nx = std::max<std::uint64_t>(1, std::llround(std::sqrt(n * aspect)));
+        s.ny = std::max<std::uint64_t>(1, std::llround(n / double(s.nx)));
+        first.push_back(first.back() + s.nx * s.ny);
+        if (s.kind == Source::Kind::beam) {
+            char text[256];
+            std::snprintf(text, sizeof text, "directional toward %s, irradiance %g", format_vec(s.to_light).c_str(),
+                          mean(s.colour));
+            s.text = text;
+        }
+        s.text += ", " + std::to_string(s.nx) + " x " + std::to_string(s.ny) + " rays";
+        report.lights.push_back(s.text);
     }
     report.rays = first.back();
     if (report.rays == 0) {
@@ -460,7 +758,7 @@ LightReport trace_light(const geom::Scene& scene, const LightReportSettings& set
     Camera camera = make_camera(scene.view, scene.bounds.empty() ? bounds : scene.bounds, 512, 512);
     EmbreeScene accel(scene, camera);
     std::vector<SurfaceMaterial> materials = make_materials(scene.materials);
-    Tracer tracer{scene, accel, organs, materials, settings};
+    Tracer tracer{scene, accel, organs, materials, settings, extent};
 
     // Blocks take every blocks-th ray (strided), so each samples the whole beam: their
     // sums are independent batches for the confidence intervals, and their number does
@@ -473,20 +771,15 @@ LightReport trace_light(const geom::Scene& scene, const LightReportSettings& set
             std::vector<Tally> t(organ_count);
             std::vector<std::uint32_t> touched;
             BlockResult& r = results[k];
-            std::size_t beam = 0;
+            std::size_t source = 0;
             for (std::uint64_t i = k; i < report.rays; i += blocks) {
-                while (i >= first[beam + 1])
-                    ++beam;
-                const Beam& b = beams[beam];
-                const std::uint64_t j = i - first[beam];
-                RayRandom rng(settings.seed, beam, j);
-                const double x = (double(j % b.nx) + rng.next()) / double(b.nx);
-                const double y = (double(j / b.nx) + rng.next()) / double(b.ny);
-                const Vec3d org = b.corner + b.u * (x * b.width) + b.v * (y * b.height);
-                const double flux = b.width * b.height / double(b.nx * b.ny);
-                const Rgb3 w{b.colour[0] * flux, b.colour[1] * flux, b.colour[2] * flux};
-                r.emitted += mean(w);
-                tracer.trace(org, b.to_light * -1.0, w, rng, t, touched, r);
+                while (i >= first[source + 1])
+                    ++source;
+                const Source& s = sources[source];
+                const std::uint64_t j = i - first[source];
+                RayRandom rng(settings.seed, source, j);
+                if (std::optional<Emitted> e = emit(s, extent, env, j, s.nx * s.ny, rng))
+                    tracer.trace(e->org, e->dir, e->w, e->falloff, rng, t, touched, r);
             }
             std::sort(touched.begin(), touched.end());
             r.organs.reserve(touched.size());
@@ -506,6 +799,7 @@ LightReport trace_light(const geom::Scene& scene, const LightReportSettings& set
         report.absorbed += r.absorbed;
         report.unattributed += r.unattributed;
         report.escaped += r.escaped;
+        report.escaped_down += r.escaped_down;
         report.truncated += r.truncated;
         for (const auto& [o, t] : r.organs) {
             OrganLight& organ = organs.list[o];
@@ -594,6 +888,7 @@ void write_light_report(const LightReport& report, const std::filesystem::path& 
                 ",\n  \"total_absorbed\": " + number(report.absorbed) +
                 ",\n  \"unattributed_absorbed\": " + number(report.unattributed) +
                 ",\n  \"escaped\": " + number(report.escaped) +
+                ",\n  \"escaped_down\": " + number(report.escaped_down) +
                 ",\n  \"truncated\": " + number(report.truncated) + ",\n  \"organs\": [";
         for (std::size_t i = 0; i < report.organs.size(); ++i) {
             const OrganLight& o = report.organs[i];
@@ -611,7 +906,8 @@ void write_light_report(const LightReport& report, const std::filesystem::path& 
         text += std::string("# ") + irradiance_unit + "; area in model units squared; flux = irradiance x area\n";
         text += "# rays " + std::to_string(report.rays) + ", emitted " + number(report.emitted) +
                 ", total_absorbed " + number(report.absorbed) + ", unattributed_absorbed " +
-                number(report.unattributed) + ", escaped " + number(report.escaped) + ", truncated " +
+                number(report.unattributed) + ", escaped " + number(report.escaped) + ", escaped_down " +
+                number(report.escaped_down) + ", truncated " +
                 number(report.truncated) + "\n";
         text += "module,index,plant,age,area,absorbed,absorbed_ci95,irradiance_front,irradiance_back\n";
         for (const OrganLight& o : report.organs)

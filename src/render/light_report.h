@@ -4,12 +4,16 @@
 // module that drew the primitive: geom's provenance). docs/light.md.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "geom/scene.h"
+#include "render/environment.h"
 
 namespace cambium::render {
 
@@ -23,6 +27,16 @@ struct LightReportSettings {
     /// reported as `truncated`) or after max_bounces surfaces.
     double cutoff = 1e-12;
     int max_bounces = 4096;
+    /// The view file's lights (directional, point, spot); false as --no-view-lights.
+    bool view_lights = true;
+    /// The --sky or --env around the scene, traced too (none: not traced).
+    std::shared_ptr<const Environment> environment;
+    /// Repeat the scene sideways: a ray leaving the x-z bounds of every primitive through
+    /// a side comes back through the opposite side (a stand of infinite extent).
+    bool infinite_canopy = false;
+    /// The canopy's tile, x0 z0 x1 z1, when not those bounds: it must hold them (a stand
+    /// of plants spaced wider than they are).
+    std::optional<std::array<double, 4>> canopy_tile;
 };
 
 /// One organ: a module that drew primitives, in one plant placement.
@@ -43,15 +57,18 @@ struct LightReport {
     double absorbed = 0;   ///< by every surface, organs or not
     double unattributed = 0;  ///< of it, by primitives no module drew (background)
     double escaped = 0;    ///< left the scene
+    double escaped_down = 0;  ///< of it, going down (-y): what reaches the ground
     double truncated = 0;  ///< in paths cut short (settings.cutoff, max_bounces)
     std::uint64_t rays = 0;
     std::vector<std::string> lights;          ///< traced, described
     std::vector<std::string> skipped_lights;  ///< not traced (and why)
 };
 
-/// Traces the scene's view-file directional lights onto its organs. Irradiance unit: a
-/// directional light of diffuse colour (1, 1, 1) delivers 1 to a surface facing it (the
-/// mean of its colour's channels in general); area unit: the model's; flux: their
+/// Traces the scene's lights onto its organs: the view file's directional, point and spot
+/// lights and settings.environment. Irradiance unit: a directional light of diffuse
+/// colour (1, 1, 1) delivers 1 to a surface facing it (the mean of its decoded colour's
+/// channels in general); the renderer's irradiance is pi times it, so an environment of
+/// radiance L all round gives L to a surface; area unit: the model's; flux: their
 /// product. Reflection and transmission are diffuse (the glossy lobe's albedo reflects
 /// with the diffuse one); transparency passes rays straight on; textures are not read.
 /// The same numbers at any thread count. Throws cambium::Error (Embree).

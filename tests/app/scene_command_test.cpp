@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include "shell_output.h"
@@ -118,5 +119,28 @@ TEST(SceneCommand, LightReportOfAField)
     EXPECT_GT(plant0, 0) << r.output;
     EXPECT_EQ(plant0, plant1);
     EXPECT_FALSE(fs::exists(dir / "field.png"));  // a report alone renders nothing
+    fs::remove_all(dir);
+}
+
+// The command traces the --sky placed by --sun-at over an infinite canopy: the report
+// names the sky and the tile, skips nothing, and what went down is below what came in; a
+// bad --sun-at fails before the work, naming the option.
+TEST(SceneCommand, LightReportUnderTheSkyOverACanopy)
+{
+    fs::path dir = scratch();
+    Result r = run("m/p.l m/p.v --sky --sun-at 48.1 11.6 2024-06-21T12:00+02:00 --no-view-lights "
+                   "--infinite-canopy --light-report light.json --light-rays 20000",
+                   dir);
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::ifstream in(dir / "light.json");
+    const std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(json.find("\"sky and sun"), std::string::npos) << json.substr(0, 800);
+    EXPECT_NE(json.find("infinite canopy: the tile"), std::string::npos);
+    EXPECT_NE(json.find("\"skipped_lights\": []"), std::string::npos);
+    EXPECT_EQ(json.find("directional toward"), std::string::npos);  // --no-view-lights
+    Result bad = run("m/p.l m/p.v --sky --sun-at 91 0 2024-06-21T12:00Z --light-report b.json", dir);
+    EXPECT_NE(bad.status, 0);
+    EXPECT_NE(bad.output.find("--sun-at: latitude"), std::string::npos) << bad.output;
+    EXPECT_FALSE(fs::exists(dir / "b.json"));
     fs::remove_all(dir);
 }

@@ -800,3 +800,47 @@ TEST(LightReportOption, ParsedAndChecked)
     EXPECT_TRUE(app::parse_command_line({"--light-report", "r.csv", "-o", "x.png", "a.l", "a.v"})->renders());
     EXPECT_THROW(app::parse_command_line({"--light-report", "r.txt", "a.l", "a.v"}), Error);
 }
+
+// --sun-at turns a place and a local time into the --sky's sun; bad values name the option.
+TEST(SunAtOption, SetsTheSunAndChecksItsValues)
+{
+    app::Options o = *app::parse_command_line(
+        {"--sky", "--sun-at", "0", "0", "2024-03-20T13:07+01:00", "a.l", "a.v"});
+    ASSERT_EQ(o.sun_direction.size(), 3u);
+    EXPECT_GT(o.sun_direction[1], 0.999f);  // the equinox noon sun over the equator
+    o = *app::parse_command_line({"--sky", "--sun-at", "52", "5", "2024-06-21T07:00Z", "a.l", "a.v"});
+    EXPECT_GT(o.sun_direction[0], 0.3f);  // the morning sun is in the east (+x)
+    auto error = [](std::vector<std::string> words) {
+        try {
+            app::parse_command_line(words);
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_NE(error({"--sky", "--sun-at", "95", "0", "2024-03-20T12:00Z", "a.l", "a.v"}).find("--sun-at: latitude"),
+              std::string::npos);
+    EXPECT_NE(error({"--sky", "--sun-at", "0", "200", "2024-03-20T12:00Z", "a.l", "a.v"}).find("--sun-at: longitude"),
+              std::string::npos);
+    EXPECT_NE(error({"--sky", "--sun-at", "0", "0", "2023-02-29T12:00Z", "a.l", "a.v"}).find("--sun-at:"),
+              std::string::npos);
+    EXPECT_NE(error({"--sky", "--sun-at", "0", "0", "2023-02-20T12:00", "a.l", "a.v"}).find("UTC offset"),
+              std::string::npos);
+    EXPECT_NE(error({"--sun-at", "0", "0", "2023-02-20T12:00Z", "a.l", "a.v"}).find("give --sky"),
+              std::string::npos);
+    EXPECT_NE(error({"--sky", "--sun", "0", "1", "0", "--sun-at", "0", "0", "2023-02-20T12:00Z", "a.l", "a.v"})
+                  .find("give one"),
+              std::string::npos);
+}
+
+TEST(InfiniteCanopyOption, NeedsTheLightReport)
+{
+    EXPECT_TRUE(app::parse_command_line({"--light-report", "r.json", "--infinite-canopy", "a.l", "a.v"})->infinite_canopy);
+    EXPECT_THROW(app::parse_command_line({"--infinite-canopy", "a.l", "a.v"}), Error);
+    app::Options o = *app::parse_command_line(
+        {"--light-report", "r.json", "--canopy-tile", "-1", "-2", "3", "4", "a.l", "a.v"});
+    EXPECT_TRUE(o.infinite_canopy);
+    EXPECT_EQ(o.canopy_tile, (std::vector<double>{-1, -2, 3, 4}));
+    EXPECT_THROW(app::parse_command_line({"--light-report", "r.json", "--canopy-tile", "3", "0", "1", "4", "a.l", "a.v"}),
+                 Error);
+}
