@@ -13,6 +13,7 @@
 #include "app/distributed.h"
 #include "app/pipeline.h"
 #include "app/stats.h"
+#include "base/output_format.h"
 #include "geom/animation_file.h"
 #include "render/render.h"
 
@@ -79,5 +80,12 @@ render::WriteOptions write_options(const Options& options);
 
 /// The scene's view with --orbit, --zoom, --fit, --fov, --perspective / --parallel.
 void apply_camera_options(geom::Scene& scene, const Options& options);
+
+/// Writes `scene` as the window shows it (the camera options applied) as a vector drawing
+/// in `format` (-ps, or an -o named .ps, .svg or .pdf): every primitive tessellated and
+/// projected, sorted far to near (render/vector_drawing.h). Throws cambium::Error when
+/// the drawing would pass --max-memory.
+void write_vector_output(const geom::Scene& scene, const Options& options,
+                         const std::filesystem::path& file, VectorFormat format);
 
 }  // namespace cambium::app
