@@ -340,6 +340,10 @@ int run_scene(Options options, const std::function<void(const std::string&)>& sa
         write_vector_output(scene, options, *options.postscript, VectorFormat::ps);
         say("wrote " + options.postscript->string());
     }
+    if (options.inventor) {
+        write_inventor_output(scene, options, *options.inventor);
+        say("wrote " + options.inventor->string());
+    }
     if (images.empty()) {
         report_stats(stats, options);
         return 0;
@@ -391,7 +395,8 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
     if (writes)
         write_strings(model, string, options,
                       options.steps.value_or(model.lsystem.derivation_length()), say);
-    if (images.empty() && !options.light_report && !options.rayshade && !options.postscript) {
+    if (images.empty() && !options.light_report && !options.rayshade && !options.postscript &&
+        !options.inventor) {
         // Only strings and the view volume are written: the turtle walks the string for
         // -vv without building geometry, and has nothing to do otherwise.
         if (options.view_volume && writes) {
@@ -430,6 +435,10 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
     if (options.postscript && writes) {
         write_vector_output(scene, options, *options.postscript, VectorFormat::ps);
         say("wrote " + options.postscript->string());
+    }
+    if (options.inventor && writes) {
+        write_inventor_output(scene, options, *options.inventor);
+        say("wrote " + options.inventor->string());
     }
     if (options.light_report && writes)
         write_light_report(scene, options, say);

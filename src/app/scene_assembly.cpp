@@ -80,6 +80,7 @@ Options plant_options(const Options& options, const ScenePlant& plant)
     o.view_volume.reset();
     o.rayshade.reset();
     o.postscript.reset();
+    o.inventor.reset();
     o.verbosity = Verbosity::normal;
     return o;
 }

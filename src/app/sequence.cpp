@@ -34,6 +34,7 @@
 #include "render/framing.h"
 #include "render/vector_writer.h"
 #include "geom/tessellate.h"
+#include "geom/inventor_export.h"
 #include "base/limits.h"
 #include "render/ground.h"
 
@@ -129,6 +130,8 @@ void require_numbered_names(const Options& options, const std::vector<fs::path>&
         check(*options.rayshade, "-ray");
     if (options.postscript)
         check(*options.postscript, "-ps");
+    if (options.inventor)
+        check(*options.inventor, "-iv");
 }
 
 render::ViewOverrides view_overrides(const ShotOptions& shot)
@@ -537,7 +540,7 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         if (writes)
             out.write_strings(model, written, f.number);
         if (!options.view_volume && !options.rayshade && !options.postscript &&
-            !filter.to_render(number))
+            !options.inventor && !filter.to_render(number))
             return;
         if (refit && animation->new_view_between_frames)
             model.view = read_view(options);
@@ -564,6 +567,13 @@ int run_animation(const Options& options, const SequenceOutputs& out)
             geom::Scene frame = interpret_turtle_string(
                 model, homo ? *homo : turtle_string(model, string, options), options);
             write_vector_output(frame, options, file, VectorFormat::ps);
+            out.say("wrote " + file.string());
+        }
+        if (options.inventor && writes) {
+            fs::path file = frame_file(*options.inventor, f.number);
+            geom::Scene frame = interpret_turtle_string(
+                model, homo ? *homo : turtle_string(model, string, options), options);
+            write_inventor_output(frame, options, file);
             out.say("wrote " + file.string());
         }
         if (!filter.to_render(number))
@@ -859,6 +869,14 @@ render::WriteOptions write_options(const Options& options)
 void apply_camera_options(geom::Scene& scene, const Options& options)
 {
     scene.view = render::apply_overrides(scene.view, view_overrides(options.shot), scene.bounds);
+}
+
+void write_inventor_output(const geom::Scene& scene, const Options& options,
+                           const std::filesystem::path& file)
+{
+    geom::MeshExportOptions how;
+    how.max_memory_bytes = options.max_memory_bytes;
+    geom::write_inventor(scene, file, how);
 }
 
 void write_vector_output(const geom::Scene& scene, const Options& options,

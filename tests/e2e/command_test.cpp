@@ -908,6 +908,22 @@ TEST(Command, PostScriptOfAStillAndOfEveryFrame)
     EXPECT_FALSE(fs::exists(dir / "f1.svg"));
 }
 
+// -iv writes the plant as an Inventor 2.1 scene: a still's alone, and one per frame.
+TEST(Command, InventorOfAStillAndOfEveryFrame)
+{
+    fs::path dir = growing_plant(scratch("iv"));
+    Result still = run("-q -iv " + (dir / "p.iv").string() + " " + plant_files(dir));
+    ASSERT_EQ(still.status, 0) << still.output;
+    const std::string text = bytes_of(dir / "p.iv");
+    EXPECT_EQ(text.rfind("#Inventor V2.1 ascii\n", 0), 0u);
+    EXPECT_NE(text.find("IndexedFaceSet"), std::string::npos);
+    EXPECT_FALSE(fs::exists(dir / "g.png"));
+    Result frames = run("-a -q -iv " + (dir / "r%d.iv").string() + " " + plant_files(dir));
+    ASSERT_EQ(frames.status, 0) << frames.output;
+    ASSERT_TRUE(fs::exists(dir / "r1.iv") && fs::exists(dir / "r3.iv"));
+    EXPECT_LT(fs::file_size(dir / "r1.iv"), fs::file_size(dir / "r3.iv"));
+}
+
 // -o chooses SVG and PDF by the extension; a picture beside them is still rendered.
 TEST(Command, SvgAndPdfByTheOutputsExtension)
 {
