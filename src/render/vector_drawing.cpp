@@ -182,7 +182,22 @@ VectorDrawing project_drawing(const geom::Scene& scene, const geom::TriangleMesh
         const double area = length(n);
         if (!(area > 0))
             continue;
-        const std::uint16_t material = i < triangles.material.size() ? triangles.material[i] : 0;
+        // the side the window sees: its vertex normals' side, else its winding's
+        geom::Vec3 front = n;
+        if (t[0] < triangles.normals.size() && t[1] < triangles.normals.size() &&
+            t[2] < triangles.normals.size()) {
+            const geom::Vec3 sum = vec(triangles.normals[t[0]]) + vec(triangles.normals[t[1]]) +
+                                   vec(triangles.normals[t[2]]);
+            if (length(sum) > 0)
+                front = sum;
+        }
+        const geom::Vec3 to_eye = camera.projection() == Camera::Projection::perspective
+                                      ? camera.origin() - centre
+                                      : -camera.forward();
+        const bool back = dot(front, to_eye) < 0 && i < triangles.back_material.size();
+        std::uint16_t material = i < triangles.material.size() ? triangles.material[i] : 0;
+        if (back)
+            material = triangles.back_material[i];
         s.colour = vector_colour(scene, material, n / area, centre, camera);
         s.depth = centre_depth;
         out.shapes.push_back(s);

@@ -36,7 +36,8 @@ inline constexpr std::uint64_t vector_shape_bytes = sizeof(VectorShape);
 
 /// Projects `triangles` (the scene's primitives tessellated, instances placed: geometry
 /// in world space) and the scene's pixel-width lines (`line style: pixel`) through
-/// `camera`, colours each shape by its material (lit by the view's first light, as
+/// `camera`, colours each shape by its material (the back material where the window sees
+/// a triangle's back; lit by the view's first light, as
 /// vector_colour() says) and sorts them far to near by the depth of their centres
 /// (painter's algorithm). Shapes wholly behind a perspective eye or outside the clipping
 /// planes are left out.

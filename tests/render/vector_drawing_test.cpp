@@ -96,6 +96,21 @@ TEST(VectorDrawing, LeavesOutWhatTheWindowCannotShow)
     EXPECT_TRUE(project_drawing(flat_scene(), off, camera).shapes.empty());
 }
 
+// A triangle whose back the window sees is filled with its back material.
+TEST(VectorDrawing, BackFacesShowTheBackMaterial)
+{
+    geom::Scene scene = flat_scene();
+    scene.materials[3].diffuse = {0, 1, 0};
+    geom::TriangleMesh m = near_then_far();
+    m.back_material = {3, 3};
+    m.normals[3] = m.normals[4] = m.normals[5] = {0, 0, -1};  // the far one faces away
+    const Camera camera = Camera::parallel({0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 0.01, 10, 200, 100);
+    const VectorDrawing d = project_drawing(scene, m, camera);
+    ASSERT_EQ(d.shapes.size(), 2u);
+    EXPECT_EQ(d.shapes[0].colour, (geom::Rgb{0, 1, 0}));  // far: its back
+    EXPECT_EQ(d.shapes[1].colour, (geom::Rgb{1, 0, 0}));  // near: its front
+}
+
 // Lit, a face turned to the light is brighter than one turned away at an angle, and a
 // material's ambient term keeps the second from black; `filled` draws the flat colour.
 TEST(VectorDrawing, ShadesByTheFirstLight)
