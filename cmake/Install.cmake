@@ -3,7 +3,7 @@
 # their headers (P/include/cambium/<layer>/...) and a CMake package, so another project can
 #   find_package(cambium 0.1 REQUIRED)
 #   target_link_libraries(app PRIVATE cambium::render)   # or cambium::lsys, ::geom, ...
-# The libraries link Embree, TBB, FreeType, fontconfig, CLI11, fmt and nlohmann-json
+# The libraries link Embree, TBB, FreeType, fontconfig, cairo, CLI11, fmt and nlohmann-json
 # privately; the package finds them again for the consumer's link
 # (cmake/cambiumConfig.cmake.in). OpenImageIO is linked only into
 # libcambium_imageio.so, installed into the library folder (src/render/CMakeLists.txt),
@@ -12,13 +12,14 @@ include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
 set(CAMBIUM_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/cambium)
-foreach(layer base lsys geom env render app)
+foreach(layer base lsys geom env render vector app)
   set_target_properties(cambium_${layer} PROPERTIES EXPORT_NAME ${layer})
 endforeach()
 # The static libraries name the warning flags' target in their link interface.
 set_target_properties(cambium_warnings PROPERTIES EXPORT_NAME warnings)
 
-install(TARGETS cambium cambium_base cambium_lsys cambium_geom cambium_env cambium_render cambium_app
+install(TARGETS cambium cambium_base cambium_lsys cambium_geom cambium_env cambium_render cambium_vector
+                cambium_app
                 cambium_warnings
   EXPORT cambiumTargets
   RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR}

@@ -21,6 +21,8 @@ packages=(
   # OpenImageIO's CMake package requires its command-line tools (iconvert, oiiotool, ...)
   # to exist; Debian has them only as a Recommends of libopenimageio-dev.
   openimageio-tools
+  # -ps, .svg and .pdf outputs: cairo (LGPL-2.1/MPL-1.1, linked dynamically) draws them
+  libcairo2-dev
   # tests and benchmarks
   libgtest-dev libbenchmark-dev
   # zlib: the conformance tests read cpfg's gzipped rayshade exports (scene.ray.gz)

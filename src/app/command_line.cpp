@@ -87,8 +87,8 @@ const std::map<std::string, CpfgOption>& cpfg_options()
         {"-ras", {1, unsupported_output("colour-index SGI raster")}},
         {"-rle", {1, unsupported_output("Utah RLE")}},
         {"-ray", {1, [](Options& o, auto& a) { o.rayshade = a[0]; }}},
-        {"-ps", {1, unsupported_output("PostScript")}},
-        {"-iv", {1, unsupported_output("Inventor")}},
+        {"-ps", {1, [](Options& o, auto& a) { o.postscript = a[0]; }}},
+        {"-iv", {1, [](Options& o, auto& a) { o.inventor = a[0]; }}},
         {"-gls", {1, gls_output}},
         {"-glsl", {1, gls_output}},
         // cpfg's animate mode: every frame of the animation file (or its defaults).
@@ -268,7 +268,7 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
 
     CLI::App cli{"cambium: renders cpfg plant models physically.\n"
                  "cpfg options: -w W H (image size, default 640 480), -m[n] file.map, -M[n] file.mat, -c<n>, -str file,\n"
-                 "-strb file, -homo, -vv file, -ray file, -rgb file, -tga file, -gls file, -v, -V, -P cpp, -e file,\n"
+                 "-strb file, -homo, -vv file, -ray file, -ps file, -iv file, -rgb file, -tga file, -gls file, -v, -V, -P cpp, -e file,\n"
                  "-a (every frame of the animation file); window options (-g -wp -wt -mb -pm -sb -s<n>)\n"
                  "are accepted and ignored.\n"
                  "--ground [COLOUR|FILE]: a ground plane under the plant, grey (default), a colour\n"

@@ -79,6 +79,8 @@ struct Options {
     bool homomorphism_in_string = false;                  ///< -homo
     std::optional<std::filesystem::path> view_volume;    ///< -vv
     std::optional<std::filesystem::path> rayshade;       ///< -ray: rayshade 4.0 scene
+    std::optional<std::filesystem::path> postscript;     ///< -ps: the window as PostScript
+    std::optional<std::filesystem::path> inventor;       ///< -iv: Inventor 2.1 scene
     // Statistics (app/stats.h): a readable block on stderr, and JSON
     bool stats = false;                                   ///< --stats
     std::optional<std::filesystem::path> stats_json;     ///< --stats-json FILE
@@ -147,7 +149,8 @@ struct Options {
     bool renders() const
     {
         return !outputs.empty() ||
-               (!string_text && !string_binary && !view_volume && !rayshade && !light_report);
+               (!string_text && !string_binary && !view_volume && !rayshade && !postscript &&
+                !inventor && !light_report);
     }
 };
 

@@ -171,11 +171,15 @@ void check_outputs(const Options& options, const std::vector<std::filesystem::pa
         throw Error("--organ-masks writes its layers into EXR images: give an -o file.exr");
     for (const auto& out : outputs) {
         const OutputFormat* format = find_output_format(out);
-        if (format && format->mesh != MeshFormat::none) {
+        if (format && (format->mesh != MeshFormat::none || format->vector != VectorFormat::none)) {
             if (is_sequence(options))
                 throw Error(out.string() + ": a " + std::string(format->name) +
-                            " file holds one still's geometry; an animation or turntable "
-                            "writes images or a video");
+                            " file holds one still's " +
+                            (format->mesh != MeshFormat::none ? "geometry" : "drawing") +
+                            "; an animation or turntable writes images or a video" +
+                            (format->vector != VectorFormat::none
+                                 ? " (-ps with a number field writes PostScript per frame)"
+                                 : ""));
             std::error_code ec;
             if (out.has_parent_path() && !std::filesystem::is_directory(out.parent_path(), ec))
                 throw Error(out.string() + ": the folder " + out.parent_path().string() +
@@ -196,8 +200,8 @@ void write_rayshade_output(const geom::Scene& scene, const Options& options,
     say("wrote " + file.string());
 }
 
-/// Writes the mesh outputs among `outputs` from `scene` (rank 0 alone under --mpi) and
-/// returns the others, the pictures to render.
+/// Writes the mesh and vector outputs among `outputs` from `scene` (rank 0 alone under
+/// --mpi) and returns the others, the pictures to render.
 std::vector<std::filesystem::path> write_meshes(const geom::Scene& scene, const Options& options,
                                                 const std::vector<std::filesystem::path>& outputs,
                                                 const std::function<void(const std::string&)>& say,
@@ -206,12 +210,17 @@ std::vector<std::filesystem::path> write_meshes(const geom::Scene& scene, const 
     std::vector<std::filesystem::path> pictures;
     for (const auto& out : outputs) {
         const OutputFormat* format = find_output_format(out);
-        if (!format || format->mesh == MeshFormat::none) {
+        if (!format || (format->mesh == MeshFormat::none && format->vector == VectorFormat::none)) {
             pictures.push_back(out);
             continue;
         }
         if (!writes)
             continue;
+        if (format->vector != VectorFormat::none) {
+            write_vector_output(scene, options, out, format->vector);
+            say("wrote " + out.string());
+            continue;
+        }
         geom::MeshExportOptions mesh;
         mesh.texture_folder = options.scene ? options.scene->parent_path() : options.view.parent_path();
         mesh.max_memory_bytes = options.max_memory_bytes;
@@ -327,6 +336,14 @@ int run_scene(Options options, const std::function<void(const std::string&)>& sa
         write_light_report(scene, options, say);
     if (options.rayshade)
         write_rayshade_output(scene, options, *options.rayshade, nullptr, say);
+    if (options.postscript) {
+        write_vector_output(scene, options, *options.postscript, VectorFormat::ps);
+        say("wrote " + options.postscript->string());
+    }
+    if (options.inventor) {
+        write_inventor_output(scene, options, *options.inventor);
+        say("wrote " + options.inventor->string());
+    }
     if (images.empty()) {
         report_stats(stats, options);
         return 0;
@@ -378,7 +395,8 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
     if (writes)
         write_strings(model, string, options,
                       options.steps.value_or(model.lsystem.derivation_length()), say);
-    if (images.empty() && !options.light_report && !options.rayshade) {
+    if (images.empty() && !options.light_report && !options.rayshade && !options.postscript &&
+        !options.inventor) {
         // Only strings and the view volume are written: the turtle walks the string for
         // -vv without building geometry, and has nothing to do otherwise.
         if (options.view_volume && writes) {
@@ -414,6 +432,14 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
     }
     if (options.rayshade && writes)
         write_rayshade_output(scene, options, *options.rayshade, &model, say);
+    if (options.postscript && writes) {
+        write_vector_output(scene, options, *options.postscript, VectorFormat::ps);
+        say("wrote " + options.postscript->string());
+    }
+    if (options.inventor && writes) {
+        write_inventor_output(scene, options, *options.inventor);
+        say("wrote " + options.inventor->string());
+    }
     if (options.light_report && writes)
         write_light_report(scene, options, say);
     if (images.empty()) {

@@ -79,6 +79,8 @@ Options plant_options(const Options& options, const ScenePlant& plant)
     o.string_binary.reset();
     o.view_volume.reset();
     o.rayshade.reset();
+    o.postscript.reset();
+    o.inventor.reset();
     o.verbosity = Verbosity::normal;
     return o;
 }

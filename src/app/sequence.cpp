@@ -32,6 +32,10 @@
 #include "render/denoise.h"
 #include "render/organ_masks.h"
 #include "render/framing.h"
+#include "render/vector_writer.h"
+#include "geom/tessellate.h"
+#include "geom/inventor_export.h"
+#include "base/limits.h"
 #include "render/ground.h"
 
 namespace cambium::app {
@@ -124,6 +128,10 @@ void require_numbered_names(const Options& options, const std::vector<fs::path>&
         check(*options.view_volume, "-vv");
     if (options.rayshade)
         check(*options.rayshade, "-ray");
+    if (options.postscript)
+        check(*options.postscript, "-ps");
+    if (options.inventor)
+        check(*options.inventor, "-iv");
 }
 
 render::ViewOverrides view_overrides(const ShotOptions& shot)
@@ -531,7 +539,8 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         const lsys::ModuleString& written = homo ? *homo : string;
         if (writes)
             out.write_strings(model, written, f.number);
-        if (!options.view_volume && !options.rayshade && !filter.to_render(number))
+        if (!options.view_volume && !options.rayshade && !options.postscript &&
+            !options.inventor && !filter.to_render(number))
             return;
         if (refit && animation->new_view_between_frames)
             model.view = read_view(options);
@@ -550,6 +559,21 @@ int run_animation(const Options& options, const SequenceOutputs& out)
             geom::Scene frame = interpret_turtle_string(
                 model, homo ? *homo : turtle_string(model, string, options), options);
             geom::write_rayshade(frame, file, rayshade_options(options, file, &model));
+            out.say("wrote " + file.string());
+        }
+        if (options.postscript && writes) {
+            // the frame's own geometry, framed as a still of it would be
+            fs::path file = frame_file(*options.postscript, f.number);
+            geom::Scene frame = interpret_turtle_string(
+                model, homo ? *homo : turtle_string(model, string, options), options);
+            write_vector_output(frame, options, file, VectorFormat::ps);
+            out.say("wrote " + file.string());
+        }
+        if (options.inventor && writes) {
+            fs::path file = frame_file(*options.inventor, f.number);
+            geom::Scene frame = interpret_turtle_string(
+                model, homo ? *homo : turtle_string(model, string, options), options);
+            write_inventor_output(frame, options, file);
             out.say("wrote " + file.string());
         }
         if (!filter.to_render(number))
@@ -851,6 +875,42 @@ render::WriteOptions write_options(const Options& options)
 void apply_camera_options(geom::Scene& scene, const Options& options)
 {
     scene.view = render::apply_overrides(scene.view, view_overrides(options.shot), scene.bounds);
+}
+
+void write_inventor_output(const geom::Scene& scene, const Options& options,
+                           const std::filesystem::path& file)
+{
+    geom::MeshExportOptions how;
+    how.max_memory_bytes = options.max_memory_bytes;
+    geom::write_inventor(scene, file, how);
+}
+
+void write_vector_output(const geom::Scene& scene, const Options& options,
+                         const std::filesystem::path& file, VectorFormat format)
+{
+    const geom::Tessellation how;
+    // the tessellated mesh and the drawing's shapes are held together
+    constexpr std::uint64_t bytes_per_triangle = 3 * (12 + 12 + 8) + 12 + 6 + 4 +
+                                                 render::vector_shape_bytes;
+    std::uint64_t shapes = geom::tessellated_triangles(scene, how);
+    if (scene.line_radius_in_pixels) {
+        shapes += scene.geometry.lines.segment_count();
+        for (const geom::Instance& in : scene.instances)
+            if (in.prototype < scene.prototypes.size())
+                shapes += scene.prototypes[in.prototype].geometry.lines.segment_count();
+    }
+    if (shapes > options.max_memory_bytes / bytes_per_triangle)
+        throw Error(file.string() + ": the drawing's " + std::to_string(shapes) +
+                    " shapes need " + byte_size_text(shapes * bytes_per_triangle) +
+                    ", more than the memory budget of " +
+                    byte_size_text(options.max_memory_bytes) + " (--max-memory)");
+    const geom::View view =
+        render::apply_overrides(scene.view, view_overrides(options.shot), scene.bounds);
+    const render::Camera camera =
+        render::make_camera(view, scene.bounds, options.width, options.height);
+    render::VectorDrawing drawing =
+        render::project_drawing(scene, geom::tessellate(scene, how), camera);
+    render::write_vector(drawing, file, format);
 }
 
 int run_sequence(const Options& options, const SequenceOutputs& outputs)

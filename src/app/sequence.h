@@ -13,6 +13,7 @@
 #include "app/distributed.h"
 #include "app/pipeline.h"
 #include "app/stats.h"
+#include "base/output_format.h"
 #include "geom/animation_file.h"
 #include "render/render.h"
 
@@ -83,5 +84,16 @@ render::WriteOptions write_options(const Options& options);
 
 /// The scene's view with --orbit, --zoom, --fit, --fov, --perspective / --parallel.
 void apply_camera_options(geom::Scene& scene, const Options& options);
+
+/// -iv: `scene` as an Inventor 2.1 file (geom/inventor_export.h), within --max-memory.
+void write_inventor_output(const geom::Scene& scene, const Options& options,
+                           const std::filesystem::path& file);
+
+/// Writes `scene` as the window shows it (the camera options applied) as a vector drawing
+/// in `format` (-ps, or an -o named .ps, .svg or .pdf): every primitive tessellated and
+/// projected, sorted far to near (render/vector_drawing.h). Throws cambium::Error when
+/// the drawing would pass --max-memory.
+void write_vector_output(const geom::Scene& scene, const Options& options,
+                         const std::filesystem::path& file, VectorFormat format);
 
 }  // namespace cambium::app

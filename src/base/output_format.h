@@ -17,6 +17,9 @@ enum class ImageFormat { png, jpeg, tiff, exr, sgi, targa };
 /// The mesh file formats geom::write_mesh knows.
 enum class MeshFormat { none, obj, ply, gls, glb };
 
+/// The vector drawing formats of the window's projection (render/vector_writer.h).
+enum class VectorFormat { none, ps, svg, pdf };
+
 /// What one kind of output file holds.
 struct OutputFormat {
     std::string_view name;                      ///< for messages: "PNG", "SGI RGB"
@@ -26,14 +29,15 @@ struct OutputFormat {
     MeshFormat mesh = MeshFormat::none;         ///< the plant's geometry, not a picture
     bool keeps_layers = false;  ///< albedo, normal and depth layers beside RGBA (EXR)
     bool keeps_alpha = false;   ///< a transparent render keeps its alpha channel
+    VectorFormat vector = VectorFormat::none;   ///< the window's projection as vector paths
 
-    bool is_image() const { return !video && mesh == MeshFormat::none; }
+    bool is_image() const { return !video && mesh == MeshFormat::none && vector == VectorFormat::none; }
 };
 
 // clang-format off
 /// The table. The image I/O module reads it too (it links nothing of render), so it lives
 /// here, whole.
-inline constexpr std::array<OutputFormat, 11> output_formats{{
+inline constexpr std::array<OutputFormat, 14> output_formats{{
     {"PNG",      {".png"},                          false, ImageFormat::png,   MeshFormat::none, false, true},
     {"OpenEXR",  {".exr"},                          false, ImageFormat::exr,   MeshFormat::none, true,  true},
     {"TIFF",     {".tif", ".tiff"},                 false, ImageFormat::tiff,  MeshFormat::none, false, true},
@@ -45,6 +49,9 @@ inline constexpr std::array<OutputFormat, 11> output_formats{{
     {"PLY",      {".ply"},                          false, ImageFormat::png,   MeshFormat::ply,  false, false},
     {"GLS",      {".gls"},                          false, ImageFormat::png,   MeshFormat::gls,  false, false},
     {"glTF binary", {".glb"},                       false, ImageFormat::png,   MeshFormat::glb,  false, false},
+    {"PostScript", {".ps"},                         false, ImageFormat::png,   MeshFormat::none, false, false, VectorFormat::ps},
+    {"SVG",      {".svg"},                          false, ImageFormat::png,   MeshFormat::none, false, false, VectorFormat::svg},
+    {"PDF",      {".pdf"},                          false, ImageFormat::png,   MeshFormat::none, false, false, VectorFormat::pdf},
 }};
 // clang-format on
 

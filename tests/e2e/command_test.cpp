@@ -880,6 +880,87 @@ TEST(Command, RayshadeSceneOfAStillAndOfEveryFrame)
     EXPECT_NE(one.output.find("-ray names one file for"), std::string::npos) << one.output;
 }
 
+// -ps writes the window as PostScript: a still's alone (nothing rendered) with the page
+// the window's size, and one per frame through the name's number field, each frame's
+// drawing growing with its plant.
+TEST(Command, PostScriptOfAStillAndOfEveryFrame)
+{
+    fs::path dir = growing_plant(scratch("ps"));
+    Result still = run("-q -w 160 120 -ps " + (dir / "p.ps").string() + " " + plant_files(dir));
+    ASSERT_EQ(still.status, 0) << still.output;
+    std::string text = bytes_of(dir / "p.ps");
+    EXPECT_EQ(text.rfind("%!PS", 0), 0u);
+    EXPECT_NE(text.find("\n%%BoundingBox: 0 0 160 120\n"), std::string::npos);
+    EXPECT_FALSE(fs::exists(dir / "g.png"));  // only the drawing was asked for
+
+    Result frames = run("-a -q -w 160 120 -ps " + (dir / "r%d.ps").string() + " " + plant_files(dir));
+    ASSERT_EQ(frames.status, 0) << frames.output;
+    ASSERT_TRUE(fs::exists(dir / "r1.ps") && fs::exists(dir / "r3.ps"));
+    EXPECT_LT(fs::file_size(dir / "r1.ps"), fs::file_size(dir / "r3.ps"));
+
+    Result one = run("-a -q -ps " + (dir / "one.ps").string() + " " + plant_files(dir));
+    EXPECT_NE(one.status, 0);
+    EXPECT_NE(one.output.find("-ps names one file for"), std::string::npos) << one.output;
+    // an SVG or PDF holds one still: a sequence refuses it before any work
+    Result svg = run("-a -q -o " + (dir / "f%d.svg").string() + " " + plant_files(dir));
+    EXPECT_NE(svg.status, 0);
+    EXPECT_NE(svg.output.find("holds one still's drawing"), std::string::npos) << svg.output;
+    EXPECT_FALSE(fs::exists(dir / "f1.svg"));
+}
+
+// -iv writes the plant as an Inventor 2.1 scene: a still's alone, and one per frame.
+TEST(Command, InventorOfAStillAndOfEveryFrame)
+{
+    fs::path dir = growing_plant(scratch("iv"));
+    Result still = run("-q -iv " + (dir / "p.iv").string() + " " + plant_files(dir));
+    ASSERT_EQ(still.status, 0) << still.output;
+    const std::string text = bytes_of(dir / "p.iv");
+    EXPECT_EQ(text.rfind("#Inventor V2.1 ascii\n", 0), 0u);
+    EXPECT_NE(text.find("IndexedFaceSet"), std::string::npos);
+    EXPECT_FALSE(fs::exists(dir / "g.png"));
+    Result frames = run("-a -q -iv " + (dir / "r%d.iv").string() + " " + plant_files(dir));
+    ASSERT_EQ(frames.status, 0) << frames.output;
+    ASSERT_TRUE(fs::exists(dir / "r1.iv") && fs::exists(dir / "r3.iv"));
+    EXPECT_LT(fs::file_size(dir / "r1.iv"), fs::file_size(dir / "r3.iv"));
+}
+
+// -o chooses SVG and PDF by the extension; a picture beside them is still rendered.
+TEST(Command, SvgAndPdfByTheOutputsExtension)
+{
+    fs::path dir = growing_plant(scratch("svg"));
+    Result r = run("-q -w 64 48 --spp 1 -o " + (dir / "p.svg").string() + " -o " +
+                   (dir / "p.pdf").string() + " -o " + (dir / "p.png").string() + " " +
+                   plant_files(dir));
+    ASSERT_EQ(r.status, 0) << r.output;
+    const std::string svg = bytes_of(dir / "p.svg");
+    EXPECT_NE(svg.find("viewBox=\"0 0 64 48\""), std::string::npos) << svg.substr(0, 400);
+    EXPECT_NE(svg.find("<path"), std::string::npos);
+    EXPECT_EQ(bytes_of(dir / "p.pdf").rfind("%PDF-", 0), 0u);
+    EXPECT_TRUE(fs::exists(dir / "p.png"));
+}
+
+// A -ps name in a folder that does not exist, or one past --max-memory, fails with a
+// message naming it, as -ray's does, and leaves no file (partial or temporary) behind.
+TEST(Command, PostScriptThatCannotBeWrittenLeavesNothing)
+{
+    fs::path dir = growing_plant(scratch("ps_bad"));
+    Result ray = run("-q -ray " + (dir / "no" / "p.ray").string() + " " + plant_files(dir));
+    Result ps = run("-q -ps " + (dir / "no" / "p.ps").string() + " " + plant_files(dir));
+    EXPECT_NE(ray.status, 0);
+    EXPECT_NE(ps.status, 0);
+    EXPECT_NE(ps.output.find((dir / "no" / "p.ps").string()), std::string::npos) << ps.output;
+    EXPECT_FALSE(fs::exists(dir / "no"));
+    // enough for the derivation and the scene, not for the drawing's 144 shapes
+    Result big = run("-q --max-memory 20K -ps " + (dir / "p.ps").string() + " " + plant_files(dir));
+    EXPECT_NE(big.status, 0);
+    EXPECT_NE(big.output.find("p.ps: the drawing's 144 shapes need"), std::string::npos) << big.output;
+    EXPECT_NE(big.output.find("memory budget"), std::string::npos) << big.output;
+    std::size_t files = 0;
+    for (const auto& e : fs::directory_iterator(dir))
+        files += e.path().filename() != "g.l" && e.path().filename() != "g.v";
+    EXPECT_EQ(files, 0u);
+}
+
 // --organ-masks in an animation: an organ keeps its name from frame to frame (its index
 // where it appeared @ that frame's step), though new modules shift string indices.
 TEST(Sequence, OrganMaskNamesAreStableAcrossFrames)

@@ -14,6 +14,7 @@
 #include "app/scene_file.h"
 #include "base/diagnostics.h"
 #include "geom/background_scene.h"
+#include "geom/inventor_export.h"
 #include "geom/mesh_export.h"
 #include "geom/tessellate.h"
 #include "model_folder.h"
@@ -108,6 +109,66 @@ TEST(MeshExport, ObjPlyAndGlsHoldTheTessellatedPlant)
     EXPECT_EQ(xyz[0], mesh.positions[0][0]);
     EXPECT_EQ(rgb[0], static_cast<unsigned char>(
                           std::lround(plant.scene.materials[mesh.material[0]].diffuse.r * 255)));
+}
+
+/// The numbers of an Inventor field's list `name [ ... ]` after `from` in `text`.
+std::vector<double> inventor_list(const std::string& text, const std::string& name, std::size_t from = 0)
+{
+    const std::size_t at = text.find(name + " [", from);
+    if (at == std::string::npos)
+        return {};
+    const std::size_t end = text.find(']', at);
+    std::string inside = text.substr(at + name.size() + 2, end - at - name.size() - 2);
+    for (char& c : inside)
+        c = c == ',' ? ' ' : c;
+    std::istringstream in(inside);
+    std::vector<double> out;
+    for (double v; in >> v;)
+        out.push_back(v);
+    return out;
+}
+
+// -iv: the Inventor 2.1 scene holds the tessellated plant: its points in order, one face
+// of three indices a triangle, and a material a face whose diffuse colour is the
+// triangle's material's.
+TEST(MeshExport, InventorHoldsTheTessellatedPlant)
+{
+    Plant plant;
+    const geom::TriangleMesh mesh = geom::tessellate(plant.scene, {});
+    geom::write_inventor(plant.scene, plant.folder / "plant.iv");
+    std::ifstream in(plant.folder / "plant.iv");
+    std::stringstream buffer;
+    buffer << in.rdbuf();
+    const std::string iv = buffer.str();
+    EXPECT_EQ(iv.rfind("#Inventor V2.1 ascii\n", 0), 0u);
+    const std::vector<double> points = inventor_list(iv, "point");
+    ASSERT_EQ(points.size(), 3 * mesh.positions.size());
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i)
+        for (int k = 0; k < 3; ++k)
+            EXPECT_NEAR(points[3 * i + k], mesh.positions[i][k], 1e-6);
+    const std::vector<double> faces = inventor_list(iv, "coordIndex");
+    ASSERT_EQ(faces.size(), 4 * mesh.size());
+    for (std::size_t t = 0; t < mesh.size(); ++t) {
+        for (int k = 0; k < 3; ++k)
+            EXPECT_EQ(faces[4 * t + k], mesh.triangles[t][k]);
+        EXPECT_EQ(faces[4 * t + 3], -1);
+    }
+    const std::vector<double> diffuse = inventor_list(iv, "diffuseColor");
+    const std::vector<double> index = inventor_list(iv, "materialIndex");
+    ASSERT_EQ(index.size(), mesh.size());
+    EXPECT_EQ(diffuse.size(), 3 * 2u);  // the stem's colour and the branch's ;(2)
+    for (std::size_t t = 0; t < mesh.size(); ++t) {
+        const auto slot = static_cast<std::size_t>(index[t]);
+        ASSERT_LT(3 * slot + 2, diffuse.size());
+        EXPECT_NEAR(diffuse[3 * slot], plant.scene.materials[mesh.material[t]].diffuse.r, 1e-6);
+        EXPECT_NEAR(diffuse[3 * slot + 2], plant.scene.materials[mesh.material[t]].diffuse.b, 1e-6);
+    }
+    EXPECT_EQ(iv.find("Camera"), std::string::npos);  // cpfg writes no camera (manual 6.5)
+
+    geom::MeshExportOptions small;
+    small.max_memory_bytes = 1000;
+    EXPECT_THROW(geom::write_inventor(plant.scene, plant.folder / "big.iv", small), Error);
+    EXPECT_FALSE(fs::exists(plant.folder / "big.iv"));
 }
 
 TEST(MeshExport, PastTheMemoryBudgetNothingIsWritten)
