@@ -171,15 +171,13 @@ void check_outputs(const Options& options, const std::vector<std::filesystem::pa
         throw Error("--organ-masks writes its layers into EXR images: give an -o file.exr");
     for (const auto& out : outputs) {
         const OutputFormat* format = find_output_format(out);
-        if (format && (format->mesh != MeshFormat::none || format->vector != VectorFormat::none)) {
-            if (is_sequence(options))
-                throw Error(out.string() + ": a " + std::string(format->name) +
-                            " file holds one still's " +
-                            (format->mesh != MeshFormat::none ? "geometry" : "drawing") +
-                            "; an animation or turntable writes images or a video" +
-                            (format->vector != VectorFormat::none
-                                 ? " (-ps with a number field writes PostScript per frame)"
-                                 : ""));
+        if (is_geometry_output(out)) {
+            // An -a animation writes a file per frame (its name's number field checked
+            // with the frames'); a turntable turns one geometry, the still's.
+            if (options.shot.turntable > 0 || (is_sequence(options) && options.scene))
+                throw Error(out.string() + ": a turntable turns one geometry: write the " +
+                            std::string(format->name) +
+                            " file from a still (without --turntable)");
             std::error_code ec;
             if (out.has_parent_path() && !std::filesystem::is_directory(out.parent_path(), ec))
                 throw Error(out.string() + ": the folder " + out.parent_path().string() +
@@ -209,22 +207,13 @@ std::vector<std::filesystem::path> write_meshes(const geom::Scene& scene, const 
 {
     std::vector<std::filesystem::path> pictures;
     for (const auto& out : outputs) {
-        const OutputFormat* format = find_output_format(out);
-        if (!format || (format->mesh == MeshFormat::none && format->vector == VectorFormat::none)) {
+        if (!is_geometry_output(out)) {
             pictures.push_back(out);
             continue;
         }
         if (!writes)
             continue;
-        if (format->vector != VectorFormat::none) {
-            write_vector_output(scene, options, out, format->vector);
-            say("wrote " + out.string());
-            continue;
-        }
-        geom::MeshExportOptions mesh;
-        mesh.texture_folder = options.scene ? options.scene->parent_path() : options.view.parent_path();
-        mesh.max_memory_bytes = options.max_memory_bytes;
-        geom::write_mesh(scene, out, format->mesh, mesh);
+        write_geometry_output(scene, options, out);
         say("wrote " + out.string());
     }
     return pictures;
@@ -376,8 +365,12 @@ int run(const Options& options, Mpi* mpi, Clock::time_point command_start)
         auto strings = [&](const Model& model, const lsys::ModuleString& s, int step) {
             write_strings(model, s, options, step, say);
         };
-        SequenceOutputs outputs{images, command_render_settings(options, images), strings, say, mpi,
-                                {},     &stats,                           command_start};
+        std::vector<std::filesystem::path> pictures, geometry;
+        for (const auto& out : images)
+            (is_geometry_output(out) ? geometry : pictures).push_back(out);
+        SequenceOutputs outputs{pictures, command_render_settings(options, pictures), strings, say,
+                                mpi,      {},     &stats,                               command_start};
+        outputs.geometry = std::move(geometry);
         return run_sequence_with_stats(options, outputs);
     }
 

@@ -348,6 +348,7 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         frames.empty() ? 0
                        : frames.size() + std::size_t(numbering.inbetween) * (frames.size() - 1);
     require_numbered_names(options, out.images, images_total);
+    require_numbered_names(Options{}, out.geometry, images_total);
     FrameFilter filter(options.shot, out.images);
     std::optional<geom::AnimationFile> animation;
     if (options.animation)
@@ -539,8 +540,9 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         const lsys::ModuleString& written = homo ? *homo : string;
         if (writes)
             out.write_strings(model, written, f.number);
-        if (!options.view_volume && !options.rayshade && !options.postscript &&
-            !options.inventor && !filter.to_render(number))
+        const bool geometry_files = writes && (options.rayshade || options.postscript ||
+                                               options.inventor || !out.geometry.empty());
+        if (!options.view_volume && !geometry_files && !filter.to_render(number))
             return;
         if (refit && animation->new_view_between_frames)
             model.view = read_view(options);
@@ -553,28 +555,32 @@ int run_animation(const Options& options, const SequenceOutputs& out)
             geom::write_view_volume(volume, file);
             out.say("wrote " + file.string());
         }
-        if (options.rayshade && writes) {
-            // the frame's own geometry, as the turtle draws it for the picture
-            fs::path file = frame_file(*options.rayshade, f.number);
-            geom::Scene frame = interpret_turtle_string(
+        if (geometry_files) {
+            // The frame's own geometry, as the turtle draws it for the picture; vector
+            // drawings are framed as a still of it would be.
+            const geom::Scene frame = interpret_turtle_string(
                 model, homo ? *homo : turtle_string(model, string, options), options);
-            geom::write_rayshade(frame, file, rayshade_options(options, file, &model));
-            out.say("wrote " + file.string());
-        }
-        if (options.postscript && writes) {
-            // the frame's own geometry, framed as a still of it would be
-            fs::path file = frame_file(*options.postscript, f.number);
-            geom::Scene frame = interpret_turtle_string(
-                model, homo ? *homo : turtle_string(model, string, options), options);
-            write_vector_output(frame, options, file, VectorFormat::ps);
-            out.say("wrote " + file.string());
-        }
-        if (options.inventor && writes) {
-            fs::path file = frame_file(*options.inventor, f.number);
-            geom::Scene frame = interpret_turtle_string(
-                model, homo ? *homo : turtle_string(model, string, options), options);
-            write_inventor_output(frame, options, file);
-            out.say("wrote " + file.string());
+            auto wrote = [&](const fs::path& file) { out.say("wrote " + file.string()); };
+            if (options.rayshade) {
+                fs::path file = frame_file(*options.rayshade, f.number);
+                geom::write_rayshade(frame, file, rayshade_options(options, file, &model));
+                wrote(file);
+            }
+            if (options.postscript) {
+                fs::path file = frame_file(*options.postscript, f.number);
+                write_vector_output(frame, options, file, VectorFormat::ps);
+                wrote(file);
+            }
+            if (options.inventor) {
+                fs::path file = frame_file(*options.inventor, f.number);
+                write_inventor_output(frame, options, file);
+                wrote(file);
+            }
+            for (const fs::path& pattern : out.geometry) {
+                fs::path file = frame_file(pattern, f.number);
+                write_geometry_output(frame, options, file);
+                wrote(file);
+            }
         }
         if (!filter.to_render(number))
             return;
@@ -875,6 +881,26 @@ render::WriteOptions write_options(const Options& options)
 void apply_camera_options(geom::Scene& scene, const Options& options)
 {
     scene.view = render::apply_overrides(scene.view, view_overrides(options.shot), scene.bounds);
+}
+
+bool is_geometry_output(const std::filesystem::path& file)
+{
+    const OutputFormat* format = find_output_format(file);
+    return format && (format->mesh != MeshFormat::none || format->vector != VectorFormat::none);
+}
+
+void write_geometry_output(const geom::Scene& scene, const Options& options,
+                           const std::filesystem::path& file)
+{
+    const OutputFormat* format = find_output_format(file);
+    if (format && format->vector != VectorFormat::none) {
+        write_vector_output(scene, options, file, format->vector);
+        return;
+    }
+    geom::MeshExportOptions mesh;
+    mesh.texture_folder = options.scene ? options.scene->parent_path() : options.view.parent_path();
+    mesh.max_memory_bytes = options.max_memory_bytes;
+    geom::write_mesh(scene, file, format ? format->mesh : MeshFormat::none, mesh);
 }
 
 void write_inventor_output(const geom::Scene& scene, const Options& options,

@@ -36,6 +36,9 @@ struct SequenceOutputs {
     /// from `command_start`.
     RunStats* stats = nullptr;
     std::chrono::steady_clock::time_point command_start{};
+    /// -o meshes and vector drawings (is_geometry_output), patterns with a number
+    /// field: one file of each -a frame's geometry.
+    std::vector<std::filesystem::path> geometry{};
 };
 
 /// Whether the command renders a sequence (-a or --turntable) instead of a still.
@@ -84,6 +87,15 @@ render::WriteOptions write_options(const Options& options);
 
 /// The scene's view with --orbit, --zoom, --fit, --fov, --perspective / --parallel.
 void apply_camera_options(geom::Scene& scene, const Options& options);
+
+/// Whether the -o `file` holds geometry (a mesh: OBJ, PLY, glTF, GLS; or a vector
+/// drawing: PostScript, SVG, PDF) rather than a picture.
+bool is_geometry_output(const std::filesystem::path& file);
+
+/// Writes `scene` to the geometry output `file` in the format its extension names
+/// (textures found beside the view file or scene file), within --max-memory.
+void write_geometry_output(const geom::Scene& scene, const Options& options,
+                           const std::filesystem::path& file);
 
 /// -iv: `scene` as an Inventor 2.1 file (geom/inventor_export.h), within --max-memory.
 void write_inventor_output(const geom::Scene& scene, const Options& options,

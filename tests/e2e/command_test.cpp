@@ -15,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -901,11 +902,48 @@ TEST(Command, PostScriptOfAStillAndOfEveryFrame)
     Result one = run("-a -q -ps " + (dir / "one.ps").string() + " " + plant_files(dir));
     EXPECT_NE(one.status, 0);
     EXPECT_NE(one.output.find("-ps names one file for"), std::string::npos) << one.output;
-    // an SVG or PDF holds one still: a sequence refuses it before any work
+    // -o drawings are written per frame too; a turntable, one geometry, refuses them
     Result svg = run("-a -q -o " + (dir / "f%d.svg").string() + " " + plant_files(dir));
-    EXPECT_NE(svg.status, 0);
-    EXPECT_NE(svg.output.find("holds one still's drawing"), std::string::npos) << svg.output;
-    EXPECT_FALSE(fs::exists(dir / "f1.svg"));
+    ASSERT_EQ(svg.status, 0) << svg.output;
+    EXPECT_LT(fs::file_size(dir / "f1.svg"), fs::file_size(dir / "f3.svg"));
+    Result turn = run("--turntable 3 -q -o " + (dir / "t%d.pdf").string() + " " + plant_files(dir));
+    EXPECT_NE(turn.status, 0);
+    EXPECT_NE(turn.output.find("a turntable turns one geometry"), std::string::npos) << turn.output;
+    EXPECT_FALSE(fs::exists(dir / "t1.pdf"));
+}
+
+/// A mesh file's lines but its `mtllib` one (which names the file's own MTL).
+std::string without_mtllib(const std::string& obj)
+{
+    std::istringstream in(obj);
+    std::string out, line;
+    while (std::getline(in, line))
+        if (line.rfind("mtllib ", 0) != 0)
+            out += line + "\n";
+    return out;
+}
+
+// An -a animation writes an OBJ per frame, each the geometry of a still derived to that
+// frame's step; the name needs a number field.
+TEST(Command, MeshOfEveryFrameIsTheStillOfItsStep)
+{
+    fs::path dir = growing_plant(scratch("objframes"));
+    Result frames = run("-a -q -o " + (dir / "m%d.obj").string() + " " + plant_files(dir));
+    ASSERT_EQ(frames.status, 0) << frames.output;
+    for (int step = 1; step <= 3; ++step) {
+        const std::string still = "s" + std::to_string(step) + ".obj";
+        Result r = run("-q --steps " + std::to_string(step) + " -o " + (dir / still).string() +
+                       " " + plant_files(dir));
+        ASSERT_EQ(r.status, 0) << r.output;
+        const std::string framed = bytes_of(dir / ("m" + std::to_string(step) + ".obj"));
+        EXPECT_NE(framed.find("\nv "), std::string::npos);
+        EXPECT_EQ(without_mtllib(framed), without_mtllib(bytes_of(dir / still))) << "step " << step;
+    }
+    EXPECT_LT(fs::file_size(dir / "m1.obj"), fs::file_size(dir / "m3.obj"));
+    Result one = run("-a -q -o " + (dir / "one.obj").string() + " " + plant_files(dir));
+    EXPECT_NE(one.status, 0);
+    EXPECT_NE(one.output.find("-o names one file for"), std::string::npos) << one.output;
+    EXPECT_FALSE(fs::exists(dir / "one.obj"));
 }
 
 // -iv writes the plant as an Inventor 2.1 scene: a still's alone, and one per frame.
