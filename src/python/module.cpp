@@ -35,6 +35,7 @@
 #include "app/sequence.h"
 #include "base/diagnostics.h"
 #include "base/subprocess.h"
+#include "geom/rayshade_export.h"
 #include "lsys/string_io.h"
 #include "render/framing.h"
 #include "render/render.h"
@@ -607,6 +608,44 @@ py::object light_report(ModelObject& m, const py::object& path, const py::object
     return py::module_::import("json").attr("loads")(text.str());
 }
 
+/// The plant's geometry written to `path` as the command writes it: a mesh or drawing by
+/// the extension (`-o`: .obj, .ply, .glb, .gls, .ps, .svg, .pdf), cpfg's rayshade scene
+/// for .ray (`-ray`) and its Inventor scene for .iv (`-iv`).
+void export_geometry(ModelObject& m, const py::object& path, const py::object& string,
+                     const py::object& progress, const py::kwargs& keywords)
+{
+    const std::filesystem::path file = word(path);
+    const std::string extension = file.extension().string();
+    if (extension != ".ray" && extension != ".iv" && !app::is_geometry_output(file))
+        throw Error(file.string() + ": export writes .obj, .ply, .glb, .gls, .ps, .svg, .pdf, "
+                                    ".ray or .iv; images come from render()");
+    const app::Options options = m.options_with(keyword_dict(keywords));
+    if (app::is_sequence(options))
+        throw Error(file.string() + ": export writes a still's geometry; not with -a or --turntable");
+    std::optional<lsys::ModuleString> given = given_string(m, string);
+    run_released(
+        [&](std::atomic<bool>&, Events& events) {
+            app::StringOrigins provenance;
+            lsys::ModuleString derived;
+            if (given) {
+                derived = std::move(*given);
+            } else {
+                events.push("derive");
+                derived = app::derive(*m.model, options, false, provenance.ages);
+            }
+            events.push("interpret");
+            const geom::Scene scene =
+                app::interpret_with_provenance(*m.model, derived, options, provenance);
+            if (extension == ".ray")
+                geom::write_rayshade(scene, file, app::rayshade_options(options, file, m.model.get()));
+            else if (extension == ".iv")
+                app::write_inventor_output(scene, options, file);
+            else
+                app::write_geometry_output(scene, options, file);
+        },
+        progress, options.quiet);
+}
+
 /// A derivation in progress, one step (or a few) at a time.
 struct DerivationObject {
     std::shared_ptr<app::Model> model;
@@ -946,6 +985,11 @@ PYBIND11_MODULE(cambium, m)
              "The light each organ absorbs (--light-report; docs/light.md): written to `path` "
              "(.json or .csv) as the command writes it when given; returns the JSON report "
              "(None for a .csv path). Keywords as render()'s (light_rays=, ...)")
+        .def("export", &export_geometry, py::arg("path"), py::arg("string") = py::none(),
+             py::arg("progress") = py::none(),
+             "Writes the plant's geometry as the command does: a mesh or drawing by the "
+             "extension (.obj, .ply, .glb, .gls, .ps, .svg, .pdf, as -o), cpfg's rayshade "
+             "scene (.ray, as -ray) or Inventor scene (.iv, as -iv); keywords as render()'s")
         .def_property_readonly("view",
                                [](const ModelObject& self) { return view_settings(*self.model->view); })
         .def_property_readonly(
