@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <limits>
 #include <map>
 #include <set>
@@ -37,6 +38,11 @@
 #include "geom/inventor_export.h"
 #include "base/limits.h"
 #include "render/ground.h"
+#include "base/input_file.h"
+#include "geom/mesh_export.h"
+#include "render/color.h"
+#include "render/image_codec.h"
+#include "render/image_io.h"
 
 namespace cambium::app {
 namespace {
@@ -883,6 +889,54 @@ void apply_camera_options(geom::Scene& scene, const Options& options)
     scene.view = render::apply_overrides(scene.view, view_overrides(options.shot), scene.bounds);
 }
 
+namespace {
+
+/// A texture file as PNG bytes (what glTF embeds), through the image codec: its pixels
+/// decoded to linear values, alpha associated, written as the renderer writes a PNG
+/// (sRGB, straight alpha) into a private folder and read back; empty when unreadable.
+std::vector<unsigned char> texture_as_png(const fs::path& file, std::uint64_t max_memory_bytes)
+{
+    std::string why;
+    std::optional<render::TexturePixels> pixels =
+        render::image_codec().read_texture(file, max_memory_bytes, why);
+    if (!pixels || pixels->channels < 1 || pixels->channels > 4)
+        return {};
+    const render::TexturePixels& t = *pixels;
+    render::Image image;
+    image.width = t.width;
+    image.height = t.height;
+    image.transparent = t.channels == 2 || t.channels == 4;
+    image.rgba.resize(std::size_t(t.width) * std::size_t(t.height) * 4);
+    const auto value = [&](std::size_t i) {
+        return t.bytes.empty() ? t.floats[i] : float(t.bytes[i]) / 255.0f;
+    };
+    const auto decoded = [&](float v) { return t.srgb ? render::srgb_to_linear(v) : v; };
+    for (std::size_t p = 0; p < std::size_t(t.width) * std::size_t(t.height); ++p) {
+        const std::size_t in = p * std::size_t(t.channels);
+        const bool grey = t.channels <= 2;
+        const float alpha = image.transparent ? value(in + std::size_t(t.channels) - 1) : 1.0f;
+        for (std::size_t c = 0; c < 3; ++c)
+            image.rgba[p * 4 + c] = decoded(value(grey ? in : in + c)) * alpha;
+        image.rgba[p * 4 + 3] = alpha;
+    }
+    std::string folder = (fs::temp_directory_path() / "cambium-texture-XXXXXX").string();
+    if (!mkdtemp(folder.data()))
+        return {};
+    std::vector<unsigned char> bytes;
+    try {
+        const fs::path png = fs::path(folder) / "texture.png";
+        render::write_image(image, png);
+        bytes = read_binary_file(png, "the re-encoded texture", std::uintmax_t{1} << 30);
+    } catch (const Error&) {
+        bytes.clear();
+    }
+    std::error_code ec;
+    fs::remove_all(folder, ec);
+    return bytes;
+}
+
+}  // namespace
+
 bool is_geometry_output(const std::filesystem::path& file)
 {
     const OutputFormat* format = find_output_format(file);
@@ -900,6 +954,9 @@ void write_geometry_output(const geom::Scene& scene, const Options& options,
     geom::MeshExportOptions mesh;
     mesh.texture_folder = options.scene ? options.scene->parent_path() : options.view.parent_path();
     mesh.max_memory_bytes = options.max_memory_bytes;
+    mesh.png_of = [&](const fs::path& texture) {
+        return texture_as_png(texture, options.max_memory_bytes);
+    };
     geom::write_mesh(scene, file, format ? format->mesh : MeshFormat::none, mesh);
 }
 

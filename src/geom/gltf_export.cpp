@@ -303,7 +303,8 @@ private:
     }
 
     /// The embedded image of texture `texture`, or -1 when its file is neither PNG nor
-    /// JPEG (glTF embeds only those; the material keeps its colour, with a warning).
+    /// JPEG and the options' png_of cannot re-encode it (glTF embeds only those; the
+    /// material keeps its colour, with a warning).
     int image_index(std::int16_t texture)
     {
         if (auto it = m_images.find(texture); it != m_images.end())
@@ -317,7 +318,11 @@ private:
             warn(FileLoc{file.string()}, "texture not found; exported without it");
         } else {
             std::vector<unsigned char> bytes = read_binary_file(file, "the texture", max_texture_file_bytes);
-            const std::string mime = embeddable_mime(bytes);
+            std::string mime = embeddable_mime(bytes);
+            if (mime.empty() && m_options.png_of) {  // re-encoded: glTF embeds PNG and JPEG only
+                bytes = m_options.png_of(file);
+                mime = embeddable_mime(bytes);
+            }
             if (mime.empty()) {
                 warn(FileLoc{file.string()},
                      "glTF embeds PNG and JPEG textures only; exported without this one");

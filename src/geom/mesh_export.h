@@ -6,6 +6,8 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
+#include <vector>
 
 #include "base/limits.h"
 #include "base/output_format.h"
@@ -20,6 +22,9 @@ struct MeshExportOptions {
     std::filesystem::path texture_folder;
     /// The tessellated mesh may take at most this much memory (--max-memory).
     std::uint64_t max_memory_bytes = default_max_memory_bytes();
+    /// A texture file glTF cannot embed (SGI, TIFF, ...) encoded as PNG bytes, empty
+    /// when it cannot be read. Unset: such textures are left out, with a warning.
+    std::function<std::vector<unsigned char>(const std::filesystem::path&)> png_of{};
 };
 
 /// Writes the scene's geometry, every primitive tessellated (geom/tessellate.h) and every

@@ -5,14 +5,17 @@
 #include <gtest/gtest.h>
 
 #include <tiny_gltf.h>
+#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <fstream>
 #include <map>
 #include <string>
 
 #include "app/pipeline.h"
+#include "app/sequence.h"
 #include "base/diagnostics.h"
 #include "geom/gltf_export.h"
 #include "geom/mesh_export.h"
@@ -185,6 +188,46 @@ TEST(GltfExport, InstancesOfAnObjectShareOneMesh)
     }
     EXPECT_EQ(geom::gltf_primitives(b.scene, {}), geom::tessellated_triangles(b.scene.geometry, false, {}) +
                                                       geom::tessellated_triangles(b.scene.prototypes[0].geometry, false, {}));
+}
+
+// glTF embeds PNG and JPEG only: an SGI texture (cpfg's usual format) is re-encoded as a
+// PNG of the same pixels rather than left out.
+TEST(GltfExport, SgiTextureIsEmbeddedAsAPngOfItsPixels)
+{
+    app::Options options = cambium::testing::write_model(
+        "gltf_sgi", "Lsystem: 1\nderivation length: 0\nAxiom: @Tx(1) F(1)\nendlsystem\n");
+    options.quiet = true;
+    const fs::path folder = options.lsystem.parent_path();
+    std::ofstream(options.view, std::ios::app) << "texture: F: bark.rgb\n";
+    // 4 x 2 texels of distinct colours
+    constexpr int w = 4, h = 2;
+    std::vector<unsigned char> texels(w * h * 3);
+    for (std::size_t i = 0; i < texels.size(); ++i)
+        texels[i] = static_cast<unsigned char>(17 + 29 * i);
+    {
+        auto out = OIIO::ImageOutput::create((folder / "bark.rgb").string());
+        ASSERT_TRUE(out);
+        ASSERT_TRUE(out->open((folder / "bark.rgb").string(), OIIO::ImageSpec(w, h, 3, OIIO::TypeDesc::UINT8)));
+        ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, texels.data()));
+        out->close();
+    }
+    app::Model model = app::load_model(options);
+    const geom::Scene scene = app::interpret(model, app::derive(model, options), options);
+    app::write_geometry_output(scene, options, folder / "bark.glb");
+
+    const tinygltf::Model m = load(folder / "bark.glb");
+    ASSERT_EQ(m.images.size(), 1u);
+    const tinygltf::Image& image = m.images[0];
+    EXPECT_EQ(image.mimeType, "image/png");
+    ASSERT_EQ(image.width, w);
+    ASSERT_EQ(image.height, h);
+    ASSERT_GE(image.component, 3);
+    for (int p = 0; p < w * h; ++p)
+        for (int c = 0; c < 3; ++c)
+            EXPECT_EQ(int(image.image[std::size_t(p * image.component + c)]), int(texels[std::size_t(p * 3 + c)]))
+                << "texel " << p << " channel " << c;
+    ASSERT_EQ(m.textures.size(), 1u);
+    EXPECT_GE(m.materials.at(0).pbrMetallicRoughness.baseColorTexture.index, 0);
 }
 
 TEST(GltfExport, PastTheMemoryBudgetNothingIsWritten)
