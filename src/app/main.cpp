@@ -160,7 +160,8 @@ int run_sequence_with_stats(const Options& options, const SequenceOutputs& outpu
 /// whole image, band I of --tile I/N into its tile file, or shared among --mpi's ranks
 /// (rank 0 writes).
 /// The outputs of the command, checked before any work: images by write_image's rules,
-/// videos by ffmpeg's, meshes (a still's geometry only) by their folder.
+/// videos by ffmpeg's, meshes and drawings by their folder (per frame of an -a animation;
+/// a turntable, one geometry, refuses them and -ray, -ps, -iv).
 void check_outputs(const Options& options, const std::vector<std::filesystem::path>& outputs)
 {
     if (options.organ_masks &&
@@ -169,6 +170,12 @@ void check_outputs(const Options& options, const std::vector<std::filesystem::pa
             return format && format->keeps_layers;
         }))
         throw Error("--organ-masks writes its layers into EXR images: give an -o file.exr");
+    if (options.shot.turntable > 0)
+        for (const auto& [file, option] :
+             {std::pair{options.rayshade, "-ray"}, {options.postscript, "-ps"}, {options.inventor, "-iv"}})
+            if (file)
+                throw Error(file->string() + ": a turntable turns one geometry: write " + option +
+                            " from a still (without --turntable)");
     for (const auto& out : outputs) {
         const OutputFormat* format = find_output_format(out);
         if (is_geometry_output(out)) {

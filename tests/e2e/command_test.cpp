@@ -910,6 +910,14 @@ TEST(Command, PostScriptOfAStillAndOfEveryFrame)
     EXPECT_NE(turn.status, 0);
     EXPECT_NE(turn.output.find("a turntable turns one geometry"), std::string::npos) << turn.output;
     EXPECT_FALSE(fs::exists(dir / "t1.pdf"));
+    for (const char* option : {"-ray", "-ps", "-iv"}) {  // not silently dropped either
+        Result r = run(std::string("--turntable 3 -q ") + option + " " + (dir / "t.x").string() +
+                       " -o " + (dir / "t%d.png").string() + " " + plant_files(dir));
+        EXPECT_NE(r.status, 0) << option;
+        EXPECT_NE(r.output.find("write " + std::string(option) + " from a still"), std::string::npos)
+            << r.output;
+        EXPECT_FALSE(fs::exists(dir / "t.x") || fs::exists(dir / "t1.png")) << option;
+    }
 }
 
 /// A mesh file's lines but its `mtllib` one (which names the file's own MTL).
