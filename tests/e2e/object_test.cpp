@@ -2,6 +2,7 @@
 // End-to-end: an L-system whose flowers are -o> objects (instanced) renders the same
 // picture as the same L-system with --> (expanded inline), through the app pipeline.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -40,8 +41,10 @@ struct Built {
 
 Built build(const std::string& arrow, const std::string& line_style = "cylinder")
 {
-    fs::path dir = fs::temp_directory_path() / ("cambium_objects_" + std::to_string(arrow.size()) +
-                                                (arrow == "-o>" ? "o" : "i"));
+    // a folder of this process's own: ctest runs this file's tests in parallel processes
+    fs::path dir = fs::temp_directory_path() /
+                   ("cambium_objects_" + std::to_string(getpid()) + (arrow == "-o>" ? "o_" : "i_") +
+                    line_style);
     fs::create_directories(dir);
     std::ofstream(dir / "plant.l") << plant(arrow);
     // `initial line width:` without a unit sets cpfg's polygon style: the style after it
