@@ -973,8 +973,8 @@ void write_vector_output(const geom::Scene& scene, const Options& options,
 {
     const geom::Tessellation how;
     // the tessellated mesh and the drawing's shapes are held together
-    constexpr std::uint64_t bytes_per_triangle = 3 * (12 + 12 + 8) + 12 + 6 + 4 +
-                                                 render::vector_shape_bytes;
+    constexpr std::uint64_t bytes_per_triangle =
+        geom::exported_triangle_bytes + render::vector_shape_bytes;
     std::uint64_t shapes = geom::tessellated_triangles(scene, how);
     if (scene.line_radius_in_pixels) {
         shapes += scene.geometry.lines.segment_count();

@@ -13,19 +13,11 @@
 #include "base/atomic_file.h"
 #include "base/diagnostics.h"
 #include "base/limits.h"
+#include "geom/mesh_export.h"
 #include "geom/tessellate.h"
 
 namespace cambium::geom {
 namespace {
-
-/// What one triangle takes while the tessellated mesh is held (as the mesh exports count).
-constexpr std::uint64_t bytes_per_triangle = 3 * (12 + 12 + 8) + 12 + 6 + 4;
-
-const Material& material_of(const Scene& scene, std::uint16_t index)
-{
-    static const Material fallback;
-    return index < scene.materials.size() ? scene.materials[index] : fallback;
-}
 
 std::string rgb(const Rgb& c)
 {
@@ -106,7 +98,7 @@ void write_materials(std::ofstream& out, const Scene& scene, const std::vector<s
 {
     std::string ambient, diffuse, specular, emissive, shininess, transparency;
     for (std::uint16_t i : used) {
-        const Material& m = material_of(scene, i);
+        const Material& m = exported_material(scene, i);
         const std::string_view sep = ambient.empty() ? "" : ", ";
         auto add = [&](std::string& list, const std::string& value) {
             list.append(sep);
@@ -131,9 +123,9 @@ void write_inventor(const Scene& scene, const std::filesystem::path& file,
                     const MeshExportOptions& options)
 {
     const std::uint64_t triangles = tessellated_triangles(scene, options.tessellation);
-    if (triangles > options.max_memory_bytes / bytes_per_triangle)
+    if (triangles > options.max_memory_bytes / exported_triangle_bytes)
         throw Error(file.string() + ": the plant's " + std::to_string(triangles) +
-                    " triangles need " + byte_size_text(triangles * bytes_per_triangle) +
+                    " triangles need " + byte_size_text(triangles * exported_triangle_bytes) +
                     ", more than the memory budget of " + byte_size_text(options.max_memory_bytes) +
                     " (--max-memory)");
     const TriangleMesh mesh = tessellate(scene, options.tessellation);

@@ -14,17 +14,15 @@
 #include "geom/gltf_export.h"
 
 namespace cambium::geom {
-namespace {
 
-/// What one exported triangle takes while the mesh is held: three vertices of position,
-/// normal and uv, three indices, two materials, a texture and a module.
-constexpr std::uint64_t bytes_per_triangle = 3 * (12 + 12 + 8) + 12 + 6 + 4;
-
-const Material& material_of(const Scene& scene, std::uint16_t index)
+const Material& exported_material(const Scene& scene, std::uint16_t index)
 {
     static const Material fallback;
     return index < scene.materials.size() ? scene.materials[index] : fallback;
 }
+
+namespace {
+
 
 /// Opens `path` for writing binary data, or throws naming `file`.
 std::ofstream open_output(const std::filesystem::path& path, const std::filesystem::path& file)
@@ -83,7 +81,7 @@ void write_mtl(const Scene& scene, const TriangleMesh& mesh, const std::vector<s
         if (key == last)
             continue;
         last = key;
-        const Material& m = material_of(scene, mesh.material[t]);
+        const Material& m = exported_material(scene, mesh.material[t]);
         out << "\nnewmtl " << material_name(mesh.material[t], mesh.texture[t]) << '\n';
         std::snprintf(line, sizeof line,
                       "Ka %g %g %g\nKd %g %g %g\nKs %g %g %g\nKe %g %g %g\nNs %g\nd %g\nillum 2\n",
@@ -156,7 +154,7 @@ void write_ply(const Scene& scene, const TriangleMesh& mesh, const std::filesyst
     std::vector<Rgb> colour(mesh.positions.size());
     for (std::size_t t = 0; t < mesh.size(); ++t)
         for (std::uint32_t i : mesh.triangles[t])
-            colour[i] = material_of(scene, mesh.material[t]).diffuse;
+            colour[i] = exported_material(scene, mesh.material[t]).diffuse;
     write_file_atomically(file, [&](const std::filesystem::path& temporary) {
         std::ofstream out = open_output(temporary, file);
         out << "ply\nformat binary_little_endian 1.0\ncomment Cambium: the plant as triangles\n"
@@ -190,7 +188,7 @@ void write_gls(const Scene& scene, const TriangleMesh& mesh, const std::filesyst
         for (std::size_t t = 0; t < mesh.size(); ++t) {
             if (mesh.material[t] != last) {
                 last = mesh.material[t];
-                const Material& m = material_of(scene, mesh.material[t]);
+                const Material& m = exported_material(scene, mesh.material[t]);
                 const double alpha = 1.0 - m.transparency;
                 std::snprintf(text, sizeof text,
                               "material %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g "
@@ -223,9 +221,9 @@ void write_mesh(const Scene& scene, const std::filesystem::path& file, MeshForma
     const std::uint64_t triangles = format == MeshFormat::glb
                                         ? gltf_primitives(scene, options.tessellation)
                                         : tessellated_triangles(scene, options.tessellation);
-    if (triangles > options.max_memory_bytes / bytes_per_triangle)
+    if (triangles > options.max_memory_bytes / exported_triangle_bytes)
         throw Error(file.string() + ": the plant's " + std::to_string(triangles) +
-                    " triangles need " + byte_size_text(triangles * bytes_per_triangle) +
+                    " triangles need " + byte_size_text(triangles * exported_triangle_bytes) +
                     ", more than the memory budget of " + byte_size_text(options.max_memory_bytes) +
                     " (--max-memory)");
     if (format == MeshFormat::glb)

@@ -27,6 +27,14 @@ struct MeshExportOptions {
     std::function<std::vector<unsigned char>(const std::filesystem::path&)> png_of{};
 };
 
+/// What one exported triangle takes while the tessellated mesh is held: three vertices
+/// of position, normal and uv, three indices, two materials, a texture and a module.
+/// Every geometry export counts it against --max-memory.
+inline constexpr std::uint64_t exported_triangle_bytes = 3 * (12 + 12 + 8) + 12 + 6 + 4;
+
+/// The scene's material `index`, or the default material past the palette's end.
+const Material& exported_material(const Scene& scene, std::uint16_t index);
+
 /// Writes the scene's geometry, every primitive tessellated (geom/tessellate.h) and every
 /// instance placed, as `file` in `format` (base/output_format.h: by its extension); an OBJ's materials go to the `.mtl` of the same
 /// name beside it. Files appear whole or not at all. Throws cambium::Error naming the file,

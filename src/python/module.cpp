@@ -550,6 +550,25 @@ py::object render_scene(SceneObject& o, bool layers, const py::object& progress,
     return image_object(std::move(image), write);
 }
 
+/// The plant's geometry, each primitive knowing its module, as the command interprets a
+/// still: the `given` string (moved from), else a derivation (with its ages when
+/// `with_ages`). Runs on the worker thread of run_released.
+geom::Scene plant_with_provenance(ModelObject& m, const app::Options& options,
+                                  std::optional<lsys::ModuleString>& given, bool with_ages,
+                                  Events& events)
+{
+    app::StringOrigins provenance;
+    lsys::ModuleString derived;
+    if (given) {
+        derived = std::move(*given);
+    } else {
+        events.push("derive");
+        derived = app::derive(*m.model, options, with_ages, provenance.ages);
+    }
+    events.push("interpret");
+    return app::interpret_with_provenance(*m.model, derived, options, provenance);
+}
+
 /// --light-report: the light each organ absorbs (docs/light.md), traced as the command
 /// traces it (the derivation's ages and the modules' provenance included) and written by
 /// its writer to `path` (.json or .csv); returns the JSON report as Python values.
@@ -586,16 +605,7 @@ py::object light_report(ModelObject& m, const py::object& path, const py::object
     std::optional<lsys::ModuleString> given = given_string(m, string);
     run_released(
         [&](std::atomic<bool>&, Events& events) {
-            app::StringOrigins provenance;
-            lsys::ModuleString derived;
-            if (given) {
-                derived = std::move(*given);
-            } else {
-                events.push("derive");
-                derived = app::derive(*m.model, options, true, provenance.ages);
-            }
-            events.push("interpret");
-            geom::Scene scene = app::interpret_with_provenance(*m.model, derived, options, provenance);
+            const geom::Scene scene = plant_with_provenance(m, options, given, true, events);
             events.push("trace");
             app::write_light_report(scene, options);
         },
@@ -625,17 +635,7 @@ void export_geometry(ModelObject& m, const py::object& path, const py::object& s
     std::optional<lsys::ModuleString> given = given_string(m, string);
     run_released(
         [&](std::atomic<bool>&, Events& events) {
-            app::StringOrigins provenance;
-            lsys::ModuleString derived;
-            if (given) {
-                derived = std::move(*given);
-            } else {
-                events.push("derive");
-                derived = app::derive(*m.model, options, false, provenance.ages);
-            }
-            events.push("interpret");
-            const geom::Scene scene =
-                app::interpret_with_provenance(*m.model, derived, options, provenance);
+            const geom::Scene scene = plant_with_provenance(m, options, given, false, events);
             if (extension == ".ray")
                 geom::write_rayshade(scene, file, app::rayshade_options(options, file, m.model.get()));
             else if (extension == ".iv")
