@@ -13,7 +13,9 @@
 #include "base/diagnostics.h"
 #include "base/output_format.h"
 #include "base/subprocess.h"
+#include "app/light_environment.h"
 #include "env/environmental_step.h"
+#include "env/light_spec.h"
 #include "geom/background_scene.h"
 #include "geom/flatten.h"
 #include "geom/function.h"
@@ -38,6 +40,56 @@ geom::Palette load_palette(const Options& options)
             palette.load_colormap(f.block, f.file);
     }
     return palette;
+}
+
+/// The materials of the selected colours, as cpfg's window has them: opaque unless
+/// --material-transparency, with the view file's translucency.
+void set_model_materials(geom::Scene& scene, const geom::Palette& palette, const geom::ViewFile& view,
+                         const Options& options)
+{
+    scene.materials = palette.entries(options.colour_block);
+    scene.background = palette.background(options.colour_block);
+    // cpfg's window draws every object of the L-system opaque (manual 9.4); only the
+    // background scene keeps its transparency.
+    if (!options.material_transparency)
+        for (geom::Material& m : scene.materials)
+            m.transparency = 0;
+    for (const geom::TranslucencySetting& t : view.translucency)
+        for (int i = t.first; i <= t.last; ++i)
+            scene.materials.at(static_cast<std::size_t>(i)).translucency = t.amount;
+}
+
+/// A pass's plant as the light environment traces it: the turtle's geometry, each
+/// primitive with its module in the derived string, and the model's materials.
+geom::Scene light_pass_scene(const env::PassPlant& plant, const geom::Palette& palette, const Options& options)
+{
+    geom::InterpretOptions turtle;
+    turtle.max_memory_bytes = options.max_memory_bytes;
+    turtle.origins = plant.string.origins;
+    if (!plant.string.origins.empty())
+        turtle.derived = &plant.string.derived;
+    geom::Scene scene = geom::interpret(plant.string.modules, plant.symbols, plant.view, turtle);
+    set_model_materials(scene, palette, plant.view, options);
+    geom::drop_unrenderable(scene);
+    return scene;
+}
+
+/// QuasiMC's `.e` line: Cambium's light environment, its specification read now so that
+/// its errors come before any work.
+env::Connection light_connection(const env::CommSpec& spec, const env::Context& context, const Options& options)
+{
+    const std::vector<std::string> args(spec.executable.begin() + 1, spec.executable.end());
+    auto light = std::make_shared<const env::LightSpec>(env::read_light_spec(args, context));
+    auto palette = std::make_shared<const geom::Palette>(load_palette(options));
+    env::Connection c;
+    c.make = [light, palette, options] {
+        return make_light_environment(
+            *light, [palette, options](const env::PassPlant& plant) { return light_pass_scene(plant, *palette, options); },
+            options.threads);
+    };
+    c.description = std::filesystem::path(spec.executable.front()).filename().string() +
+                    " (built in: Cambium's light environment traces the plant; no program is started)";
+    return c;
 }
 
 
@@ -126,7 +178,9 @@ env::Connection model_environment(const Options& options, const env::CommSpec& s
         env::prepare_message_folder(*options.environment_messages);
         programs.limits.message_folder = std::filesystem::absolute(*options.environment_messages);
     }
-    env::Connection connection = env::connect(spec, context, programs);
+    env::Connection connection = env::names_light_environment(spec.executable.front())
+                                     ? light_connection(spec, context, options)
+                                     : env::connect(spec, context, programs);
     if (!options.quiet)
         std::fprintf(stderr, "environment: %s\n", connection.description.c_str());
     return connection;
@@ -518,16 +572,7 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
     geom::Scene scene = geom::interpret(string, model.lsystem.symbols(), *model.view, turtle);
     const bool index_lit = lit_by_colour_index(model);
     scene.shading = geom::render_mode(*model.view);
-    scene.materials = model.palette.entries(options.colour_block);
-    scene.background = model.palette.background(options.colour_block);
-    // cpfg's window draws every object of the L-system opaque (manual 9.4); only the
-    // background scene keeps its transparency.
-    if (!options.material_transparency)
-        for (geom::Material& m : scene.materials)
-            m.transparency = 0;
-    for (const geom::TranslucencySetting& t : model.view->translucency)
-        for (int i = t.first; i <= t.last; ++i)
-            scene.materials.at(static_cast<std::size_t>(i)).translucency = t.amount;
+    set_model_materials(scene, model.palette, *model.view, options);
     if (index_lit)
         light_by_colour_index(scene, *model.view, model.palette, options.colour_block);
 

@@ -13,6 +13,8 @@
 #include <vector>
 
 #include "base/diagnostics.h"
+#include "geom/view_file.h"
+#include "lsys/lsystem.h"
 
 namespace cambium::env {
 
@@ -43,6 +45,10 @@ struct Query {
     /// (its whole homomorphism successor) when that module is one the `.e` names; nullopt
     /// when it is not (a program then expects no geometry block).
     std::optional<std::vector<std::string>> geometry;
+    /// The organ the ?E stands before: the index, in the derived string, of the module
+    /// that follows it (what an environment computing on the plant's own geometry
+    /// answers for: the primitives geom's provenance gives that module).
+    std::uint64_t organ = 0;
 };
 
 /// A reply: the ?E at `address` gets each given parameter; nullopt (an empty field)
@@ -68,6 +74,14 @@ struct Context {
     std::function<RgbImage(const std::filesystem::path&)> read_image;
 };
 
+/// The plant of one environmental pass as the turtle reads it: for an environment that
+/// computes on the plant's own geometry rather than on the messages alone.
+struct PassPlant {
+    const lsys::TurtleString& string;
+    const lsys::SymbolTable& symbols;
+    const geom::ViewFile& view;
+};
+
 /// An environmental process: cpfg's external program or one of Cambium's built-ins.
 /// It keeps its state from pass to pass, as a program started once for the run does.
 class Environment {
@@ -77,6 +91,9 @@ public:
     /// step counter cpfg sends at the pass's end (0 for the axiom's pass). Replies may
     /// come in any order; a reply to an address that was not sent is ignored.
     virtual std::vector<Reply> pass(const std::vector<Query>& queries, int step) = 0;
+    /// The pass's plant, just before pass(): only valid during the call. A program sees
+    /// only the messages, so the default ignores it.
+    virtual void observe(const PassPlant& /*plant*/) {}
     /// A step whose string holds no ?E: cpfg sends nothing, so an environment of its
     /// own sees nothing; one shared by several plants counts this plant as done.
     virtual void idle(int /*step*/) {}

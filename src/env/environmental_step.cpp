@@ -80,7 +80,7 @@ Connection connect(const CommSpec& spec, const Context& context, const ProgramPe
         throw Error(spec.executable_loc,
                     "the environmental program '" + program +
                         "' is not one of Cambium's built-in environments (honda81, ecosystem, "
-                        "chiba, clover); a model file starts a program only with "
+                        "chiba, clover, QuasiMC); a model file starts a program only with "
                         "--allow-environment-program");
     c.make = [spec, context, limits = programs.limits] {
         return make_external_program(spec, context, limits);
@@ -179,6 +179,7 @@ std::vector<Query> EnvironmentalStep::queries_of(const lsys::TurtleString& pass,
         q.address = t.module - first;
         q.module = sent_module(string, t.module, offset_of[t.module], symbols);
         const std::size_t i = t.module;
+        q.organ = pass.origin(i) + 1;
         if (m_spec.following_module && i + 1 < string.size()) {
             // the module after the ?E in the derived string, before the homomorphism
             if (!pass.origins.empty() && pass.origin(i + 1) != pass.origin(i))
@@ -236,6 +237,7 @@ void EnvironmentalStep::run(const lsys::TurtleString& pass, const lsys::SymbolTa
     sent.reserve(queries.size());
     for (std::size_t k = 0; k < queries.size(); ++k)
         sent.emplace(queries[k].address, k);
+    m_environment->observe(PassPlant{pass, symbols, view});
     const std::vector<Reply> replies = m_environment->pass(queries, step);
     ++m_passes;
     m_queries += queries.size();

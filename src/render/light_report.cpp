@@ -615,7 +615,7 @@ struct Tracer {
             SurfaceMaterial m = hit->material < materials.size() ? materials[hit->material] : SurfaceMaterial{};
             if (hit->material_blend > 0 && hit->end_material < materials.size())
                 m = mix(m, materials[hit->end_material], hit->material_blend);
-            if (m.opacity < 1 && rng.next() >= m.opacity) {  // passes straight through
+            if (!settings.optics && m.opacity < 1 && rng.next() >= m.opacity) {  // passes straight through
                 travelled += length(p - org);
                 org = hit->closed() ? p : p - n * hit->spawn_offset;
                 skip = hit->prim();
@@ -629,7 +629,12 @@ struct Tracer {
             const Bsdf b = make_bsdf(m);
             Rgb3 keep{}, absorbed{};
             double transmitted = 0;
-            const Vec3f refl = b.reflect + b.glossy, trans = b.transmit;
+            Vec3f refl = b.reflect + b.glossy, trans = b.transmit;
+            if (settings.optics) {
+                const SurfaceOptics& o = (*settings.optics)[hit->back ? 1 : 0];
+                refl = Vec3f(float(o.reflectance));
+                trans = Vec3f(float(o.transmittance));
+            }
             const float rf[3] = {refl.x, refl.y, refl.z}, tr[3] = {trans.x, trans.y, trans.z};
             for (int c = 0; c < 3; ++c) {
                 double rc = std::clamp<double>(rf[c], 0, 1), tc = std::clamp<double>(tr[c], 0, 1 - rc);
@@ -689,8 +694,10 @@ LightReport trace_light(const geom::Scene& scene, const LightReportSettings& set
     const Extent extent = make_extent(bounds, settings);
     const Environment* env = settings.environment.get();
     std::vector<Source> sources;
-    if (settings.view_lights && !bounds.empty())
-        for (const RenderLight& l : make_lights(scene.lights)) {
+    std::vector<RenderLight> lights = settings.view_lights ? make_lights(scene.lights) : std::vector<RenderLight>{};
+    lights.insert(lights.end(), settings.lights.begin(), settings.lights.end());
+    if (!bounds.empty())
+        for (const RenderLight& l : lights) {
             if (l.kind == RenderLight::Kind::directional) {
                 if (auto b = make_beam(l, extent))
                     sources.push_back(std::move(*b));

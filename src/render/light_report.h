@@ -14,8 +14,16 @@
 
 #include "geom/scene.h"
 #include "render/environment.h"
+#include "render/light.h"
 
 namespace cambium::render {
+
+/// A surface side's optics for the whole scene: the shares reflected and transmitted
+/// (diffusely); the rest is absorbed.
+struct SurfaceOptics {
+    double reflectance = 0;
+    double transmittance = 0;
+};
 
 struct LightReportSettings {
     /// Rays from the lights in all, shared among them by their power.
@@ -29,6 +37,12 @@ struct LightReportSettings {
     int max_bounces = 4096;
     /// The view file's lights (directional, point, spot); false as --no-view-lights.
     bool view_lights = true;
+    /// Lights traced besides the view file's, their colours linear: a directional light
+    /// of colour (w, w, w) delivers irradiance w (the light environment's sources).
+    std::vector<RenderLight> lights;
+    /// Every surface's optics, front side then back, instead of its material's (the
+    /// light environment's leaf materials); surfaces are then opaque.
+    std::optional<std::array<SurfaceOptics, 2>> optics;
     /// The --sky or --env around the scene, traced too (none: not traced).
     std::shared_ptr<const Environment> environment;
     /// Repeat the scene sideways: a ray leaving the x-z bounds of every primitive through
