@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstdio>
+#include <unistd.h>
 
 #include "base/diagnostics.h"
 
@@ -109,6 +110,38 @@ std::optional<int> for_each_oracle_model(
             continue;
         ++total;
         visit(model, reference);
+    }
+    set_warnings_enabled(true);
+    return total;
+}
+
+fs::path process_folder(const std::string& name)
+{
+    const fs::path dir = fs::temp_directory_path() / ("cambium_" + name + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+std::optional<int> sweep_self_contained_models(
+    const std::function<void(const CorpusModel&, app::Options)>& visit)
+{
+    auto corpus = corpus_dir();
+    if (!corpus)
+        return std::nullopt;
+    int total = 0;
+    set_warnings_enabled(false);
+    for (const CorpusModel& model : corpus_models(*corpus)) {
+        if (model.environmental)
+            continue;
+        ++total;
+        try {
+            app::Options options = model_options(model);
+            options.max_modules = 5'000'000;
+            visit(model, std::move(options));
+        } catch (const std::exception& e) {
+            ADD_FAILURE() << model.id << ": " << e.what();
+        }
     }
     set_warnings_enabled(true);
     return total;

@@ -47,6 +47,18 @@ std::optional<int> for_each_oracle_model(
     const std::string& oracle_file,
     const std::function<void(const CorpusModel&, const std::filesystem::path&)>& visit);
 
+/// A folder of this process's own under the temporary directory (cambium_NAME_PID, made
+/// empty): tests run in parallel, in other checkouts too.
+std::filesystem::path process_folder(const std::string& name);
+
+/// Calls visit(model, options) for every corpus model that needs no environmental
+/// program, its options parsed from its command line with the sweeps' memory bound (5
+/// million modules); warnings are silenced meanwhile, and an exception fails the test
+/// naming the model. Returns how many models it visited, or nullopt when the corpus is
+/// not found.
+std::optional<int> sweep_self_contained_models(
+    const std::function<void(const CorpusModel&, app::Options)>& visit);
+
 /// Runs `compare(model, reference text)` on every model whose oracle folder holds
 /// `oracle_file`; compare returns "" when the model matches, else what differs (an
 /// exception counts as a difference). Prints each difference and "N of M models match",

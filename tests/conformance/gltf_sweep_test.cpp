@@ -12,12 +12,10 @@
 #include <filesystem>
 #include <set>
 #include <tuple>
-#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 
 #include "app/pipeline.h"
-#include "base/diagnostics.h"
 #include "base/output_format.h"
 #include "corpus_model.h"
 #include "geom/gltf_export.h"
@@ -76,33 +74,24 @@ std::size_t expected_primitives(const geom::Scene& scene)
 
 TEST(GltfSweep, EverySelfContainedModelExportsAValidGlb)
 {
-    auto corpus = corpus_dir();
-    if (!corpus)
-        GTEST_SKIP() << "corpus not found";
-    const fs::path out = fs::temp_directory_path() / ("cambium_gltf_sweep_" + std::to_string(::getpid()));
-    fs::create_directories(out);
+    const fs::path out = process_folder("gltf_sweep");
     std::vector<std::string> files;
-    set_warnings_enabled(false);
-    for (const CorpusModel& model : corpus_models(*corpus)) {
-        if (model.environmental)
-            continue;
-        try {
-            app::Options options = model_options(model);
-            options.max_modules = 5'000'000;  // the sweep's memory bound
-            const std::string name = std::to_string(files.size()) + ".glb";
-            options.outputs = {out / name};  // instances kept, as the command keeps them for .glb
-            app::Model loaded = app::load_model(options);
-            geom::Scene scene = app::interpret(loaded, app::derive(loaded, options), options);
-            geom::MeshExportOptions how;
-            how.texture_folder = options.view.parent_path();
-            geom::write_mesh(scene, out / name, MeshFormat::glb, how);
-            EXPECT_EQ(primitives_in(out / name), expected_primitives(scene)) << model.id;
-            files.push_back(name);
-        } catch (const std::exception& e) {
-            ADD_FAILURE() << model.id << ": " << e.what();
-        }
+    const std::optional<int> models = sweep_self_contained_models([&](const CorpusModel& model,
+                                                                      app::Options options) {
+        const std::string name = std::to_string(files.size()) + ".glb";
+        options.outputs = {out / name};  // instances kept, as the command keeps them for .glb
+        app::Model loaded = app::load_model(options);
+        geom::Scene scene = app::interpret(loaded, app::derive(loaded, options), options);
+        geom::MeshExportOptions how;
+        how.texture_folder = options.view.parent_path();
+        geom::write_mesh(scene, out / name, MeshFormat::glb, how);
+        EXPECT_EQ(primitives_in(out / name), expected_primitives(scene)) << model.id;
+        files.push_back(name);
+    });
+    if (!models) {
+        fs::remove_all(out);
+        GTEST_SKIP() << "corpus not found";
     }
-    set_warnings_enabled(true);
     EXPECT_GE(files.size(), 79u);
     const std::optional<fs::path> validator = validator_folder();
     if (validator) {

@@ -656,6 +656,37 @@ TEST(Command, IdenticalRunsGiveIdenticalFiles)
     }
 }
 
+// PostScript and PDF: cairo dates them when written; Cambium dates them SOURCE_DATE_EPOCH
+// (the epoch without it), so identical runs give identical bytes.
+TEST(Command, IdenticalRunsGiveIdenticalDrawings)
+{
+    fs::path dir = scratch("identical_drawings");
+    write(dir / "p.l", plant_l);
+    write(dir / "p.v", plant_v);
+    const std::string files = (dir / "p.l").string() + " " + (dir / "p.v").string();
+    for (const char* run_name : {"a", "b"}) {
+        Result r = run("-q -w 48 32 -ps " + (dir / (std::string(run_name) + ".ps")).string() +
+                       " -o " + (dir / (std::string(run_name) + ".pdf")).string() + " " + files);
+        ASSERT_EQ(r.status, 0) << r.output;
+    }
+    for (const char* ext : {".ps", ".pdf"}) {
+        const std::string a = bytes_of(dir / (std::string("a") + ext));
+        EXPECT_FALSE(a.empty());
+        EXPECT_TRUE(a == bytes_of(dir / (std::string("b") + ext))) << ext;
+    }
+    // runs a second apart would differ without a fixed date: the date is the one given
+    EXPECT_NE(bytes_of(dir / "a.ps").find("\n%%CreationDate: Thu Jan  1 00:00:00 1970\n"), std::string::npos);
+    EXPECT_NE(bytes_of(dir / "a.pdf").find("/CreationDate (19700101000000Z)"), std::string::npos);
+    Result epoch = cambium::test::run_shell("SOURCE_DATE_EPOCH=1700000000 " + std::string(CAMBIUM_EXE) +
+                                            " -q -w 48 32 -ps c.ps -o c.pdf " + files, dir);
+    ASSERT_EQ(epoch.status, 0) << epoch.output;
+    const std::string ps = bytes_of(dir / "c.ps");
+    EXPECT_NE(ps.find("\n%%CreationDate: Tue Nov 14 22:13:20 2023\n"), std::string::npos) << ps.substr(0, 200);
+    EXPECT_NE(bytes_of(dir / "c.pdf").find("/CreationDate (20231114221320Z)"), std::string::npos);
+    // the rest of the file is cairo's as it wrote it: only the date line differs
+    EXPECT_EQ(ps.size(), bytes_of(dir / "a.ps").size());
+}
+
 // TIFF: no alpha when opaque; associated alpha when transparent, so readers that
 // premultiply and readers that do not show the same picture.
 TEST(Command, TiffAlphaIsAssociatedOrAbsent)
