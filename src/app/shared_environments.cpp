@@ -6,7 +6,6 @@
 #include <memory>
 
 #include "base/confinement.h"
-#include "env/light_spec.h"
 #include "env/comm_spec.h"
 #include "geom/text_input.h"
 
@@ -61,10 +60,6 @@ SeatedPlants seat_open_plants(const SceneFile& file, const Options& options)
         Shared* seat = nullptr;
         try {
             const env::CommSpec spec = env::read_comm_spec(*p.model.environment_file);
-            if (env::names_light_environment(spec.executable.front()))
-                throw Error(spec.executable_loc,
-                            "QuasiMC: the light environment computes on one plant's own geometry and is "
-                            "not shared by a field's plants; derive this plant alone");
             auto [it, added] = shared.try_emplace(environment_identity(spec, model_folder(o)));
             if (added)
                 it->second.connection = model_environment(o, spec);

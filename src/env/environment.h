@@ -49,6 +49,8 @@ struct Query {
     /// that follows it (what an environment computing on the plant's own geometry
     /// answers for: the primitives geom's provenance gives that module).
     std::uint64_t organ = 0;
+    /// The plant that sent it, in a shared environment (0 alone).
+    std::size_t plant = 0;
 };
 
 /// A reply: the ?E at `address` gets each given parameter; nullopt (an empty field)
@@ -80,6 +82,10 @@ struct PassPlant {
     const lsys::TurtleString& string;
     const lsys::SymbolTable& symbols;
     const geom::ViewFile& view;
+    /// The plant's number in a shared environment (0 alone), as its queries carry it.
+    std::size_t plant = 0;
+    /// Where the plant stands (a 3x4 column-major transform); null: at the origin.
+    const std::array<float, 12>* placement = nullptr;
 };
 
 /// An environmental process: cpfg's external program or one of Cambium's built-ins.
@@ -91,8 +97,9 @@ public:
     /// step counter cpfg sends at the pass's end (0 for the axiom's pass). Replies may
     /// come in any order; a reply to an address that was not sent is ignored.
     virtual std::vector<Reply> pass(const std::vector<Query>& queries, int step) = 0;
-    /// The pass's plant, just before pass(): only valid during the call. A program sees
-    /// only the messages, so the default ignores it.
+    /// The pass's plant, before pass() (also at a step without ?E: the plant is still
+    /// there); only valid during the call. In a shared environment every plant's thread
+    /// calls it, at once. A program sees only the messages, so the default ignores it.
     virtual void observe(const PassPlant& /*plant*/) {}
     /// A step whose string holds no ?E: cpfg sends nothing, so an environment of its
     /// own sees nothing; one shared by several plants counts this plant as done.

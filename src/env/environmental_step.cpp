@@ -223,6 +223,8 @@ void EnvironmentalStep::run(const lsys::TurtleString& pass, const lsys::SymbolTa
     const int communication = symbols.find("?E");
     if (communication < 0)
         return;
+    m_environment->observe(PassPlant{pass, symbols, view, 0,
+                                     m_connection.placement ? &*m_connection.placement : nullptr});
     bool any = false;
     for (std::size_t i = 0; i < string.size() && !any; ++i)
         any = static_cast<int>(string.symbol(i)) == communication;
@@ -237,7 +239,6 @@ void EnvironmentalStep::run(const lsys::TurtleString& pass, const lsys::SymbolTa
     sent.reserve(queries.size());
     for (std::size_t k = 0; k < queries.size(); ++k)
         sent.emplace(queries[k].address, k);
-    m_environment->observe(PassPlant{pass, symbols, view});
     const std::vector<Reply> replies = m_environment->pass(queries, step);
     ++m_passes;
     m_queries += queries.size();

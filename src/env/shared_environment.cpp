@@ -18,6 +18,7 @@ public:
         return m_shared.exchange(m_index, queries, step);
     }
     void idle(int step) override { m_shared.exchange(m_index, {}, step); }
+    void observe(const PassPlant& plant) override { m_shared.observe(m_index, plant); }
 
 private:
     SharedEnvironment& m_shared;
@@ -44,8 +45,10 @@ std::vector<Reply> SharedEnvironment::exchange(std::size_t index, const std::vec
         throw Error(*m_failure);
     std::vector<Query>& mine = m_queries[index];
     mine = queries;
-    for (Query& q : mine)
+    for (Query& q : mine) {
         q.address = (std::uint64_t(index) << plant_shift) | (q.address & address_mask);
+        q.plant = index;
+    }
     m_step = std::max(m_step, step);
     const std::size_t round = m_round;
     if (++m_sent == m_active)
@@ -57,6 +60,13 @@ std::vector<Reply> SharedEnvironment::exchange(std::size_t index, const std::vec
     std::vector<Reply> answers = std::move(m_replies[index]);
     m_replies[index].clear();
     return answers;
+}
+
+void SharedEnvironment::observe(std::size_t index, const PassPlant& plant)
+{
+    PassPlant numbered = plant;
+    numbered.plant = index;
+    m_environment->observe(numbered);
 }
 
 void SharedEnvironment::leave(std::size_t index)

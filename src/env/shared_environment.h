@@ -32,6 +32,10 @@ public:
     /// A plant failed: every waiting and later exchange throws an Error saying so.
     void abandon(const std::string& why);
 
+    /// Plant `index`'s pass, shown to the environment (from the plant's own thread, without
+    /// the lock: the environment's observe() is made for it).
+    void observe(std::size_t index, const PassPlant& plant);
+
     /// One plant's queries (addresses its own) for `step`; its answers.
     std::vector<Reply> exchange(std::size_t index, const std::vector<Query>& queries, int step);
 

@@ -748,6 +748,29 @@ TEST(SceneAssembly, PlantsOfOneEnvironmentCompete)
     EXPECT_EQ(segments_drawn(f, open, "[{}, {}]"), 0u);
 }
 
+/// Model m: a bud before a leaf ball, which grows a segment only when the light
+/// environment (QuasiMC's `.e` line) finds the ball lit.
+void light_bud(const SceneFolder& f)
+{
+    f.write("m/p.l", "lsystem: 1\nderivation length: 1\naxiom: B?E(0)@O(2)\n"
+                     "B > ?E(l) : l > 0.1 --> F(1)B\nendlsystem\n");
+    f.write("m/p.v", "line style: cylinder\ninitial line width: 0.1\n");
+    f.write("m/p.e", "executable: QuasiMC -e p.e light.spec\n");
+    f.write("m/light.spec", "light source: 0 -1 0 1\nleaf material (top): 0 10 0 10 1\nnumber of rays: 20000\n");
+}
+
+TEST(SceneAssembly, PlantsSharingTheLightEnvironmentShadeEachOther)
+{
+    // Far apart, both buds are lit and grow; with the second plant 4 above the first, its
+    // ball covers the first's from the light straight down, and only the upper one grows
+    SceneFolder f("light_field");
+    light_bud(f);
+    const std::string open = "cpfg -e p.e p.l p.v";
+    EXPECT_EQ(segments_drawn(f, open, R"([{}, {"translate": [100, 0, 0]}])"), 2u);
+    EXPECT_EQ(segments_drawn(f, open, R"([{}, {"translate": [0, 4, 0]}])"), 1u);
+    EXPECT_EQ(segments_drawn(f, open, R"([{}, {"translate": [0, -4, 0]}])"), 1u);
+}
+
 // --light-report: a .json or .csv file, refused before any work otherwise; without -o it
 // renders no image; its value is never taken for a scene file.
 // A scene's light report names each organ by its placement and by the derived string's
