@@ -284,6 +284,22 @@ public:
         return v;
     }
 
+    /// A `meshes` entry's OBJ: its materials and textures joined to the scene's tables,
+    /// its surface one prototype (returned).
+    std::uint32_t add_mesh(ObjModel& model, const SceneMesh& entry)
+    {
+        const std::uint16_t material_offset = palette_offset(model.materials);
+        const std::int16_t texture_offset = static_cast<std::int16_t>(
+            table_offset(m_out.textures, m_texture_tables, model.textures, same_texture, 32767,
+                         "the plants name more than 32767 textures"));
+        geom::Geometry g;
+        g.mesh = std::move(model.mesh);
+        geom::offset_materials(g, material_offset);
+        geom::offset_textures(g, texture_offset);
+        m_out.prototypes.push_back({entry.path, std::move(g)});
+        return static_cast<std::uint32_t>(m_out.prototypes.size() - 1);
+    }
+
 private:
     /// Whether drawing the organs into the prototype takes less memory than placing
     /// them at the top level: a placed organ costs an instance (Embree's ~88 B, its BVH
@@ -529,6 +545,18 @@ geom::Scene assemble(const SceneFile& file, const std::vector<std::optional<Envi
                      const Options& options, const AssemblyOptions& how, AssemblyReport* report)
 {
     auto start = Clock::now();
+    // The meshes are read first: their errors come before any derivation.
+    std::vector<ObjModel> meshes;
+    for (const SceneMesh& m : file.meshes) {
+        try {
+            meshes.push_back(read_obj_model(m.file, file.file.parent_path().empty()
+                                                        ? fs::path(".")
+                                                        : file.file.parent_path(),
+                                            options.allow_file_access, SceneLimits{}));
+        } catch (const Error& e) {
+            throw Error(file.file.string() + ": " + m.path + ".file: " + nested_message(e));
+        }
+    }
     // Group the entries and their steps: each distinct variant derived once.
     std::vector<Group> groups;
     std::map<std::string, std::size_t> group_of_key;
@@ -632,6 +660,21 @@ geom::Scene assemble(const SceneFile& file, const std::vector<std::optional<Envi
                 ++r.organ_instances;
             }
         }
+    }
+    for (std::size_t k = 0; k < file.meshes.size(); ++k) {
+        geom::Bounds3 bounds;
+        for (const geom::Float3& p : meshes[k].mesh.positions)
+            bounds.extend(geom::Vec3{p[0], p[1], p[2]});
+        const std::uint32_t prototype = combiner.add_mesh(meshes[k], file.meshes[k]);
+        for (const Transform& t : file.meshes[k].placements) {
+            out.bounds.extend(placed_bounds(bounds, t));
+            geom::Instance placed;
+            placed.prototype = prototype;
+            placed.transform = t;
+            placed.plant = static_cast<std::uint32_t>(r.plant_instances++);
+            out.instances.push_back(placed);
+        }
+        meshes[k] = ObjModel{};
     }
     if (file.ground)
         add_ground(out, *file.ground, SceneLimits{});

@@ -410,6 +410,21 @@ ScenePlant plant(const Node& n, Context& c)
     return p;
 }
 
+SceneMesh mesh_entry(const Node& n, Context& c)
+{
+    n.object({"file", "placements"});
+    for (const char* key : {"file", "placements"})
+        if (!n.has(key))
+            n.fail(std::string("needs a ") + key);
+    SceneMesh m;
+    m.path = n.path();
+    m.file = resolve_under(n["file"], c.folder, n["file"].string(), c.options.allow_file_access);
+    if (!fs::is_regular_file(m.file))
+        n["file"].fail("'" + n["file"].string() + "' is not a file");
+    m.placements = placements(n["placements"], c);
+    return m;
+}
+
 // ---- the rest ---------------------------------------------------------------------
 
 SceneGround ground(const Node& n, Context& c)
@@ -657,18 +672,30 @@ SceneFile read_scene_file(const fs::path& file, const Options& options, const Sc
     Context c{name, file.parent_path().empty() ? fs::path(".") : file.parent_path(), options,
               limits};
     Node root(name, document, "");
-    root.object({"plants", "ground", "camera", "lights", "sky", "environment", "render"});
+    root.object({"plants", "meshes", "ground", "camera", "lights", "sky", "environment", "render"});
     SceneFile scene;
     scene.file = file;
-    if (!root.has("plants"))
-        root.fail("needs a plants list");
-    Node plants = root["plants"];
-    if (!plants.value().is_array() || plants.value().empty())
-        plants.fail("must be a non-empty list of plants");
-    if (plants.value().size() > limits.max_plants)
-        plants.fail("lists more than " + std::to_string(limits.max_plants) + " plants");
-    for (std::size_t i = 0; i < plants.value().size(); ++i)
-        scene.plants.push_back(plant(plants[i], c));
+    if (!root.has("plants") && !root.has("meshes"))
+        root.fail("needs a plants list (or a meshes list)");
+    if (root.has("plants")) {
+        Node plants = root["plants"];
+        if (!plants.value().is_array() || plants.value().empty())
+            plants.fail("must be a non-empty list of plants");
+        if (plants.value().size() > limits.max_plants)
+            plants.fail("lists more than " + std::to_string(limits.max_plants) + " plants");
+        for (std::size_t i = 0; i < plants.value().size(); ++i)
+            scene.plants.push_back(plant(plants[i], c));
+    }
+    if (root.has("meshes")) {
+        Node meshes = root["meshes"];
+        if (!meshes.value().is_array() || meshes.value().empty())
+            meshes.fail("must be a non-empty list of meshes");
+        if (meshes.value().size() > limits.max_meshes)
+            meshes.fail("lists more than " + std::to_string(limits.max_meshes) + " meshes");
+        for (std::size_t i = 0; i < meshes.value().size(); ++i)
+            scene.meshes.push_back(mesh_entry(meshes[i], c));
+    }
+    Node plants = root.has("plants") ? root["plants"] : root["meshes"];
     std::size_t variants = 0;
     for (const ScenePlant& p : scene.plants)
         variants += p.steps.size();

@@ -27,6 +27,8 @@ struct SceneLimits {
     std::size_t max_mesh_triangles = 10'000'000;  ///< a ground or scatter OBJ mesh
     std::uintmax_t max_mesh_bytes = 1u << 30;     ///< its file (a regular file)
     std::size_t max_mesh_line_bytes = 64u << 10;  ///< one line of it
+    std::size_t max_mesh_materials = 65'534;      ///< MTL entries of a `meshes` OBJ
+    std::size_t max_meshes = 10'000;              ///< `meshes` entries
 };
 
 /// A 3x4 column-major transform, as geom::Instance::transform.
@@ -70,6 +72,14 @@ struct SceneGround {
     double texture_repeat = 1;
 };
 
+/// One `meshes` entry: an OBJ file with its MTL materials (a plant Cambium exported)
+/// and where its copies stand.
+struct SceneMesh {
+    std::string path;                   ///< its JSON path, "meshes[0]", for messages
+    std::filesystem::path file;         ///< resolved
+    std::vector<Transform> placements;
+};
+
 struct SceneCamera {
     std::optional<geom::Vec3> eye, look_at;
     geom::Vec3 up{0, 1, 0};
@@ -101,6 +111,7 @@ struct SceneRender {
 struct SceneFile {
     std::filesystem::path file;
     std::vector<ScenePlant> plants;
+    std::vector<SceneMesh> meshes;
     std::optional<SceneGround> ground;
     std::optional<SceneCamera> camera;
     std::vector<geom::Light> lights;  ///< empty: a default sun (or the sky's)
@@ -126,6 +137,23 @@ std::vector<Transform> scatter(const ScatterSpec& spec, const GroundMesh* mesh =
 /// regular file within limits.max_mesh_bytes, lines within max_mesh_line_bytes, at most
 /// max_mesh_triangles triangles (errors at file:line otherwise).
 GroundMesh read_obj_mesh(const std::filesystem::path& file, const SceneLimits& limits);
+
+/// An OBJ file read as the surface it describes, in its MTL's materials.
+struct ObjModel {
+    /// smooth normals from `vn` (a face without them is flat), uvs from `vt`; material
+    /// and texture index `materials` and `textures`
+    geom::TriangleMesh mesh;
+    std::vector<geom::Material> materials;  ///< one per MTL entry used (`usemtl`)
+    std::vector<geom::TextureDef> textures; ///< `map_Kd` files, absolute
+};
+
+/// Reads an OBJ file, the MTL files its `mtllib` names and their `map_Kd` textures, each
+/// of which must lie in `allowed` unless allow_file_access, within `limits` (the
+/// ground's, plus max_mesh_materials): Cambium's MTL values map back to the cpfg
+/// material they were written from (Ka, Kd, Ks, Ke, Ns, d = 1 - transparency). Errors
+/// name the file and line (an MTL's error is nested in its mtllib line's).
+ObjModel read_obj_model(const std::filesystem::path& file, const std::filesystem::path& allowed,
+                        bool allow_file_access, const SceneLimits& limits);
 
 /// The transform of an explicit placement: scale, then rotation about +y, then translation.
 Transform placement_transform(const geom::Vec3& translate, double rotate_y_deg, double scale);

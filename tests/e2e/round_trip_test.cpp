@@ -7,6 +7,7 @@
 #include <OpenImageIO/imageio.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -61,6 +62,46 @@ struct Comparison {
     double seconds = 0;
 };
 
+/// The two pictures' difference: RMSE over the picture and over the pixels either
+/// picture's plant covers (the corner's colour is the background in both).
+Comparison compare(const fs::path& direct, const fs::path& read_back, const std::string& id,
+                   std::chrono::steady_clock::time_point start)
+{
+    Comparison c;
+    int w = 0, h = 0, w2 = 0, h2 = 0;
+    const std::vector<float> a = rgb_of(direct, w, h);
+    const std::vector<float> b = rgb_of(read_back, w2, h2);
+    if (a.empty() || a.size() != b.size())
+        return c;
+    // the window's corner shows the background in both (the box frames the plant)
+    const float background[3] = {a[0], a[1], a[2]};
+    auto is_background = [&](const std::vector<float>& p, std::size_t i) {
+        return p[i] == background[0] && p[i + 1] == background[1] && p[i + 2] == background[2];
+    };
+    double all = 0, plant = 0;
+    std::size_t covered = 0;
+    for (std::size_t i = 0; i < a.size(); i += 3) {
+        double squares = 0;
+        for (int k = 0; k < 3; ++k)
+            squares += (double(a[i + k]) - b[i + k]) * (double(a[i + k]) - b[i + k]);
+        all += squares;
+        const bool in_a = !is_background(a, i), in_b = !is_background(b, i);
+        c.direct_pixels += in_a;
+        c.read_back_pixels += in_b;
+        if (in_a || in_b) {
+            plant += squares;
+            ++covered;
+        }
+    }
+    c.rmse = std::sqrt(all / double(a.size()));
+    c.plant_rmse = covered ? std::sqrt(plant / (3.0 * double(covered))) : 0;
+    c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::printf("%s: RMSE %.4f of full scale over the picture, %.4f over the plant's %zu pixels "
+                "(%.1f s)\n",
+                id.c_str(), c.rmse, c.plant_rmse, covered, c.seconds);
+    return c;
+}
+
 /// Renders the corpus model `id` (files `lsystem`, `view`, material file `materials`)
 /// in a copy of its folder of this process's own, exports it with -gls, and renders
 /// the export as the background scene of an L-system that draws nothing, through the
@@ -90,39 +131,49 @@ Comparison gls_round_trip(const fs::path& corpus, const std::string& id, const s
     run(picture + "direct.png " + lsystem + " direct.v");
     run(picture + "read_back.png empty.l read_back.v");
 
-    Comparison c;
-    int w = 0, h = 0, w2 = 0, h2 = 0;
-    const std::vector<float> a = rgb_of(dir / "direct.png", w, h);
-    const std::vector<float> b = rgb_of(dir / "read_back.png", w2, h2);
+    const Comparison c = compare(dir / "direct.png", dir / "read_back.png", id, start);
     fs::remove_all(dir);
-    if (a.empty() || a.size() != b.size())
-        return c;
-    // the window's corner shows the background in both (the box frames the plant)
-    const float background[3] = {a[0], a[1], a[2]};
-    auto is_background = [&](const std::vector<float>& p, std::size_t i) {
-        return p[i] == background[0] && p[i + 1] == background[1] && p[i + 2] == background[2];
+    return c;
+}
+
+/// Renders the corpus model `id` through a scene file (its `command`, one placement at
+/// the origin), exports it with -o plant.obj, and renders a scene file whose `meshes`
+/// entry places plant.obj: the same camera (looking at the `-vv` box's centre from the
+/// front), light, background and samples.
+Comparison obj_round_trip(const fs::path& corpus, const std::string& id, const std::string& command)
+{
+    const auto start = std::chrono::steady_clock::now();
+    const fs::path dir = fs::temp_directory_path() /
+                         ("cambium_obj_round_trip_" + fs::path(id).filename().string() + "_" +
+                          std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::copy(corpus / "cpfg" / id, dir, fs::copy_options::recursive);
+    auto run = [&](const std::string& args) {
+        const cambium::test::CommandResult r =
+            cambium::test::run_shell(std::string(CAMBIUM_EXE) + " -q " + args, dir);
+        EXPECT_EQ(r.status, 0) << args << "\n" << r.output;
     };
-    double all = 0, plant = 0;
-    std::size_t covered = 0;
-    for (std::size_t i = 0; i < a.size(); i += 3) {
-        double squares = 0;
-        for (int k = 0; k < 3; ++k)
-            squares += (double(a[i + k]) - b[i + k]) * (double(a[i + k]) - b[i + k]);
-        all += squares;
-        const bool in_a = !is_background(a, i), in_b = !is_background(b, i);
-        c.direct_pixels += in_a;
-        c.read_back_pixels += in_b;
-        if (in_a || in_b) {
-            plant += squares;
-            ++covered;
-        }
-    }
-    c.rmse = std::sqrt(all / double(a.size()));
-    c.plant_rmse = covered ? std::sqrt(plant / (3.0 * double(covered))) : 0;
-    c.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    std::printf("%s: RMSE %.4f of full scale over the picture, %.4f over the plant's %zu pixels "
-                "(%.1f s)\n",
-                id.c_str(), c.rmse, c.plant_rmse, covered, c.seconds);
+    run("-vv plant.vv -o plant.obj " + command.substr(command.find(' ') + 1));
+    double lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    std::sscanf(text_of(dir / "plant.vv").c_str(), "box: x: %lf,%lf y: %lf,%lf z: %lf,%lf", &lo[0],
+                &hi[0], &lo[1], &hi[1], &lo[2], &hi[2]);
+    const double size = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+    char camera[512];
+    std::snprintf(camera, sizeof camera,
+                  "\"camera\": {\"eye\": [%g, %g, %g], \"look_at\": [%g, %g, %g], \"fov_deg\": 30, "
+                  "\"width\": 200, \"height\": 150},\n"
+                  "\"lights\": [{\"type\": \"directional\", \"direction\": [0.4, 1, 0.6]}],\n"
+                  "\"render\": {\"spp\": 16, \"seed\": 1, \"background\": \"#000000\"}}\n",
+                  (lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] + 2.4 * size, (lo[0] + hi[0]) / 2,
+                  (lo[1] + hi[1]) / 2, (lo[2] + hi[2]) / 2);
+    std::ofstream(dir / "direct.json") << "{\"plants\": [{\"model\": \".\", \"command\": \"" << command
+                                       << "\", \"placements\": [{}]}],\n" << camera;
+    std::ofstream(dir / "read_back.json")
+        << "{\"meshes\": [{\"file\": \"plant.obj\", \"placements\": [{}]}],\n" << camera;
+    run("direct.json -o direct.png");
+    run("read_back.json -o read_back.png");
+    const Comparison c = compare(dir / "direct.png", dir / "read_back.png", id + " (OBJ)", start);
+    fs::remove_all(dir);
     return c;
 }
 
@@ -176,6 +227,37 @@ TEST(RoundTrip, GlsOfPolygonsAndWideCylindersRendersAsThePlant)
     expect_both_drawn(c);
     EXPECT_LT(c.rmse, 0.02);
     EXPECT_LT(c.plant_rmse, 0.1);
+}
+
+}  // namespace
+
+namespace {
+
+// The OBJ with its MTL, placed by a scene file's `meshes` entry, renders as the plant
+// does through the scene file: the plant's materials, smooth normals and the same
+// tessellation error as the GLS round trip's.
+TEST(RoundTrip, ObjOfCylindersAndSpheresRendersAsThePlant)
+{
+    const auto corpus = corpus_dir();
+    if (!corpus)
+        GTEST_SKIP() << "corpus not found";
+    const Comparison c = obj_round_trip(*corpus, "11-CPFG/02-Mod-vis-3D/10-sympodial",
+                                        "cpfg -M material.mat plant.l plant.v");
+    expect_both_drawn(c);
+    EXPECT_LT(c.rmse, 0.01);
+    EXPECT_LT(c.plant_rmse, 0.05);
+}
+
+TEST(RoundTrip, ObjOfPolygonsAndWideCylindersRendersAsThePlant)
+{
+    const auto corpus = corpus_dir();
+    if (!corpus)
+        GTEST_SKIP() << "corpus not found";
+    const Comparison c = obj_round_trip(*corpus, "10-manuals/11-CPFG/ArticulatedLamp",
+                                        "cpfg -M materials.mat lamp.l view.v");
+    expect_both_drawn(c);
+    EXPECT_LT(c.rmse, 0.015);
+    EXPECT_LT(c.plant_rmse, 0.07);
 }
 
 }  // namespace

@@ -108,6 +108,10 @@ GOOD = {
     "scatter_rectangle": scatter(seed=4, min_spacing=0.5, rotate_y=True, scale=[0.8, 1.2]),
     "parallel_camera": scene(camera={"projection": "parallel"}),
     "colour_block_option": plant(command="cpfg -c1 p.l p.v -w 100 100"),
+    "meshes_only": scene(plants=None, meshes=[{"file": "p.obj", "placements": [{}]}]),
+    "plants_and_meshes": scene(meshes=[{"file": "p.obj",
+                                        "placements": {"scatter": {"rectangle": [-5, -5, 5, 5],
+                                                                   "count": 2}}}]),
 }
 
 # name: (document, words the parser's error holds: the JSON path and the reason)
@@ -154,6 +158,10 @@ BAD = {
     "render_filter": (scene(render={"filter": "lanczos"}), "render.filter"),
     "render_tonemap": (scene(render={"tonemap": "aces"}), "render.tonemap"),
     "render_unknown_key": (scene(render={"samples": 4}), "render.samples: unknown key"),
+    "mesh_without_file": (scene(meshes=[{"placements": [{}]}]), "meshes[0]: needs a file"),
+    "mesh_unknown_key": (scene(meshes=[{"file": "p.obj", "placements": [{}], "colour": 1}]),
+                         "meshes[0].colour: unknown key"),
+    "empty_meshes": (scene(meshes=[]), "meshes: must be a non-empty list"),
 }
 
 # Rejected by the parser; beyond what the schema can say (files, geometry of values).
@@ -165,6 +173,10 @@ PARSER_ONLY = {
     "directional_light_zero": (scene(lights=[{"type": "directional", "direction": [0, 0, 0]}]),
                                "lights[0].direction"),
     "command_writes_files": (plant(command="cpfg -str out.str p.l p.v"), "plants[0].command"),
+    "mesh_not_a_file": (scene(meshes=[{"file": "missing.obj", "placements": [{}]}]),
+                        "meshes[0].file"),
+    "mesh_bad_index": (scene(meshes=[{"file": "bad.obj", "placements": [{}]}]),
+                       "bad.obj:4:"),
 }
 
 
@@ -205,6 +217,10 @@ def main():
             f.write(PLANT_L)
         with open(os.path.join(folder, "m", "p.v"), "w") as f:
             f.write(PLANT_V)
+        with open(os.path.join(folder, "p.obj"), "w") as f:
+            f.write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+        with open(os.path.join(folder, "bad.obj"), "w") as f:
+            f.write("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 5\n")
         for name, doc in GOOD.items():
             errors = list(validator.iter_errors(doc))
             if errors:
