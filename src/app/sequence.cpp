@@ -534,6 +534,16 @@ int run_animation(const Options& options, const SequenceOutputs& out)
                     before, string, lineage, float(k) / float(numbering.inbetween + 1), grows);
                 ledger.derived(g.number, seconds_since(blend_start));
                 std::optional<lsys::ModuleString> homo = after_homomorphism(grown);
+                if (options.organ_masks && !homo) {
+                    // the in-between has the frame's modules, in order: their names too
+                    StringOrigins origins;
+                    origins.derived = &grown;
+                    origins.ages = ages;
+                    origins.births = births;
+                    lsys::ModuleString turtle = turtle_string(model, grown, options, origins.origins);
+                    take(std::move(turtle), g, std::move(origins));
+                    continue;
+                }
                 take(homo ? std::move(*homo) : turtle_string(model, grown, options), g);
             }
         if (numbering.inbetween > 0) {

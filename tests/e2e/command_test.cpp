@@ -1079,6 +1079,23 @@ TEST(Sequence, OrganMaskNamesAreStableAcrossFrames)
     EXPECT_EQ(h2.find("\"F "), std::string::npos) << h2;
 }
 
+// In-between frames (--inbetween) hold the next frame's modules growing: they carry
+// those modules' names, so one picked id follows an organ through them too.
+TEST(Sequence, OrganMaskNamesAreStableThroughInBetweenFrames)
+{
+    fs::path dir = growing_plant(scratch("anim_masks_between"));
+    Result r = run("-a -q -w 48 36 --spp 2 --inbetween 1 --organ-masks -o " + (dir / "f%02d.exr").string() +
+                   " " + plant_files(dir));
+    ASSERT_EQ(r.status, 0) << r.output;
+    auto in = OIIO::ImageInput::open((dir / "f02.exr").string());  // between the first two frames
+    ASSERT_TRUE(in);
+    const std::string m = in->spec().get_string_attribute("cryptomatte/e72bb61/manifest");
+    in->close();
+    EXPECT_NE(m.find("\"F 0@1\""), std::string::npos) << m;
+    EXPECT_NE(m.find("\"F 5@2\""), std::string::npos) << m;  // growing from nothing, already named
+    EXPECT_EQ(m.find("\"F 5\""), std::string::npos) << m;    // no bare string index
+}
+
 TEST(Sequence, SeveralFramesIntoOneNameIsAnErrorBeforeAnyWork)
 {
     fs::path dir = growing_plant(scratch("anim_name"));
