@@ -250,6 +250,8 @@ void write_frame_images(render::Image& image, int number, const Options& options
         render::write_image(image, file, write);
         out.say("wrote " + file.string());
     }
+    if (out.frame_images)
+        out.frame_images(image, number);
 }
 
 /// The camera of one animation frame: the fixed one, else fitted to this frame; then

@@ -39,6 +39,9 @@ struct SequenceOutputs {
     /// -o meshes and vector drawings (is_geometry_output), patterns with a number
     /// field: one file of each -a frame's geometry.
     std::vector<std::filesystem::path> geometry{};
+    /// Each frame's image with its number, after its files are written: a caller that
+    /// keeps the frames (the Python module's sequences). Null: files only.
+    std::function<void(const render::Image&, int number)> frame_images{};
 };
 
 /// Whether the command renders a sequence (-a or --turntable) instead of a still.

@@ -9,6 +9,7 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdlib>
@@ -475,7 +476,7 @@ py::object render_model(ModelObject& m, const py::object& string, bool layers,
 {
     const app::Options options = m.options_with(keyword_dict(keywords));
     if (app::is_sequence(options))
-        throw Error("a sequence is not one image: use Model.turntable() (-a is the command's)");
+        throw Error("a sequence is not one image: use Model.animate() or Model.turntable()");
     std::optional<lsys::ModuleString> given = given_string(m, string);
     render::RenderSettings settings = app::render_settings(options, {});
     settings.aovs = layers;
@@ -711,6 +712,45 @@ SequenceObject turntable_model(ModelObject& m, int frames, std::optional<double>
     SequenceObject sequence;
     sequence.fps = options.shot.fps;
     for (render::Image& image : images)
+        sequence.frames.append(image_object(std::move(image), write));
+    return sequence;
+}
+
+/// cpfg's animation mode (-a, with the load's animation file or cpfg's default frames)
+/// as the command renders it, every frame kept in a Sequence in the order of its number:
+/// the same frames, cameras and in-betweens, through the command's own sequence code.
+SequenceObject animate_model(ModelObject& m, bool layers, const py::object& progress, const py::kwargs& keywords)
+{
+    py::dict more = keyword_dict(keywords);
+    more["animate"] = true;
+    const app::Options options = m.options_with(more);
+    if (options.shot.turntable > 0)
+        throw Error("animate() renders -a frames; use Model.turntable() for a turntable");
+    const render::WriteOptions write = app::write_options(options);
+    std::vector<std::pair<int, render::Image>> images;
+    int status = 0;
+    run_released(
+        [&](std::atomic<bool>& cancel, Events& events) {
+            app::SequenceOutputs out;
+            out.settings = app::render_settings(options, {});
+            out.settings.aovs = layers;
+            out.settings.cancel = &cancel;
+            out.write_strings = [](const app::Model&, const lsys::ModuleString&, int) {};
+            out.say = [](const std::string&) {};
+            out.frame_images = [&](const render::Image& image, int number) {
+                images.emplace_back(number, image);
+                events.push("frame");
+            };
+            events.push("render");
+            status = app::run_sequence(options, out);
+        },
+        progress, options.quiet, write);
+    if (status != 0)
+        throw Error("the animation stopped before its last frame (exit status " + std::to_string(status) + ")");
+    std::stable_sort(images.begin(), images.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    SequenceObject sequence;
+    sequence.fps = options.shot.fps;
+    for (auto& [number, image] : images)
         sequence.frames.append(image_object(std::move(image), write));
     return sequence;
 }
@@ -975,6 +1015,10 @@ PYBIND11_MODULE(cambium, m)
             },
             "Starts a derivation from the axiom (the Start block run): advance() it step by "
             "step")
+        .def("animate", &animate_model, py::arg("layers") = false, py::arg("progress") = py::none(),
+             "Renders cpfg's animation mode (-a: the load's animation file, or frames 1 to the "
+             "derivation length) into a Sequence, frame for frame as the command's -a "
+             "(inbetween= and the other keywords as render()'s)")
         .def("turntable", &turntable_model, py::arg("frames"), py::arg("elevation") = py::none(),
              py::arg("string") = py::none(), py::arg("layers") = false,
              py::arg("progress") = py::none(),
