@@ -212,6 +212,18 @@ EnvironmentSample Sky::sample(float u1, float u2) const
     return {d, radiance(d), pdf(d)};
 }
 
+EnvironmentSample Sky::sample_without_sun(float u1, float u2) const
+{
+    if (m_table.empty())
+        return {};
+    float density = 0;
+    int i = 0, j = 0;
+    Vec3f d = m_table.sample(u1, u2, density, i, j);
+    if (!(density > 0))
+        return {};
+    return {d, without_sun(d), density};
+}
+
 float Sky::pdf(const Vec3f& d) const
 {
     float p = m_sun_probability < 1 ? (1 - m_sun_probability) * m_table.pdf(d) : 0.0f;
@@ -442,6 +454,44 @@ bool Environment::uniform() const
     case Kind::map: return std::get<environment_kind::Map>(m_kind).constant();
     }
     return false;
+}
+
+std::optional<environment_kind::Sky::SunDisk> Environment::sun() const
+{
+    const environment_kind::Sky* s = sky();
+    if (!s || !s->sun_up())
+        return std::nullopt;
+    environment_kind::Sky::SunDisk disk = s->sun_disk();
+    if (m_turned)
+        disk.direction = turn(disk.direction);
+    return disk;
+}
+
+Vec3f Environment::radiance_without_sun(const Vec3f& direction) const
+{
+    const environment_kind::Sky* s = sky();
+    if (!s)
+        return radiance(direction);
+    return s->without_sun(m_turned ? unturn(direction) : direction);
+}
+
+EnvironmentSample Environment::sample_without_sun(float u1, float u2) const
+{
+    const environment_kind::Sky* s = sky();
+    if (!s)
+        return sample(u1, u2);
+    EnvironmentSample e = s->sample_without_sun(u1, u2);
+    if (m_turned)
+        e.direction = turn(e.direction);
+    return e;
+}
+
+float Environment::pdf_without_sun(const Vec3f& direction) const
+{
+    const environment_kind::Sky* s = sky();
+    if (!s)
+        return pdf(direction);
+    return s->pdf_without_sun(m_turned ? unturn(direction) : direction);
 }
 
 Environment Environment::hidden_below_horizon() const
