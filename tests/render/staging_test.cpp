@@ -263,10 +263,10 @@ Vec3f sky_irradiance_on_ground(const Environment& env)
 // above it adding pi x its colour x the cosine, and one from below the ground adding
 // nothing. Rendered with the per-point choice among the sun, the dome and the lights and
 // MIS against BSDF sampling; the mean of 1024 pixels at 64 spp must be within 4 standard
-// errors (the pixels' spread over 32) plus 0.2% (the quadrature) of the integral. Putting
-// the sun's light in the dome's MIS weight, or the dome's density in the sun's, moves the
-// mean by more (measured: the dome weighed by the old sun-and-dome mixture's density,
-// +1.5%).
+// errors (the pixels' spread over 32) plus 0.2% (the quadrature) of the integral. An
+// escaping ray's dome weighed with the sun-and-dome mixture's density (Environment::pdf)
+// instead of the dome's own moves the mean by more: measured +2.0% to +3.5% by channel
+// without the lights, +0.7% to +1.2% with them.
 TEST(Staging, GroundUnderTheSkyReflectsTheSkysIrradianceWithTheSunApart)
 {
     const auto sky = std::make_shared<const Environment>(make_sky_environment());
@@ -304,8 +304,9 @@ TEST(Staging, GroundUnderTheSkyReflectsTheSkysIrradianceWithTheSunApart)
 // tracer's estimate (light sampling by the per-point choice plus one BSDF ray that
 // escapes, weighed by the choice's sun and dome probabilities) must match the plain BSDF
 // sampling estimate of the same integral (no lights, no MIS) within 4 combined standard
-// errors. An escape weighed with the dome's probability for the sun, or not weighed,
-// moves it by more (measured below).
+// errors (measured 2109.0 +- 2.6 against 2110.4 +- 2.2). An escape into the disk weighed
+// with the dome's choice probability instead of the sun's gave 2527, one not weighed at
+// all 4100.
 TEST(Staging, SunSampledApartAgreesWithBsdfSamplingOnAGlossyPlane)
 {
     SkyParameters parameters;
@@ -369,13 +370,15 @@ TEST(Staging, SunSampledApartAgreesWithBsdfSamplingOnAGlossyPlane)
 
 // The ground's grain under the default --sky with FernLeaf's two view lights: the spread
 // of an open patch's pixels at 64 spp relative to their mean (the true radiance is the
-// same at every pixel: nothing shadows it). Measured 4.4% (R) and 3.9% (G); with the
-// lights chosen by power and the dome sampled uniformly over the sphere (the sun's cone
-// at 1/2) 13.1% and 11.6%, as on FernLeaf's staged still; with only the dome's sampling
-// reverted, 5.7% and 5.1%. Bound: 6%. The sky alone with independent (white-noise)
-// samples shows the dome's sampling itself: measured 8.1% and 7.7%, 10.2% and 9.6% with
-// the uniform sphere; bound 9.5% (the renders are deterministic: the margin is for
-// changes elsewhere, not for chance).
+// same at every pixel: nothing shadows it). Measured 1.4% (R and G) with the sun a light
+// of its own in the per-point choice; 4.4% and 3.9% with the sun a strategy inside the
+// environment (at a share within [1/4, 3/4]) competing with the view's lights as one
+// light; with the lights chosen by power and the dome sampled uniformly over the sphere
+// (the sun's cone at 1/2) 13.1% and 11.6%, as on FernLeaf's staged still. Bound: 2.5%.
+// The sky alone with independent (white-noise) samples shows the sky's sampling itself:
+// measured 7.1% and 6.9%, 8.1% and 7.7% with the sun inside the environment, 10.2% and
+// 9.6% with the dome sampled over the uniform sphere; bound 7.6% (the renders are
+// deterministic: the margin is for changes elsewhere, not for chance).
 TEST(Staging, GroundUnderTheSkyHasLittleGrainAt64Spp)
 {
     OpenGround g;
@@ -390,7 +393,7 @@ TEST(Staging, GroundUnderTheSkyHasLittleGrainAt64Spp)
         ASSERT_GT(mean, 0.01) << c;
         std::printf("[sky ground] channel %d: mean %.4f, relative spread %.4f\n", c, mean,
                     spread / mean);
-        EXPECT_LT(spread / mean, 0.06) << "channel " << c;
+        EXPECT_LT(spread / mean, 0.025) << "channel " << c;
     }
     // The sky alone, each sample's own variance (independent samples): the dome sampled
     // as its radiance, nothing spent below the horizon.
@@ -402,7 +405,7 @@ TEST(Staging, GroundUnderTheSkyHasLittleGrainAt64Spp)
         auto [mean, spread] = OpenGround::mean_and_spread(alone, c);
         std::printf("[sky ground] sky alone, white noise, channel %d: relative spread %.4f\n",
                     c, spread / mean);
-        EXPECT_LT(spread / mean, 0.095) << "channel " << c;
+        EXPECT_LT(spread / mean, 0.076) << "channel " << c;
     }
 }
 
