@@ -349,7 +349,8 @@ struct ChoiceAt {
 /// opaque ground lies between (FernLeaf's second light shines from below it); the
 /// environment and the sun by their irradiance estimates on the surface's two sides
 /// times the BSDF's albedo on each (the sun nothing where the ground hides all of its
-/// disk); the emissive primitives by their irradiance estimate times the albedo. Every
+/// disk; on the ground the dome never less than the sun, which the plant may shadow); the
+/// emissive primitives by their irradiance estimate times the albedo. Every
 /// light that can give the point something keeps a chance, except one the ground hides
 /// (its contribution is 0), so the estimate stays unbiased; the environment, emissive
 /// primitives' and sun's probabilities go to `choice` for MIS.
@@ -397,6 +398,17 @@ float point_weights(const PathContext& ctx, const LightSet& lights, const Vertex
         }
         weight[i] = std::isfinite(w) && w > 0 ? w : 0.0f;
         total += weight[i];
+    }
+    if (lights.has_sun() && v.hit.geom_id == ground_geom_id) {
+        // On the ground the dome gets at least what the sun gets: in the plant's shadow
+        // the sun's samples are all blocked and the dome's light is what is left. (On the
+        // plant the same floor cost more than it gained; docs/benchmarks.md.)
+        float& dome = weight[lights.environment_index()];
+        const float sun = weight[lights.sun_index()];
+        if (dome > 0 && sun > dome) {
+            total += sun - dome;
+            dome = sun;
+        }
     }
     return total;
 }

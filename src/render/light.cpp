@@ -206,10 +206,14 @@ LightSet::LightSet(const std::vector<RenderLight>& lights, const AreaLights* are
         float p = static_cast<float>(m_cdf[i + 1] - m_cdf[i]);
         if (m_lights[i].kind == LightKind::area)
             m_area_probability = p;
-        if (m_lights[i].kind == LightKind::environment)
+        if (m_lights[i].kind == LightKind::environment) {
             m_environment_probability = p;
-        if (m_lights[i].kind == LightKind::sun)
+            m_environment_index = static_cast<std::uint32_t>(i);
+        }
+        if (m_lights[i].kind == LightKind::sun) {
             m_sun_probability = p;
+            m_sun_index = static_cast<std::uint32_t>(i);
+        }
     }
 }
 

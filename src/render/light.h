@@ -156,6 +156,9 @@ public:
     /// Whether the sun is a light of its own, its unit direction and the sine of its
     /// angular radius.
     bool has_sun() const { return m_has_sun; }
+    /// The indices of the sun and of the environment (meaningful where they are in the set).
+    std::uint32_t sun_index() const { return m_sun_index; }
+    std::uint32_t environment_index() const { return m_environment_index; }
     const Vec3f& sun_direction() const { return m_sun.direction; }
     float sun_sin_radius() const { return m_sun_sin_radius; }
     /// The density of the sun's own sampling along wi (uniform over its cone; no choice)
@@ -229,6 +232,7 @@ private:
     environment_kind::Sky::SunDisk m_sun;
     float m_sun_pdf = 0, m_sun_sin_radius = 0, m_sun_normal_irradiance = 0;
     bool m_has_sun = false;
+    std::uint32_t m_sun_index = 0, m_environment_index = 0;
     float m_area_irradiance = 0;
     /// environment_irradiance() by normal: 16 azimuths x 8 polar bands (LatLongTable's
     /// directions), and its floor.

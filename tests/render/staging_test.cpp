@@ -118,8 +118,9 @@ float sun_choice(const PathContext& ctx, const SurfaceHit& hit, const Bsdf& bsdf
 
 // The sky's sun is a light of its own in the per-point choice: it gets nothing where all
 // of its disk is behind an opaque surface or hidden by the opaque ground, keeps a chance
-// where only its rim is in front (else that sliver of light would be lost: bias), and is
-// not in the set at all when it is below the horizon.
+// where only its rim is in front (else that sliver of light would be lost: bias), never
+// gets more than the dome on the ground, and is not in the set at all when it is below
+// the horizon.
 TEST(LightSelection, TheSunGetsNothingWhereItCannotLightThePoint)
 {
     SkyParameters parameters;
@@ -140,8 +141,23 @@ TEST(LightSelection, TheSunGetsNothingWhereItCannotLightThePoint)
 
     const Bsdf opaque{Vec3f(0.5f), Vec3f(), Vec3f(), 0};
     const Bsdf translucent{Vec3f(0.4f), Vec3f(0.3f), Vec3f(), 0};
-    // Facing the sun, above the ground: a good share.
+    // Facing the sun, above the ground: a good share, more than the dome's.
     EXPECT_GT(sun_choice(ctx, plant_hit({0, 1, 0}, sun), opaque, sun), 0.2f);
+    {
+        const SurfaceHit facing = plant_hit({0, 1, 0}, sun);
+        std::vector<float> p =
+            light_choice_probabilities(ctx, facing, bsdf_at(opaque, facing.normal, sun));
+        EXPECT_GT(p[lights.sun_index()], p[lights.environment_index()]);
+        EXPECT_NEAR(p[0] + p[lights.environment_index()] + p[lights.sun_index()], 1.0f, 1e-5f);
+    }
+    // On the ground (where the plant's shadow falls) the dome gets at least the sun's.
+    {
+        const SurfaceHit on_ground = ground.hit({0.5f, 2, 0.5f}, {0, -1, 0}, 2);
+        std::vector<float> p = light_choice_probabilities(
+            ctx, on_ground, bsdf_at(opaque, on_ground.normal, {0, 1, 0}));
+        EXPECT_GT(p[lights.sun_index()], 0.2f);
+        EXPECT_GE(p[lights.environment_index()], p[lights.sun_index()]);
+    }
     // An opaque leaf facing away from the sun, seen from the side it faces: none.
     EXPECT_EQ(sun_choice(ctx, plant_hit({0, 1, 0}, -sun), opaque, -sun), 0.0f);
     // A translucent one: the sun shines through it, so it keeps a chance.
@@ -265,8 +281,8 @@ Vec3f sky_irradiance_on_ground(const Environment& env)
 // MIS against BSDF sampling; the mean of 1024 pixels at 64 spp must be within 4 standard
 // errors (the pixels' spread over 32) plus 0.2% (the quadrature) of the integral. An
 // escaping ray's dome weighed with the sun-and-dome mixture's density (Environment::pdf)
-// instead of the dome's own moves the mean by more: measured +2.0% to +3.5% by channel
-// without the lights, +0.7% to +1.2% with them.
+// instead of the dome's own moves the mean by more: measured +3.6% to +6.9% by channel
+// without the lights, +1.6% to +3.0% with them.
 TEST(Staging, GroundUnderTheSkyReflectsTheSkysIrradianceWithTheSunApart)
 {
     const auto sky = std::make_shared<const Environment>(make_sky_environment());
@@ -370,15 +386,17 @@ TEST(Staging, SunSampledApartAgreesWithBsdfSamplingOnAGlossyPlane)
 
 // The ground's grain under the default --sky with FernLeaf's two view lights: the spread
 // of an open patch's pixels at 64 spp relative to their mean (the true radiance is the
-// same at every pixel: nothing shadows it). Measured 1.4% (R and G) with the sun a light
-// of its own in the per-point choice; 4.4% and 3.9% with the sun a strategy inside the
-// environment (at a share within [1/4, 3/4]) competing with the view's lights as one
-// light; with the lights chosen by power and the dome sampled uniformly over the sphere
-// (the sun's cone at 1/2) 13.1% and 11.6%, as on FernLeaf's staged still. Bound: 2.5%.
-// The sky alone with independent (white-noise) samples shows the sky's sampling itself:
-// measured 7.1% and 6.9%, 8.1% and 7.7% with the sun inside the environment, 10.2% and
-// 9.6% with the dome sampled over the uniform sphere; bound 7.6% (the renders are
-// deterministic: the margin is for changes elsewhere, not for chance).
+// same at every pixel: nothing shadows it). Measured 1.0% (R) and 1.1% (G) with the sun a
+// light of its own in the per-point choice (1.4% with the sun and the dome in proportion
+// to their irradiance, without the dome's floor at the sun's weight); 4.4% and 3.9% with
+// the sun a strategy inside the environment (at a share within [1/4, 3/4]) competing with
+// the view's lights as one light; with the lights chosen by power and the dome sampled
+// uniformly over the sphere (the sun's cone at 1/2) 13.1% and 11.6%, as on FernLeaf's
+// staged still. Bound: 2.5%. The sky alone with independent (white-noise) samples:
+// measured 10.4% and 9.5%, where open ground pays for the dome's floor (7.1% and 6.9%
+// in proportion to irradiance, 8.1% and 7.7% with the sun inside the environment);
+// bound 11% (the renders are deterministic: the margin is for changes elsewhere, not for
+// chance).
 TEST(Staging, GroundUnderTheSkyHasLittleGrainAt64Spp)
 {
     OpenGround g;
@@ -405,7 +423,7 @@ TEST(Staging, GroundUnderTheSkyHasLittleGrainAt64Spp)
         auto [mean, spread] = OpenGround::mean_and_spread(alone, c);
         std::printf("[sky ground] sky alone, white noise, channel %d: relative spread %.4f\n",
                     c, spread / mean);
-        EXPECT_LT(spread / mean, 0.076) << "channel " << c;
+        EXPECT_LT(spread / mean, 0.11) << "channel " << c;
     }
 }
 
