@@ -24,6 +24,8 @@
 // Sampling: the sun's cone with probability in proportion to its share of the luminous
 // power (within [1/4, 3/4]; when the sun is up), else the dome tabulated by luminance
 // (LatLongTable, the maps' sampler); pdf() is that mixture, so MIS weights are exact.
+// Next-event estimation (LightSet) takes the two apart instead: the sun's disk as a light
+// of its own, the dome through sample_without_sun() and pdf_without_sun().
 #include "render/environment.h"
 
 #include <algorithm>

@@ -117,7 +117,8 @@ private:
 /// sun's cone (when the sun is up) with probability in proportion to the sun's share of
 /// the sky's luminous power, kept within [1/4, 3/4], else the dome (and the ground's
 /// radiance below the horizon) tabulated as a LatLongTable of 128 x 64 cells by their
-/// mean luminance. pdf() is that mixture, so MIS against BSDF sampling stays exact.
+/// mean luminance. pdf() is that mixture, so MIS against BSDF sampling stays exact. (The
+/// light set samples the two as separate lights: sun_disk() and sample_without_sun().)
 class Sky {
 public:
     explicit Sky(const SkyParameters& parameters);
