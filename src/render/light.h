@@ -138,9 +138,9 @@ public:
     bool per_point() const { return m_per_point; }
     static constexpr std::size_t max_point_choice = 16;
     /// The luminance of the irradiance the sampled environment (without a sun of its own)
-    /// gives a surface facing n (unshadowed), estimated once from 256 of its own samples for 128 normals and
-    /// looked up at the nearest, never below 1/20 of the largest (an estimate only
-    /// steers variance). 0 without a sampled environment.
+    /// gives a surface facing n (unshadowed), estimated once from 256 of its own samples for
+    /// 128 normals and looked up at the nearest, never below 1/20 of the largest (an
+    /// estimate only steers variance). 0 without a sampled environment.
     float environment_irradiance(const Vec3f& n) const;
     /// The luminance of the irradiance the sun disk gives a surface facing n: at normal
     /// incidence times the cosine to its centre raised by the sine of its angular radius
@@ -169,8 +169,7 @@ public:
     }
     Vec3f sun_radiance(const Vec3f& wi) const
     {
-        return m_has_sun && dot(wi, m_sun.direction) >= m_sun.cos_radius ? m_sun.radiance
-                                                                         : Vec3f();
+        return m_has_sun && dot(wi, m_sun.direction) >= m_sun.cos_radius ? m_sun.radiance : Vec3f();
     }
     /// The emissive primitives' power over pi r^2 (the irradiance they give a surface r
     /// away, r the scene's radius); 0 when they are not sampled.

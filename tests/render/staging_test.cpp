@@ -10,6 +10,7 @@
 #include <numbers>
 #include <vector>
 
+#include "render/accel.h"
 #include "render/color.h"
 #include "render/environment.h"
 #include "render/ground.h"
@@ -17,7 +18,6 @@
 #include "render/light.h"
 #include "render/material.h"
 #include "render/render.h"
-#include "render/accel.h"
 #include "geom_scenes.h"
 #include "test_scenes.h"
 
@@ -378,8 +378,8 @@ TEST(Staging, SunSampledApartAgreesWithBsdfSamplingOnAGlossyPlane)
     }
     auto [sampled, sampled_se] = mean_se(sum, sum2, draws);
     const double se = std::sqrt(traced_se * traced_se + sampled_se * sampled_se);
-    std::printf("[sun mis] traced %.4f +- %.4f, BSDF sampling %.4f +- %.4f\n", traced,
-                traced_se, sampled, sampled_se);
+    std::printf("[sun mis] traced %.4f +- %.4f, BSDF sampling %.4f +- %.4f\n", traced, traced_se,
+                sampled, sampled_se);
     ASSERT_GT(sampled, 1.0);
     EXPECT_NEAR(traced, sampled, 4 * se);
 }
