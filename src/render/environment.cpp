@@ -24,6 +24,8 @@
 // Sampling: the sun's cone with probability in proportion to its share of the luminous
 // power (within [1/4, 3/4]; when the sun is up), else the dome tabulated by luminance
 // (LatLongTable, the maps' sampler); pdf() is that mixture, so MIS weights are exact.
+// Next-event estimation (LightSet) takes the two apart instead: the sun's disk as a light
+// of its own, the dome through sample_without_sun() and pdf_without_sun().
 #include "render/environment.h"
 
 #include <algorithm>
@@ -210,6 +212,18 @@ EnvironmentSample Sky::sample(float u1, float u2) const
         d = m_table.sample(std::min(u, 0x1.fffffep-1f), u2, density, i, j);
     }
     return {d, radiance(d), pdf(d)};
+}
+
+EnvironmentSample Sky::sample_without_sun(float u1, float u2) const
+{
+    if (m_table.empty())
+        return {};
+    float density = 0;
+    int i = 0, j = 0;
+    Vec3f d = m_table.sample(u1, u2, density, i, j);
+    if (!(density > 0))
+        return {};
+    return {d, without_sun(d), density};
 }
 
 float Sky::pdf(const Vec3f& d) const
@@ -442,6 +456,44 @@ bool Environment::uniform() const
     case Kind::map: return std::get<environment_kind::Map>(m_kind).constant();
     }
     return false;
+}
+
+std::optional<environment_kind::Sky::SunDisk> Environment::sun() const
+{
+    const environment_kind::Sky* s = sky();
+    if (!s || !s->sun_up())
+        return std::nullopt;
+    environment_kind::Sky::SunDisk disk = s->sun_disk();
+    if (m_turned)
+        disk.direction = turn(disk.direction);
+    return disk;
+}
+
+Vec3f Environment::radiance_without_sun(const Vec3f& direction) const
+{
+    const environment_kind::Sky* s = sky();
+    if (!s)
+        return radiance(direction);
+    return s->without_sun(m_turned ? unturn(direction) : direction);
+}
+
+EnvironmentSample Environment::sample_without_sun(float u1, float u2) const
+{
+    const environment_kind::Sky* s = sky();
+    if (!s)
+        return sample(u1, u2);
+    EnvironmentSample e = s->sample_without_sun(u1, u2);
+    if (m_turned)
+        e.direction = turn(e.direction);
+    return e;
+}
+
+float Environment::pdf_without_sun(const Vec3f& direction) const
+{
+    const environment_kind::Sky* s = sky();
+    if (!s)
+        return pdf(direction);
+    return s->pdf_without_sun(m_turned ? unturn(direction) : direction);
 }
 
 Environment Environment::hidden_below_horizon() const

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <variant>
 #include <vector>
@@ -116,7 +117,8 @@ private:
 /// sun's cone (when the sun is up) with probability in proportion to the sun's share of
 /// the sky's luminous power, kept within [1/4, 3/4], else the dome (and the ground's
 /// radiance below the horizon) tabulated as a LatLongTable of 128 x 64 cells by their
-/// mean luminance. pdf() is that mixture, so MIS against BSDF sampling stays exact.
+/// mean luminance. pdf() is that mixture, so MIS against BSDF sampling stays exact. (The
+/// light set samples the two as separate lights: sun_disk() and sample_without_sun().)
 class Sky {
 public:
     explicit Sky(const SkyParameters& parameters);
@@ -132,13 +134,20 @@ public:
     /// horizon (what another renderer's map holds when it gets the sun as a lamp).
     Vec3f without_sun(const Vec3f& d) const { return d.y < 0 ? m_ground : dome(d); }
     /// The sun disk: unit direction toward it, its solid angle and its radiance, constant
-    /// over the disk (0 when the sun is down).
+    /// over the disk (0 when the sun is down), and the cosine of its angular radius.
     struct SunDisk {
         Vec3f direction;
         float solid_angle = 0;
         Vec3f radiance;
+        float cos_radius = 1;
     };
-    SunDisk sun_disk() const { return {m_sun, m_sun_solid_angle, m_sun_radiance}; }
+    SunDisk sun_disk() const { return {m_sun, m_sun_solid_angle, m_sun_radiance, m_cos_sun}; }
+    /// Whether the sun disk is up (it has radiance).
+    bool sun_up() const { return m_sun_up; }
+    /// The dome's strategy alone (the table, no sun): sampling and density of
+    /// without_sun(), for a light set that samples the sun apart.
+    EnvironmentSample sample_without_sun(float u1, float u2) const;
+    float pdf_without_sun(const Vec3f& d) const { return m_table.pdf(d); }
 
 private:
     /// The Perez luminance distribution's five coefficients.
@@ -228,6 +237,18 @@ public:
     /// The sky this environment is, unturned (nullptr for other kinds); with
     /// rotation_degrees() about +y it is what radiance() returns.
     const environment_kind::Sky* sky() const { return std::get_if<environment_kind::Sky>(&m_kind); }
+
+    /// The sky's sun disk as the world sees it (turned), when this is a sky whose sun is
+    /// up; nullopt otherwise. radiance() is radiance_without_sun() plus the disk's
+    /// radiance within it.
+    std::optional<environment_kind::Sky::SunDisk> sun() const;
+    /// Everything but the sun disk: a sky's dome and ground (radiance, its table's
+    /// sampling and density, with nothing of the sun's strategy); for any other kind the
+    /// same as radiance(), sample() and pdf(). For a light set that samples the sun as a
+    /// light of its own.
+    Vec3f radiance_without_sun(const Vec3f& direction) const;
+    EnvironmentSample sample_without_sun(float u1, float u2) const;
+    float pdf_without_sun(const Vec3f& direction) const;
 
 private:
     using Kinds = std::variant<environment_kind::Uniform, environment_kind::Sky,

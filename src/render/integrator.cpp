@@ -326,7 +326,8 @@ LightUniforms light_uniforms(const LightSet& lights, const Sampler& sampler,
     case LightKind::spot:
     case LightKind::directional: return u;
     case LightKind::area:
-    case LightKind::environment: break;
+    case LightKind::environment:
+    case LightKind::sun: break;
     }
     if (!drawn_choice)
         u.u0 = sampler.get2d(block + sample_dimension::light_choice)[1];
@@ -336,21 +337,23 @@ LightUniforms light_uniforms(const LightSet& lights, const Sampler& sampler,
     return u;
 }
 
-/// The probabilities with which a vertex's next-event estimation chose the environment
-/// and the emissive primitives: what a BSDF ray leaving that vertex is weighed against
-/// when it finds them (0: not sampled there, full weight).
+/// The probabilities with which a vertex's next-event estimation chose the environment,
+/// the emissive primitives and the sun: what a BSDF ray leaving that vertex is weighed
+/// against when it finds them (0: not sampled there, full weight).
 struct ChoiceAt {
-    float environment = 0, area = 0;
+    float environment = 0, area = 0, sun = 0;
 };
 
 /// A light chosen for the vertex by what each light can deliver there (LightSet::
 /// per_point): a delta light by its unshadowed f |cos| Li, exactly, and nothing when the
 /// opaque ground lies between (FernLeaf's second light shines from below it); the
-/// environment by its irradiance estimate on the surface's two sides times the BSDF's
-/// albedo on each; the emissive primitives by their irradiance estimate times the
-/// albedo. Every light that can give the point something keeps a chance, except a delta
-/// light the ground hides (its contribution is 0), so the estimate stays unbiased; the
-/// environment and emissive primitives' probabilities go to `choice` for MIS.
+/// environment and the sun by their irradiance estimates on the surface's two sides
+/// times the BSDF's albedo on each (the sun nothing where the ground hides all of its
+/// disk; on the ground the dome never less than the sun, which the plant may shadow); the
+/// emissive primitives by their irradiance estimate times the albedo. Every
+/// light that can give the point something keeps a chance, except one the ground hides
+/// (its contribution is 0), so the estimate stays unbiased; the environment, emissive
+/// primitives' and sun's probabilities go to `choice` for MIS.
 using PointWeights = std::array<float, LightSet::max_point_choice>;
 
 /// choose_at's weights of each light at the vertex, and their sum.
@@ -383,9 +386,29 @@ float point_weights(const PathContext& ctx, const LightSet& lights, const Vertex
         case LightKind::area:
             w = (front + back) * lights.area_irradiance() * std::numbers::inv_pi_v<float>;
             break;
+        case LightKind::sun:
+            // A point below the ground sees none of a disk wholly above the horizon.
+            if (ground && lights.sun_direction().y > lights.sun_sin_radius() &&
+                ctx.ground->distance(v.hit.position, lights.sun_direction(), infinity))
+                break;
+            w = (front * lights.sun_irradiance(v.bsdf.n) +
+                 back * lights.sun_irradiance(-v.bsdf.n)) *
+                std::numbers::inv_pi_v<float>;
+            break;
         }
         weight[i] = std::isfinite(w) && w > 0 ? w : 0.0f;
         total += weight[i];
+    }
+    if (lights.has_sun() && v.hit.geom_id == ground_geom_id) {
+        // On the ground the dome gets at least what the sun gets: in the plant's shadow
+        // the sun's samples are all blocked and the dome's light is what is left. (On the
+        // plant the same floor cost more than it gained; docs/benchmarks.md.)
+        float& dome = weight[lights.environment_index()];
+        const float sun = weight[lights.sun_index()];
+        if (dome > 0 && sun > dome) {
+            total += sun - dome;
+            dome = sun;
+        }
     }
     return total;
 }
@@ -413,6 +436,8 @@ std::optional<ChosenLight> choose_at(const PathContext& ctx, const LightSet& lig
             choice.environment = weight[i] / total;
         else if (lights.kind(i) == LightKind::area)
             choice.area = weight[i] / total;
+        else if (lights.kind(i) == LightKind::sun)
+            choice.sun = weight[i] / total;
     }
     return ChosenLight{chosen, weight[chosen] / total};
 }
@@ -422,7 +447,7 @@ std::optional<ChosenLight> choose_at(const PathContext& ctx, const LightSet& lig
 /// chosen by what each can deliver (choose_at), else by power; a delta light at full
 /// weight, the others weighted against BSDF sampling of the same direction by the power
 /// heuristic (full weight at the path's last vertex, where no BSDF ray follows). The
-/// choice's probabilities of the environment and the area lights go to `choice`.
+/// choice's probabilities of the environment, the area lights and the sun go to `choice`.
 Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, const Vertex& v,
                 bool last, const Sampler& sampler, std::uint32_t block, ChoiceAt& choice)
 {
@@ -444,7 +469,7 @@ Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, co
         chosen = choose_at(ctx, lights, v, u.choose, choice);
         if (chosen) {
             LightKind k = lights.kind(chosen->index);
-            if (k == LightKind::area || k == LightKind::environment) {
+            if (k == LightKind::area || k == LightKind::environment || k == LightKind::sun) {
                 auto [u1, u2] = sampler.get2d(block + sample_dimension::light_point);
                 u.u1 = u1;
                 u.u2 = u2;
@@ -452,7 +477,8 @@ Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, co
         }
     } else {
         u = light_uniforms(lights, sampler, block, chosen);
-        choice = {lights.environment_probability(), lights.area_probability()};
+        choice = {lights.environment_probability(), lights.area_probability(),
+                  lights.sun_probability()};
     }
     if (!chosen || !(chosen->probability > 0))
         return {};
@@ -686,7 +712,16 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             } else if (!facts.environment_black) {
                 float w = bsdf_hit_weight(bsdf_pdf_prev,
                                           choice.environment * lights.environment_pdf(dir));
-                result.radiance += beta * env_radiance(dir) * w;
+                const float sun_pdf = lights.sun_pdf(dir);
+                if (sun_pdf > 0) {
+                    // Into the sun sampled apart: the disk weighed against the sun's
+                    // sampling, the sky behind it against the environment's.
+                    float w_sun = bsdf_hit_weight(bsdf_pdf_prev, choice.sun * sun_pdf);
+                    result.radiance += beta * (ctx.environment->radiance_without_sun(dir) * w +
+                                               lights.sun_radiance(dir) * w_sun);
+                } else {
+                    result.radiance += beta * env_radiance(dir) * w;
+                }
             }
             break;
         }

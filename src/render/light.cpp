@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The scene's lights as one closed set for next-event estimation: the view file's point,
 // spot and directional lights (delta lights), the emissive primitives (one area-light
-// group) and the environment, chosen by power.
+// group), the environment and a sky's sun disk, chosen by power or per point.
 #include "render/light.h"
 
 #include <algorithm>
@@ -84,16 +84,16 @@ namespace cambium::render {
 
 namespace {
 
-/// The integral of the environment's luminance over the sphere, estimated from its own
-/// importance sampling on a fixed 16 x 16 grid of uniforms (the same for every render, so
-/// images stay a function of the seed).
+/// The integral of the environment's luminance over the sphere (a sky's sun disk left
+/// out), estimated from its own importance sampling on a fixed 16 x 16 grid of uniforms
+/// (the same for every render, so images stay a function of the seed).
 double environment_luminance(const Environment& env)
 {
     constexpr int n = 16;
     double sum = 0;
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) {
-            EnvironmentSample s = env.sample((i + 0.5f) / n, (j + 0.5f) / n);
+            EnvironmentSample s = env.sample_without_sun((i + 0.5f) / n, (j + 0.5f) / n);
             if (s.pdf > 0)
                 sum += luminance(s.radiance) / s.pdf;
         }
@@ -138,6 +138,17 @@ LightKind kind_of(const RenderLight& l)
     return LightKind::point;
 }
 
+/// A direction uniform in the cone of unit axis `axis` and cosine `cos_max`.
+Vec3f uniform_cone(const Vec3f& axis, float cos_max, float u1, float u2)
+{
+    float cos_t = 1 - u1 * (1 - cos_max);
+    float sin_t = std::sqrt(std::max(0.0f, 1 - cos_t * cos_t));
+    float phi = 2 * pi * u2;
+    Vec3f t, b;
+    make_basis(axis, t, b);
+    return normalize(t * (sin_t * std::cos(phi)) + b * (sin_t * std::sin(phi)) + axis * cos_t);
+}
+
 }  // namespace
 
 LightSet::LightSet(const std::vector<RenderLight>& lights, const AreaLights* area_lights,
@@ -157,6 +168,18 @@ LightSet::LightSet(const std::vector<RenderLight>& lights, const AreaLights* are
         m_environment = environment;
         add({LightKind::environment, {}}, environment_luminance(*environment) / 4);
         tabulate_irradiance();
+        if (std::optional<environment_kind::Sky::SunDisk> sun = environment->sun();
+            sun && sun->solid_angle > 0) {
+            // The sun apart from the dome: each is chosen by what it gives a point, where
+            // as one mixture the sun's share of the sky's samples was fixed and competed
+            // with the view's lights as one whole.
+            m_sun = *sun;
+            m_has_sun = true;
+            m_sun_pdf = 1 / sun->solid_angle;
+            m_sun_sin_radius = std::sqrt(std::max(0.0f, 1 - sun->cos_radius * sun->cos_radius));
+            m_sun_normal_irradiance = luminance(sun->radiance) * sun->solid_angle;
+            add({LightKind::sun, {}}, m_sun_normal_irradiance);
+        }
     }
     // Every light keeps a chance: a weight of 0 (black, or a failed estimate) would make
     // its light unreachable, which is bias, not just variance.
@@ -174,7 +197,8 @@ LightSet::LightSet(const std::vector<RenderLight>& lights, const AreaLights* are
     m_weights.clear();
     m_delta_only = !m_lights.empty() && m_lights.size() <= max_delta_choice &&
                    std::none_of(m_lights.begin(), m_lights.end(), [](const Entry& e) {
-                       return e.kind == LightKind::area || e.kind == LightKind::environment;
+                       return e.kind == LightKind::area || e.kind == LightKind::environment ||
+                              e.kind == LightKind::sun;
                    });
     m_per_point = !m_delta_only && m_lights.size() <= max_point_choice &&
                   (m_area != nullptr || m_environment != nullptr);
@@ -182,8 +206,14 @@ LightSet::LightSet(const std::vector<RenderLight>& lights, const AreaLights* are
         float p = static_cast<float>(m_cdf[i + 1] - m_cdf[i]);
         if (m_lights[i].kind == LightKind::area)
             m_area_probability = p;
-        if (m_lights[i].kind == LightKind::environment)
+        if (m_lights[i].kind == LightKind::environment) {
             m_environment_probability = p;
+            m_environment_index = static_cast<std::uint32_t>(i);
+        }
+        if (m_lights[i].kind == LightKind::sun) {
+            m_sun_probability = p;
+            m_sun_index = static_cast<std::uint32_t>(i);
+        }
     }
 }
 
@@ -226,9 +256,16 @@ LightLiSample LightSet::sample_li_other(std::uint32_t index, const Vec3f& p, flo
     }
     case LightKind::environment: {
         // (u1, u2): the pair the sampler stratifies jointly; u0 chooses among areas.
-        EnvironmentSample es = m_environment->sample(u1, u2);
+        EnvironmentSample es = m_environment->sample_without_sun(u1, u2);
         return {es.direction, es.radiance, es.pdf, std::numeric_limits<float>::infinity(),
                 false};
+    }
+    case LightKind::sun: {
+        // Uniform over the disk's cone, whose radiance is constant.
+        Vec3f wi = uniform_cone(m_sun.direction, m_sun.cos_radius, u1, u2);
+        if (!(dot(wi, m_sun.direction) >= m_sun.cos_radius))
+            return {};  // rounding at the rim: sun_pdf() would say 0 there
+        return {wi, m_sun.radiance, m_sun_pdf, std::numeric_limits<float>::infinity(), false};
     }
     }
     return {};
@@ -250,7 +287,8 @@ void LightSet::tabulate_irradiance()
     std::vector<Ray> rays;
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) {
-            EnvironmentSample s = m_environment->sample((i + 0.5f) / n, (j + 0.5f) / n);
+            EnvironmentSample s =
+                m_environment->sample_without_sun((i + 0.5f) / n, (j + 0.5f) / n);
             float w = s.pdf > 0 ? luminance(s.radiance) / s.pdf : 0.0f;
             if (std::isfinite(w) && w > 0)
                 rays.push_back({s.direction, w / (n * n)});

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The scene's lights as one closed set for next-event estimation: the view file's point,
 // spot and directional lights (delta lights), the emissive primitives (one area-light
-// group) and the environment, chosen by power.
+// group), the environment and a sky's sun disk, chosen by power or per point.
 #pragma once
 
 #include <cstdint>
@@ -51,7 +51,9 @@ LightSample sample_light(const RenderLight& light, const Vec3f& p);
 std::vector<RenderLight> make_lights(const std::vector<geom::Light>& lights);
 
 /// The kinds of light next-event estimation knows: a closed set, dispatched by switch.
-enum class LightKind : std::uint8_t { point, spot, directional, area, environment };
+/// A sky's sun disk is a light of its own (`sun`), the rest of the sky the `environment`:
+/// each is then chosen by what it gives a point, not as one mixture.
+enum class LightKind : std::uint8_t { point, spot, directional, area, environment, sun };
 
 /// Light arriving at a shading point from one light: the unit direction toward it, the
 /// radiance along -wi (a delta light: the irradiance on a surface facing it), the
@@ -80,7 +82,9 @@ struct ChosenLight {
 /// environment by the integral of its luminance over the sphere (a quarter of it reaches an
 /// average surface, as a quarter of a delta light's does), the emissive primitives by
 /// their power over pi r^2, r the scene's radius (the irradiance they give a surface that
-/// far away). The weights only steer variance: every light keeps a non-zero chance.
+/// far away), a sky's sun disk (when up) by the irradiance it gives a surface facing it,
+/// as a directional light, and the rest of the sky as the environment. The weights only
+/// steer variance: every light keeps a non-zero chance.
 /// Emissive primitives so faint that a hemisphere full of the brightest of them would give
 /// a surface less than 1% of the irradiance of the directional (and unattenuated point)
 /// lights are not in the set (Lilac's petals glow at 0.002 under a sun of 1): BSDF
@@ -91,7 +95,9 @@ class LightSet {
 public:
     LightSet() = default;
     /// `environment` is sampled only if `environment_nee` (a uniform one is left to BSDF
-    /// sampling, which is perfect for it).
+    /// sampling, which is perfect for it); a sky's sun, when up, is then a light of its own
+    /// (LightKind::sun) and the environment entry is the rest (Environment::
+    /// sample_without_sun).
     LightSet(const std::vector<RenderLight>& lights, const AreaLights* area_lights,
              const Environment* environment, bool environment_nee, float scene_radius);
 
@@ -124,42 +130,76 @@ public:
     /// Whether next-event estimation chooses among the lights by what each can deliver
     /// to the shading point (sets with the environment or emissive primitives, at most
     /// max_point_choice lights): a delta light by its exact unshadowed contribution (0
-    /// where the opaque ground hides it), the environment by environment_irradiance() on
-    /// either side of the surface, the emissive primitives by area_irradiance(), each
-    /// times the BSDF's albedo on that side. The choice probabilities then differ from
+    /// where the opaque ground hides it), the environment by environment_irradiance() and
+    /// the sun by sun_irradiance() on either side of the surface (the sun 0 where the
+    /// ground hides it), the emissive primitives by area_irradiance(), each times the
+    /// BSDF's albedo on that side. The choice probabilities then differ from
     /// vertex to vertex, and the integrator carries them to weigh the next BSDF ray.
     bool per_point() const { return m_per_point; }
     static constexpr std::size_t max_point_choice = 16;
-    /// The luminance of the irradiance the sampled environment gives a surface facing n
-    /// (unshadowed), estimated once from 256 of its own samples for 128 normals and
-    /// looked up at the nearest, never below 1/20 of the largest (an estimate only
-    /// steers variance). 0 without a sampled environment.
+    /// The luminance of the irradiance the sampled environment (without a sun of its own)
+    /// gives a surface facing n (unshadowed), estimated once from 256 of its own samples for
+    /// 128 normals and looked up at the nearest, never below 1/20 of the largest (an
+    /// estimate only steers variance). 0 without a sampled environment.
     float environment_irradiance(const Vec3f& n) const;
+    /// The luminance of the irradiance the sun disk gives a surface facing n: at normal
+    /// incidence times the cosine to its centre raised by the sine of its angular radius
+    /// (at most 1), so it is above 0 wherever any of the disk is in front of the surface.
+    /// 0 without a sun of its own.
+    float sun_irradiance(const Vec3f& n) const
+    {
+        if (!m_has_sun)
+            return 0;
+        float c = dot(n, m_sun.direction) + m_sun_sin_radius;
+        return c > 0 ? m_sun_normal_irradiance * (c < 1 ? c : 1.0f) : 0.0f;
+    }
+    /// Whether the sun is a light of its own, its unit direction and the sine of its
+    /// angular radius.
+    bool has_sun() const { return m_has_sun; }
+    /// The indices of the sun and of the environment (meaningful where they are in the set).
+    std::uint32_t sun_index() const { return m_sun_index; }
+    std::uint32_t environment_index() const { return m_environment_index; }
+    const Vec3f& sun_direction() const { return m_sun.direction; }
+    float sun_sin_radius() const { return m_sun_sin_radius; }
+    /// The density of the sun's own sampling along wi (uniform over its cone; no choice)
+    /// and the disk's radiance along wi: 0 outside it or without a sun of its own.
+    float sun_pdf(const Vec3f& wi) const
+    {
+        return m_has_sun && dot(wi, m_sun.direction) >= m_sun.cos_radius ? m_sun_pdf : 0.0f;
+    }
+    Vec3f sun_radiance(const Vec3f& wi) const
+    {
+        return m_has_sun && dot(wi, m_sun.direction) >= m_sun.cos_radius ? m_sun.radiance : Vec3f();
+    }
     /// The emissive primitives' power over pi r^2 (the irradiance they give a surface r
     /// away, r the scene's radius); 0 when they are not sampled.
     float area_irradiance() const { return m_area_irradiance; }
-    /// The density of the environment's own sampling along wi (no choice); 0 when it is
-    /// not sampled.
+    /// The density of the environment's own sampling along wi (no choice; without the
+    /// sun, which is sampled apart); 0 when it is not sampled.
     float environment_pdf(const Vec3f& wi) const
     {
-        return m_environment ? m_environment->pdf(wi) : 0.0f;
+        return m_environment ? m_environment->pdf_without_sun(wi) : 0.0f;
     }
     /// The density of the area lights' own sampling of `hit` from p (no choice).
     float area_pdf(const Vec3f& p, const SurfaceHit& hit) const;
-    /// The choice probabilities by power (choose()) of the environment and of the area
-    /// lights (0 when not in the set).
+    /// The choice probabilities by power (choose()) of the environment, of the area
+    /// lights and of the sun (0 when not in the set).
     float environment_probability() const { return m_environment_probability; }
     float area_probability() const { return m_area_probability; }
+    float sun_probability() const { return m_sun_probability; }
 
     /// The density (choice included) with which sampling the set finds the emissive
     /// point `hit` seen from p; 0 when it is not a sampled area light.
     float pdf_li(const Vec3f& p, const SurfaceHit& hit) const;
-    /// The density (choice included) with which sampling the set finds the environment
-    /// along wi; 0 when the environment is not sampled. Inline: most bounce rays off a
-    /// leaf escape and ask, and most sets hold no environment.
+    /// The density (choice by power included) with which sampling the set finds the
+    /// environment along wi, the sun's sampling included; 0 when the environment is not
+    /// sampled. Inline: most bounce rays off a leaf escape and ask, and most sets hold no
+    /// environment.
     float pdf_li(const Vec3f& wi) const
     {
-        return m_environment ? m_environment_probability * m_environment->pdf(wi) : 0.0f;
+        return m_environment ? m_environment_probability * m_environment->pdf_without_sun(wi) +
+                                   m_sun_probability * sun_pdf(wi)
+                             : 0.0f;
     }
 
 private:
@@ -186,7 +226,12 @@ private:
     std::vector<double> m_weights;  ///< unnormalised, while adding
     const AreaLights* m_area = nullptr;
     const Environment* m_environment = nullptr;
-    float m_area_probability = 0, m_environment_probability = 0;
+    float m_area_probability = 0, m_environment_probability = 0, m_sun_probability = 0;
+    /// The sky's sun disk (world space), when it is a light of its own.
+    environment_kind::Sky::SunDisk m_sun;
+    float m_sun_pdf = 0, m_sun_sin_radius = 0, m_sun_normal_irradiance = 0;
+    bool m_has_sun = false;
+    std::uint32_t m_sun_index = 0, m_environment_index = 0;
     float m_area_irradiance = 0;
     /// environment_irradiance() by normal: 16 azimuths x 8 polar bands (LatLongTable's
     /// directions), and its floor.
