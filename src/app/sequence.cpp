@@ -158,8 +158,10 @@ render::ViewOverrides view_overrides(const ShotOptions& shot)
 /// Which frame numbers to render: --frames, and --resume's frames already written.
 class FrameFilter {
 public:
-    FrameFilter(const ShotOptions& shot, const std::vector<fs::path>& images)
-        : m_resume(shot.resume), m_images(images)
+    /// `kept`: the caller keeps every frame's image (SequenceOutputs::frame_images), so
+    /// frames render without files too.
+    FrameFilter(const ShotOptions& shot, const std::vector<fs::path>& images, bool kept)
+        : m_resume(shot.resume), m_images(images), m_kept(kept)
     {
         if (shot.frames)
             m_range = frame_range(*shot.frames);
@@ -172,9 +174,9 @@ public:
     /// Selected and, with --resume, not every image of it written yet.
     bool to_render(int number) const
     {
-        if (!selected(number) || m_images.empty())
+        if (!selected(number) || (m_images.empty() && !m_kept))
             return false;
-        if (!m_resume)
+        if (!m_resume || m_images.empty())
             return true;
         if (m_written)
             return m_written->count(number) == 0;
@@ -206,6 +208,7 @@ private:
     std::optional<std::set<int>> m_written;  ///< agreed among MPI ranks (agree())
     bool m_resume;
     const std::vector<fs::path>& m_images;
+    bool m_kept = false;
 };
 
 /// "frame 12: 3 of 40 done, 37 left, about 1:05 to go" after each rendered frame.
@@ -357,7 +360,7 @@ int run_animation(const Options& options, const SequenceOutputs& out)
                        : frames.size() + std::size_t(numbering.inbetween) * (frames.size() - 1);
     require_numbered_names(options, out.images, images_total);
     require_numbered_names(Options{}, out.geometry, images_total);
-    FrameFilter filter(options.shot, out.images);
+    FrameFilter filter(options.shot, out.images, bool(out.frame_images));
     std::optional<geom::AnimationFile> animation;
     if (options.animation)
         animation = geom::read_animation_file(*options.animation);
@@ -683,7 +686,7 @@ int run_turntable(const Options& options, const SequenceOutputs& out)
     std::vector<render::Camera> orbit = render::turntable_cameras(
         scene.view, scene.bounds, n, options.shot.turntable_elevation, s.width, s.height);
     // Frames are numbered 1..N; the first looks from the view file's side.
-    FrameFilter filter(options.shot, out.images);
+    FrameFilter filter(options.shot, out.images, bool(out.frame_images));
     if (out.mpi) {
         std::vector<int> all(static_cast<std::size_t>(n));
         std::iota(all.begin(), all.end(), 1);

@@ -36,3 +36,24 @@ def test_render_refuses_a_sequence(default_scene):
     m = cambium.load("plant.l", "plant.v", materials="plant.mat")
     with pytest.raises(cambium.Error, match="turntable"):
         m.render(turntable=3)
+
+
+def test_animation_frames_are_the_commands_bytes(default_scene, command):
+    # cpfg's default frames (1 to the derivation length), with one in-between each
+    subprocess.run([command, "-q", "-M", "plant.mat", "-a", "--steps", "3", "--inbetween", "1",
+                    "-w", "40", "30", "--spp", "2", "-o", "cmd%02d.png", "plant.l", "plant.v"], check=True)
+    made = sorted(p.name for p in default_scene.glob("cmd*.png"))
+    m = cambium.load("plant.l", "plant.v", materials="plant.mat")
+    seq = m.animate(steps=3, inbetween=1, width=40, height=30, spp=2)
+    assert len(seq) == len(made) and len(seq) > 2
+    assert seq.write("py%02d.png") == [n.replace("cmd", "py") for n in made]
+    for name in made:
+        assert (default_scene / name.replace("cmd", "py")).read_bytes() == (default_scene / name).read_bytes(), name
+    # the plant grows from frame to frame
+    assert not np.array_equal(np.asarray(seq[0]), np.asarray(seq[-1]))
+
+
+def test_animate_refuses_a_turntable(default_scene):
+    m = cambium.load("plant.l", "plant.v", materials="plant.mat")
+    with pytest.raises(cambium.Error, match="turntable"):
+        m.animate(turntable=3)
