@@ -24,6 +24,7 @@
 #include <span>
 #include <string>
 #include <tuple>
+#include <type_traits>
 #include <vector>
 
 #include "base/diagnostics.h"
@@ -896,7 +897,14 @@ struct EmbreeScene::Impl : HitResolver {
 
     Vec3f traced(const Vec3f& dir) const { return tilt_rays ? off_axis(dir) : dir; }
     /// The hit Embree reported for the ray org + t dir, ready for shading.
-    SurfaceHit surface_hit(const RTCRayHit& rh, const Vec3f& org, const Vec3f& dir) const;
+    SurfaceHit surface_hit(const RTCRayHit& rh, const Vec3f& org, const Vec3f& dir) const
+    {
+        return hit_of<SurfaceHit>(rh, org, dir);
+    }
+    /// The hit as a SurfaceHit, or as a LightHit: the same values, without the shading
+    /// normal and texture, which are not made.
+    template <class Hit>
+    Hit hit_of(const RTCRayHit& rh, const Vec3f& org, const Vec3f& dir) const;
     /// The same made in `out`, in place: written once, not copied (a copy read right after
     /// the hit's stores stalled on store forwarding).
     void surface_hit(const RTCRayHit& rh, const Vec3f& org, const Vec3f& dir,
@@ -1657,6 +1665,51 @@ bool EmbreeScene::intersect(SurfaceHit& hit, const Vec3f& org, const Vec3f& dir,
     return true;
 }
 
+bool EmbreeScene::intersect_light(LightHit& hit, const Vec3f& org, const Vec3f& dir, float tnear,
+                                  float tfar, PrimId skip) const
+{
+    RTCRayHit rh;
+    if (!m_impl->trace(rh, org, dir, tnear, tfar, skip, false))
+        return false;
+    ::new (&hit) LightHit(m_impl->hit_of<LightHit>(rh, org, dir));
+    return true;
+}
+
+std::uint32_t EmbreeScene::intersect_light(std::span<const LightRay> rays,
+                                           std::span<LightHit> hits) const
+{
+    const Impl& m = *m_impl;
+    std::array<RTCRayHit, max_coherent_rays> rh;
+    std::array<std::uint32_t, max_coherent_rays> index;  // rh[k] is rays[index[k]]
+    const std::size_t n = std::min({rays.size(), hits.size(), rh.size()});
+    m.rays.add(n);
+    std::size_t traced = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const LightRay& r = rays[i];
+        if (!traceable(r.org, r.dir, 0, r.tfar)) {
+            ++m.skipped_rays;
+            continue;
+        }
+        set_query(rh[traced], r.org, m.traced(r.dir), 0, r.tfar);
+        index[traced++] = static_cast<std::uint32_t>(i);
+    }
+    if (traced == 0)
+        return 0;
+    SkipContext context = make_context({}, true);
+    if (!m.triangle_records.empty())
+        context.context.filter = &prefetch_records;
+    rtcIntersect1M(m.scene, &context.context, rh.data(), static_cast<unsigned>(traced),
+                   sizeof(RTCRayHit));
+    std::uint32_t hit_bits = 0;
+    for (std::size_t k = 0; k < traced; ++k)
+        if (rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID) {
+            const std::size_t i = index[k];
+            ::new (&hits[i]) LightHit(m.hit_of<LightHit>(rh[k], rays[i].org, rays[i].dir));
+            hit_bits |= std::uint32_t{1} << i;
+        }
+    return hit_bits;
+}
+
 bool EmbreeScene::Impl::trace(RTCRayHit& rh, const Vec3f& org, const Vec3f& dir, float tnear,
                               float tfar, PrimId skip, bool coherent) const
 {
@@ -1754,9 +1807,10 @@ std::uint32_t EmbreeScene::intersect_coherent(const ParallelRays& rays, std::siz
         rh, n, [](std::size_t k) { return k; }, [&](std::size_t i) { return rays.ray(i); }, hits);
 }
 
-SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
-                                          const Vec3f& dir) const
+template <class Hit>
+Hit EmbreeScene::Impl::hit_of(const RTCRayHit& rh, const Vec3f& org, const Vec3f& dir) const
 {
+    constexpr bool full = std::is_same_v<Hit, SurfaceHit>;
     const float t = rh.ray.tfar;
     // Where Embree found it: along the direction it traced (make_ray stored traced(dir),
     // which Embree leaves as it was: read back, not tilted a second time).
@@ -1781,29 +1835,32 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
     // Only triangles interpolate a shading normal; the other shapes shade by their true one.
     // It is made unit before the side hit is known, beside the true normal, so that their
     // square roots and divisions overlap (turned to the side after: negation is exact).
-    const bool smooth = part.shape == Shape::triangle;
+    const bool smooth = full && part.shape == Shape::triangle;
     Vec3f shading;
-    if (smooth)
-        shading = unit(placement ? placement->normals * local.shading : local.shading);
+    if constexpr (full)
+        if (smooth)
+            shading = unit(placement ? placement->normals * local.shading : local.shading);
     geometric = unit(geometric);
     const bool facing_away = dot(geometric, dir) > 0;
     const bool back = local.two_sided && facing_away;
     if (facing_away)
         geometric = -geometric;
     Vec3f normal = geometric;
-    if (smooth) {
-        if (back)
-            shading = -shading;
-        // A shading normal turned away from the ray (or absent) gives way to the true one.
-        if (dot(shading, dir) < 0)
-            normal = shading;
-    }
+    if constexpr (full)
+        if (smooth) {
+            if (back)
+                shading = -shading;
+            // A shading normal turned away from the ray (or absent) gives way to the true
+            // one.
+            if (dot(shading, dir) < 0)
+                normal = shading;
+        }
 
     HitMaterials materials = materials_at(part, prim, own_materials, back, style, rh.hit.u);
-    const int texture = texture_of(part, prim, style);
+    const int texture = full ? texture_of(part, prim, style) : geom::no_texture;
     TextureCoords st{0, 0};
     TextureTangents tangents{};
-    if (texture != geom::no_texture) {
+    if (full && texture != geom::no_texture) {
         const TextureFrame frame =
             shape.texture_frame(part, prim, rh.hit.u, rh.hit.v, ng, local.radius);
         st = frame.st;
@@ -1820,6 +1877,29 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
         float extent = local.extent * (placement ? placement->largest_scale() : 1);
         scale = std::max(scale, extent) + 0.2f * t;
     }
+    const float spawn_offset =
+        shape.offset_per_radius * radius + shape.offset_per_scale * scale + shape.offset_absolute;
+    const std::uint32_t primitive =
+        part.geometry == &placed_lines ? PrimId::none : part.attribute_index(prim);
+    if constexpr (!full)
+        return LightHit{
+            .t = t,
+            .position = position,
+            .geometric_normal = geometric,
+            .geom_id = rh.hit.geomID,
+            .prim_id = prim,
+            .inst_id = inst_id,
+            .instance = placement ? placement->index : PrimId::none,
+            .primitive = primitive,
+            .material = materials.material,
+            .end_material = materials.end_material,
+            .material_blend = materials.blend,
+            .spawn_offset = spawn_offset,
+            .shape = part.shape,
+            .back = back,
+            .unlit = part.unlit,
+        };
+    else
     // Every field named, so the hit is written once, in the caller's storage (a
     // default-made hit was zeroed first by a string store, about 8 ns, then overwritten).
     return SurfaceHit{
@@ -1831,7 +1911,7 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
         .prim_id = prim,
         .inst_id = inst_id,
         .instance = placement ? placement->index : PrimId::none,
-        .primitive = part.geometry == &placed_lines ? PrimId::none : part.attribute_index(prim),
+        .primitive = primitive,
         .material = materials.material,
         .end_material = materials.end_material,
         .material_blend = materials.blend,
@@ -1845,8 +1925,7 @@ SurfaceHit EmbreeScene::Impl::surface_hit(const RTCRayHit& rh, const Vec3f& org,
         // Curves' and spheres' true normals point out of them.
         .inside = !local.two_sided && facing_away,
         .radius = radius,
-        .spawn_offset = shape.offset_per_radius * radius + shape.offset_per_scale * scale +
-                        shape.offset_absolute,
+        .spawn_offset = spawn_offset,
         .unlit = part.unlit,
     };
 }

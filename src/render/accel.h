@@ -80,6 +80,37 @@ struct SurfaceHit {
     }
 };
 
+/// What the light report reads of a hit (EmbreeScene::intersect_light): SurfaceHit's
+/// fields of these names, with the same values, and nothing of the shading normal or the
+/// texture, which it does not read (benchmarks/light_report: making them was a tenth of
+/// its time).
+struct LightHit {
+    float t = 0;
+    Vec3f position;
+    Vec3f geometric_normal;    ///< unit true surface normal, facing the incoming ray
+    std::uint32_t geom_id = 0;
+    std::uint32_t prim_id = 0;
+    std::uint32_t inst_id = PrimId::none;
+    std::uint32_t instance = PrimId::none;
+    std::uint32_t primitive = PrimId::none;
+    std::uint16_t material = 0;
+    std::uint16_t end_material = 0;
+    float material_blend = 0;
+    float spawn_offset = 0;
+    Shape shape = Shape::line;
+    bool back = false;
+    bool unlit = false;
+
+    PrimId prim() const { return {geom_id, prim_id, inst_id}; }
+    bool closed() const { return shape != Shape::disc && shape != Shape::triangle; }
+};
+
+/// A ray of a stream for EmbreeScene::intersect_light: org + t dir, t in [0, tfar].
+struct LightRay {
+    Vec3f org, dir;
+    float tfar = 0;
+};
+
 /// The Geometry array a shape's primitives are in.
 enum class PrimitiveKind : std::uint8_t { lines, curves, spheres, discs, mesh };
 inline PrimitiveKind primitive_kind(Shape s)
@@ -147,6 +178,16 @@ public:
     std::uint32_t intersect_coherent(const ParallelRays& rays, std::size_t n,
                                      std::span<std::optional<SurfaceHit>> hits,
                                      bool checked = false) const;
+    /// intersect(org, dir, tnear, tfar, skip) made as a LightHit in `hit`; returns whether
+    /// there is one.
+    bool intersect_light(LightHit& hit, const Vec3f& org, const Vec3f& dir, float tnear,
+                         float tfar, PrimId skip = {}) const;
+    /// The same for each of `rays` (at most max_coherent_rays, skipping nothing) into
+    /// `hits`, traced together as one stream of coherent rays (a light's neighbouring
+    /// rays). The same hits, their distance (and what is made from it) as Embree's packet
+    /// kernels round it: within a few float ulps of the single ray's (accel_test). Returns
+    /// a bit per ray, set where it hit.
+    std::uint32_t intersect_light(std::span<const LightRay> rays, std::span<LightHit> hits) const;
     /// Whether anything but `skip` blocks org + t dir for t in [tnear, tfar].
     bool occluded(const Vec3f& org, const Vec3f& dir, float tnear, float tfar,
                   PrimId skip = {}) const;

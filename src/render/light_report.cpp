@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "render/light_report.h"
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -161,7 +162,7 @@ struct Organs {
         return it->second;
     }
 
-    std::uint32_t of(const geom::Scene& scene, const SurfaceHit& hit) const
+    std::uint32_t of(const geom::Scene& scene, const LightHit& hit) const
     {
         if (hit.primitive == PrimId::none)
             return no_organ;
@@ -534,11 +535,35 @@ struct Tracer {
         return std::max(0.0, disc > 0 ? b + std::sqrt(disc) : b);
     }
 
+    /// With the canopy, the distance along dir to the side the ray leaves the bounds by
+    /// and that side's axis (0: x, 2: z); else infinity and -1.
+    std::pair<double, int> to_side(Vec3d org, Vec3d dir) const
+    {
+        const Extent& e = extent;
+        double wall = std::numeric_limits<double>::infinity();
+        if (!e.canopy)
+            return {wall, -1};
+        auto to_wall = [&](double o, double d, double lo, double hi) {
+            return d > 0 ? (hi - o) / d : d < 0 ? (lo - o) / d : wall;
+        };
+        const double tx = to_wall(org.x, dir.x, e.lo.x, e.hi.x);
+        const double tz = to_wall(org.z, dir.z, e.lo.z, e.hi.z);
+        return {std::max(0.0, std::min(tx, tz)), tx <= tz ? 0 : 2};
+    }
+
+    /// The query trace() makes first for a ray from org along dir.
+    LightRay first_query(Vec3d org, Vec3d dir) const
+    {
+        return {f3(org), f3(dir), float(to_side(org, dir).first)};
+    }
+
     /// One path: `w` its power per channel (for a point light, at unit distance: its
     /// falloff by the distance to the first surface still to come); tallies into `t` (by
-    /// organ, dense) and `r`.
+    /// organ, dense) and `r`. `first`: where given, the answer to its first query
+    /// (first_query(org, dir)), traced already (in a stream): its hit, or null for none.
     void trace(Vec3d org, Vec3d dir, Rgb3 w, const RenderLight* falloff, RayRandom& rng,
-               std::vector<Tally>& t, std::vector<std::uint32_t>& touched, BlockResult& r) const
+               std::vector<Tally>& t, std::vector<std::uint32_t>& touched, BlockResult& r,
+               std::optional<const LightHit*> first = std::nullopt) const
     {
         const Extent& e = extent;
         double travelled = 0;  // from a point light, until its first surface
@@ -556,25 +581,21 @@ struct Tracer {
         double start = mean(w);
         PrimId skip{};
         std::uint32_t wraps = 0;
+        LightHit found;
         for (int bounce = 0;; ++bounce) {
             if (!falloff && (bounce >= settings.max_bounces || mean(w) < settings.cutoff * start)) {
                 r.truncated += mean(w);
                 return;
             }
             // with the canopy, up to the side the ray leaves the bounds by
-            double wall = std::numeric_limits<double>::infinity();
-            int axis = -1;
-            if (e.canopy) {
-                auto to_wall = [&](double o, double d, double lo, double hi) {
-                    return d > 0 ? (hi - o) / d : d < 0 ? (lo - o) / d : wall;
-                };
-                const double tx = to_wall(org.x, dir.x, e.lo.x, e.hi.x);
-                const double tz = to_wall(org.z, dir.z, e.lo.z, e.hi.z);
-                wall = std::max(0.0, std::min(tx, tz));
-                axis = tx <= tz ? 0 : 2;
+            const auto [wall, axis] = to_side(org, dir);
+            const LightHit* hit = nullptr;
+            if (first) {
+                hit = *first;
+                first.reset();
+            } else if (accel.intersect_light(found, f3(org), f3(dir), 0, float(wall), skip)) {
+                hit = &found;
             }
-            std::optional<SurfaceHit> hit =
-                accel.intersect(f3(org), f3(dir), 0, float(wall), skip);
             if (!hit && axis >= 0) {
                 Vec3d q = org + dir * wall;
                 const bool leaving = (q.y >= e.hi.y && dir.y >= 0) || (q.y <= e.lo.y && dir.y <= 0);
@@ -767,31 +788,79 @@ LightReport trace_light(const geom::Scene& scene, const LightReportSettings& set
     std::vector<SurfaceMaterial> materials = make_materials(scene.materials);
     Tracer tracer{scene, accel, organs, materials, settings, extent};
 
-    // Blocks take every blocks-th ray (strided), so each samples the whole beam: their
-    // sums are independent batches for the confidence intervals, and their number does
-    // not depend on the threads.
-    const std::uint64_t blocks = std::min<std::uint64_t>(256, report.rays);
+    // Blocks take every blocks-th run of `run` neighbouring rays (strided), so each
+    // samples the whole beam: their sums are independent batches for the confidence
+    // intervals, and their number does not depend on the threads. A run's first rays
+    // are traced as one stream (neighbours in a beam or about a point light: coherent),
+    // which Embree takes in SIMD packets (benchmarks/light_report).
+    const std::uint64_t run_length =
+        std::clamp<std::uint64_t>(report.rays / 256, 1, EmbreeScene::max_coherent_rays);
+    const std::uint64_t runs = (report.rays + run_length - 1) / run_length;
+    const std::uint64_t blocks = std::min<std::uint64_t>(256, runs);
     std::vector<BlockResult> results(blocks);
     const std::size_t organ_count = organs.list.size();
+    // Each thread's tallies by organ, zero between blocks (only the organs a block touched
+    // are reset): a fresh vector a block cost a page fault per 4 KiB and cold loads
+    // (benchmarks/light_report, --synthetic 10000).
+    struct Scratch {
+        std::vector<Tally> t;
+        std::vector<std::uint32_t> touched;
+    };
+    tbb::enumerable_thread_specific<Scratch> scratch;
     auto run = [&] {
         tbb::parallel_for(std::uint64_t(0), blocks, [&](std::uint64_t k) {
-            std::vector<Tally> t(organ_count);
-            std::vector<std::uint32_t> touched;
+            Scratch& own = scratch.local();
+            if (own.t.size() != organ_count)
+                own.t.assign(organ_count, Tally{});
+            std::vector<Tally>& t = own.t;
+            std::vector<std::uint32_t>& touched = own.touched;
+            touched.clear();
             BlockResult& r = results[k];
             std::size_t source = 0;
-            for (std::uint64_t i = k; i < report.rays; i += blocks) {
-                while (i >= first[source + 1])
-                    ++source;
-                const Source& s = sources[source];
-                const std::uint64_t j = i - first[source];
-                RayRandom rng(settings.seed, source, j);
-                if (std::optional<Emitted> e = emit(s, extent, env, j, s.nx * s.ny, rng))
-                    tracer.trace(e->org, e->dir, e->w, e->falloff, rng, t, touched, r);
+            constexpr std::size_t most = EmbreeScene::max_coherent_rays;
+            struct Ray {
+                Emitted e;
+                RayRandom rng;
+                int slot;  ///< its place in the stream (-1: traced alone)
+            };
+            std::array<std::optional<Ray>, most> ray;
+            std::array<LightRay, most> stream;
+            std::array<LightHit, most> hits;
+            for (std::uint64_t c = k; c < runs; c += blocks) {
+                const std::uint64_t i0 = c * run_length, i1 = std::min(report.rays, i0 + run_length);
+                std::size_t streamed = 0;
+                for (std::uint64_t i = i0; i < i1; ++i) {
+                    while (i >= first[source + 1])
+                        ++source;
+                    const Source& s = sources[source];
+                    const std::uint64_t j = i - first[source];
+                    RayRandom rng(settings.seed, source, j);
+                    std::optional<Ray>& here = ray[i - i0];
+                    here.reset();
+                    if (std::optional<Emitted> e = emit(s, extent, env, j, s.nx * s.ny, rng)) {
+                        // the environment's directions are random: no stream
+                        const bool coherent = s.kind != Source::Kind::environment;
+                        here = Ray{*e, rng, coherent ? int(streamed) : -1};
+                        if (coherent)
+                            stream[streamed++] = tracer.first_query(e->org, e->dir);
+                    }
+                }
+                const std::uint32_t hit_bits =
+                    accel.intersect_light(std::span(stream.data(), streamed), std::span(hits.data(), streamed));
+                for (std::uint64_t i = i0; i < i1; ++i)
+                    if (std::optional<Ray>& x = ray[i - i0]) {
+                        std::optional<const LightHit*> known;
+                        if (x->slot >= 0)
+                            known = (hit_bits >> x->slot & 1) ? &hits[std::size_t(x->slot)] : nullptr;
+                        tracer.trace(x->e.org, x->e.dir, x->e.w, x->e.falloff, x->rng, t, touched, r, known);
+                    }
             }
             std::sort(touched.begin(), touched.end());
             r.organs.reserve(touched.size());
-            for (std::uint32_t o : touched)
+            for (std::uint32_t o : touched) {
                 r.organs.emplace_back(o, t[o]);
+                t[o] = Tally{};
+            }
         });
     };
     if (settings.threads > 0)

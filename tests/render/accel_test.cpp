@@ -2,8 +2,10 @@
 // EmbreeScene: hits on round linear curves, pixel radii, empty scenes, spawn offsets.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <utility>
 
 #include "base/diagnostics.h"
@@ -231,6 +233,78 @@ TEST(EmbreeScene, OnlyTrianglesShadeByAnInterpolatedNormal)
         EXPECT_NEAR(hit->geometric_normal.z, side, 1e-6f);
         EXPECT_GT(std::fabs(hit->normal.x - hit->geometric_normal.x), 0.05f);
     }
+}
+
+// The light report's lean hit is the full hit's fields of the same names, whether traced
+// alone or in a stream, on every shape and on both sides of flat ones.
+TEST(EmbreeScene, LightHitsAreTheSurfaceHitsFields)
+{
+    geom::Scene s = round_and_flat_shapes(0.5f);
+    s.geometry.discs.back_material.push_back(2);
+    geom::TriangleMesh& m = s.geometry.mesh;
+    m.positions = {{4, -1, 0}, {8, -1, 0}, {4, 3, 0}};
+    m.normals = {{-0.6f, 0, 0.8f}, {0.6f, 0, 0.8f}, {0, 0.6f, 0.8f}};
+    m.triangles = {{0, 1, 2}};
+    m.material = {1};
+    m.back_material = {2};
+    EmbreeScene accel(s, unit_camera(s));
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> uniform(0, 1);
+    auto next = [&] { return uniform(rng); };
+    std::array<int, 7> shapes{};
+    int backs = 0;
+    for (int round = 0; round < 200; ++round) {
+        std::array<LightRay, EmbreeScene::max_coherent_rays> rays;
+        for (LightRay& r : rays) {
+            // from a sphere of radius 12 toward a point among the shapes
+            const Vec3f target(next() * 10 - 2, next() * 8 - 4, next() - 0.5f);
+            const Vec3f from = normalize(Vec3f(next() - 0.5f, next() - 0.5f, next() - 0.5f)) * 12;
+            r = {target + from, normalize(-from), inf};
+        }
+        std::array<LightHit, EmbreeScene::max_coherent_rays> streamed;
+        const std::uint32_t bits = accel.intersect_light(rays, streamed);
+        for (std::size_t k = 0; k < rays.size(); ++k) {
+            const auto full = accel.intersect(rays[k].org, rays[k].dir, 0, inf);
+            LightHit alone;
+            ASSERT_EQ(accel.intersect_light(alone, rays[k].org, rays[k].dir, 0, inf), bool(full));
+            ASSERT_EQ(bool(bits >> k & 1), bool(full));
+            if (!full)
+                continue;
+            ++shapes[static_cast<std::size_t>(full->shape)];
+            backs += full->back;
+            // Traced alone: the very numbers. In a stream, Embree's packet kernels may round
+            // the distance differently in its last bit: the numbers made from it within it.
+            for (const auto& [h, ulps] : {std::pair{alone, 0.0f}, std::pair{streamed[k], 4.0f}}) {
+                auto expect_near = [&, ulps = ulps](float a, float b, float scale) {
+                    EXPECT_NEAR(a, b, ulps * std::numeric_limits<float>::epsilon() * scale) << int(full->shape);
+                };
+                expect_near(h.t, full->t, full->t);
+                const float scale = 1 + std::fabs(full->t);
+                expect_near(h.position.x, full->position.x, scale);
+                expect_near(h.position.y, full->position.y, scale);
+                expect_near(h.position.z, full->position.z, scale);
+                expect_near(h.geometric_normal.x, full->geometric_normal.x, scale);
+                expect_near(h.geometric_normal.y, full->geometric_normal.y, scale);
+                expect_near(h.geometric_normal.z, full->geometric_normal.z, scale);
+                expect_near(h.spawn_offset, full->spawn_offset, full->spawn_offset);
+                EXPECT_EQ(h.prim().geom, full->prim().geom);
+                EXPECT_EQ(h.prim().prim, full->prim().prim);
+                EXPECT_EQ(h.prim().inst, full->prim().inst);
+                EXPECT_EQ(h.instance, full->instance);
+                EXPECT_EQ(h.primitive, full->primitive);
+                EXPECT_EQ(h.material, full->material);
+                EXPECT_EQ(h.end_material, full->end_material);
+                EXPECT_EQ(h.material_blend, full->material_blend);
+                EXPECT_EQ(h.shape, full->shape);
+                EXPECT_EQ(h.back, full->back);
+                EXPECT_EQ(h.unlit, full->unlit);
+                EXPECT_EQ(h.closed(), full->closed());
+            }
+        }
+    }
+    for (Shape shape : {Shape::line, Shape::sphere, Shape::disc, Shape::triangle, Shape::cap})
+        EXPECT_GT(shapes[static_cast<std::size_t>(shape)], 10) << int(shape);
+    EXPECT_GT(backs, 10);
 }
 
 // A straight polyline of short joined segments (neighbour flags) is one convex tube: rays
