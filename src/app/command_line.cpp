@@ -255,6 +255,17 @@ void check_distributed_options(const Options& options)
         throw Error("--tile and --assemble need an image output (-o)");
 }
 
+/// Help as the command is called: the usage names the program and its two forms, where
+/// CLI11's own would count the positional words ("files(2x)").
+class HelpFormatter : public CLI::Formatter {
+public:
+    std::string make_usage(const CLI::App*, std::string) const override
+    {
+        return "Usage: cambium [OPTIONS] plant.l plant.v [plant.a]\n"
+               "       cambium [OPTIONS] scene.json\n";
+    }
+};
+
 }  // namespace
 
 std::optional<Options> parse_command_line(const std::vector<std::string>& words)
@@ -274,10 +285,12 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
                  "--ground [COLOUR|FILE]: a ground plane under the plant, grey (default), a colour\n"
                  "(#rrggbb or R,G,B) or a tiled texture image."};
     cli.name("cambium");
+    cli.formatter(std::make_shared<HelpFormatter>());
     cli.set_version_flag("--version", "cambium " CAMBIUM_VERSION);
     cli.add_option("-o", options.outputs,
                    "Output: an image (.png .exr .tif .jpg .rgb .tga), a video (.mp4 .mov .mkv .webm) "
-                   "or the still's geometry (.obj .ply .gls .glb); may be given more than once")
+                   "or the still's geometry (.obj .ply .gls .glb) or drawing (.svg .pdf .ps); may be "
+                   "given more than once")
         ->take_all()
         ->allow_extra_args(false);
     cli.add_option("--spp", options.samples_per_pixel, "Samples per pixel (default 64)")
@@ -418,6 +431,7 @@ std::optional<Options> parse_command_line(const std::vector<std::string>& words)
     cli.add_option("files", files, "plant.l plant.v [plant.a], or scene.json (docs/scenes.md)")
         ->required()
         ->type_name("FILE")
+        ->option_text("FILE ...")
         ->expected(scene ? 1 : 2, 3);
 
     std::vector<std::string> reversed(args.rbegin(), args.rend());

@@ -9,6 +9,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "app/obj_lines.h"
 #include "app/scene_file.h"
 #include "base/confinement.h"
 #include "base/diagnostics.h"
@@ -17,36 +18,6 @@
 namespace cambium::app {
 namespace fs = std::filesystem;
 namespace {
-
-/// Reads `file` line by line within the limits, handing each line's words and location
-/// to `each`; a line is read into a buffer of the limit's size, never grown.
-template <typename Each>
-void for_each_line(const fs::path& file, const char* what, const SceneLimits& limits, Each each)
-{
-    regular_file_size(file, what, limits.max_mesh_bytes);
-    std::ifstream in(file, std::ios::binary);
-    if (!in)
-        throw Error(FileLoc{file.string()}, std::string("cannot read ") + what);
-    std::vector<char> buffer(limits.max_mesh_line_bytes + 1);
-    int line = 0;
-    while (in.getline(buffer.data(), std::streamsize(buffer.size())) || in.gcount() > 0) {
-        ++line;
-        FileLoc loc{file.string(), line, 1};
-        if (in.fail() && !in.eof()) {
-            loc.column = int(limits.max_mesh_line_bytes) + 1;
-            throw Error(loc, "the line is longer than " +
-                                 std::to_string(limits.max_mesh_line_bytes) + " bytes");
-        }
-        std::string text(buffer.data());
-        if (!text.empty() && text.back() == '\r')
-            text.pop_back();
-        std::istringstream words(text);
-        std::string kind;
-        words >> kind;
-        if (!kind.empty() && kind[0] != '#')
-            each(kind, words, text, loc);
-    }
-}
 
 /// The rest of a statement's line (a file or material name may hold spaces), trimmed.
 std::string rest(const std::string& text, const std::string& kind, const FileLoc& loc)
@@ -101,7 +72,7 @@ void read_mtl(const fs::path& file, const fs::path& allowed, bool allow_file_acc
               std::map<fs::path, std::int16_t>& texture_index, ObjModel& model)
 {
     MtlEntry* current = nullptr;
-    for_each_line(file, "the MTL file", limits, [&](const std::string& kind, std::istringstream& words,
+    for_each_obj_line(file, "the MTL file", limits, [&](const std::string& kind, std::istringstream& words,
                                                    const std::string& text, const FileLoc& loc) {
         if (kind == "newmtl") {
             if (entries.size() >= limits.max_mesh_materials)
@@ -201,7 +172,7 @@ ObjModel read_obj_model(const fs::path& file, const fs::path& allowed, bool allo
         return k;
     };
 
-    for_each_line(file, "the mesh", limits, [&](const std::string& kind, std::istringstream& words,
+    for_each_obj_line(file, "the mesh", limits, [&](const std::string& kind, std::istringstream& words,
                                                const std::string& text, const FileLoc& loc) {
         if (kind == "v" || kind == "vn") {
             double x, y, z;

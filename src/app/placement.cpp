@@ -9,6 +9,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "app/obj_lines.h"
 #include "app/scene_file.h"
 #include "base/diagnostics.h"
 #include "geom/text_input.h"
@@ -212,25 +213,9 @@ std::vector<Transform> scatter(const ScatterSpec& spec, const GroundMesh* mesh)
 GroundMesh read_obj_mesh(const std::filesystem::path& file, const SceneLimits& limits)
 {
     const std::size_t max_triangles = limits.max_mesh_triangles;
-    regular_file_size(file, "the mesh", limits.max_mesh_bytes);
-    std::ifstream in(file, std::ios::binary);
-    if (!in)
-        throw Error(FileLoc{file.string()}, "cannot read the mesh");
     GroundMesh mesh;
-    // a line is read into a buffer of the limit's size, never grown to the whole file
-    std::vector<char> buffer(limits.max_mesh_line_bytes + 1);
-    int line = 0;
-    while (in.getline(buffer.data(), std::streamsize(buffer.size())) || in.gcount() > 0) {
-        ++line;
-        FileLoc loc{file.string(), line, 1};
-        if (in.fail() && !in.eof()) {
-            loc.column = int(limits.max_mesh_line_bytes) + 1;
-            throw Error(loc, "the line is longer than " +
-                                 std::to_string(limits.max_mesh_line_bytes) + " bytes");
-        }
-        std::istringstream words(std::string(buffer.data()));
-        std::string kind;
-        words >> kind;
+    for_each_obj_line(file, "the mesh", limits, [&](const std::string& kind, std::istringstream& words,
+                                                   const std::string&, const FileLoc& loc) {
         if (kind == "v") {
             double x, y, z;
             if (!(words >> x >> y >> z) || !std::isfinite(x) || !std::isfinite(y) ||
@@ -262,10 +247,10 @@ GroundMesh read_obj_mesh(const std::filesystem::path& file, const SceneLimits& l
                 throw Error(loc, "the mesh has more than " + std::to_string(max_triangles) +
                                      " triangles");
         }
-        // other statements (vt, vn, g, o, s, usemtl, mtllib, comments) carry nothing needed
+        // other statements (vt, vn, g, o, s, usemtl, mtllib) carry nothing needed
         if (mesh.positions.size() > 3 * max_triangles + 3)
             throw Error(loc, "the mesh has too many vertices");
-    }
+    });
     if (mesh.triangles.empty())
         throw Error(FileLoc{file.string()}, "the mesh has no faces");
     return mesh;

@@ -491,6 +491,21 @@ int run_animation(const Options& options, const SequenceOutputs& out)
     std::vector<std::uint16_t> ages;
     std::vector<std::uint32_t> births;
     int steps_so_far = 0;
+    // One frame's derived string to take(): the homomorphism's output as -homo writes it,
+    // else the string the turtle reads, its organs named by birth for the masks.
+    auto take_derived = [&](const lsys::ModuleString& derived, std::optional<lsys::ModuleString> homo,
+                            const geom::AnimationFrame& frame) {
+        if (homo)
+            return take(std::move(*homo), frame);
+        if (!options.organ_masks)
+            return take(turtle_string(model, derived, options), frame);
+        StringOrigins origins;
+        origins.derived = &derived;
+        origins.ages = ages;
+        origins.births = births;
+        lsys::ModuleString turtle = turtle_string(model, derived, options, origins.origins);
+        take(std::move(turtle), frame, std::move(origins));
+    };
     int derived = derive_frames_with_lineage(
         model, frames, numbering.inbetween > 0 || options.organ_masks,
         [&](const geom::AnimationFrame& f, const lsys::ModuleString& string,
@@ -538,18 +553,8 @@ int run_animation(const Options& options, const SequenceOutputs& out)
                 lsys::ModuleString grown = lsys::inbetween(
                     before, string, lineage, float(k) / float(numbering.inbetween + 1), grows);
                 ledger.derived(g.number, seconds_since(blend_start));
-                std::optional<lsys::ModuleString> homo = after_homomorphism(grown);
-                if (options.organ_masks && !homo) {
-                    // the in-between has the frame's modules, in order: their names too
-                    StringOrigins origins;
-                    origins.derived = &grown;
-                    origins.ages = ages;
-                    origins.births = births;
-                    lsys::ModuleString turtle = turtle_string(model, grown, options, origins.origins);
-                    take(std::move(turtle), g, std::move(origins));
-                    continue;
-                }
-                take(homo ? std::move(*homo) : turtle_string(model, grown, options), g);
+                // the in-between has the frame's modules, in order: their names too
+                take_derived(grown, after_homomorphism(grown), g);
             }
         if (numbering.inbetween > 0) {
             before = string;
@@ -607,16 +612,7 @@ int run_animation(const Options& options, const SequenceOutputs& out)
             return;
         geom::AnimationFrame anchor = f;
         anchor.number = number;
-        if (options.organ_masks && !homo) {
-            StringOrigins origins;
-            origins.derived = &string;
-            origins.ages = ages;
-            origins.births = births;
-            lsys::ModuleString turtle = turtle_string(model, string, options, origins.origins);
-            take(std::move(turtle), anchor, std::move(origins));
-            return;
-        }
-        take(homo ? std::move(*homo) : turtle_string(model, string, options), anchor);
+        take_derived(string, std::move(homo), anchor);
     });
     out.say(fmt::format("derived {} steps once for {} frames", derived, images_total));
     if (keep_all && !kept.empty()) {

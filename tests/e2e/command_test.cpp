@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <iterator>
 #include <sstream>
 #include <string>
@@ -102,6 +103,26 @@ double rgb_difference(const Picture& a, const Picture& b)
 }
 
 }  // namespace
+
+// --help names the program and its two forms of files, and lists each option once.
+TEST(Command, HelpShowsHowTheCommandIsCalled)
+{
+    Result r = run("--help");
+    EXPECT_EQ(r.status, 0);
+    EXPECT_NE(r.output.find("Usage: cambium [OPTIONS] plant.l plant.v [plant.a]\n"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("cambium [OPTIONS] scene.json"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("(2x)"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("x 2 REQUIRED"), std::string::npos) << r.output;
+    // every option line's flags once ("  -o TEXT ...", "  --spp INT ...")
+    std::istringstream lines(r.output);
+    std::map<std::string, int> seen;
+    for (std::string line; std::getline(lines, line);)
+        if (line.rfind("  -", 0) == 0)
+            ++seen[line.substr(2, line.find(' ', 2) - 2)];
+    EXPECT_GT(seen.size(), 20u);
+    for (const auto& [flag, count] : seen)
+        EXPECT_EQ(count, 1) << flag;
+}
 
 TEST(Command, RendersAPlantToPngAndExr)
 {
