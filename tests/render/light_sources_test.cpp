@@ -266,6 +266,61 @@ double random_canopy(geom::Scene& scene, int count, double leaf_area, std::uint3
     return count * leaf_area / ((hi[0] - lo[0]) * (hi[1] - lo[1]));
 }
 
+using Polygon = std::vector<std::array<double, 3>>;
+
+/// The part of a convex polygon where coordinate `axis` lies in [lo, hi].
+Polygon clip(const Polygon& polygon, int axis, double lo, double hi)
+{
+    Polygon out = polygon;
+    for (const auto& [bound, sign] : {std::pair{lo, 1.0}, std::pair{hi, -1.0}}) {
+        Polygon in = std::move(out);
+        out.clear();
+        for (std::size_t i = 0; i < in.size(); ++i) {
+            const auto& a = in[i];
+            const auto& b = in[(i + 1) % in.size()];
+            const double da = sign * (a[axis] - bound), db = sign * (b[axis] - bound);
+            if (da >= 0) out.push_back(a);
+            if ((da < 0) != (db < 0)) {
+                const double t = da / (da - db);
+                out.push_back({a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]),
+                               a[2] + t * (b[2] - a[2])});
+            }
+        }
+    }
+    return out;
+}
+
+/// `count` black triangles of equal area, uniformly placed and spherically oriented, in
+/// a unit layer made periodic: a leaf crossing the unit square's side is cut there and
+/// its outer piece moved in by one, so the leaf area density is the same everywhere in
+/// the tile and the tile's leaf area index is count x leaf_area.
+void periodic_canopy(geom::Scene& scene, int count, double leaf_area, std::uint32_t seed)
+{
+    geom::Scene loose = dark_scene();
+    random_canopy(loose, count, leaf_area, seed);
+    const auto& positions = loose.geometry.mesh.positions;
+    for (int k = 0; k < count; ++k) {
+        Polygon leaf;
+        for (int i = 0; i < 3; ++i) {
+            const Float3& p = positions[std::size_t(3 * k + i)];
+            leaf.push_back({p[0], p[1], p[2]});
+        }
+        for (int cx = -1; cx <= 1; ++cx)
+            for (int cz = -1; cz <= 1; ++cz) {
+                Polygon piece = clip(clip(leaf, 0, cx, cx + 1), 2, cz, cz + 1);
+                for (std::size_t i = 1; i + 1 < piece.size(); ++i) {
+                    Float3 v[3];
+                    for (int j = 0; j < 3; ++j) {
+                        const auto& q = piece[j == 0 ? 0 : i + std::size_t(j) - 1];
+                        v[j] = {float(q[0] - cx), float(q[1]), float(q[2] - cz)};
+                    }
+                    add_triangle(scene, std::uint32_t(k), v[0], v[1], v[2]);
+                }
+            }
+        scene.geometry.modules.records.push_back({std::uint32_t(k), 0, 0});
+    }
+}
+
 }  // namespace
 
 // Beer-Lambert: through a canopy of small black leaves, randomly placed and spherically
@@ -299,6 +354,32 @@ TEST(LightSources, InfiniteCanopyFollowsBeerLambert)
     EXPECT_GT(without, 2 * expected);
     EXPECT_NEAR(stand.absorbed + stand.escaped + stand.truncated, stand.emitted,
                 1e-9 * stand.emitted);
+}
+
+// The same law across leaf area indices 1 to 5, on what a periodic canopy intercepts:
+// 1 - exp(-G LAI / cos theta) within 1%, from the zenith and at 60 degrees. Many small
+// leaves keep one canopy's own randomness (the union of their shadows) well inside that.
+TEST(LightSources, InfiniteCanopyInterceptsAsBeerLambertForLai1To5)
+{
+    const int count = 40'000;
+    for (const double theta : {0.0, pi / 3})
+        for (int lai = 1; lai <= 5; ++lai) {
+            geom::Scene scene = dark_scene();
+            periodic_canopy(scene, count, double(lai) / count, std::uint32_t(20 + lai));
+            const double azimuth = 0.5;
+            geom::Light light;
+            light.kind = geom::Light::Kind::directional;
+            light.direction = {std::sin(theta) * std::cos(azimuth), std::cos(theta),
+                               std::sin(theta) * std::sin(azimuth)};
+            scene.lights = {light};
+            LightReportSettings s;
+            s.rays = 400'000;
+            s.infinite_canopy = true;
+            const LightReport r = trace_light(scene, s);
+            const double expected = 1 - std::exp(-0.5 * lai / std::cos(theta));
+            EXPECT_NEAR(r.absorbed / r.emitted, expected, 0.01 * expected)
+                << "LAI " << lai << ", zenith angle " << theta;
+        }
 }
 
 // A stated tile twice as wide as the leaves' bounds: half of it bare. A beam whose
