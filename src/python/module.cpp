@@ -171,6 +171,29 @@ struct Events {
 struct ImageObject;
 py::object image_object(render::Image image, render::WriteOptions write);
 
+/// The module's calls run one at a time, whichever Python thread makes them: each one
+/// already uses every core, installs the process's warning sink, and reads symbol tables
+/// that a string edit may grow.
+std::mutex& call_mutex()
+{
+    static std::mutex calls;
+    return calls;
+}
+
+/// Holds call_mutex() for a call that runs with the GIL held (a string edit): the GIL is
+/// released while waiting, so the call under way can finish.
+class HeldCall {
+public:
+    HeldCall() : m_lock(call_mutex(), std::defer_lock)
+    {
+        py::gil_scoped_release release;
+        m_lock.lock();
+    }
+
+private:
+    std::unique_lock<std::mutex> m_lock;
+};
+
 /// Runs `work` on a thread of its own while the calling (Python) thread, the GIL
 /// released, waits for it and checks for signals every 50 ms: Ctrl-C (or any handler
 /// that raises) sets `cancel`, which a render checks every tile row, and the exception
@@ -187,6 +210,9 @@ void run_released(const std::function<void(std::atomic<bool>& cancel, Events& ev
     std::atomic<bool> done{false};
     std::thread worker([&] {
         try {
+            std::lock_guard one_at_a_time(call_mutex());
+            if (cancel.load())
+                return;
             ScopedDiagnostics install(diagnostics, ScopedDiagnostics::Reach::process);
             work(cancel, events);
         } catch (...) {
@@ -302,6 +328,42 @@ struct StringObject {
     {
         return std::string(model->lsystem.symbols().name(string.symbol(i)));
     }
+    /// The position for an insertion before module i (i == size() appends).
+    std::size_t gap(long i) const
+    {
+        long n = long(string.size());
+        if (i < 0)
+            i += n;
+        if (i < 0 || i > n)
+            throw py::index_error("insertion point out of range");
+        return std::size_t(i);
+    }
+    /// Modules [first, last) replaced by those cpfg's string text `text` reads as; names
+    /// the model never used are added to its symbols (the turtle reads them by name).
+    void splice(std::size_t first, std::size_t last, const std::string& text)
+    {
+        HeldCall held;
+        std::istringstream in(text);
+        const lsys::ModuleString middle = lsys::read_string_text(
+            in, model->lsystem.symbols(), "<string text>", {.max_modules = max_modules});
+        const std::size_t size = string.size() - (last - first) + middle.size();
+        if (size > max_modules)
+            throw Error("the edited string would have " + std::to_string(size) +
+                        " modules, more than the limit of " + std::to_string(max_modules) +
+                        " (max_modules=)");
+        const std::vector<std::int64_t> at = offsets();
+        const auto param_at = [&](std::size_t i) {
+            return i < at.size() ? std::size_t(at[i]) : string.param_total();
+        };
+        lsys::ModuleString out;
+        out.reserve(size, string.param_total() + middle.param_total());
+        out.append_range(string, 0, first, 0);
+        out.append(middle);
+        out.append_range(string, last, string.size(), param_at(last));
+        string = std::move(out);
+    }
+
+    std::size_t max_modules = lsys::StringReadLimits{}.max_modules;
 };
 
 /// A rendered image: rows top to bottom, RGBA floats (linear; the buffer numpy reads),
@@ -519,38 +581,6 @@ SceneObject load_scene(const py::object& file, const py::object& progress,
 
 /// The scene's plants derived, interpreted and placed (each time: a render's options
 /// may change their steps or limits), then rendered as the command renders a still.
-py::object render_scene(SceneObject& o, bool layers, const py::object& progress,
-                        const py::kwargs& keywords)
-{
-    app::Options options = o.options_with(keyword_dict(keywords));
-    if (app::is_sequence(options))
-        throw Error("a sequence is not one image; the command renders a scene's turntable");
-    app::SceneFile file = *o.scene;
-    app::apply_scene_settings(file, options);
-    if (options.steps)  // steps= derives every plant that many steps
-        for (app::ScenePlant& plant : file.plants)
-            plant.steps = {options.steps};
-    render::RenderSettings settings = app::render_settings(options, {});
-    settings.aovs = layers;
-    const render::WriteOptions write = app::write_options(options);
-    render::Image image;
-    run_released(
-        [&](std::atomic<bool>& cancel, Events& events) {
-            events.push("assemble");
-            geom::Scene scene = app::assemble_scene(file, options);
-            app::apply_camera_options(scene, options);
-            settings.cancel = &cancel;
-            if (!progress.is_none())
-                settings.on_pass = [&](const render::Image& so_far) {
-                    events.push("pass", std::make_shared<render::Image>(so_far));
-                };
-            events.push("render");
-            image = render::render(scene, settings);
-        },
-        progress, options.quiet, write);
-    return image_object(std::move(image), write);
-}
-
 /// The plant's geometry, each primitive knowing its module, as the command interprets a
 /// still: the `given` string (moved from), else a derivation (with its ages when
 /// `with_ages`). Runs on the worker thread of run_released.
@@ -570,39 +600,64 @@ geom::Scene plant_with_provenance(ModelObject& m, const app::Options& options,
     return app::interpret_with_provenance(*m.model, derived, options, provenance);
 }
 
+/// Where light_report() writes: the caller's file (checked by the command line's rules),
+/// or a private temporary one read back and removed.
+class ReportFile {
+public:
+    explicit ReportFile(const py::object& path)
+    {
+        if (!path.is_none()) {
+            m_file = word(path);
+            return;
+        }
+        std::string pattern = (std::filesystem::temp_directory_path() / "cambium-XXXXXX").string();
+        if (!mkdtemp(pattern.data()))
+            throw Error("cannot make a temporary folder for the light report");
+        m_folder = pattern;
+        m_file = m_folder / "light.json";
+    }
+    ReportFile(const ReportFile&) = delete;
+    ReportFile& operator=(const ReportFile&) = delete;
+    ~ReportFile()
+    {
+        std::error_code ec;
+        if (!m_folder.empty())
+            std::filesystem::remove_all(m_folder, ec);
+    }
+    const std::filesystem::path& file() const { return m_file; }
+    /// The JSON report as Python values; None for a .csv file.
+    py::object json() const
+    {
+        if (m_file.extension() != ".json")
+            return py::none();
+        std::ifstream in(m_file, std::ios::binary);
+        std::ostringstream text;
+        text << in.rdbuf();
+        return py::module_::import("json").attr("loads")(text.str());
+    }
+
+private:
+    std::filesystem::path m_folder;
+    std::filesystem::path m_file;
+};
+
+void check_still_light_report(const app::Options& options)
+{
+    if (app::is_sequence(options))
+        throw Error("--light-report measures a still; not with -a, --turntable or --inbetween");
+}
+
 /// --light-report: the light each organ absorbs (docs/light.md), traced as the command
 /// traces it (the derivation's ages and the modules' provenance included) and written by
 /// its writer to `path` (.json or .csv); returns the JSON report as Python values.
 py::object light_report(ModelObject& m, const py::object& path, const py::object& string,
                         const py::object& progress, const py::kwargs& keywords)
 {
+    const ReportFile report(path);
     py::dict more = keyword_dict(keywords);
-    // the file is the report's own name (checked by the command line's rules), or a
-    // private temporary one read back
-    std::filesystem::path folder;
-    std::filesystem::path file;
-    if (!path.is_none()) {
-        file = word(path);
-    } else {
-        std::string pattern = (std::filesystem::temp_directory_path() / "cambium-XXXXXX").string();
-        if (!mkdtemp(pattern.data()))
-            throw Error("cannot make a temporary folder for the light report");
-        folder = pattern;
-        file = folder / "light.json";
-    }
-    more["light_report"] = file.string();
-    struct Cleanup {
-        std::filesystem::path folder;
-        ~Cleanup()
-        {
-            std::error_code ec;
-            if (!folder.empty())
-                std::filesystem::remove_all(folder, ec);
-        }
-    } cleanup{folder};
+    more["light_report"] = report.file().string();
     const app::Options options = m.options_with(more);
-    if (app::is_sequence(options))
-        throw Error("--light-report measures a still; not with -a, --turntable or --inbetween");
+    check_still_light_report(options);
     std::optional<lsys::ModuleString> given = given_string(m, string);
     run_released(
         [&](std::atomic<bool>&, Events& events) {
@@ -611,12 +666,30 @@ py::object light_report(ModelObject& m, const py::object& path, const py::object
             app::write_light_report(scene, options);
         },
         progress, options.quiet);
-    if (file.extension() != ".json")
-        return py::none();
-    std::ifstream in(file, std::ios::binary);
-    std::ostringstream text;
-    text << in.rdbuf();
-    return py::module_::import("json").attr("loads")(text.str());
+    return report.json();
+}
+
+/// Refuses an export name whose extension names no geometry or drawing output.
+void check_export_name(const std::filesystem::path& file)
+{
+    const std::string extension = file.extension().string();
+    if (extension != ".ray" && extension != ".iv" && !app::is_geometry_output(file))
+        throw Error(file.string() + ": export writes .obj, .ply, .glb, .gls, .ps, .svg, .pdf, "
+                                    ".ray or .iv; images come from render()");
+}
+
+/// Writes `scene` to `file` by its extension, as the command's -o, -ray and -iv do;
+/// `model` (a plant's, or null for a scene file's plants) gives -ray its predefined surfaces.
+void write_export(const geom::Scene& scene, const app::Options& options,
+                  const std::filesystem::path& file, const app::Model* model)
+{
+    const std::string extension = file.extension().string();
+    if (extension == ".ray")
+        geom::write_rayshade(scene, file, app::rayshade_options(options, file, model));
+    else if (extension == ".iv")
+        app::write_inventor_output(scene, options, file);
+    else
+        app::write_geometry_output(scene, options, file);
 }
 
 /// The plant's geometry written to `path` as the command writes it: a mesh or drawing by
@@ -626,10 +699,7 @@ void export_geometry(ModelObject& m, const py::object& path, const py::object& s
                      const py::object& progress, const py::kwargs& keywords)
 {
     const std::filesystem::path file = word(path);
-    const std::string extension = file.extension().string();
-    if (extension != ".ray" && extension != ".iv" && !app::is_geometry_output(file))
-        throw Error(file.string() + ": export writes .obj, .ply, .glb, .gls, .ps, .svg, .pdf, "
-                                    ".ray or .iv; images come from render()");
+    check_export_name(file);
     const app::Options options = m.options_with(keyword_dict(keywords));
     if (app::is_sequence(options))
         throw Error(file.string() + ": export writes a still's geometry; not with -a or --turntable");
@@ -637,14 +707,94 @@ void export_geometry(ModelObject& m, const py::object& path, const py::object& s
     run_released(
         [&](std::atomic<bool>&, Events& events) {
             const geom::Scene scene = plant_with_provenance(m, options, given, false, events);
-            if (extension == ".ray")
-                geom::write_rayshade(scene, file, app::rayshade_options(options, file, m.model.get()));
-            else if (extension == ".iv")
-                app::write_inventor_output(scene, options, file);
-            else
-                app::write_geometry_output(scene, options, file);
+            write_export(scene, options, file, m.model.get());
         },
         progress, options.quiet);
+}
+
+/// A scene call's file and options: the load's keywords with the call's over them, and
+/// both over the scene file's settings, as the command applies them.
+struct SceneCall {
+    app::SceneFile file;
+    app::Options options;
+};
+
+SceneCall scene_call(const SceneObject& o, const py::dict& more)
+{
+    SceneCall call{*o.scene, o.options_with(more)};
+    app::apply_scene_settings(call.file, call.options);
+    if (call.options.steps)  // steps= derives every plant that many steps
+        for (app::ScenePlant& plant : call.file.plants)
+            plant.steps = {call.options.steps};
+    return call;
+}
+
+py::object render_scene(SceneObject& o, bool layers, const py::object& progress,
+                        const py::kwargs& keywords)
+{
+    const SceneCall call = scene_call(o, keyword_dict(keywords));
+    const app::Options& options = call.options;
+    if (app::is_sequence(options))
+        throw Error("a sequence is not one image; the command renders a scene's turntable");
+    render::RenderSettings settings = app::render_settings(options, {});
+    settings.aovs = layers;
+    const render::WriteOptions write = app::write_options(options);
+    render::Image image;
+    run_released(
+        [&](std::atomic<bool>& cancel, Events& events) {
+            events.push("assemble");
+            geom::Scene scene = app::assemble_scene(call.file, options);
+            app::apply_camera_options(scene, options);
+            settings.cancel = &cancel;
+            if (!progress.is_none())
+                settings.on_pass = [&](const render::Image& so_far) {
+                    events.push("pass", std::make_shared<render::Image>(so_far));
+                };
+            events.push("render");
+            image = render::render(scene, settings);
+        },
+        progress, options.quiet, write);
+    return image_object(std::move(image), write);
+}
+
+/// The scene's plants, each organ of each placement, written as the command's -o, -ray
+/// and -iv write a scene file's still (instanced plants kept as instances where the
+/// format can).
+void export_scene(SceneObject& o, const py::object& path, const py::object& progress,
+                  const py::kwargs& keywords)
+{
+    const std::filesystem::path file = word(path);
+    check_export_name(file);
+    const SceneCall call = scene_call(o, keyword_dict(keywords));
+    if (app::is_sequence(call.options))
+        throw Error(file.string() + ": export writes a still's geometry; not with --turntable");
+    run_released(
+        [&](std::atomic<bool>&, Events& events) {
+            events.push("assemble");
+            const geom::Scene scene = app::assemble_scene(call.file, call.options);
+            write_export(scene, call.options, file, nullptr);
+        },
+        progress, call.options.quiet);
+}
+
+/// --light-report over a scene file's plants: each organ of each placement.
+py::object scene_light_report(SceneObject& o, const py::object& path, const py::object& progress,
+                              const py::kwargs& keywords)
+{
+    const ReportFile report(path);
+    py::dict more = keyword_dict(keywords);
+    more["light_report"] = report.file().string();
+    const SceneCall call = scene_call(o, more);
+    check_still_light_report(call.options);
+    run_released(
+        [&](std::atomic<bool>&, Events& events) {
+            events.push("assemble");
+            const geom::Scene scene = app::assemble_scene(call.file, call.options);
+            events.push("trace");
+            app::write_light_report(scene, call.options);
+        },
+        progress, call.options.quiet);
+    return report.json();
 }
 
 /// A derivation in progress, one step (or a few) at a time.
@@ -922,7 +1072,40 @@ PYBIND11_MODULE(cambium, m)
                 s.string.mutable_params()[std::size_t(s.offsets()[m]) + std::size_t(k)] = value;
             },
             py::arg("module"), py::arg("parameter"), py::arg("value"),
-            "Sets parameter k of module i");
+            "Sets parameter k of module i")
+        .def(
+            "insert",
+            [](StringObject& s, long i, const std::string& text) {
+                const std::size_t at = s.gap(i);
+                s.splice(at, at, text);
+            },
+            py::arg("index"), py::arg("text"),
+            "Inserts the modules of cpfg's string text (as -str writes it: \"[+F(1.5)]\") "
+            "before module `index` (len(string) appends)")
+        .def(
+            "replace",
+            [](StringObject& s, long start, long stop, const std::string& text) {
+                const std::size_t first = s.gap(start), last = s.gap(stop);
+                if (last < first)
+                    throw py::index_error("replace: stop before start");
+                s.splice(first, last, text);
+            },
+            py::arg("start"), py::arg("stop"), py::arg("text"),
+            "Replaces modules start to stop (stop excluded) by those of cpfg's string text")
+        .def("__delitem__",
+             [](StringObject& s, long i) {
+                 const std::size_t at = s.index(i);
+                 s.splice(at, at + 1, "");
+             })
+        .def("__delitem__", [](StringObject& s, const py::slice& range) {
+            py::ssize_t start = 0, stop = 0, step = 0, length = 0;
+            if (!range.compute(py::ssize_t(s.string.size()), &start, &stop, &step, &length))
+                throw py::error_already_set();
+            if (step != 1)
+                throw py::value_error("deleting modules takes a slice with step 1");
+            if (length > 0)
+                s.splice(std::size_t(start), std::size_t(stop), "");
+        });
 
     py::class_<DerivationObject>(m, "Derivation",
                                  "A derivation from the axiom, advanced step by step")
@@ -984,7 +1167,7 @@ PYBIND11_MODULE(cambium, m)
                 if (steps)
                     more["steps"] = *steps;
                 const app::Options options = self.options_with(more);
-                StringObject s{self.model, {}};
+                StringObject s{self.model, {}, options.max_modules};
                 run_released(
                     [&](std::atomic<bool>&, Events& events) {
                         events.push("derive");
@@ -996,6 +1179,16 @@ PYBIND11_MODULE(cambium, m)
             py::arg("steps") = py::none(), py::arg("progress") = py::none(),
             "Derives the L-system (its derivation length, or `steps`) and returns the string, "
             "as -str writes it")
+        .def(
+            "parse",
+            [](ModelObject& self, const std::string& text) {
+                StringObject s{self.model, {}, self.options.max_modules};
+                s.splice(0, 0, text);
+                return s;
+            },
+            py::arg("text"),
+            "A String of this model from cpfg's string text (as -str writes it), to edit and "
+            "render; names the L-system never used are added to its symbols")
         .def(
             "render", &render_model, py::arg("string") = py::none(), py::arg("layers") = true,
             py::arg("progress") = py::none(),
@@ -1048,6 +1241,14 @@ PYBIND11_MODULE(cambium, m)
         .def("render", &render_scene, py::arg("layers") = true, py::arg("progress") = py::none(),
              "Derives, places and renders the scene's plants into an Image; keywords are the "
              "command's options over the load's, and both over the scene file's settings")
+        .def("export", &export_scene, py::arg("path"), py::arg("progress") = py::none(),
+             "Writes the scene's plants as the command does for a scene file: a mesh or "
+             "drawing by the extension (.obj, .ply, .glb, .gls, .ps, .svg, .pdf), .ray or .iv; "
+             "keywords as render()'s")
+        .def("light_report", &scene_light_report, py::arg("path") = py::none(),
+             py::arg("progress") = py::none(),
+             "The light each organ of each plant absorbs (--light-report): written to `path` "
+             "(.json or .csv) when given; returns the JSON report (None for a .csv path)")
         .def_property_readonly("files", [](const SceneObject& self) { return self.files; })
         .def("__repr__", [](const SceneObject& self) {
             return "<cambium.Scene " + self.files[0] + ">";

@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: Apache-2.0
 # Scene files of many plants: the command's bytes, and its errors.
+import json
 import os
 import shutil
 import subprocess
@@ -34,3 +35,20 @@ def test_a_scene_error_is_a_cambium_error(field):
         cambium.load_scene("field.json")
     assert caught.value.file.endswith("field.json")
     assert caught.value.line == 1
+
+
+def test_a_scenes_exports_and_light_report_are_the_commands(field, command):
+    scene = cambium.load_scene("field.json")
+    for name in ("field.glb", "field.ply"):
+        subprocess.run([command, "-q", "field.json", "-o", "cmd-" + name], check=True)
+        scene.export("py-" + name)
+        cmd = (field / ("cmd-" + name)).read_bytes()
+        assert len(cmd) > 1000 and (field / ("py-" + name)).read_bytes() == cmd, name
+    subprocess.run([command, "-q", "field.json", "--light-report", "cmd.json",
+                    "--light-rays", "20000"], check=True)
+    report = scene.light_report(light_rays=20000)
+    assert report == json.loads((field / "cmd.json").read_text())
+    plants = {organ["plant"] for organ in report["organs"]}
+    assert len(plants) > 100  # each placement's organs, not one plant's
+    with pytest.raises(cambium.Error, match="images come from render"):
+        scene.export("field.png")

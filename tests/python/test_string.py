@@ -99,3 +99,78 @@ def test_a_derivation_advanced_step_by_step_gives_each_steps_string(default_scen
     # the step's string renders like any other
     img = m.render(string=d.advance(2), **SMALL)
     assert np.array_equal(np.asarray(img), np.asarray(m.render(steps=5, **SMALL)))
+
+
+def edit_axiom(default_scene, tmp_path, new_axiom):
+    """scenes/default with another axiom, loaded from a folder of its own."""
+    folder = tmp_path / "edited"
+    shutil.copytree(default_scene, folder)
+    edit_lsystem(folder, "axiom: ;(1)!(0.55)F(2.2)!(0.4)A(2.0,0.4)", "axiom: " + new_axiom)
+    return cambium.load(folder / "plant.l", folder / "plant.v", materials=folder / "plant.mat")
+
+
+def test_structural_edits_render_as_the_same_edits_in_the_file(default_scene, tmp_path):
+    m = cambium.load("plant.l", "plant.v", materials="plant.mat")
+    axiom = m.derive(steps=0)  # ;(1)!(0.55)F(2.2)!(0.4)A(2.0,0.4)
+    branched = m.derive(steps=0)
+    branched.insert(3, "[+(60)F(1.5)]")
+    assert len(branched) == len(axiom) + 4
+    assert [branched[i][0] for i in range(3, 8)] == ["[", "+", "F", "]", "!"]
+    assert branched[5] == ("F", (1.5,))
+    shorter = m.derive(steps=0)
+    del shorter[2]  # F(2.2)
+    replaced = m.derive(steps=0)
+    replaced.replace(2, 3, "F(1)F(1.2)")
+    sliced = m.derive(steps=0)
+    del sliced[1:3]
+    cases = [(branched, ";(1)!(0.55)F(2.2)[+(60)F(1.5)]!(0.4)A(2.0,0.4)"),
+             (shorter, ";(1)!(0.55)!(0.4)A(2.0,0.4)"),
+             (replaced, ";(1)!(0.55)F(1)F(1.2)!(0.4)A(2.0,0.4)"),
+             (sliced, ";(1)!(0.4)A(2.0,0.4)")]
+    original = np.asarray(m.render(string=axiom, **SMALL))
+    for edited, in_file in cases:
+        picture = np.asarray(m.render(string=edited, **SMALL))
+        expected = np.asarray(edit_axiom(default_scene, tmp_path / str(len(edited)),
+                                         in_file).render(steps=0, **SMALL))
+        assert np.array_equal(picture, expected), in_file
+        assert not np.array_equal(picture, original), in_file
+
+
+def test_a_string_parsed_from_text_is_the_derived_one(default_scene):
+    m = cambium.load("plant.l", "plant.v", materials="plant.mat")
+    s = m.derive()
+    parsed = m.parse(str(s))
+    assert np.array_equal(parsed.symbols, s.symbols)
+    assert np.array_equal(parsed.counts, s.counts)
+    assert np.allclose(parsed.parameters, s.parameters, rtol=1e-5)  # -str prints %g
+    assert len(m.parse("")) == 0
+
+
+def test_a_name_the_lsystem_never_used_is_added_and_means_nothing(default_scene):
+    m = cambium.load("plant.l", "plant.v", materials="plant.mat")
+    s = m.derive(steps=1)
+    assert "Y" not in s.names
+    picture = np.asarray(m.render(string=s, **SMALL))
+    s.insert(0, "Y(3)")
+    assert s[0] == ("Y", (3.0,)) and "Y" in s.names
+    assert np.array_equal(np.asarray(m.render(string=s, **SMALL)), picture)
+
+
+def test_bad_edits_are_errors_and_leave_the_string_as_it_was(default_scene):
+    m = cambium.load("plant.l", "plant.v", materials="plant.mat", max_modules=8)
+    s = m.derive(steps=0)
+    text = str(s)
+    with pytest.raises(cambium.Error) as caught:
+        s.insert(0, "F(1")  # no closing parenthesis
+    assert caught.value.file == "<string text>"
+    with pytest.raises(cambium.Error, match="max_modules"):
+        s.insert(0, "FFFF")  # 9 modules, past the load's limit of 8
+    with pytest.raises(IndexError):
+        s.insert(len(s) + 1, "F")
+    with pytest.raises(IndexError):
+        s.replace(3, 2, "F")
+    with pytest.raises(ValueError):
+        del s[::2]
+    assert str(s) == text
+    s.insert(len(s), "F")  # appends
+    assert s[-1] == ("F", ())
