@@ -151,24 +151,28 @@ void Sky::tabulate(bool hidden)
     // solid angle), the ground's below the horizon: the table's density follows the
     // dome to within its variation over a cell (2.8 x 2.8 degrees).
     constexpr int width = 128, height = 64, sub = 3;
-    std::vector<float> weight(std::size_t(width) * height);
+    std::vector<float> weight(std::size_t(width) * height), up(weight.size());
     const float ground = luminance(m_ground);
     for (int j = 0; j < height; ++j) {
         const float c0 = std::cos(pi * float(j) / height), c1 = std::cos(pi * float(j + 1) / height);
         for (int i = 0; i < width; ++i) {
-            float sum = 0;
+            float sum = 0, up_sum = 0;
             for (int a = 0; a < sub; ++a)
                 for (int b = 0; b < sub; ++b) {
                     float c = c0 + (c1 - c0) * (a + 0.5f) / sub;
                     Vec3f d = LatLongTable::direction((i + (b + 0.5f) / sub) / width, c);
-                    sum += d.y < 0 ? ground : luminance(dome(d));
+                    const float l = d.y < 0 ? ground : luminance(dome(d));
+                    sum += l;
+                    up_sum += l * std::max(d.y, 0.0f);
                 }
             bool below = j >= height / 2;
-            weight[std::size_t(j) * width + std::size_t(i)] =
-                hidden && below ? 0.0f : sum / (sub * sub);
+            const std::size_t at = std::size_t(j) * width + std::size_t(i);
+            weight[at] = hidden && below ? 0.0f : sum / (sub * sub);
+            up[at] = below ? 0.0f : up_sum / (sub * sub);
         }
     }
     m_table = LatLongTable(width, height, weight);
+    m_up_table = LatLongTable(width, height, up);
     // The sun's strategy by its share of the luminous power, within [1/4, 3/4]: each
     // strategy keeps enough samples for the points the other serves badly (the plant's
     // shadow on the ground, where the sun's samples are all blocked).
@@ -486,6 +490,37 @@ EnvironmentSample Environment::sample_without_sun(float u1, float u2) const
     if (m_turned)
         e.direction = turn(e.direction);
     return e;
+}
+
+EnvironmentSample environment_kind::Sky::sample_without_sun_facing_up(float u1, float u2) const
+{
+    if (m_up_table.empty())
+        return {};
+    float density = 0;
+    int i = 0, j = 0;
+    Vec3f d = m_up_table.sample(u1, u2, density, i, j);
+    if (!(density > 0))
+        return {};
+    return {d, without_sun(d), density};
+}
+
+EnvironmentSample Environment::sample_without_sun_facing_up(float u1, float u2) const
+{
+    const environment_kind::Sky* s = sky();
+    if (!s)
+        return sample_without_sun(u1, u2);
+    EnvironmentSample e = s->sample_without_sun_facing_up(u1, u2);
+    if (m_turned)  // a turn about +y keeps the cosine to +y
+        e.direction = turn(e.direction);
+    return e;
+}
+
+float Environment::pdf_without_sun_facing_up(const Vec3f& direction) const
+{
+    const environment_kind::Sky* s = sky();
+    if (!s)
+        return pdf_without_sun(direction);
+    return s->pdf_without_sun_facing_up(m_turned ? unturn(direction) : direction);
 }
 
 float Environment::pdf_without_sun(const Vec3f& direction) const

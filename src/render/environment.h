@@ -148,6 +148,11 @@ public:
     /// without_sun(), for a light set that samples the sun apart.
     EnvironmentSample sample_without_sun(float u1, float u2) const;
     float pdf_without_sun(const Vec3f& d) const { return m_table.pdf(d); }
+    /// The same for a surface facing straight up (the ground): the dome drawn by its
+    /// luminance times the cosine to +y, so that open ground's light from the dome hardly
+    /// varies from sample to sample; nothing below the horizon.
+    EnvironmentSample sample_without_sun_facing_up(float u1, float u2) const;
+    float pdf_without_sun_facing_up(const Vec3f& d) const { return m_up_table.pdf(d); }
 
 private:
     /// The Perez luminance distribution's five coefficients.
@@ -161,6 +166,7 @@ private:
     void tabulate(bool hidden);
 
     LatLongTable m_table;
+    LatLongTable m_up_table;  ///< the dome by luminance times the cosine to +y
 
     Vec3f m_sun, m_sun_dome, m_ground, m_sun_radiance;
     Perez m_Y{}, m_x{}, m_y{};
@@ -249,6 +255,11 @@ public:
     Vec3f radiance_without_sun(const Vec3f& direction) const;
     EnvironmentSample sample_without_sun(float u1, float u2) const;
     float pdf_without_sun(const Vec3f& direction) const;
+    /// Whether a surface facing straight up has a sampling of its own (a sky's dome:
+    /// Sky::sample_without_sun_facing_up); the two below then use it.
+    bool samples_facing_up() const { return sky() != nullptr; }
+    EnvironmentSample sample_without_sun_facing_up(float u1, float u2) const;
+    float pdf_without_sun_facing_up(const Vec3f& direction) const;
 
 private:
     using Kinds = std::variant<environment_kind::Uniform, environment_kind::Sky,

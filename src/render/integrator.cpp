@@ -342,6 +342,7 @@ LightUniforms light_uniforms(const LightSet& lights, const Sampler& sampler,
 /// against when it finds them (0: not sampled there, full weight).
 struct ChoiceAt {
     float environment = 0, area = 0, sun = 0;
+    bool facing_up = false;  ///< the environment drawn for a surface facing up (the ground)
 };
 
 /// A light chosen for the vertex by what each light can deliver there (LightSet::
@@ -442,6 +443,46 @@ std::optional<ChosenLight> choose_at(const PathContext& ctx, const LightSet& lig
     return ChosenLight{chosen, weight[chosen] / total};
 }
 
+/// Whether the vertex is the opaque ground seen from above, whose environment light is
+/// drawn by radiance times the cosine to +y (Environment::samples_facing_up).
+bool draws_facing_up(const Vertex& v, const LightSet& lights)
+{
+    return v.hit.geom_id == ground_geom_id && v.bsdf.n.y > 0.999f &&
+           lights.environment_facing_up();
+}
+
+/// Direct light from a sky alone, its sun and its dome each sampled at every vertex and
+/// weighed against BSDF sampling, so that no choice between the two adds variance: in the
+/// plant's shadow the dome's sample carries all the light, in the open both do their part
+/// (benchmarks/cycles/compare.py --staged sky-without-view-lights, turntable azimuths).
+Vec3f sample_sky_ld(const PathContext& ctx, const PathContext::SceneFlags& facts,
+                    const Vertex& v, bool last, const Sampler& sampler, std::uint32_t block,
+                    ChoiceAt& choice)
+{
+    const LightSet& lights = facts.lights;
+    const bool up = draws_facing_up(v, lights);
+    choice = {.environment = 1, .area = 0, .sun = 1, .facing_up = up};
+    auto one = [&](std::uint32_t index, float u1, float u2) {
+        const LightLiSample ls =
+            up && index == lights.environment_index()
+                ? lights.environment_li_facing_up(u1, u2)
+                : lights.sample_li(index, v.hit.position, 0, u1, u2);
+        if (!(ls.pdf > 0))
+            return Vec3f();
+        const Vec3f c = unshadowed(v, ls);
+        if (is_black(c))
+            return Vec3f();
+        const float through = light_visibility(ctx, facts, v.hit, ls.wi, ls.tfar);
+        if (through <= 0)
+            return Vec3f();
+        const float w = last ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf(v.bsdf, ls.wi));
+        return c * (through * w / ls.pdf);
+    };
+    auto [dome1, dome2] = sampler.get2d(block + sample_dimension::light_choice);
+    auto [sun1, sun2] = sampler.get2d(block + sample_dimension::light_point);
+    return one(lights.environment_index(), dome1, dome2) + one(lights.sun_index(), sun1, sun2);
+}
+
 /// Direct light from one light (pbrt's SampleLd): among delta lights only, chosen by what
 /// each gives the point (sample_delta_ld); with the environment or emissive primitives,
 /// chosen by what each can deliver (choose_at), else by power; a delta light at full
@@ -460,6 +501,8 @@ Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, co
                 sample_delta_ld(ctx, facts, v, sampler, block + sample_dimension::light_choice))
             return *ld;
     }
+    if (lights.has_sun() && lights.size() == 2)
+        return sample_sky_ld(ctx, facts, v, last, sampler, block, choice);
     std::optional<ChosenLight> chosen;
     LightUniforms u{};
     if (lights.per_point()) {
@@ -467,6 +510,7 @@ Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, co
         u.choose = choose;
         u.u0 = area;
         chosen = choose_at(ctx, lights, v, u.choose, choice);
+        choice.facing_up = draws_facing_up(v, lights);
         if (chosen) {
             LightKind k = lights.kind(chosen->index);
             if (k == LightKind::area || k == LightKind::environment || k == LightKind::sun) {
@@ -482,7 +526,9 @@ Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, co
     }
     if (!chosen || !(chosen->probability > 0))
         return {};
-    LightLiSample ls = lights.sample_li(chosen->index, v.hit.position, u.u0, u.u1, u.u2);
+    LightLiSample ls = choice.facing_up && chosen->index == lights.environment_index()
+                           ? lights.environment_li_facing_up(u.u1, u.u2)
+                           : lights.sample_li(chosen->index, v.hit.position, u.u0, u.u1, u.u2);
     Vec3f c = unshadowed(v, ls);
     if (is_black(c))
         return {};
@@ -710,8 +756,10 @@ PathResult trace_path(const PathContext& ctx, const Vec3f& camera_org, const Vec
             if (depth == 0) {
                 result.radiance += beta * seen_by_camera(ctx, dir);
             } else if (!facts.environment_black) {
-                float w = bsdf_hit_weight(bsdf_pdf_prev,
-                                          choice.environment * lights.environment_pdf(dir));
+                float w = bsdf_hit_weight(
+                    bsdf_pdf_prev, choice.environment * (choice.facing_up
+                                                             ? lights.environment_pdf_facing_up(dir)
+                                                             : lights.environment_pdf(dir)));
                 const float sun_pdf = lights.sun_pdf(dir);
                 if (sun_pdf > 0) {
                     // Into the sun sampled apart: the disk weighed against the sun's

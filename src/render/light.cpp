@@ -271,6 +271,12 @@ LightLiSample LightSet::sample_li_other(std::uint32_t index, const Vec3f& p, flo
     return {};
 }
 
+LightLiSample LightSet::environment_li_facing_up(float u1, float u2) const
+{
+    EnvironmentSample es = m_environment->sample_without_sun_facing_up(u1, u2);
+    return {es.direction, es.radiance, es.pdf, std::numeric_limits<float>::infinity(), false};
+}
+
 namespace {
 constexpr int irradiance_azimuths = 16, irradiance_bands = 8;
 }  // namespace

@@ -180,6 +180,17 @@ public:
     {
         return m_environment ? m_environment->pdf_without_sun(wi) : 0.0f;
     }
+    /// The environment for a surface facing straight up (the ground), where it has a
+    /// sampling of its own (Environment::samples_facing_up): a sample and its density.
+    bool environment_facing_up() const
+    {
+        return m_environment && m_environment->samples_facing_up();
+    }
+    LightLiSample environment_li_facing_up(float u1, float u2) const;
+    float environment_pdf_facing_up(const Vec3f& wi) const
+    {
+        return m_environment ? m_environment->pdf_without_sun_facing_up(wi) : 0.0f;
+    }
     /// The density of the area lights' own sampling of `hit` from p (no choice).
     float area_pdf(const Vec3f& p, const SurfaceHit& hit) const;
     /// The choice probabilities by power (choose()) of the environment, of the area
