@@ -22,10 +22,8 @@
 #include <cstdio>
 #include <cstdint>
 #include <ctime>
-#include <limits>
 #include <memory>
 #include <mutex>
-#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -34,6 +32,7 @@
 #include "render/accel.h"
 #include "render/color.h"
 #include "render/denoise.h"
+#include "render/film.h"
 #include "render/float_mode.h"
 #include "render/integrator.h"
 #include "render/labels.h"
@@ -49,8 +48,6 @@ using Clock = std::chrono::steady_clock;
 
 constexpr int tile_size = 16;
 constexpr int first_pass_samples = 8;    // automatic passes: 8, 16, 32, ... spp
-constexpr int min_adaptive_samples = 16;  // fewer give no useful variance estimate
-constexpr float infinity = std::numeric_limits<float>::infinity();
 
 void check_settings(const RenderSettings& s)
 {
@@ -110,83 +107,6 @@ PixelRect sampled_rect(const RenderSettings& s, std::size_t passes)
     return {x0, y0, x1 - x0, y1 - y0};
 }
 
-/// Draws a pixel-space offset from a separable filter profile: a 1D table over
-/// [-radius, radius], piecewise constant, inverted by binary search.
-class FilterTable {
-public:
-    FilterTable(PixelFilter filter, float radius)
-    {
-        if (filter == PixelFilter::box)
-            return;
-        m_radius = radius > 0 ? radius : (filter == PixelFilter::gaussian ? 1.5f : 1.0f);
-        constexpr int bins = 128;
-        m_cdf.resize(bins + 1);
-        double sigma = m_radius / 3.0;
-        double edge = std::exp(-m_radius * m_radius / (2 * sigma * sigma));
-        for (int i = 0; i < bins; ++i) {
-            double x = -m_radius + (i + 0.5) * 2 * m_radius / bins;
-            double f;
-            if (filter == PixelFilter::gaussian) {
-                f = std::max(0.0, std::exp(-x * x / (2 * sigma * sigma)) - edge);
-            } else {
-                double t = 2 * std::numbers::pi * (x + m_radius) / (2 * m_radius);
-                f = 0.35875 - 0.48829 * std::cos(t) + 0.14128 * std::cos(2 * t) -
-                    0.01168 * std::cos(3 * t);
-            }
-            m_cdf[i + 1] = m_cdf[i] + std::max(f, 0.0);
-        }
-        for (double& c : m_cdf)
-            c /= m_cdf.back();
-    }
-
-    bool box() const { return m_cdf.empty(); }
-    /// How far from the pixel centre a sample may lie, in pixels.
-    double radius() const { return m_radius; }
-
-    /// The offset from the pixel centre for the uniform u.
-    double offset(float u) const
-    {
-        auto it = std::upper_bound(m_cdf.begin(), m_cdf.end(), double(u));
-        std::size_t bin = std::min<std::size_t>(
-            std::size_t(std::max<std::ptrdiff_t>(it - m_cdf.begin() - 1, 0)), m_cdf.size() - 2);
-        double width = m_cdf[bin + 1] - m_cdf[bin];
-        double t = width > 0 ? std::clamp((u - m_cdf[bin]) / width, 0.0, 1.0) : 0.5;
-        double bins = double(m_cdf.size() - 1);
-        return -m_radius + (double(bin) + t) * 2 * m_radius / bins;
-    }
-
-private:
-    double m_radius = 0.5;
-    std::vector<double> m_cdf;
-};
-
-/// A pixel's running sums that every render keeps: small (24 bytes), because every pass
-/// reads and writes them for every pixel, most of them the background's, so a tile row's
-/// sums share a few cache lines (with the other sums beside them, 104 bytes a pixel,
-/// reading them was most of the pixel loop's cache misses).
-struct PixelState {
-    Vec3f radiance;
-    std::uint32_t samples = 0, hits = 0;
-    bool done = false;  // adaptive sampling: converged
-};
-
-/// A pixel's sums that only some renders keep (Film::extras): the albedo, normal and depth
-/// layers, adaptive sampling's luminance sums, the shadow catcher's light.
-struct PixelExtras {
-    Vec3f albedo, normal;
-    float depth = infinity;
-    /// Luminance sums of the two independent replicas (even and odd samples), for the
-    /// adaptive error estimate (relative_error).
-    std::array<double, 2> replica_luminance{};
-    double luminance_sq = 0;
-    double lit_with = 0, lit_without = 0;  // shadow-catcher samples' light (PathResult)
-    std::uint32_t caught = 0;              // samples that met the shadow catcher
-    /// Denoising: the odd samples' radiance sum (the even ones' is the rest), and the
-    /// organ of the nearest camera-ray hit (the one `depth` is of).
-    Vec3f odd_radiance, odd_albedo, odd_normal;
-    std::uint32_t organ = organ_background;
-};
-
 const std::vector<std::uint32_t>& modules_of(const geom::Geometry& g, PrimitiveKind k)
 {
     switch (k) {
@@ -238,23 +158,6 @@ std::uint32_t organ_of(const geom::Scene& scene, const VisibleSurface& v)
         return std::min(static_cast<std::uint32_t>(key), organ_unknown - 1);
     return std::min(static_cast<std::uint32_t>(mix64(key)), organ_unknown - 1);
 }
-
-/// The sampled pixels' sums, row by row.
-struct Film {
-    std::vector<PixelState> px;
-    /// Beside px, where the render has AOVs, adaptive sampling or a shadow catcher (the
-    /// only renders whose samples add to them); else empty.
-    std::vector<PixelExtras> extras;
-
-    /// Organ masks: the organs each pixel's samples met; else empty.
-    std::vector<OrganSamples> organs;
-
-    Film(std::size_t pixels, bool with_extras, bool with_organs)
-        : px(pixels), extras(with_extras ? pixels : 0), organs(with_organs ? pixels : 0)
-    {
-    }
-    PixelExtras* extra(std::size_t i) { return extras.empty() ? nullptr : &extras[i]; }
-};
 
 /// What a camera ray that meets nothing adds to its pixel when that is the same in every
 /// direction (no visible environment) and finite: take_sample's sums for camera_miss's
@@ -742,136 +645,6 @@ std::vector<int> pass_targets(const RenderSettings& s)
     return targets;
 }
 
-/// The squared relative standard error of a pixel's mean luminance (infinite when too
-/// few samples): the replicas' estimate (see replica_index), but never below the samples'
-/// variance over n^2 (their spread over n, the error of independent samples, times a
-/// stratification gain of 1/sqrt(n), more than nets achieve on an edge). From a few
-/// samples the replicas often agree exactly on an edge (each net's coverage count is an
-/// integer): an estimate of zero, which without the floor would stop the pixel at once.
-double relative_error_squared(const PixelState& st, const PixelExtras& ex)
-{
-    if (st.samples < std::uint32_t(min_adaptive_samples))
-        return std::numeric_limits<double>::infinity();
-    double n = st.samples, n_even = (st.samples + 1) / 2, n_odd = st.samples / 2;
-    double sum = ex.replica_luminance[0] + ex.replica_luminance[1], mean = sum / n;
-    double replica_error = (ex.replica_luminance[0] / n_even - ex.replica_luminance[1] / n_odd) / 2;
-    double variance = std::max(0.0, (ex.luminance_sq - sum * mean) / (n - 1));
-    double error_sq = std::max(replica_error * replica_error, variance / (n * n));
-    return error_sq / std::max(mean * mean, 1e-4);
-}
-
-/// Marks pixels whose 3x3 neighbourhood meets the noise target as done (over the sampled
-/// rectangle, w x h: its edges are the image's or lie in the crop's margin). A pixel's
-/// replica estimate has one degree of freedom; pooled over the neighbourhood (the mean of
-/// the squared errors) it has nine, so a lucky pair of replicas rarely stops a pixel early.
-void mark_converged(Film& film, int w, int h, double target)
-{
-    std::vector<PixelState>& px = film.px;
-    std::vector<double> err(px.size());
-    for (std::size_t i = 0; i < px.size(); ++i)
-        err[i] = relative_error_squared(px[i], film.extras[i]);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            double pooled = 0;
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) {
-                    int nx = std::clamp(x + dx, 0, w - 1), ny = std::clamp(y + dy, 0, h - 1);
-                    pooled = std::max(pooled, err[std::size_t(ny) * w + nx]);
-                }
-            if (pooled <= target * target)
-                px[std::size_t(y) * w + x].done = true;
-        }
-}
-
-/// A shadow catcher's share of a pixel's coverage, in samples: its samples that met the
-/// catcher (those with light) times the fraction of the light the plant takes away, as a
-/// ratio of the sums (Cycles' catcher): 0 where nothing is in the way.
-float shadow_coverage(const PixelExtras& ex)
-{
-    if (!(ex.lit_without > 0) || ex.lit_with >= ex.lit_without)
-        return 0;
-    float missing = static_cast<float>(1 - ex.lit_with / ex.lit_without);
-    return missing * static_cast<float>(ex.caught);
-}
-
-/// The image of the sums so far over `out`, from the sums over `sampled` (which holds it),
-/// row by row (each output row is a run of a sampled row).
-Image resolve(const Film& film, const PixelRect& sampled, const PixelRect& out,
-              const RenderSettings& s, const geom::Scene& scene)
-{
-    const std::size_t width = std::size_t(out.width), count = width * std::size_t(out.height);
-    Image img{out.width, out.height, std::vector<float>(count * 4)};
-    img.transparent = s.transparent_background || s.ground.shadow_catcher;
-    const bool aovs = s.aovs || s.denoiser, denoise = s.denoiser != nullptr;
-    if (aovs) {
-        img.albedo.assign(count * 3, 0.0f);
-        img.normal.assign(count * 3, 0.0f);
-        img.depth.assign(count, infinity);
-    }
-    if (denoise) {
-        img.variance.assign(count * 3, 0.0f);
-        img.feature_variance.assign(count * 2, 0.0f);
-        img.organ.assign(count, organ_background);
-    }
-    const bool extras = !film.extras.empty();  // (without them no pixel has a catcher's light)
-    std::optional<OrganMaskBuilder> masks;
-    if (!film.organs.empty())
-        masks.emplace(scene, count, s.organ_mask_depth);
-    for (std::size_t row = 0; row < std::size_t(out.height); ++row) {
-        const std::size_t from = (std::size_t(out.y - sampled.y) + row) * std::size_t(sampled.width) +
-                                 std::size_t(out.x - sampled.x);
-        for (std::size_t x = 0, i = row * width; x < width; ++x, ++i) {
-            const PixelState& st = film.px[from + x];
-            if (st.samples == 0)
-                continue;
-            float inv = 1.0f / static_cast<float>(st.samples);
-            float coverage = extras ? shadow_coverage(film.extras[from + x]) : 0.0f;
-            img.rgba[i * 4 + 0] = st.radiance.x * inv;
-            img.rgba[i * 4 + 1] = st.radiance.y * inv;
-            img.rgba[i * 4 + 2] = st.radiance.z * inv;
-            img.rgba[i * 4 + 3] = (static_cast<float>(st.hits) + coverage) * inv;
-            if (masks)
-                masks->pixel(i, film.organs[from + x], st.samples);
-            if (denoise) {
-                // A quarter of the squared difference of the two replicas' means: the
-                // variance of the pixel's mean, without bias (1 degree of freedom).
-                const PixelExtras& ex = film.extras[from + x];
-                const std::uint32_t odd = st.samples / 2, even = st.samples - odd;
-                if (odd > 0) {
-                    const Vec3f a = (st.radiance - ex.odd_radiance) * (1.0f / float(even));
-                    const Vec3f b = ex.odd_radiance * (1.0f / float(odd));
-                    const Vec3f d = a - b;
-                    img.variance[i * 3 + 0] = 0.25f * d.x * d.x;
-                    img.variance[i * 3 + 1] = 0.25f * d.y * d.y;
-                    img.variance[i * 3 + 2] = 0.25f * d.z * d.z;
-                    // The same for the albedo and the normal, summed over their channels.
-                    auto half_variance = [&](const Vec3f& sum, const Vec3f& odd_sum) {
-                        const Vec3f e = (sum - odd_sum) * (1.0f / float(even)) - odd_sum * (1.0f / float(odd));
-                        return 0.25f * (e.x * e.x + e.y * e.y + e.z * e.z);
-                    };
-                    img.feature_variance[i * 2 + 0] = half_variance(ex.albedo, ex.odd_albedo);
-                    img.feature_variance[i * 2 + 1] = half_variance(ex.normal, ex.odd_normal);
-                }
-                img.organ[i] = ex.organ;
-            }
-            if (aovs) {
-                const PixelExtras& ex = film.extras[from + x];
-                Vec3f a = ex.albedo * inv, n = ex.normal * inv;
-                img.albedo[i * 3 + 0] = a.x;
-                img.albedo[i * 3 + 1] = a.y;
-                img.albedo[i * 3 + 2] = a.z;
-                img.normal[i * 3 + 0] = n.x;
-                img.normal[i * 3 + 1] = n.y;
-                img.normal[i * 3 + 2] = n.z;
-                img.depth[i] = ex.depth;
-            }
-        }
-    }
-    if (masks)
-        img.organ_masks = masks->finish();
-    return img;
-}
-
 /// The progress line on stderr, redrawn at most 4 times a second by whichever thread
 /// finishes a tile first.
 class ProgressLine {
@@ -923,6 +696,13 @@ private:
 std::atomic<bool> interrupted{false};
 
 extern "C" void on_interrupt(int) { interrupted.store(true); }
+
+/// The layers beside RGBA that the settings ask of the film.
+ImageLayers image_layers(const RenderSettings& s)
+{
+    return {s.transparent_background || s.ground.shadow_catcher, s.aovs || s.denoiser != nullptr,
+            s.denoiser != nullptr, s.organ_mask_depth};
+}
 
 /// The ground plane of the settings under `scene`: its material appended to `materials`,
 /// its texture after the scene's (load_textures).
@@ -1272,7 +1052,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
             if (settings.noise_target > 0)
                 mark_converged(film, w, h, settings.noise_target);
             if (settings.on_pass)
-                settings.on_pass(resolve(film, region, out_rect, settings, scene));
+                settings.on_pass(resolve(film, region, out_rect, image_layers(settings), scene));
         }
         progress.finish();
         rep.cancelled = cancelled;
@@ -1296,7 +1076,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                  " ray(s) not finite or starting too far from the origin were skipped");
         for (const PixelState& st : pixels)
             rep.samples += st.samples;
-        Image image = resolve(film, region, out_rect, settings, scene);
+        Image image = resolve(film, region, out_rect, image_layers(settings), scene);
         if (settings.denoiser) {
             auto denoise_start = Clock::now();
             denoise(*settings.denoiser, image);

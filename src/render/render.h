@@ -16,6 +16,7 @@
 #include "render/camera.h"
 #include "render/environment.h"
 #include "render/image_io.h"
+#include "render/pixel_filter.h"
 #include "render/sampler.h"
 
 namespace cambium::render {
@@ -23,25 +24,8 @@ namespace cambium::render {
 class Denoiser;
 class TextureSet;
 
-/// The pixel reconstruction filter. Filters are importance sampled: each sample's
-/// position within the pixel's footprint is drawn from the filter (tabulated, 64 bins
-/// per radius) and weighted 1, so every pixel stays a pure function of its own samples.
-enum class PixelFilter {
-    box,              ///< uniform over the pixel (radius fixed at 0.5): cpfg-like crisp edges
-    gaussian,         ///< exp(-x^2 / (2 s^2)) - its edge value, s = radius / 3
-    blackman_harris,  ///< the 4-term Blackman-Harris window over [-radius, radius]
-};
-
 /// The largest image rendered: 2^26 pixels (8192 x 8192, about 5 GiB of pixel state).
 inline constexpr std::int64_t max_image_pixels = std::int64_t{1} << 26;
-
-/// A rectangle of pixels: columns x .. x + width - 1 and rows y .. y + height - 1, rows
-/// counted from the top.
-struct PixelRect {
-    int x = 0, y = 0, width = 0, height = 0;
-    bool empty() const { return width <= 0 || height <= 0; }
-    bool operator==(const PixelRect&) const = default;
-};
 
 /// How to render a frame.
 struct RenderSettings {
