@@ -18,8 +18,6 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
-#include <csignal>
-#include <cstdio>
 #include <cstdint>
 #include <ctime>
 #include <memory>
@@ -645,17 +643,20 @@ std::vector<int> pass_targets(const RenderSettings& s)
     return targets;
 }
 
-/// The progress line on stderr, redrawn at most 4 times a second by whichever thread
-/// finishes a tile first.
-class ProgressLine {
+/// A view's samples taken, told to RenderSettings::progress at most 4 times a second by
+/// whichever thread finishes a tile first (one at a time), and once at the end.
+class ProgressReporter {
 public:
-    ProgressLine(bool enabled, Clock::time_point start) : m_enabled(enabled), m_start(start) {}
+    ProgressReporter(const RenderSettings& settings, Clock::time_point start)
+        : m_report(settings.progress), m_start(start)
+    {
+    }
 
     void set_total(double total) { m_total.store(total); }
     void add(std::uint64_t samples)
     {
         std::uint64_t done = m_done.fetch_add(samples) + samples;
-        if (!m_enabled)
+        if (!m_report)
             return;
         std::unique_lock lock(m_mutex, std::try_to_lock);
         if (!lock.owns_lock())
@@ -664,38 +665,32 @@ public:
         if (now - m_last < std::chrono::milliseconds(250))
             return;
         m_last = now;
-        draw(double(done));
+        report(double(done), false);
     }
     void finish()
     {
-        if (!m_enabled)
+        if (!m_report)
             return;
         std::lock_guard lock(m_mutex);
-        draw(double(m_done.load()));  // 100% unless stopped early
-        std::fputc('\n', stderr);
+        report(double(m_done.load()), true);  // 100% unless stopped early
     }
     std::uint64_t done() const { return m_done.load(); }
 
 private:
-    void draw(double done) const
+    void report(double done, bool finished) const
     {
         double elapsed = std::chrono::duration<double>(Clock::now() - m_start).count();
         double total = m_total.load();
         double fraction = total > 0 ? std::min(1.0, done / total) : 0.0;
-        std::fprintf(stderr, "\r%s   ", format_progress(fraction, elapsed).c_str());
-        std::fflush(stderr);
+        m_report({fraction, elapsed, finished});
     }
 
-    bool m_enabled;
+    const std::function<void(const RenderProgress&)>& m_report;
     Clock::time_point m_start, m_last{};
     std::atomic<std::uint64_t> m_done{0};
     std::atomic<double> m_total{0};
     std::mutex m_mutex;
 };
-
-std::atomic<bool> interrupted{false};
-
-extern "C" void on_interrupt(int) { interrupted.store(true); }
 
 /// The layers beside RGBA that the settings ask of the film.
 ImageLayers image_layers(const RenderSettings& s)
@@ -786,28 +781,7 @@ void check_organ_mask_memory(const RenderSettings& s)
                     " (--max-memory)");
 }
 
-std::string clock_time(double seconds)
-{
-    long s = std::lround(std::max(0.0, seconds));
-    char buffer[32];
-    if (s >= 3600)
-        std::snprintf(buffer, sizeof buffer, "%ld:%02ld:%02ld", s / 3600, s / 60 % 60, s % 60);
-    else
-        std::snprintf(buffer, sizeof buffer, "%ld:%02ld", s / 60, s % 60);
-    return buffer;
-}
-
 }  // namespace
-
-std::string format_progress(double fraction, double elapsed_s)
-{
-    fraction = std::clamp(fraction, 0.0, 1.0);
-    std::string line = "render " + std::to_string(int(std::floor(fraction * 100))) + "%  elapsed " +
-                       clock_time(elapsed_s) + "  remaining ";
-    if (fraction <= 0)
-        return line + "?";
-    return line + clock_time(elapsed_s * (1 - fraction) / fraction);
-}
 
 std::shared_ptr<const TextureSet> load_textures(const geom::Scene& scene,
                                                 const RenderSettings& settings)
@@ -819,20 +793,6 @@ std::shared_ptr<const TextureSet> load_textures(const geom::Scene& scene,
     // it as the user gave it on the command line (the ground's: the current folder's).
     return std::make_shared<const TextureSet>(defs, std::filesystem::path{},
                                               settings.max_memory_bytes);
-}
-
-const std::atomic<bool>* install_interrupt_handler()
-{
-    static std::once_flag once;
-    std::call_once(once, [] {
-        struct sigaction action {};
-        action.sa_handler = &on_interrupt;
-        sigemptyset(&action.sa_mask);
-        // The second Ctrl-C finds the default action again and ends the process.
-        action.sa_flags = SA_RESETHAND;
-        sigaction(SIGINT, &action, nullptr);
-    });
-    return &interrupted;
 }
 
 Image render(const geom::Scene& scene, const RenderSettings& settings, RenderReport* report)
@@ -975,7 +935,7 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         }
         const int tiles_x = (w + tile_size - 1) / tile_size;
         const int tiles_y = (h + tile_size - 1) / tile_size;
-        ProgressLine progress(settings.progress, start);
+        ProgressReporter progress(settings, start);
         std::atomic<bool> stop{false}, cancelled{false}, out_of_time{false};
         std::atomic<std::uint64_t> background_samples{0};
         double last_pass_s = 0;
