@@ -781,6 +781,250 @@ void check_organ_mask_memory(const RenderSettings& s)
                     " (--max-memory)");
 }
 
+/// Throws on settings or cameras render_views cannot take.
+void check_views(const RenderSettings& settings, std::span<const Camera> cameras)
+{
+    check_settings(settings);
+    check_denoise_memory(settings);
+    check_organ_mask_memory(settings);
+    for (const Camera& camera : cameras) {
+        if (camera.width() != settings.width || camera.height() != settings.height)
+            throw Error("render: the camera's image size differs from the settings'");
+        camera.check_range("view");
+    }
+}
+
+/// A path tracer's context and the area lights it samples (which it points to).
+struct PreparedContext {
+    std::unique_ptr<AreaLights> area_lights;
+    PathContext ctx;
+};
+
+/// The scene's path tracer context under the settings, over its BVH and textures, for
+/// every view: materials, lights, ground, background and environment, prepared
+/// (prepare_path_context). A view sets its camera's part (aim_context).
+PreparedContext make_path_context(const geom::Scene& scene, const RenderSettings& settings,
+                                  const EmbreeScene& accel, const TextureSet* textures)
+{
+    PreparedContext prepared;
+    PathContext& ctx = prepared.ctx;
+    ctx.accel = &accel;
+    ctx.textures = textures;
+    const std::vector<geom::Light> no_lights;
+    const std::vector<geom::Light>& scene_lights = settings.view_lights ? scene.lights : no_lights;
+    // Without the scene's lights there is no OpenGL ambient term either (an empty
+    // list would mean cpfg's default light to opengl_ambient_light).
+    ctx.materials = make_materials(scene.materials,
+                                   settings.opengl_ambient && settings.view_lights
+                                       ? opengl_ambient_light(scene.lights)
+                                       : geom::Rgb{0, 0, 0});
+    if (scene.colour_index_light) {
+        ctx.index_light = *scene.colour_index_light;
+        ctx.index_ramps = make_index_ramps(scene.materials, ctx.index_light);
+    }
+    if (settings.ground.enabled)
+        ctx.ground = make_ground(scene, settings, ctx.materials);
+    ctx.lights = make_lights(scene_lights);
+    if (settings.area_lights) {
+        prepared.area_lights = std::make_unique<AreaLights>(scene, ctx.materials);
+        ctx.area_lights = prepared.area_lights.get();
+    }
+    ctx.background = decode_display(settings.backdrop == RenderSettings::Backdrop::colour
+                                        ? settings.backdrop_colour
+                                        : scene.background);
+    ctx.environment = settings.environment.get();
+    ctx.ambient = {settings.ambient.r, settings.ambient.g, settings.ambient.b};
+    ctx.max_depth = settings.max_depth;
+    ctx.unlit = scene.shading == geom::Shading::filled || scene.shading == geom::Shading::wireframe;
+    ctx.facet_normals = scene.shading == geom::Shading::flat;
+    ctx.roulette_depth = settings.roulette_depth;
+    if (!scene.bounds.empty())
+        ctx.scene_radius = static_cast<float>(0.5 * geom::length(scene.bounds.hi - scene.bounds.lo));
+    prepare_path_context(ctx);
+    return prepared;
+}
+
+/// The context's part that depends on the view's camera.
+void aim_context(PathContext& ctx, const Camera& camera, const RenderSettings& settings)
+{
+    // A parallel camera looks along one direction: its misses would all see the same
+    // environment radiance, so they keep cpfg's background there.
+    ctx.environment_visible =
+        settings.environment != nullptr &&
+        (settings.backdrop == RenderSettings::Backdrop::environment ||
+         (settings.backdrop == RenderSettings::Backdrop::view &&
+          camera.projection() == Camera::Projection::perspective));
+    ctx.camera_cone = camera_cone(camera);
+}
+
+/// What every view of render_views shares: the pass schedule and the pixels.
+struct ViewPlan {
+    const geom::Scene& scene;
+    const RenderSettings& settings;
+    std::vector<int> targets;  ///< pass_targets
+    /// The sampled pixels, in image coordinates (the film holds them row by row), and
+    /// the pixels returned.
+    PixelRect region, out;
+    Clock::time_point start;  ///< of the view: its time budget and seconds
+};
+
+/// The view's samples, its stop checks and progress, for the passes over its tiles.
+struct PassRun {
+    const ViewPlan& plan;
+    const RenderState& state;
+    Film& film;
+    ProgressReporter progress;
+    std::atomic<bool> stop{false}, cancelled{false}, out_of_time{false};
+    std::atomic<std::uint64_t> background_samples{0};
+    /// The time budget may stop a render only once every pixel has a sample: an
+    /// image with unsampled (black) bands is never the result of a budget.
+    bool budget_applies = false;
+    // Each thread's camera batches, made on its first tile (not once per tile: their
+    // members' initialisers, ~60 kB of stores a tile, were a tenth of the pixel loop).
+    tbb::enumerable_thread_specific<std::unique_ptr<RowBatches>> thread_rows;
+
+    PassRun(const ViewPlan& p, const RenderState& s, Film& f)
+        : plan(p), state(s), film(f), progress(p.settings, p.start)
+    {
+    }
+    double elapsed() const { return std::chrono::duration<double>(Clock::now() - plan.start).count(); }
+
+    bool should_stop()
+    {
+        const RenderSettings& settings = plan.settings;
+        if (settings.cancel && settings.cancel->load(std::memory_order_relaxed)) {
+            cancelled = true;
+            stop = true;
+        }
+        if (budget_applies && settings.time_budget_s > 0 && elapsed() > settings.time_budget_s) {
+            out_of_time = true;
+            stop = true;
+        }
+        return stop.load(std::memory_order_relaxed);
+    }
+
+    /// Tile t's pixels sampled up to `target`, a row at a time.
+    void take_tile(int t, std::uint32_t target, RowBatches& row)
+    {
+        const int w = plan.region.width, h = plan.region.height;
+        const int tiles_x = (w + tile_size - 1) / tile_size;
+        int x0 = (t % tiles_x) * tile_size, y0 = (t / tiles_x) * tile_size;
+        RowSamples tile;
+        row.background = {};  // (a pure function of the view's miss, so per tile)
+        const int x1 = std::min(x0 + tile_size, w);
+        const int y1 = std::min(y0 + tile_size, h);
+        prefetch_row(film, y0, x0, x1, w);
+        // Checked every row, so even passes of thousands of samples stop soon.
+        for (int y = y0; y < y1 && !should_stop(); ++y) {
+            if (y + 1 < y1)
+                prefetch_row(film, y + 1, x0, x1, w);
+            RowSamples taken = take_row(state, plan.region, y, x0, x1, target, film, w, row);
+            tile.taken += taken.taken;
+            tile.background_only += taken.background_only;
+        }
+        progress.add(tile.taken);
+        background_samples.fetch_add(tile.background_only, std::memory_order_relaxed);
+    }
+
+    /// One pass: every tile's pixels sampled up to `target`, in parallel.
+    void take_pass(std::uint32_t target)
+    {
+        const int w = plan.region.width, h = plan.region.height;
+        const int tiles = ((w + tile_size - 1) / tile_size) * ((h + tile_size - 1) / tile_size);
+        // Each tile writes only its own pixels; no exception leaves a task.
+        tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& r) {
+            // Taken from the thread's slot while in use: a task this one waits on inside
+            // (nested parallelism) may run another tile on this thread, with its own.
+            std::unique_ptr<RowBatches> row = std::move(thread_rows.local());
+            if (!row)
+                row = std::make_unique_for_overwrite<RowBatches>();  // no zero fill
+            for (int t = r.begin(); t != r.end(); ++t)
+                take_tile(t, target, *row);
+            thread_rows.local() = std::move(row);
+        });
+    }
+
+    /// The passes of the schedule until the last, a stop or the time budget; the passes
+    /// completed and why they ended into `rep`.
+    void run(RenderReport& rep)
+    {
+        const RenderSettings& settings = plan.settings;
+        double last_pass_s = 0;
+        std::uint64_t last_pass_samples = 0;
+        for (std::size_t pass = 0; pass < plan.targets.size(); ++pass) {
+            const std::uint32_t target = static_cast<std::uint32_t>(plan.targets[pass]);
+            // Samples still to take to reach the end of the render, for the progress reports.
+            std::uint64_t pass_samples = 0, remaining = 0;
+            for (const PixelState& st : film.px)
+                if (!st.done) {
+                    pass_samples += target > st.samples ? target - st.samples : 0;
+                    remaining += std::uint32_t(settings.samples_per_pixel) - st.samples;
+                }
+            if (pass_samples == 0)
+                break;
+            progress.set_total(double(progress.done() + remaining));
+            if (settings.time_budget_s > 0 && pass > 0 && last_pass_samples > 0) {
+                double predicted = last_pass_s * double(pass_samples) / double(last_pass_samples);
+                if (elapsed() + predicted > settings.time_budget_s) {
+                    out_of_time = true;
+                    break;
+                }
+            }
+            budget_applies = pass > 0;
+            auto pass_start = Clock::now();
+            take_pass(target);
+            if (stop)
+                break;
+            last_pass_s = std::chrono::duration<double>(Clock::now() - pass_start).count();
+            last_pass_samples = pass_samples;
+            rep.passes += 1;
+            if (settings.noise_target > 0)
+                mark_converged(film, plan.region.width, plan.region.height, settings.noise_target);
+            if (settings.on_pass)
+                settings.on_pass(resolve(film, plan.region, plan.out, image_layers(settings), plan.scene));
+        }
+        progress.finish();
+        rep.cancelled = cancelled;
+        rep.out_of_time = out_of_time;
+        rep.background_only_samples = background_samples.load();
+    }
+};
+
+/// The BVH's figures for the view's report, and warnings for samples and rays lost.
+void report_accel(const EmbreeScene& accel, RenderReport& rep)
+{
+    rep.skipped_rays = accel.skipped_rays();
+    rep.embree_bytes = accel.embree_bytes();
+    rep.embree_peak_bytes = accel.embree_peak_bytes();
+    rep.embree_shared_bytes = accel.shared_bytes();
+    rep.render_buffer_bytes = accel.own_bytes();
+    rep.embree_unmonitored_bytes = accel.embree_unmonitored_bytes();
+    if (rep.nonfinite_samples > 0)
+        warn("render: " + std::to_string(rep.nonfinite_samples) +
+             " sample(s) with a radiance that is not finite were counted as black");
+    if (rep.skipped_rays > 0)
+        warn("render: " + std::to_string(rep.skipped_rays) +
+             " ray(s) not finite or starting too far from the origin were skipped");
+}
+
+/// The view's image from the film: resolved, denoised where asked, its labels drawn.
+Image finish_image(const ViewPlan& plan, const Film& film, const Camera& camera,
+                   const EmbreeScene& accel, RenderReport& rep)
+{
+    const RenderSettings& settings = plan.settings;
+    Image image = resolve(film, plan.region, plan.out, image_layers(settings), plan.scene);
+    if (settings.denoiser) {
+        auto denoise_start = Clock::now();
+        denoise(*settings.denoiser, image);
+        rep.denoise_seconds = std::chrono::duration<double>(Clock::now() - denoise_start).count();
+    }
+    // Labels over the image, as cpfg's window draws them (on the crop's pixels).
+    draw_labels(image, plan.scene, camera, accel,
+                LabelCanvas{plan.out.x, plan.out.y, settings.width, settings.height},
+                LabelLimits{settings.max_memory_bytes});
+    return image;
+}
+
 }  // namespace
 
 std::shared_ptr<const TextureSet> load_textures(const geom::Scene& scene,
@@ -821,28 +1065,15 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
 void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                   const RenderSettings& settings, const ViewCallback& on_view)
 {
-    check_settings(settings);
-    check_denoise_memory(settings);
-    check_organ_mask_memory(settings);
-    for (const Camera& camera : cameras) {
-        if (camera.width() != settings.width || camera.height() != settings.height)
-            throw Error("render: the camera's image size differs from the settings'");
-        camera.check_range("view");
-    }
+    check_views(settings, cameras);
     if (cameras.empty())
         return;
-    auto start = Clock::now();
+    const Clock::time_point start = Clock::now();
     const std::clock_t cpu_start = std::clock();
-    auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
-    tbb::task_arena arena(settings.threads > 0 ? settings.threads
-                                               : tbb::task_arena::automatic);
+    ViewPlan plan{scene, settings, pass_targets(settings), {}, output_rect(settings), start};
+    plan.region = sampled_rect(settings, plan.targets.size());
+    tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
     ArenaDenormalsFlushed flush_workers(arena);  // as Embree asks (render/float_mode.h)
-    std::vector<int> targets = pass_targets(settings);
-    // The sampled pixels, in image coordinates; `pixels` below holds them row by row.
-    const PixelRect region = sampled_rect(settings, targets.size());
-    const PixelRect out_rect = output_rect(settings);
-    const int w = region.width, h = region.height;
-    std::atomic<std::uint64_t> nonfinite{0};
     arena.execute([&] {
         DenormalsFlushed flush_here;
         std::shared_ptr<const TextureSet> textures = settings.textures;
@@ -851,206 +1082,54 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         // Embree builds with TBB too, so the build also stays within the arena. One
         // build serves every view, except for pixel-wide lines, whose width is the view's.
         auto accel = std::make_unique<EmbreeScene>(scene, cameras.front(), textures.get());
+        PreparedContext prepared = make_path_context(scene, settings, *accel, textures.get());
+        PathContext& ctx = prepared.ctx;
         std::uint64_t rays_before = 0;
-        PathContext ctx;
-        ctx.accel = accel.get();
-        ctx.textures = textures.get();
-        const std::vector<geom::Light> no_lights;
-        const std::vector<geom::Light>& scene_lights =
-            settings.view_lights ? scene.lights : no_lights;
-        // Without the scene's lights there is no OpenGL ambient term either (an empty
-        // list would mean cpfg's default light to opengl_ambient_light).
-        ctx.materials = make_materials(scene.materials,
-                                       settings.opengl_ambient && settings.view_lights
-                                           ? opengl_ambient_light(scene.lights)
-                                           : geom::Rgb{0, 0, 0});
-        if (scene.colour_index_light) {
-            ctx.index_light = *scene.colour_index_light;
-            ctx.index_ramps = make_index_ramps(scene.materials, ctx.index_light);
-        }
-        if (settings.ground.enabled)
-            ctx.ground = make_ground(scene, settings, ctx.materials);
-        ctx.lights = make_lights(scene_lights);
-        std::unique_ptr<AreaLights> area_lights;
-        if (settings.area_lights) {
-            area_lights = std::make_unique<AreaLights>(scene, ctx.materials);
-            ctx.area_lights = area_lights.get();
-        }
-        ctx.background = decode_display(settings.backdrop == RenderSettings::Backdrop::colour
-                                            ? settings.backdrop_colour
-                                            : scene.background);
-        ctx.environment = settings.environment.get();
-        ctx.ambient = {settings.ambient.r, settings.ambient.g, settings.ambient.b};
-        ctx.max_depth = settings.max_depth;
-        ctx.unlit = scene.shading == geom::Shading::filled || scene.shading == geom::Shading::wireframe;
-        ctx.facet_normals = scene.shading == geom::Shading::flat;
-        ctx.roulette_depth = settings.roulette_depth;
-        if (!scene.bounds.empty())
-            ctx.scene_radius =
-                static_cast<float>(0.5 * geom::length(scene.bounds.hi - scene.bounds.lo));
-        prepare_path_context(ctx);
-
         for (std::size_t view = 0; view < cameras.size(); ++view) {
-        const Camera& camera = cameras[view];
-        if (view > 0 && scene.line_radius_in_pixels) {
-            accel.reset();  // one BVH at a time
-            accel = std::make_unique<EmbreeScene>(scene, camera, textures.get());
-            ctx.accel = accel.get();
-            rays_before = 0;  // a new scene counts its rays from 0
-        }
-        // A parallel camera looks along one direction: its misses would all see the same
-        // environment radiance, so they keep cpfg's background there.
-        ctx.environment_visible =
-            settings.environment != nullptr &&
-            (settings.backdrop == RenderSettings::Backdrop::environment ||
-             (settings.backdrop == RenderSettings::Backdrop::view &&
-              camera.projection() == Camera::Projection::perspective));
-        ctx.camera_cone = camera_cone(camera);
-        RenderReport rep;
-        RenderState state{ctx, *accel, camera, settings,
-                    FilterTable(settings.filter, settings.filter_radius),
-                    camera.aperture_radius() > 0 &&
-                        camera.projection() == Camera::Projection::perspective,
-                    &nonfinite};
-        state.organs = settings.denoiser ? &scene : nullptr;
-        Film film(std::size_t(w) * h,
-                  state.aovs || state.adaptive || (ctx.ground && ctx.ground->shadow_catcher),
-                  settings.organ_mask_depth > 0);
-        if (!film.organs.empty()) {
-            state.mask_scene = &scene;
-            state.organ_samples = film.organs.data();
-            state.extras = film.extras.data();
-        }
-        std::vector<PixelState>& pixels = film.px;
-        // Each thread's camera batches, made on its first tile (not once per tile: their
-        // members' initialisers, ~60 kB of stores a tile, were a tenth of the pixel loop).
-        tbb::enumerable_thread_specific<std::unique_ptr<RowBatches>> thread_rows;
-
-        const ScreenMask mask = screen_mask(scene, state);
-        state.mask = &mask;
-        if (view == 0) {
-            rep.setup_seconds = elapsed();
-            rep.setup_cpu_seconds = double(std::clock() - cpu_start) / CLOCKS_PER_SEC;
-            rep.build_seconds = accel->build_seconds();
-        }
-        const int tiles_x = (w + tile_size - 1) / tile_size;
-        const int tiles_y = (h + tile_size - 1) / tile_size;
-        ProgressReporter progress(settings, start);
-        std::atomic<bool> stop{false}, cancelled{false}, out_of_time{false};
-        std::atomic<std::uint64_t> background_samples{0};
-        double last_pass_s = 0;
-        std::uint64_t last_pass_samples = 0;
-        // The time budget may stop a render only once every pixel has a sample: an
-        // image with unsampled (black) bands is never the result of a budget.
-        bool budget_applies = false;
-        auto should_stop = [&] {
-            if (settings.cancel && settings.cancel->load(std::memory_order_relaxed)) {
-                cancelled = true;
-                stop = true;
+            const Camera& camera = cameras[view];
+            if (view > 0 && scene.line_radius_in_pixels) {
+                accel.reset();  // one BVH at a time
+                accel = std::make_unique<EmbreeScene>(scene, camera, textures.get());
+                ctx.accel = accel.get();
+                rays_before = 0;  // a new scene counts its rays from 0
             }
-            if (budget_applies && settings.time_budget_s > 0 && elapsed() > settings.time_budget_s) {
-                out_of_time = true;
-                stop = true;
+            aim_context(ctx, camera, settings);
+            std::atomic<std::uint64_t> nonfinite{0};
+            RenderState state{ctx, *accel, camera, settings,
+                              FilterTable(settings.filter, settings.filter_radius),
+                              camera.aperture_radius() > 0 &&
+                                  camera.projection() == Camera::Projection::perspective,
+                              &nonfinite};
+            state.organs = settings.denoiser ? &scene : nullptr;
+            Film film(std::size_t(plan.region.width) * std::size_t(plan.region.height),
+                      state.aovs || state.adaptive || (ctx.ground && ctx.ground->shadow_catcher),
+                      settings.organ_mask_depth > 0);
+            if (!film.organs.empty()) {
+                state.mask_scene = &scene;
+                state.organ_samples = film.organs.data();
+                state.extras = film.extras.data();
             }
-            return stop.load(std::memory_order_relaxed);
-        };
-
-        for (std::size_t pass = 0; pass < targets.size(); ++pass) {
-            const std::uint32_t target = static_cast<std::uint32_t>(targets[pass]);
-            // Samples still to take to reach the end of the render, for the progress line.
-            std::uint64_t pass_samples = 0, remaining = 0;
-            for (const PixelState& st : pixels)
-                if (!st.done) {
-                    pass_samples += target > st.samples ? target - st.samples : 0;
-                    remaining += std::uint32_t(settings.samples_per_pixel) - st.samples;
-                }
-            if (pass_samples == 0)
+            const ScreenMask mask = screen_mask(scene, state);
+            state.mask = &mask;
+            RenderReport rep;
+            if (view == 0) {
+                rep.setup_seconds = std::chrono::duration<double>(Clock::now() - plan.start).count();
+                rep.setup_cpu_seconds = double(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+                rep.build_seconds = accel->build_seconds();
+            }
+            PassRun(plan, state, film).run(rep);
+            rep.empty_pixel_share = mask.empty_share();
+            rep.rays = accel->rays_traced() - rays_before;
+            rays_before += rep.rays;
+            rep.nonfinite_samples = nonfinite.load();
+            report_accel(*accel, rep);
+            for (const PixelState& st : film.px)
+                rep.samples += st.samples;
+            Image image = finish_image(plan, film, camera, *accel, rep);
+            rep.seconds = std::chrono::duration<double>(Clock::now() - plan.start).count();
+            if (!on_view(view, image, rep) || rep.cancelled)
                 break;
-            progress.set_total(double(progress.done() + remaining));
-            if (settings.time_budget_s > 0 && pass > 0 && last_pass_samples > 0) {
-                double predicted = last_pass_s * double(pass_samples) / double(last_pass_samples);
-                if (elapsed() + predicted > settings.time_budget_s) {
-                    out_of_time = true;
-                    break;
-                }
-            }
-            budget_applies = pass > 0;
-            auto pass_start = Clock::now();
-            // Each tile writes only its own pixels; no exception leaves a task.
-            tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1),
-                              [&](const tbb::blocked_range<int>& r) {
-                // Taken from the thread's slot while in use: a task this one waits on inside
-                // (nested parallelism) may run another tile on this thread, with its own.
-                std::unique_ptr<RowBatches> row = std::move(thread_rows.local());
-                if (!row)
-                    row = std::make_unique_for_overwrite<RowBatches>();  // no zero fill
-                for (int t = r.begin(); t != r.end(); ++t) {
-                    int x0 = (t % tiles_x) * tile_size, y0 = (t / tiles_x) * tile_size;
-                    RowSamples tile;
-                    row->background = {};  // (a pure function of the view's miss, so per tile)
-                    const int x1 = std::min(x0 + tile_size, w);
-                    const int y1 = std::min(y0 + tile_size, h);
-                    prefetch_row(film, y0, x0, x1, w);
-                    // Checked every row, so even passes of thousands of samples stop soon.
-                    for (int y = y0; y < y1 && !should_stop(); ++y) {
-                        if (y + 1 < y1)
-                            prefetch_row(film, y + 1, x0, x1, w);
-                        RowSamples taken = take_row(state, region, y, x0, x1, target, film, w, *row);
-                        tile.taken += taken.taken;
-                        tile.background_only += taken.background_only;
-                    }
-                    progress.add(tile.taken);
-                    background_samples.fetch_add(tile.background_only, std::memory_order_relaxed);
-                }
-                thread_rows.local() = std::move(row);
-            });
-            if (stop)
-                break;
-            last_pass_s = std::chrono::duration<double>(Clock::now() - pass_start).count();
-            last_pass_samples = pass_samples;
-            rep.passes += 1;
-            if (settings.noise_target > 0)
-                mark_converged(film, w, h, settings.noise_target);
-            if (settings.on_pass)
-                settings.on_pass(resolve(film, region, out_rect, image_layers(settings), scene));
-        }
-        progress.finish();
-        rep.cancelled = cancelled;
-        rep.out_of_time = out_of_time;
-        rep.background_only_samples = background_samples.load();
-        rep.empty_pixel_share = mask.empty_share();
-        rep.skipped_rays = accel->skipped_rays();
-        rep.rays = accel->rays_traced() - rays_before;
-        rays_before += rep.rays;
-        rep.embree_bytes = accel->embree_bytes();
-        rep.embree_peak_bytes = accel->embree_peak_bytes();
-        rep.embree_shared_bytes = accel->shared_bytes();
-        rep.render_buffer_bytes = accel->own_bytes();
-        rep.embree_unmonitored_bytes = accel->embree_unmonitored_bytes();
-        rep.nonfinite_samples = nonfinite.exchange(0);
-        if (rep.nonfinite_samples > 0)
-            warn("render: " + std::to_string(rep.nonfinite_samples) +
-                 " sample(s) with a radiance that is not finite were counted as black");
-        if (rep.skipped_rays > 0)
-            warn("render: " + std::to_string(rep.skipped_rays) +
-                 " ray(s) not finite or starting too far from the origin were skipped");
-        for (const PixelState& st : pixels)
-            rep.samples += st.samples;
-        Image image = resolve(film, region, out_rect, image_layers(settings), scene);
-        if (settings.denoiser) {
-            auto denoise_start = Clock::now();
-            denoise(*settings.denoiser, image);
-            rep.denoise_seconds =
-                std::chrono::duration<double>(Clock::now() - denoise_start).count();
-        }
-        // Labels over the image, as cpfg's window draws them (on the crop's pixels).
-        draw_labels(image, scene, camera, *accel,
-                    LabelCanvas{out_rect.x, out_rect.y, settings.width, settings.height},
-                    LabelLimits{settings.max_memory_bytes});
-        rep.seconds = elapsed();
-        if (!on_view(view, image, rep) || rep.cancelled)
-            break;
-        start = Clock::now();  // the next view's time budget and seconds
+            plan.start = Clock::now();  // the next view's time budget and seconds
         }
     });
 }
