@@ -25,6 +25,7 @@
 #include "base/atomic_file.h"
 #include "app/sequence.h"
 #include "app/stats.h"
+#include "app/terminal.h"
 #include "app/video.h"
 #include "base/diagnostics.h"
 #include "base/subprocess.h"
@@ -60,8 +61,9 @@ render::RenderSettings command_render_settings(const Options& options,
                                                const std::vector<std::filesystem::path>& images)
 {
     render::RenderSettings settings = render_settings(options, images);
-    settings.progress = !options.quiet && isatty(fileno(stderr));
-    settings.cancel = render::install_interrupt_handler();
+    if (!options.quiet && isatty(fileno(stderr)))
+        settings.progress = draw_progress_line;
+    settings.cancel = install_interrupt_handler();
     return settings;
 }
 

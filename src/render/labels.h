@@ -11,7 +11,7 @@
 #include "geom/scene.h"
 #include "render/accel.h"
 #include "render/camera.h"
-#include "render/image_io.h"
+#include "render/image.h"
 
 namespace cambium::render {
 

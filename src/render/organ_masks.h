@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "geom/scene.h"
-#include "render/image_io.h"
+#include "render/image.h"
 
 namespace cambium::render {
 

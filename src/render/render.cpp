@@ -18,14 +18,10 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
-#include <csignal>
-#include <cstdio>
 #include <cstdint>
 #include <ctime>
-#include <limits>
 #include <memory>
 #include <mutex>
-#include <numbers>
 #include <optional>
 #include <string>
 #include <vector>
@@ -34,6 +30,7 @@
 #include "render/accel.h"
 #include "render/color.h"
 #include "render/denoise.h"
+#include "render/film.h"
 #include "render/float_mode.h"
 #include "render/integrator.h"
 #include "render/labels.h"
@@ -49,8 +46,6 @@ using Clock = std::chrono::steady_clock;
 
 constexpr int tile_size = 16;
 constexpr int first_pass_samples = 8;    // automatic passes: 8, 16, 32, ... spp
-constexpr int min_adaptive_samples = 16;  // fewer give no useful variance estimate
-constexpr float infinity = std::numeric_limits<float>::infinity();
 
 void check_settings(const RenderSettings& s)
 {
@@ -110,83 +105,6 @@ PixelRect sampled_rect(const RenderSettings& s, std::size_t passes)
     return {x0, y0, x1 - x0, y1 - y0};
 }
 
-/// Draws a pixel-space offset from a separable filter profile: a 1D table over
-/// [-radius, radius], piecewise constant, inverted by binary search.
-class FilterTable {
-public:
-    FilterTable(PixelFilter filter, float radius)
-    {
-        if (filter == PixelFilter::box)
-            return;
-        m_radius = radius > 0 ? radius : (filter == PixelFilter::gaussian ? 1.5f : 1.0f);
-        constexpr int bins = 128;
-        m_cdf.resize(bins + 1);
-        double sigma = m_radius / 3.0;
-        double edge = std::exp(-m_radius * m_radius / (2 * sigma * sigma));
-        for (int i = 0; i < bins; ++i) {
-            double x = -m_radius + (i + 0.5) * 2 * m_radius / bins;
-            double f;
-            if (filter == PixelFilter::gaussian) {
-                f = std::max(0.0, std::exp(-x * x / (2 * sigma * sigma)) - edge);
-            } else {
-                double t = 2 * std::numbers::pi * (x + m_radius) / (2 * m_radius);
-                f = 0.35875 - 0.48829 * std::cos(t) + 0.14128 * std::cos(2 * t) -
-                    0.01168 * std::cos(3 * t);
-            }
-            m_cdf[i + 1] = m_cdf[i] + std::max(f, 0.0);
-        }
-        for (double& c : m_cdf)
-            c /= m_cdf.back();
-    }
-
-    bool box() const { return m_cdf.empty(); }
-    /// How far from the pixel centre a sample may lie, in pixels.
-    double radius() const { return m_radius; }
-
-    /// The offset from the pixel centre for the uniform u.
-    double offset(float u) const
-    {
-        auto it = std::upper_bound(m_cdf.begin(), m_cdf.end(), double(u));
-        std::size_t bin = std::min<std::size_t>(
-            std::size_t(std::max<std::ptrdiff_t>(it - m_cdf.begin() - 1, 0)), m_cdf.size() - 2);
-        double width = m_cdf[bin + 1] - m_cdf[bin];
-        double t = width > 0 ? std::clamp((u - m_cdf[bin]) / width, 0.0, 1.0) : 0.5;
-        double bins = double(m_cdf.size() - 1);
-        return -m_radius + (double(bin) + t) * 2 * m_radius / bins;
-    }
-
-private:
-    double m_radius = 0.5;
-    std::vector<double> m_cdf;
-};
-
-/// A pixel's running sums that every render keeps: small (24 bytes), because every pass
-/// reads and writes them for every pixel, most of them the background's, so a tile row's
-/// sums share a few cache lines (with the other sums beside them, 104 bytes a pixel,
-/// reading them was most of the pixel loop's cache misses).
-struct PixelState {
-    Vec3f radiance;
-    std::uint32_t samples = 0, hits = 0;
-    bool done = false;  // adaptive sampling: converged
-};
-
-/// A pixel's sums that only some renders keep (Film::extras): the albedo, normal and depth
-/// layers, adaptive sampling's luminance sums, the shadow catcher's light.
-struct PixelExtras {
-    Vec3f albedo, normal;
-    float depth = infinity;
-    /// Luminance sums of the two independent replicas (even and odd samples), for the
-    /// adaptive error estimate (relative_error).
-    std::array<double, 2> replica_luminance{};
-    double luminance_sq = 0;
-    double lit_with = 0, lit_without = 0;  // shadow-catcher samples' light (PathResult)
-    std::uint32_t caught = 0;              // samples that met the shadow catcher
-    /// Denoising: the odd samples' radiance sum (the even ones' is the rest), and the
-    /// organ of the nearest camera-ray hit (the one `depth` is of).
-    Vec3f odd_radiance, odd_albedo, odd_normal;
-    std::uint32_t organ = organ_background;
-};
-
 const std::vector<std::uint32_t>& modules_of(const geom::Geometry& g, PrimitiveKind k)
 {
     switch (k) {
@@ -238,23 +156,6 @@ std::uint32_t organ_of(const geom::Scene& scene, const VisibleSurface& v)
         return std::min(static_cast<std::uint32_t>(key), organ_unknown - 1);
     return std::min(static_cast<std::uint32_t>(mix64(key)), organ_unknown - 1);
 }
-
-/// The sampled pixels' sums, row by row.
-struct Film {
-    std::vector<PixelState> px;
-    /// Beside px, where the render has AOVs, adaptive sampling or a shadow catcher (the
-    /// only renders whose samples add to them); else empty.
-    std::vector<PixelExtras> extras;
-
-    /// Organ masks: the organs each pixel's samples met; else empty.
-    std::vector<OrganSamples> organs;
-
-    Film(std::size_t pixels, bool with_extras, bool with_organs)
-        : px(pixels), extras(with_extras ? pixels : 0), organs(with_organs ? pixels : 0)
-    {
-    }
-    PixelExtras* extra(std::size_t i) { return extras.empty() ? nullptr : &extras[i]; }
-};
 
 /// What a camera ray that meets nothing adds to its pixel when that is the same in every
 /// direction (no visible environment) and finite: take_sample's sums for camera_miss's
@@ -742,147 +643,20 @@ std::vector<int> pass_targets(const RenderSettings& s)
     return targets;
 }
 
-/// The squared relative standard error of a pixel's mean luminance (infinite when too
-/// few samples): the replicas' estimate (see replica_index), but never below the samples'
-/// variance over n^2 (their spread over n, the error of independent samples, times a
-/// stratification gain of 1/sqrt(n), more than nets achieve on an edge). From a few
-/// samples the replicas often agree exactly on an edge (each net's coverage count is an
-/// integer): an estimate of zero, which without the floor would stop the pixel at once.
-double relative_error_squared(const PixelState& st, const PixelExtras& ex)
-{
-    if (st.samples < std::uint32_t(min_adaptive_samples))
-        return std::numeric_limits<double>::infinity();
-    double n = st.samples, n_even = (st.samples + 1) / 2, n_odd = st.samples / 2;
-    double sum = ex.replica_luminance[0] + ex.replica_luminance[1], mean = sum / n;
-    double replica_error = (ex.replica_luminance[0] / n_even - ex.replica_luminance[1] / n_odd) / 2;
-    double variance = std::max(0.0, (ex.luminance_sq - sum * mean) / (n - 1));
-    double error_sq = std::max(replica_error * replica_error, variance / (n * n));
-    return error_sq / std::max(mean * mean, 1e-4);
-}
-
-/// Marks pixels whose 3x3 neighbourhood meets the noise target as done (over the sampled
-/// rectangle, w x h: its edges are the image's or lie in the crop's margin). A pixel's
-/// replica estimate has one degree of freedom; pooled over the neighbourhood (the mean of
-/// the squared errors) it has nine, so a lucky pair of replicas rarely stops a pixel early.
-void mark_converged(Film& film, int w, int h, double target)
-{
-    std::vector<PixelState>& px = film.px;
-    std::vector<double> err(px.size());
-    for (std::size_t i = 0; i < px.size(); ++i)
-        err[i] = relative_error_squared(px[i], film.extras[i]);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            double pooled = 0;
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx) {
-                    int nx = std::clamp(x + dx, 0, w - 1), ny = std::clamp(y + dy, 0, h - 1);
-                    pooled = std::max(pooled, err[std::size_t(ny) * w + nx]);
-                }
-            if (pooled <= target * target)
-                px[std::size_t(y) * w + x].done = true;
-        }
-}
-
-/// A shadow catcher's share of a pixel's coverage, in samples: its samples that met the
-/// catcher (those with light) times the fraction of the light the plant takes away, as a
-/// ratio of the sums (Cycles' catcher): 0 where nothing is in the way.
-float shadow_coverage(const PixelExtras& ex)
-{
-    if (!(ex.lit_without > 0) || ex.lit_with >= ex.lit_without)
-        return 0;
-    float missing = static_cast<float>(1 - ex.lit_with / ex.lit_without);
-    return missing * static_cast<float>(ex.caught);
-}
-
-/// The image of the sums so far over `out`, from the sums over `sampled` (which holds it),
-/// row by row (each output row is a run of a sampled row).
-Image resolve(const Film& film, const PixelRect& sampled, const PixelRect& out,
-              const RenderSettings& s, const geom::Scene& scene)
-{
-    const std::size_t width = std::size_t(out.width), count = width * std::size_t(out.height);
-    Image img{out.width, out.height, std::vector<float>(count * 4)};
-    img.transparent = s.transparent_background || s.ground.shadow_catcher;
-    const bool aovs = s.aovs || s.denoiser, denoise = s.denoiser != nullptr;
-    if (aovs) {
-        img.albedo.assign(count * 3, 0.0f);
-        img.normal.assign(count * 3, 0.0f);
-        img.depth.assign(count, infinity);
-    }
-    if (denoise) {
-        img.variance.assign(count * 3, 0.0f);
-        img.feature_variance.assign(count * 2, 0.0f);
-        img.organ.assign(count, organ_background);
-    }
-    const bool extras = !film.extras.empty();  // (without them no pixel has a catcher's light)
-    std::optional<OrganMaskBuilder> masks;
-    if (!film.organs.empty())
-        masks.emplace(scene, count, s.organ_mask_depth);
-    for (std::size_t row = 0; row < std::size_t(out.height); ++row) {
-        const std::size_t from = (std::size_t(out.y - sampled.y) + row) * std::size_t(sampled.width) +
-                                 std::size_t(out.x - sampled.x);
-        for (std::size_t x = 0, i = row * width; x < width; ++x, ++i) {
-            const PixelState& st = film.px[from + x];
-            if (st.samples == 0)
-                continue;
-            float inv = 1.0f / static_cast<float>(st.samples);
-            float coverage = extras ? shadow_coverage(film.extras[from + x]) : 0.0f;
-            img.rgba[i * 4 + 0] = st.radiance.x * inv;
-            img.rgba[i * 4 + 1] = st.radiance.y * inv;
-            img.rgba[i * 4 + 2] = st.radiance.z * inv;
-            img.rgba[i * 4 + 3] = (static_cast<float>(st.hits) + coverage) * inv;
-            if (masks)
-                masks->pixel(i, film.organs[from + x], st.samples);
-            if (denoise) {
-                // A quarter of the squared difference of the two replicas' means: the
-                // variance of the pixel's mean, without bias (1 degree of freedom).
-                const PixelExtras& ex = film.extras[from + x];
-                const std::uint32_t odd = st.samples / 2, even = st.samples - odd;
-                if (odd > 0) {
-                    const Vec3f a = (st.radiance - ex.odd_radiance) * (1.0f / float(even));
-                    const Vec3f b = ex.odd_radiance * (1.0f / float(odd));
-                    const Vec3f d = a - b;
-                    img.variance[i * 3 + 0] = 0.25f * d.x * d.x;
-                    img.variance[i * 3 + 1] = 0.25f * d.y * d.y;
-                    img.variance[i * 3 + 2] = 0.25f * d.z * d.z;
-                    // The same for the albedo and the normal, summed over their channels.
-                    auto half_variance = [&](const Vec3f& sum, const Vec3f& odd_sum) {
-                        const Vec3f e = (sum - odd_sum) * (1.0f / float(even)) - odd_sum * (1.0f / float(odd));
-                        return 0.25f * (e.x * e.x + e.y * e.y + e.z * e.z);
-                    };
-                    img.feature_variance[i * 2 + 0] = half_variance(ex.albedo, ex.odd_albedo);
-                    img.feature_variance[i * 2 + 1] = half_variance(ex.normal, ex.odd_normal);
-                }
-                img.organ[i] = ex.organ;
-            }
-            if (aovs) {
-                const PixelExtras& ex = film.extras[from + x];
-                Vec3f a = ex.albedo * inv, n = ex.normal * inv;
-                img.albedo[i * 3 + 0] = a.x;
-                img.albedo[i * 3 + 1] = a.y;
-                img.albedo[i * 3 + 2] = a.z;
-                img.normal[i * 3 + 0] = n.x;
-                img.normal[i * 3 + 1] = n.y;
-                img.normal[i * 3 + 2] = n.z;
-                img.depth[i] = ex.depth;
-            }
-        }
-    }
-    if (masks)
-        img.organ_masks = masks->finish();
-    return img;
-}
-
-/// The progress line on stderr, redrawn at most 4 times a second by whichever thread
-/// finishes a tile first.
-class ProgressLine {
+/// A view's samples taken, told to RenderSettings::progress at most 4 times a second by
+/// whichever thread finishes a tile first (one at a time), and once at the end.
+class ProgressReporter {
 public:
-    ProgressLine(bool enabled, Clock::time_point start) : m_enabled(enabled), m_start(start) {}
+    ProgressReporter(const RenderSettings& settings, Clock::time_point start)
+        : m_report(settings.progress), m_start(start)
+    {
+    }
 
     void set_total(double total) { m_total.store(total); }
     void add(std::uint64_t samples)
     {
         std::uint64_t done = m_done.fetch_add(samples) + samples;
-        if (!m_enabled)
+        if (!m_report)
             return;
         std::unique_lock lock(m_mutex, std::try_to_lock);
         if (!lock.owns_lock())
@@ -891,38 +665,39 @@ public:
         if (now - m_last < std::chrono::milliseconds(250))
             return;
         m_last = now;
-        draw(double(done));
+        report(double(done), false);
     }
     void finish()
     {
-        if (!m_enabled)
+        if (!m_report)
             return;
         std::lock_guard lock(m_mutex);
-        draw(double(m_done.load()));  // 100% unless stopped early
-        std::fputc('\n', stderr);
+        report(double(m_done.load()), true);  // 100% unless stopped early
     }
     std::uint64_t done() const { return m_done.load(); }
 
 private:
-    void draw(double done) const
+    void report(double done, bool finished) const
     {
         double elapsed = std::chrono::duration<double>(Clock::now() - m_start).count();
         double total = m_total.load();
         double fraction = total > 0 ? std::min(1.0, done / total) : 0.0;
-        std::fprintf(stderr, "\r%s   ", format_progress(fraction, elapsed).c_str());
-        std::fflush(stderr);
+        m_report({fraction, elapsed, finished});
     }
 
-    bool m_enabled;
+    const std::function<void(const RenderProgress&)>& m_report;
     Clock::time_point m_start, m_last{};
     std::atomic<std::uint64_t> m_done{0};
     std::atomic<double> m_total{0};
     std::mutex m_mutex;
 };
 
-std::atomic<bool> interrupted{false};
-
-extern "C" void on_interrupt(int) { interrupted.store(true); }
+/// The layers beside RGBA that the settings ask of the film.
+ImageLayers image_layers(const RenderSettings& s)
+{
+    return {s.transparent_background || s.ground.shadow_catcher, s.aovs || s.denoiser != nullptr,
+            s.denoiser != nullptr, s.organ_mask_depth};
+}
 
 /// The ground plane of the settings under `scene`: its material appended to `materials`,
 /// its texture after the scene's (load_textures).
@@ -1006,28 +781,251 @@ void check_organ_mask_memory(const RenderSettings& s)
                     " (--max-memory)");
 }
 
-std::string clock_time(double seconds)
+/// Throws on settings or cameras render_views cannot take.
+void check_views(const RenderSettings& settings, std::span<const Camera> cameras)
 {
-    long s = std::lround(std::max(0.0, seconds));
-    char buffer[32];
-    if (s >= 3600)
-        std::snprintf(buffer, sizeof buffer, "%ld:%02ld:%02ld", s / 3600, s / 60 % 60, s % 60);
-    else
-        std::snprintf(buffer, sizeof buffer, "%ld:%02ld", s / 60, s % 60);
-    return buffer;
+    check_settings(settings);
+    check_denoise_memory(settings);
+    check_organ_mask_memory(settings);
+    for (const Camera& camera : cameras) {
+        if (camera.width() != settings.width || camera.height() != settings.height)
+            throw Error("render: the camera's image size differs from the settings'");
+        camera.check_range("view");
+    }
+}
+
+/// A path tracer's context and the area lights it samples (which it points to).
+struct PreparedContext {
+    std::unique_ptr<AreaLights> area_lights;
+    PathContext ctx;
+};
+
+/// The scene's path tracer context under the settings, over its BVH and textures, for
+/// every view: materials, lights, ground, background and environment, prepared
+/// (prepare_path_context). A view sets its camera's part (aim_context).
+PreparedContext make_path_context(const geom::Scene& scene, const RenderSettings& settings,
+                                  const EmbreeScene& accel, const TextureSet* textures)
+{
+    PreparedContext prepared;
+    PathContext& ctx = prepared.ctx;
+    ctx.accel = &accel;
+    ctx.textures = textures;
+    const std::vector<geom::Light> no_lights;
+    const std::vector<geom::Light>& scene_lights = settings.view_lights ? scene.lights : no_lights;
+    // Without the scene's lights there is no OpenGL ambient term either (an empty
+    // list would mean cpfg's default light to opengl_ambient_light).
+    ctx.materials = make_materials(scene.materials,
+                                   settings.opengl_ambient && settings.view_lights
+                                       ? opengl_ambient_light(scene.lights)
+                                       : geom::Rgb{0, 0, 0});
+    if (scene.colour_index_light) {
+        ctx.index_light = *scene.colour_index_light;
+        ctx.index_ramps = make_index_ramps(scene.materials, ctx.index_light);
+    }
+    if (settings.ground.enabled)
+        ctx.ground = make_ground(scene, settings, ctx.materials);
+    ctx.lights = make_lights(scene_lights);
+    if (settings.area_lights) {
+        prepared.area_lights = std::make_unique<AreaLights>(scene, ctx.materials);
+        ctx.area_lights = prepared.area_lights.get();
+    }
+    ctx.background = decode_display(settings.backdrop == RenderSettings::Backdrop::colour
+                                        ? settings.backdrop_colour
+                                        : scene.background);
+    ctx.environment = settings.environment.get();
+    ctx.ambient = {settings.ambient.r, settings.ambient.g, settings.ambient.b};
+    ctx.max_depth = settings.max_depth;
+    ctx.unlit = scene.shading == geom::Shading::filled || scene.shading == geom::Shading::wireframe;
+    ctx.facet_normals = scene.shading == geom::Shading::flat;
+    ctx.roulette_depth = settings.roulette_depth;
+    if (!scene.bounds.empty())
+        ctx.scene_radius = static_cast<float>(0.5 * geom::length(scene.bounds.hi - scene.bounds.lo));
+    prepare_path_context(ctx);
+    return prepared;
+}
+
+/// The context's part that depends on the view's camera.
+void aim_context(PathContext& ctx, const Camera& camera, const RenderSettings& settings)
+{
+    // A parallel camera looks along one direction: its misses would all see the same
+    // environment radiance, so they keep cpfg's background there.
+    ctx.environment_visible =
+        settings.environment != nullptr &&
+        (settings.backdrop == RenderSettings::Backdrop::environment ||
+         (settings.backdrop == RenderSettings::Backdrop::view &&
+          camera.projection() == Camera::Projection::perspective));
+    ctx.camera_cone = camera_cone(camera);
+}
+
+/// What every view of render_views shares: the pass schedule and the pixels.
+struct ViewPlan {
+    const geom::Scene& scene;
+    const RenderSettings& settings;
+    std::vector<int> targets;  ///< pass_targets
+    /// The sampled pixels, in image coordinates (the film holds them row by row), and
+    /// the pixels returned.
+    PixelRect region, out;
+    Clock::time_point start;  ///< of the view: its time budget and seconds
+};
+
+/// The view's samples, its stop checks and progress, for the passes over its tiles.
+struct PassRun {
+    const ViewPlan& plan;
+    const RenderState& state;
+    Film& film;
+    ProgressReporter progress;
+    std::atomic<bool> stop{false}, cancelled{false}, out_of_time{false};
+    std::atomic<std::uint64_t> background_samples{0};
+    /// The time budget may stop a render only once every pixel has a sample: an
+    /// image with unsampled (black) bands is never the result of a budget.
+    bool budget_applies = false;
+    // Each thread's camera batches, made on its first tile (not once per tile: their
+    // members' initialisers, ~60 kB of stores a tile, were a tenth of the pixel loop).
+    tbb::enumerable_thread_specific<std::unique_ptr<RowBatches>> thread_rows;
+
+    PassRun(const ViewPlan& p, const RenderState& s, Film& f)
+        : plan(p), state(s), film(f), progress(p.settings, p.start)
+    {
+    }
+    double elapsed() const { return std::chrono::duration<double>(Clock::now() - plan.start).count(); }
+
+    bool should_stop()
+    {
+        const RenderSettings& settings = plan.settings;
+        if (settings.cancel && settings.cancel->load(std::memory_order_relaxed)) {
+            cancelled = true;
+            stop = true;
+        }
+        if (budget_applies && settings.time_budget_s > 0 && elapsed() > settings.time_budget_s) {
+            out_of_time = true;
+            stop = true;
+        }
+        return stop.load(std::memory_order_relaxed);
+    }
+
+    /// Tile t's pixels sampled up to `target`, a row at a time.
+    void take_tile(int t, std::uint32_t target, RowBatches& row)
+    {
+        const int w = plan.region.width, h = plan.region.height;
+        const int tiles_x = (w + tile_size - 1) / tile_size;
+        int x0 = (t % tiles_x) * tile_size, y0 = (t / tiles_x) * tile_size;
+        RowSamples tile;
+        row.background = {};  // (a pure function of the view's miss, so per tile)
+        const int x1 = std::min(x0 + tile_size, w);
+        const int y1 = std::min(y0 + tile_size, h);
+        prefetch_row(film, y0, x0, x1, w);
+        // Checked every row, so even passes of thousands of samples stop soon.
+        for (int y = y0; y < y1 && !should_stop(); ++y) {
+            if (y + 1 < y1)
+                prefetch_row(film, y + 1, x0, x1, w);
+            RowSamples taken = take_row(state, plan.region, y, x0, x1, target, film, w, row);
+            tile.taken += taken.taken;
+            tile.background_only += taken.background_only;
+        }
+        progress.add(tile.taken);
+        background_samples.fetch_add(tile.background_only, std::memory_order_relaxed);
+    }
+
+    /// One pass: every tile's pixels sampled up to `target`, in parallel.
+    void take_pass(std::uint32_t target)
+    {
+        const int w = plan.region.width, h = plan.region.height;
+        const int tiles = ((w + tile_size - 1) / tile_size) * ((h + tile_size - 1) / tile_size);
+        // Each tile writes only its own pixels; no exception leaves a task.
+        tbb::parallel_for(tbb::blocked_range<int>(0, tiles, 1), [&](const tbb::blocked_range<int>& r) {
+            // Taken from the thread's slot while in use: a task this one waits on inside
+            // (nested parallelism) may run another tile on this thread, with its own.
+            std::unique_ptr<RowBatches> row = std::move(thread_rows.local());
+            if (!row)
+                row = std::make_unique_for_overwrite<RowBatches>();  // no zero fill
+            for (int t = r.begin(); t != r.end(); ++t)
+                take_tile(t, target, *row);
+            thread_rows.local() = std::move(row);
+        });
+    }
+
+    /// The passes of the schedule until the last, a stop or the time budget; the passes
+    /// completed and why they ended into `rep`.
+    void run(RenderReport& rep)
+    {
+        const RenderSettings& settings = plan.settings;
+        double last_pass_s = 0;
+        std::uint64_t last_pass_samples = 0;
+        for (std::size_t pass = 0; pass < plan.targets.size(); ++pass) {
+            const std::uint32_t target = static_cast<std::uint32_t>(plan.targets[pass]);
+            // Samples still to take to reach the end of the render, for the progress reports.
+            std::uint64_t pass_samples = 0, remaining = 0;
+            for (const PixelState& st : film.px)
+                if (!st.done) {
+                    pass_samples += target > st.samples ? target - st.samples : 0;
+                    remaining += std::uint32_t(settings.samples_per_pixel) - st.samples;
+                }
+            if (pass_samples == 0)
+                break;
+            progress.set_total(double(progress.done() + remaining));
+            if (settings.time_budget_s > 0 && pass > 0 && last_pass_samples > 0) {
+                double predicted = last_pass_s * double(pass_samples) / double(last_pass_samples);
+                if (elapsed() + predicted > settings.time_budget_s) {
+                    out_of_time = true;
+                    break;
+                }
+            }
+            budget_applies = pass > 0;
+            auto pass_start = Clock::now();
+            take_pass(target);
+            if (stop)
+                break;
+            last_pass_s = std::chrono::duration<double>(Clock::now() - pass_start).count();
+            last_pass_samples = pass_samples;
+            rep.passes += 1;
+            if (settings.noise_target > 0)
+                mark_converged(film, plan.region.width, plan.region.height, settings.noise_target);
+            if (settings.on_pass)
+                settings.on_pass(resolve(film, plan.region, plan.out, image_layers(settings), plan.scene));
+        }
+        progress.finish();
+        rep.cancelled = cancelled;
+        rep.out_of_time = out_of_time;
+        rep.background_only_samples = background_samples.load();
+    }
+};
+
+/// The BVH's figures for the view's report, and warnings for samples and rays lost.
+void report_accel(const EmbreeScene& accel, RenderReport& rep)
+{
+    rep.skipped_rays = accel.skipped_rays();
+    rep.embree_bytes = accel.embree_bytes();
+    rep.embree_peak_bytes = accel.embree_peak_bytes();
+    rep.embree_shared_bytes = accel.shared_bytes();
+    rep.render_buffer_bytes = accel.own_bytes();
+    rep.embree_unmonitored_bytes = accel.embree_unmonitored_bytes();
+    if (rep.nonfinite_samples > 0)
+        warn("render: " + std::to_string(rep.nonfinite_samples) +
+             " sample(s) with a radiance that is not finite were counted as black");
+    if (rep.skipped_rays > 0)
+        warn("render: " + std::to_string(rep.skipped_rays) +
+             " ray(s) not finite or starting too far from the origin were skipped");
+}
+
+/// The view's image from the film: resolved, denoised where asked, its labels drawn.
+Image finish_image(const ViewPlan& plan, const Film& film, const Camera& camera,
+                   const EmbreeScene& accel, RenderReport& rep)
+{
+    const RenderSettings& settings = plan.settings;
+    Image image = resolve(film, plan.region, plan.out, image_layers(settings), plan.scene);
+    if (settings.denoiser) {
+        auto denoise_start = Clock::now();
+        denoise(*settings.denoiser, image);
+        rep.denoise_seconds = std::chrono::duration<double>(Clock::now() - denoise_start).count();
+    }
+    // Labels over the image, as cpfg's window draws them (on the crop's pixels).
+    draw_labels(image, plan.scene, camera, accel,
+                LabelCanvas{plan.out.x, plan.out.y, settings.width, settings.height},
+                LabelLimits{settings.max_memory_bytes});
+    return image;
 }
 
 }  // namespace
-
-std::string format_progress(double fraction, double elapsed_s)
-{
-    fraction = std::clamp(fraction, 0.0, 1.0);
-    std::string line = "render " + std::to_string(int(std::floor(fraction * 100))) + "%  elapsed " +
-                       clock_time(elapsed_s) + "  remaining ";
-    if (fraction <= 0)
-        return line + "?";
-    return line + clock_time(elapsed_s * (1 - fraction) / fraction);
-}
 
 std::shared_ptr<const TextureSet> load_textures(const geom::Scene& scene,
                                                 const RenderSettings& settings)
@@ -1039,20 +1037,6 @@ std::shared_ptr<const TextureSet> load_textures(const geom::Scene& scene,
     // it as the user gave it on the command line (the ground's: the current folder's).
     return std::make_shared<const TextureSet>(defs, std::filesystem::path{},
                                               settings.max_memory_bytes);
-}
-
-const std::atomic<bool>* install_interrupt_handler()
-{
-    static std::once_flag once;
-    std::call_once(once, [] {
-        struct sigaction action {};
-        action.sa_handler = &on_interrupt;
-        sigemptyset(&action.sa_mask);
-        // The second Ctrl-C finds the default action again and ends the process.
-        action.sa_flags = SA_RESETHAND;
-        sigaction(SIGINT, &action, nullptr);
-    });
-    return &interrupted;
 }
 
 Image render(const geom::Scene& scene, const RenderSettings& settings, RenderReport* report)
@@ -1081,28 +1065,15 @@ Image render(const geom::Scene& scene, const Camera& camera, const RenderSetting
 void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
                   const RenderSettings& settings, const ViewCallback& on_view)
 {
-    check_settings(settings);
-    check_denoise_memory(settings);
-    check_organ_mask_memory(settings);
-    for (const Camera& camera : cameras) {
-        if (camera.width() != settings.width || camera.height() != settings.height)
-            throw Error("render: the camera's image size differs from the settings'");
-        camera.check_range("view");
-    }
+    check_views(settings, cameras);
     if (cameras.empty())
         return;
-    auto start = Clock::now();
+    const Clock::time_point start = Clock::now();
     const std::clock_t cpu_start = std::clock();
-    auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
-    tbb::task_arena arena(settings.threads > 0 ? settings.threads
-                                               : tbb::task_arena::automatic);
+    ViewPlan plan{scene, settings, pass_targets(settings), {}, output_rect(settings), start};
+    plan.region = sampled_rect(settings, plan.targets.size());
+    tbb::task_arena arena(settings.threads > 0 ? settings.threads : tbb::task_arena::automatic);
     ArenaDenormalsFlushed flush_workers(arena);  // as Embree asks (render/float_mode.h)
-    std::vector<int> targets = pass_targets(settings);
-    // The sampled pixels, in image coordinates; `pixels` below holds them row by row.
-    const PixelRect region = sampled_rect(settings, targets.size());
-    const PixelRect out_rect = output_rect(settings);
-    const int w = region.width, h = region.height;
-    std::atomic<std::uint64_t> nonfinite{0};
     arena.execute([&] {
         DenormalsFlushed flush_here;
         std::shared_ptr<const TextureSet> textures = settings.textures;
@@ -1111,206 +1082,54 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
         // Embree builds with TBB too, so the build also stays within the arena. One
         // build serves every view, except for pixel-wide lines, whose width is the view's.
         auto accel = std::make_unique<EmbreeScene>(scene, cameras.front(), textures.get());
+        PreparedContext prepared = make_path_context(scene, settings, *accel, textures.get());
+        PathContext& ctx = prepared.ctx;
         std::uint64_t rays_before = 0;
-        PathContext ctx;
-        ctx.accel = accel.get();
-        ctx.textures = textures.get();
-        const std::vector<geom::Light> no_lights;
-        const std::vector<geom::Light>& scene_lights =
-            settings.view_lights ? scene.lights : no_lights;
-        // Without the scene's lights there is no OpenGL ambient term either (an empty
-        // list would mean cpfg's default light to opengl_ambient_light).
-        ctx.materials = make_materials(scene.materials,
-                                       settings.opengl_ambient && settings.view_lights
-                                           ? opengl_ambient_light(scene.lights)
-                                           : geom::Rgb{0, 0, 0});
-        if (scene.colour_index_light) {
-            ctx.index_light = *scene.colour_index_light;
-            ctx.index_ramps = make_index_ramps(scene.materials, ctx.index_light);
-        }
-        if (settings.ground.enabled)
-            ctx.ground = make_ground(scene, settings, ctx.materials);
-        ctx.lights = make_lights(scene_lights);
-        std::unique_ptr<AreaLights> area_lights;
-        if (settings.area_lights) {
-            area_lights = std::make_unique<AreaLights>(scene, ctx.materials);
-            ctx.area_lights = area_lights.get();
-        }
-        ctx.background = decode_display(settings.backdrop == RenderSettings::Backdrop::colour
-                                            ? settings.backdrop_colour
-                                            : scene.background);
-        ctx.environment = settings.environment.get();
-        ctx.ambient = {settings.ambient.r, settings.ambient.g, settings.ambient.b};
-        ctx.max_depth = settings.max_depth;
-        ctx.unlit = scene.shading == geom::Shading::filled || scene.shading == geom::Shading::wireframe;
-        ctx.facet_normals = scene.shading == geom::Shading::flat;
-        ctx.roulette_depth = settings.roulette_depth;
-        if (!scene.bounds.empty())
-            ctx.scene_radius =
-                static_cast<float>(0.5 * geom::length(scene.bounds.hi - scene.bounds.lo));
-        prepare_path_context(ctx);
-
         for (std::size_t view = 0; view < cameras.size(); ++view) {
-        const Camera& camera = cameras[view];
-        if (view > 0 && scene.line_radius_in_pixels) {
-            accel.reset();  // one BVH at a time
-            accel = std::make_unique<EmbreeScene>(scene, camera, textures.get());
-            ctx.accel = accel.get();
-            rays_before = 0;  // a new scene counts its rays from 0
-        }
-        // A parallel camera looks along one direction: its misses would all see the same
-        // environment radiance, so they keep cpfg's background there.
-        ctx.environment_visible =
-            settings.environment != nullptr &&
-            (settings.backdrop == RenderSettings::Backdrop::environment ||
-             (settings.backdrop == RenderSettings::Backdrop::view &&
-              camera.projection() == Camera::Projection::perspective));
-        ctx.camera_cone = camera_cone(camera);
-        RenderReport rep;
-        RenderState state{ctx, *accel, camera, settings,
-                    FilterTable(settings.filter, settings.filter_radius),
-                    camera.aperture_radius() > 0 &&
-                        camera.projection() == Camera::Projection::perspective,
-                    &nonfinite};
-        state.organs = settings.denoiser ? &scene : nullptr;
-        Film film(std::size_t(w) * h,
-                  state.aovs || state.adaptive || (ctx.ground && ctx.ground->shadow_catcher),
-                  settings.organ_mask_depth > 0);
-        if (!film.organs.empty()) {
-            state.mask_scene = &scene;
-            state.organ_samples = film.organs.data();
-            state.extras = film.extras.data();
-        }
-        std::vector<PixelState>& pixels = film.px;
-        // Each thread's camera batches, made on its first tile (not once per tile: their
-        // members' initialisers, ~60 kB of stores a tile, were a tenth of the pixel loop).
-        tbb::enumerable_thread_specific<std::unique_ptr<RowBatches>> thread_rows;
-
-        const ScreenMask mask = screen_mask(scene, state);
-        state.mask = &mask;
-        if (view == 0) {
-            rep.setup_seconds = elapsed();
-            rep.setup_cpu_seconds = double(std::clock() - cpu_start) / CLOCKS_PER_SEC;
-            rep.build_seconds = accel->build_seconds();
-        }
-        const int tiles_x = (w + tile_size - 1) / tile_size;
-        const int tiles_y = (h + tile_size - 1) / tile_size;
-        ProgressLine progress(settings.progress, start);
-        std::atomic<bool> stop{false}, cancelled{false}, out_of_time{false};
-        std::atomic<std::uint64_t> background_samples{0};
-        double last_pass_s = 0;
-        std::uint64_t last_pass_samples = 0;
-        // The time budget may stop a render only once every pixel has a sample: an
-        // image with unsampled (black) bands is never the result of a budget.
-        bool budget_applies = false;
-        auto should_stop = [&] {
-            if (settings.cancel && settings.cancel->load(std::memory_order_relaxed)) {
-                cancelled = true;
-                stop = true;
+            const Camera& camera = cameras[view];
+            if (view > 0 && scene.line_radius_in_pixels) {
+                accel.reset();  // one BVH at a time
+                accel = std::make_unique<EmbreeScene>(scene, camera, textures.get());
+                ctx.accel = accel.get();
+                rays_before = 0;  // a new scene counts its rays from 0
             }
-            if (budget_applies && settings.time_budget_s > 0 && elapsed() > settings.time_budget_s) {
-                out_of_time = true;
-                stop = true;
+            aim_context(ctx, camera, settings);
+            std::atomic<std::uint64_t> nonfinite{0};
+            RenderState state{ctx, *accel, camera, settings,
+                              FilterTable(settings.filter, settings.filter_radius),
+                              camera.aperture_radius() > 0 &&
+                                  camera.projection() == Camera::Projection::perspective,
+                              &nonfinite};
+            state.organs = settings.denoiser ? &scene : nullptr;
+            Film film(std::size_t(plan.region.width) * std::size_t(plan.region.height),
+                      state.aovs || state.adaptive || (ctx.ground && ctx.ground->shadow_catcher),
+                      settings.organ_mask_depth > 0);
+            if (!film.organs.empty()) {
+                state.mask_scene = &scene;
+                state.organ_samples = film.organs.data();
+                state.extras = film.extras.data();
             }
-            return stop.load(std::memory_order_relaxed);
-        };
-
-        for (std::size_t pass = 0; pass < targets.size(); ++pass) {
-            const std::uint32_t target = static_cast<std::uint32_t>(targets[pass]);
-            // Samples still to take to reach the end of the render, for the progress line.
-            std::uint64_t pass_samples = 0, remaining = 0;
-            for (const PixelState& st : pixels)
-                if (!st.done) {
-                    pass_samples += target > st.samples ? target - st.samples : 0;
-                    remaining += std::uint32_t(settings.samples_per_pixel) - st.samples;
-                }
-            if (pass_samples == 0)
+            const ScreenMask mask = screen_mask(scene, state);
+            state.mask = &mask;
+            RenderReport rep;
+            if (view == 0) {
+                rep.setup_seconds = std::chrono::duration<double>(Clock::now() - plan.start).count();
+                rep.setup_cpu_seconds = double(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+                rep.build_seconds = accel->build_seconds();
+            }
+            PassRun(plan, state, film).run(rep);
+            rep.empty_pixel_share = mask.empty_share();
+            rep.rays = accel->rays_traced() - rays_before;
+            rays_before += rep.rays;
+            rep.nonfinite_samples = nonfinite.load();
+            report_accel(*accel, rep);
+            for (const PixelState& st : film.px)
+                rep.samples += st.samples;
+            Image image = finish_image(plan, film, camera, *accel, rep);
+            rep.seconds = std::chrono::duration<double>(Clock::now() - plan.start).count();
+            if (!on_view(view, image, rep) || rep.cancelled)
                 break;
-            progress.set_total(double(progress.done() + remaining));
-            if (settings.time_budget_s > 0 && pass > 0 && last_pass_samples > 0) {
-                double predicted = last_pass_s * double(pass_samples) / double(last_pass_samples);
-                if (elapsed() + predicted > settings.time_budget_s) {
-                    out_of_time = true;
-                    break;
-                }
-            }
-            budget_applies = pass > 0;
-            auto pass_start = Clock::now();
-            // Each tile writes only its own pixels; no exception leaves a task.
-            tbb::parallel_for(tbb::blocked_range<int>(0, tiles_x * tiles_y, 1),
-                              [&](const tbb::blocked_range<int>& r) {
-                // Taken from the thread's slot while in use: a task this one waits on inside
-                // (nested parallelism) may run another tile on this thread, with its own.
-                std::unique_ptr<RowBatches> row = std::move(thread_rows.local());
-                if (!row)
-                    row = std::make_unique_for_overwrite<RowBatches>();  // no zero fill
-                for (int t = r.begin(); t != r.end(); ++t) {
-                    int x0 = (t % tiles_x) * tile_size, y0 = (t / tiles_x) * tile_size;
-                    RowSamples tile;
-                    row->background = {};  // (a pure function of the view's miss, so per tile)
-                    const int x1 = std::min(x0 + tile_size, w);
-                    const int y1 = std::min(y0 + tile_size, h);
-                    prefetch_row(film, y0, x0, x1, w);
-                    // Checked every row, so even passes of thousands of samples stop soon.
-                    for (int y = y0; y < y1 && !should_stop(); ++y) {
-                        if (y + 1 < y1)
-                            prefetch_row(film, y + 1, x0, x1, w);
-                        RowSamples taken = take_row(state, region, y, x0, x1, target, film, w, *row);
-                        tile.taken += taken.taken;
-                        tile.background_only += taken.background_only;
-                    }
-                    progress.add(tile.taken);
-                    background_samples.fetch_add(tile.background_only, std::memory_order_relaxed);
-                }
-                thread_rows.local() = std::move(row);
-            });
-            if (stop)
-                break;
-            last_pass_s = std::chrono::duration<double>(Clock::now() - pass_start).count();
-            last_pass_samples = pass_samples;
-            rep.passes += 1;
-            if (settings.noise_target > 0)
-                mark_converged(film, w, h, settings.noise_target);
-            if (settings.on_pass)
-                settings.on_pass(resolve(film, region, out_rect, settings, scene));
-        }
-        progress.finish();
-        rep.cancelled = cancelled;
-        rep.out_of_time = out_of_time;
-        rep.background_only_samples = background_samples.load();
-        rep.empty_pixel_share = mask.empty_share();
-        rep.skipped_rays = accel->skipped_rays();
-        rep.rays = accel->rays_traced() - rays_before;
-        rays_before += rep.rays;
-        rep.embree_bytes = accel->embree_bytes();
-        rep.embree_peak_bytes = accel->embree_peak_bytes();
-        rep.embree_shared_bytes = accel->shared_bytes();
-        rep.render_buffer_bytes = accel->own_bytes();
-        rep.embree_unmonitored_bytes = accel->embree_unmonitored_bytes();
-        rep.nonfinite_samples = nonfinite.exchange(0);
-        if (rep.nonfinite_samples > 0)
-            warn("render: " + std::to_string(rep.nonfinite_samples) +
-                 " sample(s) with a radiance that is not finite were counted as black");
-        if (rep.skipped_rays > 0)
-            warn("render: " + std::to_string(rep.skipped_rays) +
-                 " ray(s) not finite or starting too far from the origin were skipped");
-        for (const PixelState& st : pixels)
-            rep.samples += st.samples;
-        Image image = resolve(film, region, out_rect, settings, scene);
-        if (settings.denoiser) {
-            auto denoise_start = Clock::now();
-            denoise(*settings.denoiser, image);
-            rep.denoise_seconds =
-                std::chrono::duration<double>(Clock::now() - denoise_start).count();
-        }
-        // Labels over the image, as cpfg's window draws them (on the crop's pixels).
-        draw_labels(image, scene, camera, *accel,
-                    LabelCanvas{out_rect.x, out_rect.y, settings.width, settings.height},
-                    LabelLimits{settings.max_memory_bytes});
-        rep.seconds = elapsed();
-        if (!on_view(view, image, rep) || rep.cancelled)
-            break;
-        start = Clock::now();  // the next view's time budget and seconds
+            plan.start = Clock::now();  // the next view's time budget and seconds
         }
     });
 }

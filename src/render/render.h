@@ -9,13 +9,13 @@
 #include <memory>
 #include <optional>
 #include <span>
-#include <string>
 
 #include "base/limits.h"
 #include "geom/scene.h"
 #include "render/camera.h"
 #include "render/environment.h"
 #include "render/image_io.h"
+#include "render/pixel_filter.h"
 #include "render/sampler.h"
 
 namespace cambium::render {
@@ -23,24 +23,15 @@ namespace cambium::render {
 class Denoiser;
 class TextureSet;
 
-/// The pixel reconstruction filter. Filters are importance sampled: each sample's
-/// position within the pixel's footprint is drawn from the filter (tabulated, 64 bins
-/// per radius) and weighted 1, so every pixel stays a pure function of its own samples.
-enum class PixelFilter {
-    box,              ///< uniform over the pixel (radius fixed at 0.5): cpfg-like crisp edges
-    gaussian,         ///< exp(-x^2 / (2 s^2)) - its edge value, s = radius / 3
-    blackman_harris,  ///< the 4-term Blackman-Harris window over [-radius, radius]
-};
-
 /// The largest image rendered: 2^26 pixels (8192 x 8192, about 5 GiB of pixel state).
 inline constexpr std::int64_t max_image_pixels = std::int64_t{1} << 26;
 
-/// A rectangle of pixels: columns x .. x + width - 1 and rows y .. y + height - 1, rows
-/// counted from the top.
-struct PixelRect {
-    int x = 0, y = 0, width = 0, height = 0;
-    bool empty() const { return width <= 0 || height <= 0; }
-    bool operator==(const PixelRect&) const = default;
+/// How far the render of a view has got (RenderSettings::progress).
+struct RenderProgress {
+    double fraction = 0;   ///< of the view's samples taken, 0 to 1
+    /// Seconds since the view began (the first view: since the call, setup included).
+    double elapsed_s = 0;
+    bool finished = false;  ///< the view's last report: its passes have ended
 };
 
 /// How to render a frame.
@@ -173,11 +164,13 @@ struct RenderSettings {
     /// (counted against max_memory_bytes) and the AOVs' first hits are traced.
     int organ_mask_depth = 0;
 
-    /// Print progress to stderr as one updating line (percentage, elapsed, remaining).
-    bool progress = false;
+    /// Told how far each view has got (null: not told): at most 4 times a second while it
+    /// renders, on whichever render thread finishes a tile first, never two calls at once;
+    /// and once when its passes end. The command draws its progress line with it.
+    std::function<void(const RenderProgress&)> progress;
     /// Checked every tile row: when it becomes true, render() stops and returns the image
     /// so far (each pixel averages the samples it got; pixels never reached are black
-    /// with alpha 0). See install_interrupt_handler().
+    /// with alpha 0). The command sets it on Ctrl-C.
     const std::atomic<bool>* cancel = nullptr;
     /// Called on the calling thread after each completed pass with the image so far
     /// (e.g. to write a preview).
@@ -243,12 +236,5 @@ void render_views(const geom::Scene& scene, std::span<const Camera> cameras,
 /// share them between the frames of a sequence through RenderSettings::textures.
 std::shared_ptr<const TextureSet> load_textures(const geom::Scene& scene,
                                                 const RenderSettings& settings);
-
-/// Installs a SIGINT handler that sets the returned flag (pass it as
-/// RenderSettings::cancel); a second Ctrl-C kills the process as usual. Idempotent.
-const std::atomic<bool>* install_interrupt_handler();
-
-/// The progress line: "render  42%  elapsed 0:12  remaining 0:17" (hours when needed).
-std::string format_progress(double fraction, double elapsed_s);
 
 }  // namespace cambium::render

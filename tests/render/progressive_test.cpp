@@ -1,11 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 // Rendering features: passes, adaptive sampling, cancel, filters, thin lens, clipping,
-// transparency, convergence rate, progress line.
+// transparency, convergence rate, progress reports.
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <cmath>
-#include <csignal>
 #include <cstdio>
 #include <cstring>
 #include <vector>
@@ -278,23 +277,26 @@ TEST(Progressive, SpentTimeBudgetStillSamplesEveryPixelOnce)
     EXPECT_GT(img.at(20, 12, 3), 0.0f);  // the crossing is there
 }
 
-TEST(Progressive, InterruptHandlerSetsTheFlag)
+TEST(Progressive, ProgressIsToldUntilEachViewFinishes)
 {
-    const std::atomic<bool>* flag = install_interrupt_handler();
-    ASSERT_NE(flag, nullptr);
-    EXPECT_EQ(install_interrupt_handler(), flag);
-    EXPECT_FALSE(flag->load());
-    std::raise(SIGINT);
-    EXPECT_TRUE(flag->load());
-    std::signal(SIGINT, SIG_DFL);
-}
-
-TEST(Progressive, ProgressLineFormat)
-{
-    EXPECT_EQ(format_progress(0.42, 12), "render 42%  elapsed 0:12  remaining 0:17");
-    EXPECT_EQ(format_progress(0.5, 3700), "render 50%  elapsed 1:01:40  remaining 1:01:40");
-    EXPECT_EQ(format_progress(0, 5), "render 0%  elapsed 0:05  remaining ?");
-    EXPECT_EQ(format_progress(1, 65), "render 100%  elapsed 1:05  remaining 0:00");
+    geom::Scene s = crossing_scene();
+    RenderSettings set = small(40, 24, 12, 4);
+    set.passes = 3;
+    std::vector<RenderProgress> told;
+    std::atomic<int> inside{0};
+    set.progress = [&](const RenderProgress& p) {
+        EXPECT_EQ(inside.fetch_add(1), 0);  // never two calls at once
+        told.push_back(p);
+        inside.fetch_sub(1);
+    };
+    render(s, set);
+    ASSERT_FALSE(told.empty());
+    EXPECT_TRUE(told.back().finished);
+    EXPECT_EQ(told.back().fraction, 1.0);
+    for (std::size_t i = 0; i + 1 < told.size(); ++i) {
+        EXPECT_FALSE(told[i].finished);
+        EXPECT_LE(told[i].elapsed_s, told[i + 1].elapsed_s);
+    }
 }
 
 // A horizontal segment of radius 2 seen at 5 px per unit: rows 40..60 of a 40x100 window
