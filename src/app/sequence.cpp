@@ -982,7 +982,7 @@ void write_inventor_output(const geom::Scene& scene, const Options& options,
 void write_vector_output(const geom::Scene& scene, const Options& options,
                          const std::filesystem::path& file, VectorFormat format)
 {
-    const geom::Tessellation how;
+    const geom::Tessellation how = geom::drawing_tessellation;
     // the tessellated mesh and the drawing's shapes are held together
     constexpr std::uint64_t bytes_per_triangle =
         geom::exported_triangle_bytes + render::vector_shape_bytes;

@@ -16,8 +16,9 @@ namespace cambium::geom {
 using GlsPolygon = std::vector<Vec3>;
 
 /// Round primitives become this many sides: enough for an environment that computes
-/// areas or shadows from the polygons, few enough to keep the messages short.
-inline constexpr Tessellation gls_tessellation{8, 4};
+/// areas or shadows from the polygons, few enough to keep the messages short. Cylinders
+/// stay open: a module's joint depends on a segment a later module draws.
+inline constexpr Tessellation gls_tessellation{8, 4, false};
 
 /// Appends, as triangles in the scene's coordinates, every primitive `scene` gained
 /// since `since` (tessellate_since with gls_tessellation).

@@ -13,7 +13,16 @@ namespace cambium::geom {
 struct Tessellation {
     int sides = 12;          ///< around a cylinder, disc or sphere (meridians)
     int curve_pieces = 4;    ///< along one generalized-cylinder segment
+    /// Cylinders (F, G) closed as the renderer closes them: a disc on each free end and,
+    /// at each joint bent by more than about 0.8 degrees, the part of the joint's sphere
+    /// between the two segments (geom/line_ends.h). Off: open walls.
+    bool closed_lines = true;
 };
+
+/// How the vector drawing (-ps, .svg, .pdf; render/vector_drawing.h) tessellates:
+/// cylinders stay open, as painting far to near by centres would paint a branch's base
+/// disc, inside its parent, over the parent's wall.
+inline constexpr Tessellation drawing_tessellation{12, 4, false};
 
 /// How far a Scene's primitive arrays had grown at one moment of interpretation.
 struct GeometryMark {
@@ -26,8 +35,12 @@ GeometryMark geometry_mark(const Scene& scene);
 /// Appends to `out` (smooth normals; uvs where the scene's mesh has them, else zero;
 /// the front material, texture and module: an instance's module for its primitives)
 /// every primitive `scene` gained since `since`:
-/// triangles as they are, line and generalized-cylinder segments as their side walls,
-/// spheres as `sides` meridians and half as many parallels, discs as fans, and the
+/// triangles as they are; line segments as their side walls, with closed_lines a fan of
+/// `sides` on each free end and, at each bent joint, the zone of the joint's sphere
+/// the end ring sweeps turning to the next segment, one ring of `sides` per 360 /
+/// `sides` degrees of bend (the renderer's discs and joint spheres); generalized-cylinder
+/// segments as their side walls, open at the ends as the renderer's round Hermite curves
+/// are; spheres as `sides` meridians and half as many parallels, discs as fans, and the
 /// primitives of placed instances (predefined surfaces, objects) moved into place.
 /// Lines measured in pixels (`line style: pixel`) have no size in the scene and give
 /// nothing.

@@ -11,9 +11,9 @@
 #include <tbb/parallel_for.h>
 
 #include "base/diagnostics.h"
+#include "geom/line_ends.h"
 #include "geom/scene_limits.h"
 #include "render/pixel_lines.h"
-#include "render/vecf.h"
 
 namespace cambium::render {
 
@@ -84,37 +84,10 @@ std::vector<geom::Float4> keys_in_world_units(const geom::LinearCurves& lines, c
 
 LineEnds line_ends(const geom::LinearCurves& l, const geom::Float4* keys)
 {
-    constexpr std::uint8_t left = 1, right = 2;  // RTC_CURVE_FLAG_NEIGHBOR_LEFT / _RIGHT
-    // Below this bend (about 0.8 degrees) the frustums meet without a visible wedge.
-    constexpr float straight = 0.9999f;
     const std::size_t n = l.segments.size();
-    auto flags_of = [&](std::size_t i) -> std::uint8_t {
-        return l.flags.size() == n ? l.flags[i] : 0;
-    };
-    auto direction = [&](std::uint32_t k) {
-        Vec3f d = Vec3f(keys[k + 1][0], keys[k + 1][1], keys[k + 1][2]) -
-                  Vec3f(keys[k][0], keys[k][1], keys[k][2]);
-        float length = std::sqrt(dot(d, d));
-        return length > 0 ? d * (1 / length) : Vec3f();
-    };
-    // Segment i's ends in order: cap(at, outward normal, at its second key?) for each free
-    // end that has a radius and a direction, joint() for a bent joint.
+    // the mesh exports close the same ends (geom/line_ends.h)
     auto visit = [&](std::size_t i, auto&& cap, auto&& joint) {
-        const std::uint32_t k = l.segments[i];
-        const std::uint8_t f = flags_of(i);
-        Vec3f dir = direction(k);
-        auto add_cap = [&](const geom::Float4& at, const Vec3f& out, bool end) {
-            if (at[3] > 0 && dot(out, out) != 0)  // else tapered to nothing or no direction
-                cap(at, out, end);
-        };
-        if (!(f & left))
-            add_cap(keys[k], -dir, false);
-        if (!(f & right)) {
-            add_cap(keys[k + 1], dir, true);
-        } else if (k + 2 < l.keys.size() && keys[k + 1][3] > 0 &&
-                   dot(dir, direction(k + 1)) < straight) {
-            joint(keys[k + 1]);
-        }
+        geom::visit_line_ends(l, keys, i, cap, joint);
     };
     // Two passes over blocks of segments on all cores: count each block's caps and
     // joints, then write them at the block's offsets, in the order one pass would make.
@@ -126,7 +99,7 @@ LineEnds line_ends(const geom::LinearCurves& l, const geom::Float4* keys)
     tbb::parallel_for(std::size_t{0}, blocks, [&](std::size_t b) {
         std::size_t caps = 0, joints = 0;
         for (std::size_t i = b * block; i < std::min(n, (b + 1) * block); ++i)
-            visit(i, [&](const geom::Float4&, const Vec3f&, bool) { ++caps; },
+            visit(i, [&](const geom::Float4&, const geom::Float3&, bool) { ++caps; },
                   [&](const geom::Float4&) { ++joints; });
         cap_start[b + 1] = caps;
         joint_start[b + 1] = joints;
@@ -153,9 +126,9 @@ LineEnds line_ends(const geom::LinearCurves& l, const geom::Float4* keys)
             auto segment = static_cast<std::uint32_t>(i);
             visit(
                 i,
-                [&](const geom::Float4& at, const Vec3f& out, bool end) {
+                [&](const geom::Float4& at, const geom::Float3& out, bool end) {
                     e.caps[c] = at;
-                    e.cap_normals[c] = {out.x, out.y, out.z};
+                    e.cap_normals[c] = out;
                     e.cap_segment[c] = segment;
                     e.cap_at_end[c++] = end ? 1 : 0;
                 },

@@ -55,7 +55,7 @@ TEST(VectorSweep, EverySelfContainedModelDrawsAsPostScriptAndSvg)
         const render::Camera camera =
             render::make_camera(scene.view, scene.bounds, options.width, options.height);
         const render::VectorDrawing drawing =
-            render::project_drawing(scene, geom::tessellate(scene, {}), camera);
+            render::project_drawing(scene, geom::tessellate(scene, geom::drawing_tessellation), camera);
         render::write_vector(drawing, ps, VectorFormat::ps);
         const std::string ps_text = bytes_of(ps);
         EXPECT_EQ(ps_text.rfind("%!PS", 0), 0u) << model.id;

@@ -109,8 +109,9 @@ std::pair<geom::Vec3, geom::Vec3> box(const std::vector<geom::Vec3>& p)
 
 TEST(GltfExport, EachOrganIsANodeNamedByItsModule)
 {
-    // modules 0 F, 1 [, 2 +, 3 ;, 4 F, 5 @O, 6 ]: two cylinders (24 triangles each) and a
-    // sphere (120)
+    // modules 0 F, 1 [, 2 +, 3 ;, 4 F, 5 @O, 6 ]: two cylinders in one bent chain (24
+    // triangles each and a fan of 12 on each free end; the joint's ring of 24 with the
+    // first, whose end it rounds) and a sphere (120)
     Built b = build("gltf_organs", "Lsystem: 1\nderivation length: 0\n"
                                    "Axiom: F(1)[+(30);(2)F(1)@O(0.2)]\nendlsystem\n");
     const fs::path file = b.folder / "plant.glb";
@@ -123,7 +124,7 @@ TEST(GltfExport, EachOrganIsANodeNamedByItsModule)
         for (const geom::Vec3& p : placed_positions(m, node))
             all.push_back(p);
     }
-    EXPECT_EQ(organs, (std::map<std::string, std::size_t>{{"F 0", 24}, {"F 4", 24}, {"@O 5", 120}}));
+    EXPECT_EQ(organs, (std::map<std::string, std::size_t>{{"F 0", 60}, {"F 4", 36}, {"@O 5", 120}}));
     // the same plant as the other mesh formats' tessellation
     const geom::TriangleMesh mesh = geom::tessellate(b.scene, {});
     std::vector<geom::Vec3> expected;

@@ -28,16 +28,18 @@ namespace fs = std::filesystem;
 geom::Vec3 vec(const geom::Float3& p) { return {p[0], p[1], p[2]}; }
 
 /// A stem with a coloured branch ending in a sphere: two cylinders of 12 sides (24
-/// triangles each) and a sphere of 12 meridians and 6 bands (120 triangles).
+/// triangles each) in one chain bent by 30 degrees (the branch continues the stem's
+/// polyline), closed by a fan of 12 at each free end and one ring of the joint's sphere
+/// (24), and a sphere of 12 meridians and 6 bands (120 triangles).
 struct Plant {
     app::Options options;
     geom::Scene scene;
     fs::path folder;
 
-    Plant()
+    explicit Plant(const char* axiom = "F(1)[+(30);(2)F(1)@O(0.2)]")
     {
-        options = cambium::testing::write_model("mesh_export", "Lsystem: 1\nderivation length: 0\n"
-                                                      "Axiom: F(1)[+(30);(2)F(1)@O(0.2)]\nendlsystem\n");
+        options = cambium::testing::write_model("mesh_export", std::string("Lsystem: 1\nderivation length: 0\n"
+                                                      "Axiom: ") + axiom + "\nendlsystem\n");
         options.quiet = true;
         folder = options.lsystem.parent_path();
         app::Model model = app::load_model(options);
@@ -49,17 +51,63 @@ TEST(Tessellate, EveryTriangleFacesWhereItsNormalsPoint)
 {
     Plant plant;
     const geom::TriangleMesh mesh = geom::tessellate(plant.scene, {});
-    ASSERT_EQ(mesh.size(), 2 * 24u + 120u);
+    ASSERT_EQ(mesh.size(), 2 * 24u + 2 * 12u + 24u + 120u);
     EXPECT_EQ(geom::tessellated_triangles(plant.scene, {}), mesh.size());
+    // the joint's zone turns the whole end ring: its half on the bend's inner side lies
+    // inside both cylinders, folded back (the two halves' volumes cancel, so the surface
+    // stays closed), and faces inward
+    const geom::LinearCurves& lines = plant.scene.geometry.lines;
+    ASSERT_EQ(lines.keys.size(), 3u);
+    const geom::Vec3 joint{lines.keys[1][0], lines.keys[1][1], lines.keys[1][2]};
+    auto key = [&](int k) { return geom::Vec3{lines.keys[k][0], lines.keys[k][1], lines.keys[k][2]}; };
+    const geom::Vec3 inner = geom::normalize(key(2) - key(1)) - geom::normalize(key(1) - key(0));
+    const double r = lines.keys[1][3];
+    auto folded_back = [&](const geom::Vec3& a, const geom::Vec3& b, const geom::Vec3& c) {
+        for (const geom::Vec3& p : {a, b, c})
+            if (std::abs(geom::length(p - joint) - r) > 1e-5 * r)
+                return false;
+        return geom::dot((a + b + c) / 3 - joint, inner) > 0;
+    };
     for (const auto& t : mesh.triangles) {
         const geom::Vec3 a = vec(mesh.positions[t[0]]), b = vec(mesh.positions[t[1]]),
                          c = vec(mesh.positions[t[2]]);
         const geom::Vec3 face = geom::cross(b - a, c - a);
-        if (geom::length(face) < 1e-9)
-            continue;  // a pole's sliver
+        if (geom::length(face) < 1e-9 || folded_back(a, b, c))
+            continue;  // a pole's sliver, or inside the cylinders
         const geom::Vec3 n = vec(mesh.normals[t[0]]) + vec(mesh.normals[t[1]]) + vec(mesh.normals[t[2]]);
         EXPECT_GT(geom::dot(face, n), 0);
     }
+}
+
+/// The volume the triangles enclose, measured from `origin`: the same from every origin
+/// only when the surface is closed.
+double enclosed_volume(const geom::TriangleMesh& mesh, const geom::Vec3& origin)
+{
+    double volume = 0;
+    for (const auto& t : mesh.triangles) {
+        const geom::Vec3 a = vec(mesh.positions[t[0]]) - origin, b = vec(mesh.positions[t[1]]) - origin,
+                         c = vec(mesh.positions[t[2]]) - origin;
+        volume += geom::dot(a, geom::cross(b, c)) / 6;
+    }
+    return volume;
+}
+
+// A bent chain of two cylinders is closed as the renderer closes it: a fan on each free
+// end and, at the 45 degree joint, two rings' zone of the joint's sphere (one ring per
+// 30 degrees of bend), so the surface encloses the same volume from any origin: the two
+// 12-sided prisms' (the zone's inner and outer halves cancel).
+TEST(Tessellate, BentChainIsClosedAtItsEndsAndJoint)
+{
+    Plant plant("F(1)+(45)F(1)");
+    const geom::TriangleMesh mesh = geom::tessellate(plant.scene, {});
+    ASSERT_EQ(mesh.size(), 2 * 24u + 2 * 12u + 2 * 24u);
+    EXPECT_EQ(geom::tessellated_triangles(plant.scene, {}), mesh.size());
+    const double r = plant.scene.geometry.lines.keys.at(0)[3];
+    ASSERT_GT(r, 0);
+    const double prisms = 2 * 6 * r * r * std::sin(2 * std::acos(-1.0) / 12) * 1.0;
+    for (const geom::Vec3 origin : {geom::Vec3{0, 0, 0}, geom::Vec3{5, -3, 7}, geom::Vec3{-20, 10, 2}})
+        EXPECT_NEAR(enclosed_volume(mesh, origin), prisms, 1e-4 * prisms);
+    EXPECT_EQ(geom::tessellate(plant.scene, {12, 4, false}).size(), 2 * 24u);
 }
 
 TEST(MeshExport, ObjPlyAndGlsHoldTheTessellatedPlant)

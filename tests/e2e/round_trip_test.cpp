@@ -177,16 +177,25 @@ Comparison obj_round_trip(const fs::path& corpus, const std::string& id, const s
     return c;
 }
 
+/// Records the comparison's figures in the test's XML report.
+void record(const Comparison& c)
+{
+    ::testing::Test::RecordProperty("rmse", std::to_string(c.rmse));
+    ::testing::Test::RecordProperty("plant_rmse", std::to_string(c.plant_rmse));
+}
+
 /// The plant is there in both pictures, in about as many pixels.
 void expect_both_drawn(const Comparison& c)
 {
+    record(c);
     EXPECT_GT(c.direct_pixels, 200 * 150 / 50u);
     EXPECT_GT(c.read_back_pixels, c.direct_pixels * 9 / 10);
     EXPECT_LT(c.read_back_pixels, c.direct_pixels * 11 / 10);
 }
 
 // Predefined surfaces (leaves placed by ~) on cylinder stems: the leaves' triangles are
-// exported as drawn, so only the stems' 12-sided walls differ.
+// exported as drawn, so only the stems' 12-sided walls differ. Measured 0.0002 over the
+// picture, 0.0007 over the plant.
 TEST(RoundTrip, GlsOfPredefinedSurfacesRendersAsThePlant)
 {
     const auto corpus = corpus_dir();
@@ -195,13 +204,14 @@ TEST(RoundTrip, GlsOfPredefinedSurfacesRendersAsThePlant)
     const Comparison c = gls_round_trip(*corpus, "11-CPFG/02-Mod-vis-3D/08-leaf-pos",
                                         "material.mat", "leaf.l", "leaf.v");
     expect_both_drawn(c);
-    EXPECT_LT(c.rmse, 0.01);
-    EXPECT_LT(c.plant_rmse, 0.01);
+    EXPECT_LT(c.rmse, 0.001);
+    EXPECT_LT(c.plant_rmse, 0.003);
 }
 
 // Cylinders and spheres: the export's 12-sided walls and 12 x 6 spheres against the
-// renderer's round ones, and no joint spheres (docs/export.md): within 1% over the
-// picture, not over the plant's own pixels.
+// renderer's round ones (docs/export.md); ends and joints closed as the renderer closes
+// them. Measured 0.0079 over the picture, 0.026 over the plant: the thin stems' faceted
+// silhouettes.
 TEST(RoundTrip, GlsOfCylindersAndSpheresRendersAsThePlant)
 {
     const auto corpus = corpus_dir();
@@ -211,12 +221,12 @@ TEST(RoundTrip, GlsOfCylindersAndSpheresRendersAsThePlant)
                                         "material.mat", "plant.l", "plant.v");
     expect_both_drawn(c);
     EXPECT_LT(c.rmse, 0.01);
-    EXPECT_LT(c.plant_rmse, 0.05);
+    EXPECT_LT(c.plant_rmse, 0.035);
 }
 
-// Polygons and wide cylinders (a lamp): the exported walls have no end discs where the
-// renderer closes a free end, so the lamp's shade shows its inside and its foot its
-// hollow (docs/export.md): the bound is that loss's.
+// Polygons and wide tapered cylinders (a lamp): the exported ends are closed by discs
+// and the cone walls' normals lean as the cones' do, so the shade and the foot shade as
+// drawn (docs/export.md). Measured 0.0039 over the picture, 0.017 over the plant.
 TEST(RoundTrip, GlsOfPolygonsAndWideCylindersRendersAsThePlant)
 {
     const auto corpus = corpus_dir();
@@ -225,8 +235,8 @@ TEST(RoundTrip, GlsOfPolygonsAndWideCylindersRendersAsThePlant)
     const Comparison c = gls_round_trip(*corpus, "10-manuals/11-CPFG/ArticulatedLamp",
                                         "materials.mat", "lamp.l", "view.v");
     expect_both_drawn(c);
-    EXPECT_LT(c.rmse, 0.02);
-    EXPECT_LT(c.plant_rmse, 0.1);
+    EXPECT_LT(c.rmse, 0.006);
+    EXPECT_LT(c.plant_rmse, 0.025);
 }
 
 }  // namespace
@@ -235,7 +245,8 @@ namespace {
 
 // The OBJ with its MTL, placed by a scene file's `meshes` entry, renders as the plant
 // does through the scene file: the plant's materials, smooth normals and the same
-// tessellation error as the GLS round trip's.
+// tessellation error as the GLS round trip's. Measured 0.0053 over the picture, 0.025
+// over the plant.
 TEST(RoundTrip, ObjOfCylindersAndSpheresRendersAsThePlant)
 {
     const auto corpus = corpus_dir();
@@ -244,10 +255,11 @@ TEST(RoundTrip, ObjOfCylindersAndSpheresRendersAsThePlant)
     const Comparison c = obj_round_trip(*corpus, "11-CPFG/02-Mod-vis-3D/10-sympodial",
                                         "cpfg -M material.mat plant.l plant.v");
     expect_both_drawn(c);
-    EXPECT_LT(c.rmse, 0.01);
-    EXPECT_LT(c.plant_rmse, 0.05);
+    EXPECT_LT(c.rmse, 0.008);
+    EXPECT_LT(c.plant_rmse, 0.035);
 }
 
+// Measured 0.0025 over the picture, 0.012 over the plant.
 TEST(RoundTrip, ObjOfPolygonsAndWideCylindersRendersAsThePlant)
 {
     const auto corpus = corpus_dir();
@@ -256,8 +268,8 @@ TEST(RoundTrip, ObjOfPolygonsAndWideCylindersRendersAsThePlant)
     const Comparison c = obj_round_trip(*corpus, "10-manuals/11-CPFG/ArticulatedLamp",
                                         "cpfg -M materials.mat lamp.l view.v");
     expect_both_drawn(c);
-    EXPECT_LT(c.rmse, 0.015);
-    EXPECT_LT(c.plant_rmse, 0.07);
+    EXPECT_LT(c.rmse, 0.004);
+    EXPECT_LT(c.plant_rmse, 0.017);
 }
 
 }  // namespace
