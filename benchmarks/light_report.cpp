@@ -5,7 +5,8 @@
 //   build/benchmarks/light_report plant.l plant.v [rays] [--allow-file-access]
 //   build/benchmarks/light_report --synthetic ORGANS [rays]
 //
-// Either may end with --sky (the default sky and sun too) and --infinite-canopy.
+// Either may end with --sky (the default sky and sun too), --infinite-canopy and --ground
+// (mid grey, under the lowest point).
 //
 // The synthetic plant: ORGANS / 2 grey translucent leaves and as many internodes
 // (cylinders) at random in a crown of radius 1, each its own module.
@@ -120,11 +121,16 @@ int main(int argc, char** argv)
         geom::Scene scene;
         double interpret_s = 0;
         auto t = Clock::now();
-        bool sky = false, canopy = false;
-        while (argc > 3 && (std::strcmp(argv[argc - 1], "--sky") == 0 ||
-                            std::strcmp(argv[argc - 1], "--infinite-canopy") == 0)) {
-            (std::strcmp(argv[argc - 1], "--sky") == 0 ? sky : canopy) = true;
-            --argc;
+        bool sky = false, canopy = false, ground = false;
+        for (;; --argc) {
+            const char* last = argv[argc - 1];
+            bool* flag = std::strcmp(last, "--sky") == 0               ? &sky
+                         : std::strcmp(last, "--infinite-canopy") == 0 ? &canopy
+                         : std::strcmp(last, "--ground") == 0          ? &ground
+                                                                       : nullptr;
+            if (argc <= 3 || !flag)
+                break;
+            *flag = true;
         }
         if (std::strcmp(argv[1], "--synthetic") == 0) {
             const auto organs = static_cast<std::uint32_t>(std::stoul(argv[2]));
@@ -160,6 +166,8 @@ int main(int argc, char** argv)
         if (sky)
             settings.environment = std::make_shared<const render::Environment>(render::make_sky_environment());
         settings.infinite_canopy = canopy;
+        if (ground)
+            settings.ground = render::LightReportSettings::Ground{};
         auto cpu_seconds = [] {
             struct rusage u {};
             getrusage(RUSAGE_SELF, &u);

@@ -112,8 +112,9 @@ geom::Scene field_of(const std::map<std::size_t, PlantPass>& plants)
 
 class LightEnvironment final : public env::Environment {
 public:
-    LightEnvironment(env::LightSpec spec, PassScene scene_of, int threads)
-        : m_spec(std::move(spec)), m_scene_of(std::move(scene_of)), m_threads(threads)
+    LightEnvironment(env::LightSpec spec, PassScene scene_of, int threads,
+                     std::optional<render::LightReportSettings::Ground> ground)
+        : m_spec(std::move(spec)), m_scene_of(std::move(scene_of)), m_threads(threads), m_ground(std::move(ground))
     {
     }
 
@@ -136,6 +137,7 @@ public:
         settings.threads = m_threads;
         settings.max_bounces = m_spec.max_depth;
         settings.view_lights = false;
+        settings.ground = m_ground;
         for (const env::ParallelLight& l : m_spec.lights)
             settings.lights.push_back(parallel_light(l));
         if (m_spec.optics) {
@@ -192,6 +194,7 @@ private:
     env::LightSpec m_spec;
     PassScene m_scene_of;
     int m_threads = 0;
+    std::optional<render::LightReportSettings::Ground> m_ground;
     std::mutex m_mutex;
     std::map<std::size_t, PlantPass> m_plants;
     bool m_warned_sky = false;
@@ -199,9 +202,10 @@ private:
 
 }  // namespace
 
-std::unique_ptr<env::Environment> make_light_environment(env::LightSpec spec, PassScene scene_of, int threads)
+std::unique_ptr<env::Environment> make_light_environment(env::LightSpec spec, PassScene scene_of, int threads,
+                                                         std::optional<render::LightReportSettings::Ground> ground)
 {
-    return std::make_unique<LightEnvironment>(std::move(spec), std::move(scene_of), threads);
+    return std::make_unique<LightEnvironment>(std::move(spec), std::move(scene_of), threads, std::move(ground));
 }
 
 }  // namespace cambium::app

@@ -8,10 +8,12 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 
 #include "env/environment.h"
 #include "env/light_spec.h"
 #include "geom/scene.h"
+#include "render/light_report.h"
 
 namespace cambium::app {
 
@@ -24,6 +26,8 @@ using PassScene = std::function<geom::Scene(const env::PassPlant&)>;
 /// later passes (QuasiMC's Q module). Pass k traces with seed k, so runs repeat at any
 /// thread count (`threads`, 0: TBB's default). Shared by a scene file's field, it traces
 /// every plant together where it stands, each plant's last geometry shading the others.
-std::unique_ptr<env::Environment> make_light_environment(env::LightSpec spec, PassScene scene_of, int threads);
+/// `ground`: the --ground under them (light_report_ground), reflecting as in the report.
+std::unique_ptr<env::Environment> make_light_environment(env::LightSpec spec, PassScene scene_of, int threads,
+                                                         std::optional<render::LightReportSettings::Ground> ground);
 
 }  // namespace cambium::app

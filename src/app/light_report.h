@@ -4,11 +4,17 @@
 // file; the command and the Python module both measure through it.
 #pragma once
 
+#include <optional>
+
 #include "app/command_line.h"
 #include "geom/scene.h"
 #include "render/light_report.h"
 
 namespace cambium::app {
+
+/// The --ground as the light report traces it (none without --ground): its colour; a
+/// texture is not read (mid grey).
+std::optional<render::LightReportSettings::Ground> light_report_ground(const Options& options);
 
 /// Traces `scene`'s lights onto its organs and writes the report to
 /// `*options.light_report` (.json or .csv); lights the report cannot trace are warned of.

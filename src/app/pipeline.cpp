@@ -14,6 +14,7 @@
 #include "base/output_format.h"
 #include "base/subprocess.h"
 #include "app/light_environment.h"
+#include "app/light_report.h"
 #include "env/environmental_step.h"
 #include "env/light_spec.h"
 #include "geom/background_scene.h"
@@ -85,7 +86,7 @@ env::Connection light_connection(const env::CommSpec& spec, const env::Context& 
     c.make = [light, palette, options] {
         return make_light_environment(
             *light, [palette, options](const env::PassPlant& plant) { return light_pass_scene(plant, *palette, options); },
-            options.threads);
+            options.threads, light_report_ground(options));
     };
     c.description = std::filesystem::path(spec.executable.front()).filename().string() +
                     " (built in: Cambium's light environment traces the plant; no program is started)";

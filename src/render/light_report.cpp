@@ -18,6 +18,7 @@
 #include "base/diagnostics.h"
 #include "render/accel.h"
 #include "render/camera.h"
+#include "render/ground.h"
 #include "render/light.h"
 #include "render/material.h"
 
@@ -267,6 +268,7 @@ struct Tally {
 struct BlockResult {
     std::vector<std::pair<std::uint32_t, Tally>> organs;
     double absorbed = 0, unattributed = 0, escaped = 0, escaped_down = 0, truncated = 0, emitted = 0;
+    double ground_reached = 0, ground_absorbed = 0, ground_emitted = 0;
 };
 
 /// A cosine-distributed direction about n.
@@ -318,6 +320,44 @@ Extent make_extent(const geom::Bounds3& b, const LightReportSettings& settings)
     return e;
 }
 
+/// The ground plane as the report traces it.
+struct Ground {
+    bool on = false;
+    double height = 0;
+    Rgb3 albedo{};
+    /// Its unshadowed irradiance is a source of its own (no canopy): a light's ray that
+    /// lands unshadowed ends there, one the plant stops first leaves a shadow ray.
+    bool split = false;
+
+    /// The distance along dir from org to the plane, infinity where the ray never meets
+    /// it; a light's ray that starts under it (outside the bounds) going down is on it.
+    double distance(Vec3d org, Vec3d dir, bool from_light) const
+    {
+        if (!on || dir.y == 0)
+            return std::numeric_limits<double>::infinity();
+        const double t = (height - org.y) / dir.y;
+        if (t > 0)
+            return t;
+        return from_light && dir.y < 0 ? 0.0 : std::numeric_limits<double>::infinity();
+    }
+};
+
+Ground make_ground(const geom::Scene& scene, const LightReportSettings& settings)
+{
+    Ground g;
+    if (!settings.ground)
+        return g;
+    g.on = true;
+    g.height = settings.ground->height.value_or(lowest_point(scene));
+    geom::Material surface;  // as the renderer makes its ground's material
+    surface.diffuse = settings.ground->colour;
+    const Bsdf b = make_bsdf(make_materials({surface}).front());
+    const Vec3f a = b.reflect + b.glossy;
+    g.albedo = {std::clamp<double>(a.x, 0, 1), std::clamp<double>(a.y, 0, 1), std::clamp<double>(a.z, 0, 1)};
+    g.split = !(settings.infinite_canopy || settings.canopy_tile);
+    return g;
+}
+
 /// Two unit vectors across the unit vector d.
 std::pair<Vec3d, Vec3d> frame(Vec3d d)
 {
@@ -331,7 +371,7 @@ std::pair<Vec3d, Vec3d> frame(Vec3d d)
 /// of an nx x ny grid over the unit square of the two numbers that place it
 /// (stratified).
 struct Source {
-    enum class Kind { beam, environment, point };
+    enum class Kind { beam, environment, point, ground };
     Kind kind = Kind::beam;
     Rgb3 colour{};  ///< beam: irradiance; point: intensity at unit falloff
     double power = 0;  ///< what it sends into the scene, roughly: shares the rays
@@ -345,6 +385,11 @@ struct Source {
     Vec3d position, axis;
     double cos_cone = -1;
     double solid_angle() const { return 2 * std::numbers::pi * (1 - cos_cone); }
+    // ground: its unshadowed irradiance, the directional lights' (uniform) and the point
+    // lights' (by place), with the environment's drawn for each ray
+    Rgb3 uniform{};
+    std::vector<RenderLight> points;
+    bool environment = false;
 };
 
 /// A ray as emitted: its power per channel, and for a point light the falloff by the
@@ -353,6 +398,7 @@ struct Emitted {
     Vec3d org, dir;
     Rgb3 w{};
     const RenderLight* falloff = nullptr;
+    bool from_ground = false;
 };
 
 /// A directional light's beam: over the rectangle the scene's bounds project onto across
@@ -427,7 +473,7 @@ Source make_point(const RenderLight& light, const Extent& e)
 /// The environment: directions drawn from its own sampling, each ray from a point drawn
 /// uniformly over the disc across that direction that covers the bounding sphere (with
 /// the canopy, over the bounds' top or bottom face).
-Source make_environment_source(const Environment& env, const Extent& e, std::uint64_t seed)
+Source make_environment_source(const Environment& env, const Extent& e, const Ground& g, std::uint64_t seed)
 {
     Source s;
     s.kind = Source::Kind::environment;
@@ -437,7 +483,7 @@ Source make_environment_source(const Environment& env, const Extent& e, std::uin
     constexpr int n = 1024;
     for (int i = 0; i < n; ++i) {
         EnvironmentSample es = env.sample(float(rng.next()), float(rng.next()));
-        if (es.pdf > 0)
+        if (es.pdf > 0 && !(g.on && es.direction.y <= 0))  // the ground hides the lower half
             sum += mean({es.radiance.x, es.radiance.y, es.radiance.z}) / es.pdf *
                    (e.canopy ? std::abs(es.direction.y) * e.width() * e.depth() / std::numbers::pi
                              : e.radius * e.radius);
@@ -446,7 +492,82 @@ Source make_environment_source(const Environment& env, const Extent& e, std::uin
     return s;
 }
 
-std::optional<Emitted> emit(const Source& s, const Extent& e, const Environment* env,
+/// A point or spot light's irradiance on the ground's upper side at x, unshadowed.
+Rgb3 point_irradiance(const RenderLight& l, Vec3d x)
+{
+    const Vec3d to = d3(l.position) - x;
+    const double d = length(to);
+    if (!(to.y > 0))
+        return {};
+    const double a = l.att_constant + l.att_linear * d + l.att_quadratic * d * d;
+    if (!(a > 0))
+        return {};
+    double k = to.y / d / a;
+    if (l.kind == RenderLight::Kind::spot) {  // OpenGL's spot factor, as emit's
+        const double along = -dot(to, d3(l.spot_axis)) / d;
+        if (along < l.spot_cos_cutoff)
+            return {};
+        if (l.spot_exponent > 0)
+            k *= std::pow(std::max(along, 0.0), double(l.spot_exponent));
+    }
+    return {l.colour.x * k, l.colour.y * k, l.colour.z * k};
+}
+
+/// The environment's irradiance on an upward face from one of its own samples (unbiased;
+/// exact for a uniform one).
+Rgb3 environment_irradiance(const Environment& env, RayRandom& rng)
+{
+    if (env.uniform()) {
+        const Vec3f l = env.radiance(Vec3f(0, 1, 0));
+        return {l.x, l.y, l.z};
+    }
+    const EnvironmentSample es = env.sample(float(rng.next()), float(rng.next()));
+    if (!(es.pdf > 0) || !(es.direction.y > 0))
+        return {};
+    const double k = es.direction.y / (std::numbers::pi * es.pdf);
+    return {es.radiance.x * k, es.radiance.y * k, es.radiance.z * k};
+}
+
+/// The ground's unshadowed irradiance at x (on the plane).
+Rgb3 ground_irradiance(const Source& s, const Environment* env, Vec3d x, RayRandom& rng)
+{
+    Rgb3 e = s.uniform;
+    auto add = [&](const Rgb3& a) {
+        for (int c = 0; c < 3; ++c)
+            e[c] += a[c];
+    };
+    for (const RenderLight& l : s.points)
+        add(point_irradiance(l, x));
+    if (s.environment && env)
+        add(environment_irradiance(*env, rng));
+    return e;
+}
+
+/// The ground's unshadowed reflection as a source: radiance albedo x irradiance (its
+/// irradiance as a view-file light's, over pi), up through the bounding sphere from
+/// every direction of the upper hemisphere (uniform: a sphere's cross-section is the
+/// same from all).
+Source make_ground_source(Source s, const Extent& e, const Ground& g, const Environment* env,
+                          std::uint64_t seed)
+{
+    s.kind = Source::Kind::ground;
+    RayRandom rng(seed, 0x96, 0);
+    const Vec3d below{e.centre.x, g.height, e.centre.z};
+    double sum = 0;
+    constexpr int n = 64;
+    for (int i = 0; i < n; ++i)
+        sum += mean(ground_irradiance(s, env, below, rng));
+    s.power = mean(g.albedo) * sum / n * 2 * std::numbers::pi * e.radius * e.radius;
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "ground at height %g, albedo (%g, %g, %g): its unshadowed reflection, up through the "
+                  "scene's bounding sphere",
+                  g.height, g.albedo[0], g.albedo[1], g.albedo[2]);
+    s.text = text;
+    return s;
+}
+
+std::optional<Emitted> emit(const Source& s, const Extent& e, const Ground& g, const Environment* env,
                             std::uint64_t j, std::uint64_t count, RayRandom& rng)
 {
     const double x = (double(j % s.nx) + rng.next()) / double(s.nx);
@@ -465,6 +586,8 @@ std::optional<Emitted> emit(const Source& s, const Extent& e, const Environment*
         if (!(es.pdf > 0))
             return std::nullopt;
         const Vec3d w = unit(d3(es.direction));  // toward the sky
+        if (g.on && w.y <= 0)
+            return std::nullopt;  // the ground hides it
         // radiance / pdf over the area rays start from, in units where irradiance pi
         // (the renderer's) is 1
         double area = 0;
@@ -505,6 +628,27 @@ std::optional<Emitted> emit(const Source& s, const Extent& e, const Environment*
         out.falloff = &s.light;
         return out;
     }
+    case Source::Kind::ground: {
+        if (!(x > 0))
+            return std::nullopt;
+        const double sine = std::sqrt(std::max(0.0, 1 - x * x)), phi = 2 * std::numbers::pi * y;
+        const Vec3d d{sine * std::cos(phi), x, sine * std::sin(phi)};  // up, uniform in solid angle
+        auto [t, b] = frame(d);
+        const double r = e.radius * std::sqrt(rng.next()), psi = 2 * std::numbers::pi * rng.next();
+        const Vec3d q = e.centre - d * e.radius + t * (r * std::cos(psi)) + b * (r * std::sin(psi));
+        const double along = (g.height - q.y) / d.y;
+        Vec3d land = q + d * along;  // where the line leaves the ground
+        land.y = g.height;
+        out.org = along > 0 ? land : q;  // nothing lies between the ground and the disc
+        out.dir = d;
+        const Rgb3 irradiance = ground_irradiance(s, env, land, rng);
+        // radiance albedo E (the renderer's pi E / pi) x pi R^2 / (pi pdf), pdf = 1 / 2 pi
+        const double k = 2 * std::numbers::pi * e.radius * e.radius / double(count);
+        for (int c = 0; c < 3; ++c)
+            out.w[c] = g.albedo[c] * irradiance[c] * k;
+        out.from_ground = true;
+        return out;
+    }
     }
     return std::nullopt;
 }
@@ -520,6 +664,7 @@ struct Tracer {
     static constexpr std::uint32_t wrap_limit = 1u << 16;
 
     const Extent& extent;
+    const Ground& ground;
 
     /// The distance from org along dir to where the ray leaves the slab of the bounds
     /// (the canopy) or their bounding sphere.
@@ -554,47 +699,96 @@ struct Tracer {
     /// The query trace() makes first for a ray from org along dir.
     LightRay first_query(Vec3d org, Vec3d dir) const
     {
-        return {f3(org), f3(dir), float(to_side(org, dir).first)};
+        return {f3(org), f3(dir), float(std::min(to_side(org, dir).first, ground.distance(org, dir, true)))};
     }
 
     /// One path: `w` its power per channel (for a point light, at unit distance: its
     /// falloff by the distance to the first surface still to come); tallies into `t` (by
     /// organ, dense) and `r`. `first`: where given, the answer to its first query
     /// (first_query(org, dir)), traced already (in a stream): its hit, or null for none.
-    void trace(Vec3d org, Vec3d dir, Rgb3 w, const RenderLight* falloff, RayRandom& rng,
+    /// With the ground split off, a light's ray that the plant stops before the ground
+    /// leaves a shadow: the ground's reflection of it, negative, traced after it.
+    void trace(Vec3d org, Vec3d dir, Rgb3 w, const RenderLight* falloff, bool from_ground, RayRandom& rng,
                std::vector<Tally>& t, std::vector<std::uint32_t>& touched, BlockResult& r,
                std::optional<const LightHit*> first = std::nullopt) const
     {
+        if (!falloff)
+            (from_ground ? r.ground_emitted : r.emitted) += mean(w);
+        std::optional<Shadow> shadow;
+        follow(org, dir, w, falloff, !from_ground, rng, t, touched, r, first, shadow);
+        if (shadow) {
+            r.ground_emitted += mean(shadow->w);
+            std::optional<Shadow> none;
+            follow(shadow->org, cosine_direction({0, 1, 0}, rng), shadow->w, nullptr, false, rng, t, touched, r,
+                   std::nullopt, none);
+        }
+    }
+
+    /// Where the plane would have taken a light's ray, its reflection of it negated.
+    struct Shadow {
+        Vec3d org;
+        Rgb3 w;
+    };
+
+    void follow(Vec3d org, Vec3d dir, Rgb3 w, const RenderLight* falloff, bool from_light, RayRandom& rng,
+                std::vector<Tally>& t, std::vector<std::uint32_t>& touched, BlockResult& r,
+                std::optional<const LightHit*> first, std::optional<Shadow>& shadow) const
+    {
         const Extent& e = extent;
+        // unshadowed so far: where it lands is the ground source's (no canopy)
+        bool unshadowed = from_light && ground.split;
         double travelled = 0;  // from a point light, until its first surface
+        auto falloff_at = [&](double d) {
+            const double a = falloff->att_constant + falloff->att_linear * d + falloff->att_quadratic * d * d;
+            return a > 0 ? d * d / a : 0;
+        };
         // a point light's ray has its power once its distance is known
         auto arrive = [&](double d) {
-            const double a = falloff->att_constant + falloff->att_linear * d + falloff->att_quadratic * d * d;
-            const double k = a > 0 ? d * d / a : 0;
+            const double k = falloff_at(d);
             for (double& c : w)
                 c *= k;
             falloff = nullptr;
             r.emitted += mean(w);
         };
-        if (!falloff)
-            r.emitted += mean(w);
         double start = mean(w);
         PrimId skip{};
         std::uint32_t wraps = 0;
         LightHit found;
         for (int bounce = 0;; ++bounce) {
-            if (!falloff && (bounce >= settings.max_bounces || mean(w) < settings.cutoff * start)) {
+            // signed: a shadow's power is negative
+            if (!falloff && (bounce >= settings.max_bounces || std::abs(mean(w)) < settings.cutoff * std::abs(start))) {
                 r.truncated += mean(w);
                 return;
             }
             // with the canopy, up to the side the ray leaves the bounds by
             const auto [wall, axis] = to_side(org, dir);
+            const double to_ground = ground.distance(org, dir, unshadowed);
             const LightHit* hit = nullptr;
             if (first) {
                 hit = *first;
                 first.reset();
-            } else if (accel.intersect_light(found, f3(org), f3(dir), 0, float(wall), skip)) {
+            } else if (accel.intersect_light(found, f3(org), f3(dir), 0, float(std::min(wall, to_ground)), skip)) {
                 hit = &found;
+            }
+            if (hit && !(hit->t < to_ground))
+                hit = nullptr;  // the ground comes first
+            if (!hit && std::isfinite(to_ground) && to_ground <= wall) {
+                if (falloff)
+                    arrive(travelled + to_ground);
+                Rgb3 keep{};
+                for (int c = 0; c < 3; ++c)
+                    keep[c] = w[c] * ground.albedo[c];
+                r.ground_reached += mean(w);
+                r.ground_absorbed += mean(w) - mean(keep);
+                if (unshadowed || !(std::abs(mean(keep)) > 0))
+                    return;  // unshadowed: its reflection is the ground source's
+                w = keep;
+                r.ground_emitted += mean(w);
+                org = org + dir * to_ground;
+                org.y = ground.height;  // on the plane: it cannot meet it again going away
+                dir = cosine_direction({0, dir.y < 0 ? 1.0 : -1.0, 0}, rng);
+                skip = {};
+                continue;
             }
             if (!hit && axis >= 0) {
                 Vec3d q = org + dir * wall;
@@ -642,6 +836,11 @@ struct Tracer {
                 skip = hit->prim();
                 continue;
             }
+            if (unshadowed) {
+                unshadowed = false;
+                if (std::isfinite(to_ground))
+                    shadow = shadow_of(org, dir, w, to_ground, falloff ? falloff_at(travelled + to_ground) : 1.0);
+            }
             if (falloff) {
                 arrive(travelled + length(p - org));
                 start = mean(w);
@@ -674,7 +873,7 @@ struct Tracer {
                 (hit->back ? t[organ].back : t[organ].front) += mean(w);
             }
             const double kept = mean(keep);
-            if (!(kept > 0))
+            if (!(std::abs(kept) > 0))
                 return;
             w = keep;
             // the direction: transmitted with transmission's share of what goes on
@@ -685,6 +884,19 @@ struct Tracer {
             org = p + side * hit->spawn_offset;
             skip = hit->prim();
         }
+    }
+
+    /// The shadow a light's ray of power w leaves where the ground, `to_ground` along dir,
+    /// would have taken it (`falloff`: a point light's at that distance).
+    std::optional<Shadow> shadow_of(Vec3d org, Vec3d dir, const Rgb3& w, double to_ground, double falloff) const
+    {
+        Shadow s{org + dir * to_ground, {}};
+        s.org.y = ground.height;
+        for (int c = 0; c < 3; ++c)
+            s.w[c] = -w[c] * falloff * ground.albedo[c];
+        if (!(std::abs(mean(s.w)) > 0))
+            return std::nullopt;
+        return s;
     }
 
     static double mean_of_sum(const float* rf, const float* tr)
@@ -713,16 +925,27 @@ LightReport trace_light(const geom::Scene& scene, const LightReportSettings& set
     Organs organs = find_organs(scene);
     const geom::Bounds3 bounds = world_bounds(scene);
     const Extent extent = make_extent(bounds, settings);
-    const Environment* env = settings.environment.get();
+    const Ground ground = make_ground(scene, settings);
+    // with the ground, the environment's sampling spends nothing below the horizon
+    std::optional<Environment> hidden;
+    if (ground.on && settings.environment)
+        hidden = settings.environment->hidden_below_horizon();
+    const Environment* env = hidden ? &*hidden : settings.environment.get();
     std::vector<Source> sources;
+    Source unshadowed_ground;  // the ground's unshadowed irradiance, by light
     std::vector<RenderLight> lights = settings.view_lights ? make_lights(scene.lights) : std::vector<RenderLight>{};
     lights.insert(lights.end(), settings.lights.begin(), settings.lights.end());
     if (!bounds.empty())
         for (const RenderLight& l : lights) {
             if (l.kind == RenderLight::Kind::directional) {
-                if (auto b = make_beam(l, extent))
+                if (ground.on && !(l.toward_light.y > 0))
+                    report.skipped_lights.push_back("directional light toward " + format_vec(d3(l.toward_light)) +
+                                                    ": below the ground's horizon");
+                else if (auto b = make_beam(l, extent)) {
+                    for (int c = 0; c < 3; ++c)
+                        unshadowed_ground.uniform[c] += b->colour[c] * b->to_light.y;
                     sources.push_back(std::move(*b));
-                else
+                } else
                     report.skipped_lights.push_back("directional light toward " + format_vec(d3(l.toward_light)) +
                                                     ": below the horizon of the infinite canopy");
                 continue;
@@ -735,7 +958,13 @@ LightReport trace_light(const geom::Scene& scene, const LightReportSettings& set
                                                 ": outside the infinite canopy's tile");
                 continue;
             }
+            if (ground.on && !(p.y > ground.height)) {
+                report.skipped_lights.push_back(std::string(kind) + " light at " + format_vec(p) +
+                                                ": under the ground");
+                continue;
+            }
             Source s = make_point(l, extent);
+            unshadowed_ground.points.push_back(l);
             char text[256];
             std::snprintf(text, sizeof text, "%s light at %s, intensity %g, attenuation 1/(%g + %g d + %g d^2)",
                           kind, format_vec(p).c_str(), mean(s.colour), l.att_constant, l.att_linear,
@@ -744,13 +973,25 @@ LightReport trace_light(const geom::Scene& scene, const LightReportSettings& set
             sources.push_back(std::move(s));
         }
     if (env && !env->black() && !bounds.empty()) {
-        Source s = make_environment_source(*env, extent, settings.seed);
+        Source s = make_environment_source(*env, extent, ground, settings.seed);
+        unshadowed_ground.environment = true;
         s.text = env->kind() == Environment::Kind::sky   ? "sky and sun"
                  : env->kind() == Environment::Kind::map ? "environment map"
                                                           : "uniform environment";
         s.text += " (radiance L gives irradiance L to a surface under all of it)";
         sources.push_back(std::move(s));
     }
+    if (ground.split && mean(ground.albedo) > 0 && !bounds.empty())
+        sources.push_back(make_ground_source(std::move(unshadowed_ground), extent, ground, env, settings.seed));
+    else if (ground.on) {
+        char text[256];
+        std::snprintf(text, sizeof text, "ground at height %g, albedo (%g, %g, %g)", ground.height,
+                      ground.albedo[0], ground.albedo[1], ground.albedo[2]);
+        report.lights.emplace_back(text);
+    }
+    report.ground = ground.on;
+    report.ground_height = ground.height;
+    report.ground_albedo = mean(ground.albedo);
     if (extent.canopy) {
         char text[256];
         std::snprintf(text, sizeof text, "infinite canopy: the tile x %g .. %g, z %g .. %g repeats sideways",
@@ -786,7 +1027,7 @@ LightReport trace_light(const geom::Scene& scene, const LightReportSettings& set
     Camera camera = make_camera(scene.view, scene.bounds.empty() ? bounds : scene.bounds, 512, 512);
     EmbreeScene accel(scene, camera);
     std::vector<SurfaceMaterial> materials = make_materials(scene.materials);
-    Tracer tracer{scene, accel, organs, materials, settings, extent};
+    Tracer tracer{scene, accel, organs, materials, settings, extent, ground};
 
     // Blocks take every blocks-th run of `run` neighbouring rays (strided), so each
     // samples the whole beam: their sums are independent batches for the confidence
@@ -837,9 +1078,9 @@ LightReport trace_light(const geom::Scene& scene, const LightReportSettings& set
                     RayRandom rng(settings.seed, source, j);
                     std::optional<Ray>& here = ray[i - i0];
                     here.reset();
-                    if (std::optional<Emitted> e = emit(s, extent, env, j, s.nx * s.ny, rng)) {
-                        // the environment's directions are random: no stream
-                        const bool coherent = s.kind != Source::Kind::environment;
+                    if (std::optional<Emitted> e = emit(s, extent, ground, env, j, s.nx * s.ny, rng)) {
+                        // the environment's and the ground's directions are random: no stream
+                        const bool coherent = s.kind == Source::Kind::beam || s.kind == Source::Kind::point;
                         here = Ray{*e, rng, coherent ? int(streamed) : -1};
                         if (coherent)
                             stream[streamed++] = tracer.first_query(e->org, e->dir);
@@ -852,7 +1093,8 @@ LightReport trace_light(const geom::Scene& scene, const LightReportSettings& set
                         std::optional<const LightHit*> known;
                         if (x->slot >= 0)
                             known = (hit_bits >> x->slot & 1) ? &hits[std::size_t(x->slot)] : nullptr;
-                        tracer.trace(x->e.org, x->e.dir, x->e.w, x->e.falloff, x->rng, t, touched, r, known);
+                        tracer.trace(x->e.org, x->e.dir, x->e.w, x->e.falloff, x->e.from_ground, x->rng, t, touched,
+                                     r, known);
                     }
             }
             std::sort(touched.begin(), touched.end());
@@ -877,6 +1119,9 @@ LightReport trace_light(const geom::Scene& scene, const LightReportSettings& set
         report.escaped += r.escaped;
         report.escaped_down += r.escaped_down;
         report.truncated += r.truncated;
+        report.ground_reached += r.ground_reached;
+        report.ground_absorbed += r.ground_absorbed;
+        report.ground_emitted += r.ground_emitted;
         for (const auto& [o, t] : r.organs) {
             OrganLight& organ = organs.list[o];
             organ.absorbed += t.absorbed;
@@ -965,7 +1210,14 @@ void write_light_report(const LightReport& report, const std::filesystem::path& 
                 ",\n  \"unattributed_absorbed\": " + number(report.unattributed) +
                 ",\n  \"escaped\": " + number(report.escaped) +
                 ",\n  \"escaped_down\": " + number(report.escaped_down) +
-                ",\n  \"truncated\": " + number(report.truncated) + ",\n  \"organs\": [";
+                ",\n  \"truncated\": " + number(report.truncated);
+        if (report.ground)
+            text += ",\n  \"ground\": {\"height\": " + number(report.ground_height) +
+                    ", \"albedo\": " + number(report.ground_albedo) +
+                    ", \"reached\": " + number(report.ground_reached) +
+                    ", \"absorbed\": " + number(report.ground_absorbed) +
+                    ", \"emitted\": " + number(report.ground_emitted) + "}";
+        text += ",\n  \"organs\": [";
         for (std::size_t i = 0; i < report.organs.size(); ++i) {
             const OrganLight& o = report.organs[i];
             text += i ? ",\n    " : "\n    ";
@@ -983,8 +1235,13 @@ void write_light_report(const LightReport& report, const std::filesystem::path& 
         text += "# rays " + std::to_string(report.rays) + ", emitted " + number(report.emitted) +
                 ", total_absorbed " + number(report.absorbed) + ", unattributed_absorbed " +
                 number(report.unattributed) + ", escaped " + number(report.escaped) + ", escaped_down " +
-                number(report.escaped_down) + ", truncated " +
-                number(report.truncated) + "\n";
+                number(report.escaped_down) + ", truncated " + number(report.truncated);
+        if (report.ground)
+            text += ", ground_height " + number(report.ground_height) + ", ground_albedo " +
+                    number(report.ground_albedo) + ", ground_reached " + number(report.ground_reached) +
+                    ", ground_absorbed " + number(report.ground_absorbed) + ", ground_emitted " +
+                    number(report.ground_emitted);
+        text += "\n";
         text += "module,index,plant,age,area,absorbed,absorbed_ci95,irradiance_front,irradiance_back\n";
         for (const OrganLight& o : report.organs)
             text += csv_field(o.symbol) + "," + std::to_string(o.module) + "," +

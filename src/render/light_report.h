@@ -51,6 +51,14 @@ struct LightReportSettings {
     /// The canopy's tile, x0 z0 x1 z1, when not those bounds: it must hold them (a stand
     /// of plants spaced wider than they are).
     std::optional<std::array<double, 4>> canopy_tile;
+    /// The --ground: an infinite Lambertian plane, as the renderer's (its display colour
+    /// decoded to albedo), at `height` or the scene's lowest point (lowest_point). It hides
+    /// what lies below its horizon (the environment's lower half, lights under it).
+    struct Ground {
+        geom::Rgb colour{0.5f, 0.5f, 0.5f};
+        std::optional<double> height;
+    };
+    std::optional<Ground> ground;
 };
 
 /// One organ: a module that drew primitives, in one plant placement.
@@ -73,6 +81,15 @@ struct LightReport {
     double escaped = 0;    ///< left the scene
     double escaped_down = 0;  ///< of it, going down (-y): what reaches the ground
     double truncated = 0;  ///< in paths cut short (settings.cutoff, max_bounces)
+    /// With a ground: its albedo (the channels' mean) and height; the flux of the traced
+    /// rays that reach it (the lights' unshadowed rays, light the plant sends down; signed),
+    /// the part of that it absorbs, and what it sends up into the scene (its unshadowed
+    /// reflection over the whole plane, less the plant's shadow, and its reflection of the
+    /// light the plant sends down). emitted + ground_emitted = absorbed + ground_reached +
+    /// escaped + truncated.
+    bool ground = false;
+    double ground_albedo = 0, ground_height = 0;
+    double ground_reached = 0, ground_absorbed = 0, ground_emitted = 0;
     std::uint64_t rays = 0;
     std::vector<std::string> lights;          ///< traced, described
     std::vector<std::string> skipped_lights;  ///< not traced (and why)

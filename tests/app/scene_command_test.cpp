@@ -144,3 +144,23 @@ TEST(SceneCommand, LightReportUnderTheSkyOverACanopy)
     EXPECT_FALSE(fs::exists(dir / "b.json"));
     fs::remove_all(dir);
 }
+
+// --ground reaches the report: its colour as albedo under the plant, the light it
+// reflects traced; a texture is not read (mid grey, warned of).
+TEST(SceneCommand, LightReportOverTheGround)
+{
+    fs::path dir = scratch();
+    Result r = run("m/p.l m/p.v --ground 0.8,0.8,0.8 --sky --light-report light.json --light-rays 20000", dir);
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::ifstream in(dir / "light.json");
+    const std::string json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(json.find("\"ground\": {\"height\": "), std::string::npos) << json.substr(0, 1200);
+    EXPECT_NE(json.find("\"albedo\": 0.6038"), std::string::npos);
+    EXPECT_NE(json.find("its unshadowed reflection"), std::string::npos);
+    EXPECT_FALSE(fs::exists(dir / "p.png"));
+    std::ofstream(dir / "soil.png") << "not read";
+    r = run("m/p.l m/p.v --ground soil.png --light-report soil.json --light-rays 2000", dir);
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("is not read; the ground is traced mid grey"), std::string::npos) << r.output;
+    fs::remove_all(dir);
+}
