@@ -24,10 +24,10 @@ each plant's median ratios over the rounds. Both renderers cache their reference
 
 --staged env | env-without-view-lights | sky | sky-without-view-lights: the plant staged
 (convergence --stage) on a ground of albedo 0.2 (`--ground`, the plane at the plant's
-lowest point), seen in
-perspective (`--perspective --fit --orbit 30 10`), lit by the lat-long map sky_map.py
-writes (`--env`, seen behind the plant: `--background env`), with the view file's lights
-kept or dropped (`--no-view-lights`). Noise is then measured apart on the plant's pixels
+lowest point), seen in perspective (`--perspective --fit --orbit 30 10`; with `--azimuth
+A`, `--orbit A 10`: a turntable's frame is a still from another azimuth), lit by the
+lat-long map sky_map.py writes (`--env`, seen behind the plant: `--background env`), with
+the view file's lights kept or dropped (`--no-view-lights`). Noise is then measured apart on the plant's pixels
 and the ground's; the JSON adds the noise at 16 and 64 spp of both renderers on both, and
 `ground_cpu_ratio` / `ground_wall_ratio`: Cambium's time to Cycles' 64-spp ground noise.
 The sky stagings light it with Cambium's `--sky` instead (seen behind it: `--background
@@ -43,7 +43,7 @@ import subprocess
 import sys
 
 # A ground of albedo 0.2: --ground takes a display (sRGB) value.
-GROUND_AND_CAMERA = "--ground 0.4845,0.4845,0.4845 --perspective --fit --orbit 30 10 "
+GROUND_AND_CAMERA = "--ground 0.4845,0.4845,0.4845 --perspective --fit --orbit {azimuth:g} 10 "
 STAGE = GROUND_AND_CAMERA + "--env {map} --background env"
 SKY = GROUND_AND_CAMERA + "--sky --background sky"
 STAGINGS = {"env": STAGE, "env-without-view-lights": STAGE + " --no-view-lights",
@@ -89,6 +89,9 @@ def main():
                         help="turn Cycles' camera by this many radians (cycles_convergence.py)")
     parser.add_argument("--staged", choices=sorted(STAGINGS),
                         help="the plant staged on a ground under an HDR map (see the top)")
+    parser.add_argument("--azimuth", type=float, default=30.0,
+                        help="the staged camera's turn about the vertical, degrees: a "
+                             "turntable's frames are stills from other azimuths")
     args = parser.parse_args()
     convergence = os.path.join(args.build, "benchmarks", "convergence")
     scenes = os.path.join(args.build, "cycles", "scenes")
@@ -99,9 +102,10 @@ def main():
         if args.staged.startswith("env") and not os.path.exists(sky):
             os.makedirs(os.path.dirname(sky), exist_ok=True)
             subprocess.run([sys.executable, os.path.join(HERE, "sky_map.py"), sky], check=True)
-        stage = ["--stage", STAGINGS[args.staged].format(map=sky)]
-        scenes = os.path.join(args.build, "cycles", "staged", args.staged, "scenes")
-        cache = os.path.join(args.build, "cycles", "staged", args.staged, "cache")
+        stage = ["--stage", STAGINGS[args.staged].format(map=sky, azimuth=args.azimuth)]
+        staging = args.staged + ("" if args.azimuth == 30 else f"-azimuth{args.azimuth:g}")
+        scenes = os.path.join(args.build, "cycles", "staged", staging, "scenes")
+        cache = os.path.join(args.build, "cycles", "staged", staging, "cache")
     ratios = {}
     for round_index in range(args.rounds):
         for plant in args.plant or PLANTS:
@@ -148,7 +152,7 @@ def main():
             if args.staged:
                 at16 = cycles["spp"].index(16)
                 result.update({
-                    "staged": args.staged,
+                    "staged": args.staged, "azimuth": args.azimuth,
                     "cycles_noise_16": cycles["relative_rmse"][at16],
                     "cambium_rmse_16": cambium["relative_rmse"][at16],
                     "cycles_ground_noise_16": cycles["ground_relative_rmse"][at16],
