@@ -266,6 +266,17 @@ double random_canopy(geom::Scene& scene, int count, double leaf_area, std::uint3
     return count * leaf_area / ((hi[0] - lo[0]) * (hi[1] - lo[1]));
 }
 
+/// A white directional light at zenith angle theta (radians), half a radian round from +x.
+geom::Light sun_at(double theta)
+{
+    const double azimuth = 0.5;
+    geom::Light light;
+    light.kind = geom::Light::Kind::directional;
+    light.direction = {std::sin(theta) * std::cos(azimuth), std::cos(theta),
+                       std::sin(theta) * std::sin(azimuth)};
+    return light;
+}
+
 using Polygon = std::vector<std::array<double, 3>>;
 
 /// The part of a convex polygon where coordinate `axis` lies in [lo, hi].
@@ -331,12 +342,8 @@ TEST(LightSources, InfiniteCanopyFollowsBeerLambert)
 {
     geom::Scene scene = dark_scene();
     const double lai = random_canopy(scene, 6000, 2.0 / 6000, 11);
-    const double theta = 60 * pi / 180, azimuth = 0.5;
-    geom::Light light;
-    light.kind = geom::Light::Kind::directional;
-    light.direction = {std::sin(theta) * std::cos(azimuth), std::cos(theta),
-                       std::sin(theta) * std::sin(azimuth)};
-    scene.lights = {light};
+    const double theta = 60 * pi / 180;
+    scene.lights = {sun_at(theta)};
     LightReportSettings s;
     s.rays = 200'000;
     s.infinite_canopy = true;
@@ -366,12 +373,7 @@ TEST(LightSources, InfiniteCanopyInterceptsAsBeerLambertForLai1To5)
         for (int lai = 1; lai <= 5; ++lai) {
             geom::Scene scene = dark_scene();
             periodic_canopy(scene, count, double(lai) / count, std::uint32_t(20 + lai));
-            const double azimuth = 0.5;
-            geom::Light light;
-            light.kind = geom::Light::Kind::directional;
-            light.direction = {std::sin(theta) * std::cos(azimuth), std::cos(theta),
-                               std::sin(theta) * std::sin(azimuth)};
-            scene.lights = {light};
+            scene.lights = {sun_at(theta)};
             LightReportSettings s;
             s.rays = 400'000;
             s.infinite_canopy = true;
