@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 // Inputs the fuzz targets (fuzz/, docs/security.md) found to crash, each replayed as the
-// target replays it and answered with the located error a user should see. Tests named
-// DISABLED_ wait for the fix of the issue-11 row their comment names.
+// target replays it and answered with the located error a user should see.
 #include <gtest/gtest.h>
 
 #include <algorithm>

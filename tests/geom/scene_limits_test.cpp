@@ -65,7 +65,7 @@ TEST(SceneLimits, WholeNumbersRefuseWhatNoIntHolds)
 
 TEST(SceneLimits, HugeAndNotFiniteSegmentsAreDroppedWithOneCountedWarning)
 {
-    // the string: F(1e38) goes far out, F(-1e38) comes back; both segments go
+    // a hostile string: F(1e38) goes far out, F(-1e38) comes back; both segments go
     Scene scene = interpret_text("F(1e38)F(-1e38)F");
     scene.bounds = Bounds3{};  // (the view volume is checked separately below)
     scene.bounds.extend(Vec3{0, 0, 0});

@@ -62,7 +62,7 @@ const char* const allowed_conversions =
 
 TEST(FormatStrings, StringConversionIsALoadErrorAtItsColumn)
 {
-    // the issue's crash: %s read a pointer from a double. '%' is column 17.
+    // a crash once: %s read a pointer from a double. '%' is column 17.
     EXPECT_EQ(load_error(with_start(R"(printf("%s%s\n", 1);)")),
               std::string("test.l:2:17: error: printf format: conversion '%s' is not allowed; ") +
                   allowed_conversions);
