@@ -237,6 +237,14 @@ Vec3f unshadowed(const Vertex& v, const LightLiSample& ls)
     return f * ls.li * cos;
 }
 
+/// Whether the opaque ground lies between the vertex and the light sample (FernLeaf's
+/// second light shines from below it): such a light gives the point nothing.
+bool ground_hides(const PathContext& ctx, const Vertex& v, const LightLiSample& ls)
+{
+    return ground_blocks(ctx, v.hit.prim()) && ls.pdf > 0 &&
+           ctx.ground->distance(v.hit.position, ls.wi, ls.tfar);
+}
+
 /// Room for a vector per delta light, each made in place as its light is met: a
 /// std::array<Vec3f> would be zeroed whole (Vec3f's members are initialised), a
 /// `rep stos` at every vertex.
@@ -374,9 +382,8 @@ float point_weights(const PathContext& ctx, const LightSet& lights, const Vertex
         case LightKind::spot:
         case LightKind::directional: {
             const LightLiSample ls = lights.sample_li(i, v.hit.position, 0, 0, 0);
-            if (ground && ls.pdf > 0 && ctx.ground->distance(v.hit.position, ls.wi, ls.tfar))
-                break;  // the opaque ground is in the way
-            w = luminance(unshadowed(v, ls));
+            if (!ground_hides(ctx, v, ls))
+                w = luminance(unshadowed(v, ls));
             break;
         }
         case LightKind::environment:
@@ -451,22 +458,32 @@ bool draws_facing_up(const Vertex& v, const LightSet& lights)
            lights.environment_facing_up();
 }
 
-/// Direct light from a sky alone, its sun and its dome each sampled at every vertex and
-/// weighed against BSDF sampling, so that no choice between the two adds variance: in the
-/// plant's shadow the dome's sample carries all the light, in the open both do their part
-/// (benchmarks/cycles/compare.py --staged sky-without-view-lights, turntable azimuths).
-Vec3f sample_sky_ld(const PathContext& ctx, const PathContext::SceneFlags& facts,
-                    const Vertex& v, bool last, const Sampler& sampler, std::uint32_t block,
-                    ChoiceAt& choice)
+/// Whether next-event estimation at the vertex samples every light of the set
+/// (LightSet::every_light): under the sky everywhere, under a map on the ground only. On
+/// the plant under a map, one light chosen by what it delivers (choose_at) reaches the
+/// same noise for two thirds of the time; on the ground, in the plant's shadow, the
+/// choice's variance dominates (benchmarks/cycles/compare.py --staged env and sky).
+bool samples_every_light(const Vertex& v, const LightSet& lights)
+{
+    return lights.every_light() && (lights.has_sun() || v.hit.geom_id == ground_geom_id);
+}
+
+/// Direct light from every light of the set at once (LightSet::every_light): each delta
+/// light that gives the point something, exactly, with its shadow ray; the environment
+/// and the sky's sun a sample each, weighed against BSDF sampling. No choice among them
+/// adds variance: in the plant's shadow the dome's sample carries the light the blocked
+/// sun and view lights do not (benchmarks/cycles/compare.py --staged sky, turntable
+/// azimuths). The environment takes light_point's pair, as a chosen light does; with a
+/// sun, the sun takes that pair and the dome the choice's, which no choice needs.
+Vec3f sample_every_light_ld(const PathContext& ctx, const PathContext::SceneFlags& facts,
+                            const Vertex& v, bool last, const Sampler& sampler,
+                            std::uint32_t block, ChoiceAt& choice)
 {
     const LightSet& lights = facts.lights;
     const bool up = draws_facing_up(v, lights);
-    choice = {.environment = 1, .area = 0, .sun = 1, .facing_up = up};
-    auto one = [&](std::uint32_t index, float u1, float u2) {
-        const LightLiSample ls =
-            up && index == lights.environment_index()
-                ? lights.environment_li_facing_up(u1, u2)
-                : lights.sample_li(index, v.hit.position, 0, u1, u2);
+    choice = {.environment = 1, .area = 0, .sun = lights.has_sun() ? 1.0f : 0.0f,
+              .facing_up = up};
+    auto reaching = [&](const LightLiSample& ls) {
         if (!(ls.pdf > 0))
             return Vec3f();
         const Vec3f c = unshadowed(v, ls);
@@ -475,12 +492,29 @@ Vec3f sample_sky_ld(const PathContext& ctx, const PathContext::SceneFlags& facts
         const float through = light_visibility(ctx, facts, v.hit, ls.wi, ls.tfar);
         if (through <= 0)
             return Vec3f();
-        const float w = last ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf(v.bsdf, ls.wi));
+        const float w =
+            ls.delta || last ? 1.0f : power_heuristic(ls.pdf, bsdf_pdf(v.bsdf, ls.wi));
         return c * (through * w / ls.pdf);
     };
-    auto [dome1, dome2] = sampler.get2d(block + sample_dimension::light_choice);
-    auto [sun1, sun2] = sampler.get2d(block + sample_dimension::light_point);
-    return one(lights.environment_index(), dome1, dome2) + one(lights.sun_index(), sun1, sun2);
+    auto one = [&](std::uint32_t index, float u1, float u2) {
+        return reaching(up && index == lights.environment_index()
+                            ? lights.environment_li_facing_up(u1, u2)
+                            : lights.sample_li(index, v.hit.position, 0, u1, u2));
+    };
+    Vec3f sum;
+    for (std::uint32_t i = 0; i < lights.size(); ++i) {
+        if (!is_delta(lights.kind(i)))
+            continue;
+        const LightLiSample ls = lights.sample_li(i, v.hit.position, 0, 0, 0);
+        if (!ground_hides(ctx, v, ls))
+            sum += reaching(ls);
+    }
+    auto [choice1, choice2] = sampler.get2d(block + sample_dimension::light_choice);
+    auto [point1, point2] = sampler.get2d(block + sample_dimension::light_point);
+    if (!lights.has_sun())
+        return sum + one(lights.environment_index(), point1, point2);
+    return sum + one(lights.environment_index(), choice1, choice2) +
+           one(lights.sun_index(), point1, point2);
 }
 
 /// Direct light from one light (pbrt's SampleLd): among delta lights only, chosen by what
@@ -501,8 +535,8 @@ Vec3f sample_ld(const PathContext& ctx, const PathContext::SceneFlags& facts, co
                 sample_delta_ld(ctx, facts, v, sampler, block + sample_dimension::light_choice))
             return *ld;
     }
-    if (lights.has_sun() && lights.size() == 2)
-        return sample_sky_ld(ctx, facts, v, last, sampler, block, choice);
+    if (samples_every_light(v, lights))
+        return sample_every_light_ld(ctx, facts, v, last, sampler, block, choice);
     std::optional<ChosenLight> chosen;
     LightUniforms u{};
     if (lights.per_point()) {
@@ -894,6 +928,16 @@ std::vector<float> light_choice_probabilities(const PathContext& ctx, const Surf
     const Vertex v{hit, bsdf};
     PointWeights weight{};
     float total = 0;
+    if (samples_every_light(v, lights)) {
+        for (std::uint32_t i = 0; i < lights.size(); ++i)
+            if (!is_delta(lights.kind(i))) {
+                p[i] = 1;
+            } else {
+                const LightLiSample ls = lights.sample_li(i, hit.position, 0, 0, 0);
+                p[i] = !ground_hides(ctx, v, ls) && !is_black(unshadowed(v, ls)) ? 1.0f : 0.0f;
+            }
+        return p;
+    }
     if (lights.per_point()) {
         total = point_weights(ctx, lights, v, weight);
     } else if (lights.delta_only()) {

@@ -160,8 +160,11 @@ inline PathResult camera_miss(const PathContext& ctx, const Vec3f& dir)
 }
 
 /// The probability with which next-event estimation at `hit` (its BSDF seen as `bsdf`)
-/// chooses each light of the prepared light set, in the set's order: what the path
-/// tracer draws its one light from there (LightSet::per_point, delta_only or by power).
+/// samples each light of the prepared light set, in the set's order. Where it samples
+/// every light (LightSet::every_light): 1 for the environment, the sun and each delta
+/// light that gives the point something, 0 for a delta light that gives it nothing (its
+/// back, or the opaque ground between). Otherwise what the path tracer draws its one
+/// light from (LightSet::per_point, delta_only or by power).
 std::vector<float> light_choice_probabilities(const PathContext& ctx, const SurfaceHit& hit,
                                               const BsdfAt& bsdf);
 

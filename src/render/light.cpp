@@ -202,6 +202,10 @@ LightSet::LightSet(const std::vector<RenderLight>& lights, const AreaLights* are
                    });
     m_per_point = !m_delta_only && m_lights.size() <= max_point_choice &&
                   (m_area != nullptr || m_environment != nullptr);
+    const auto delta_lights = std::count_if(m_lights.begin(), m_lights.end(),
+                                            [](const Entry& e) { return is_delta(e.kind); });
+    m_every_light = m_environment != nullptr && m_area == nullptr &&
+                    static_cast<std::size_t>(delta_lights) <= max_delta_choice;
     for (std::size_t i = 0; i < m_lights.size(); ++i) {
         float p = static_cast<float>(m_cdf[i + 1] - m_cdf[i]);
         if (m_lights[i].kind == LightKind::area)

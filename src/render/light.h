@@ -55,6 +55,12 @@ std::vector<RenderLight> make_lights(const std::vector<geom::Light>& lights);
 /// each is then chosen by what it gives a point, not as one mixture.
 enum class LightKind : std::uint8_t { point, spot, directional, area, environment, sun };
 
+/// Whether a light of this kind is a delta light: one direction toward it from any point.
+constexpr bool is_delta(LightKind k)
+{
+    return k == LightKind::point || k == LightKind::spot || k == LightKind::directional;
+}
+
 /// Light arriving at a shading point from one light: the unit direction toward it, the
 /// radiance along -wi (a delta light: the irradiance on a surface facing it), the
 /// solid-angle density wi was drawn with (a delta light: 1; the light's choice not
@@ -137,6 +143,13 @@ public:
     /// vertex to vertex, and the integrator carries them to weigh the next BSDF ray.
     bool per_point() const { return m_per_point; }
     static constexpr std::size_t max_point_choice = 16;
+    /// Whether next-event estimation can sample every light at a vertex instead of
+    /// choosing one (the integrator says where): an environment (a sky's dome with its
+    /// sun, or a map) and at most max_delta_choice delta lights, no emissive primitives.
+    /// Each delta light costs a shadow ray where it gives the point something and no
+    /// random number; the environment and the sun a sample each. Then no choice adds
+    /// variance where lights are shadowed (the ground in the plant's shadow).
+    bool every_light() const { return m_every_light; }
     /// The luminance of the irradiance the sampled environment (without a sun of its own)
     /// gives a surface facing n (unshadowed), estimated once from 256 of its own samples for
     /// 128 normals and looked up at the nearest, never below 1/20 of the largest (an
@@ -248,7 +261,7 @@ private:
     /// directions), and its floor.
     std::vector<float> m_irradiance;
     float m_irradiance_floor = 0;
-    bool m_delta_only = false, m_per_point = false;
+    bool m_delta_only = false, m_per_point = false, m_every_light = false;
 };
 
 }  // namespace cambium::render
