@@ -388,17 +388,45 @@ Map::Map(int width, int height, std::vector<float> rgb)
     m_constant = std::equal(m_rgb->begin() + 3, m_rgb->end(), m_rgb->begin());
 }
 
+namespace {
+
+/// The mean of max(0, cos theta) over a band of cos theta from c1 up to c0, uniform in
+/// solid angle as cos theta is.
+float mean_cos_above_horizon(float c0, float c1)
+{
+    if (c1 >= 0)
+        return 0.5f * (c0 + c1);
+    if (c0 <= 0)
+        return 0;
+    return 0.5f * c0 * c0 / (c0 - c1);
+}
+
+}  // namespace
+
 void Map::tabulate(bool hidden)
 {
-    std::vector<float> weight(std::size_t(m_width) * std::size_t(m_height));
+    std::vector<float> weight(std::size_t(m_width) * std::size_t(m_height)), up;
+    if (hidden)
+        up.resize(weight.size());
     for (int j = 0; j < m_height; ++j) {
+        const float c0 = std::cos(pi * float(j) / float(m_height));
+        const float c1 = std::cos(pi * float(j + 1) / float(m_height));
         // A row whose top border is at or below the horizon lies wholly below it.
-        bool below = hidden && std::cos(pi * float(j) / float(m_height)) <= 0;
-        for (int i = 0; i < m_width; ++i)
-            weight[std::size_t(j) * std::size_t(m_width) + std::size_t(i)] =
-                below ? 0.0f : std::max(0.0f, luminance(texel(i, j)));
+        const bool below = hidden && c0 <= 0;
+        const float cos_up = mean_cos_above_horizon(c0, c1);
+        for (int i = 0; i < m_width; ++i) {
+            const std::size_t at = std::size_t(j) * std::size_t(m_width) + std::size_t(i);
+            const float l = std::max(0.0f, luminance(texel(i, j)));
+            weight[at] = below ? 0.0f : l;
+            if (hidden)
+                up[at] = l * cos_up;
+        }
     }
     m_table = LatLongTable(m_width, m_height, weight);
+    // Only under an opaque ground is a surface seen facing straight up (the table costs
+    // as much memory as the map's own).
+    if (hidden)
+        m_up_table = LatLongTable(m_width, m_height, up);
 }
 
 Vec3f Map::radiance(const Vec3f& d) const
@@ -412,6 +440,16 @@ EnvironmentSample Map::sample(float u1, float u2) const
     float density = 0;
     int i = 0, j = 0;
     Vec3f d = m_table.sample(u1, u2, density, i, j);
+    if (!(density > 0))
+        return {};
+    return {d, texel(i, j), density};
+}
+
+EnvironmentSample Map::sample_facing_up(float u1, float u2) const
+{
+    float density = 0;
+    int i = 0, j = 0;
+    Vec3f d = m_up_table.sample(u1, u2, density, i, j);
     if (!(density > 0))
         return {};
     return {d, texel(i, j), density};
@@ -504,12 +542,22 @@ EnvironmentSample environment_kind::Sky::sample_without_sun_facing_up(float u1, 
     return {d, without_sun(d), density};
 }
 
+bool Environment::samples_facing_up() const
+{
+    const auto* map = std::get_if<environment_kind::Map>(&m_kind);
+    return sky() != nullptr || (map && map->samples_facing_up());
+}
+
 EnvironmentSample Environment::sample_without_sun_facing_up(float u1, float u2) const
 {
-    const environment_kind::Sky* s = sky();
-    if (!s)
+    EnvironmentSample e;
+    if (const environment_kind::Sky* s = sky())
+        e = s->sample_without_sun_facing_up(u1, u2);
+    else if (const auto* map = std::get_if<environment_kind::Map>(&m_kind);
+             map && map->samples_facing_up())
+        e = map->sample_facing_up(u1, u2);
+    else
         return sample_without_sun(u1, u2);
-    EnvironmentSample e = s->sample_without_sun_facing_up(u1, u2);
     if (m_turned)  // a turn about +y keeps the cosine to +y
         e.direction = turn(e.direction);
     return e;
@@ -517,10 +565,13 @@ EnvironmentSample Environment::sample_without_sun_facing_up(float u1, float u2) 
 
 float Environment::pdf_without_sun_facing_up(const Vec3f& direction) const
 {
-    const environment_kind::Sky* s = sky();
-    if (!s)
-        return pdf_without_sun(direction);
-    return s->pdf_without_sun_facing_up(m_turned ? unturn(direction) : direction);
+    const Vec3f d = m_turned ? unturn(direction) : direction;
+    if (const environment_kind::Sky* s = sky())
+        return s->pdf_without_sun_facing_up(d);
+    if (const auto* map = std::get_if<environment_kind::Map>(&m_kind);
+        map && map->samples_facing_up())
+        return map->pdf_facing_up(d);
+    return pdf_without_sun(direction);
 }
 
 float Environment::pdf_without_sun(const Vec3f& direction) const

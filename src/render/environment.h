@@ -189,8 +189,14 @@ public:
     /// Whether every texel has the same colour.
     bool constant() const { return m_constant; }
     /// From now on sample nothing below the horizon (an opaque ground hides it): rows
-    /// wholly below it weigh 0.
+    /// wholly below it weigh 0. A second table then draws texels for a surface facing
+    /// straight up (the ground), by luminance times the cosine to +y.
     void hide_below_horizon() { tabulate(true); }
+    /// Whether the table for a surface facing up is made (hide_below_horizon); the two
+    /// below then sample and give the density of the map drawn by it.
+    bool samples_facing_up() const { return !m_up_table.empty(); }
+    EnvironmentSample sample_facing_up(float u1, float u2) const;
+    float pdf_facing_up(const Vec3f& d) const { return m_up_table.pdf(d); }
 
 private:
     Vec3f texel(int i, int j) const;
@@ -199,6 +205,7 @@ private:
     int m_width, m_height;
     std::shared_ptr<const std::vector<float>> m_rgb;
     LatLongTable m_table;
+    LatLongTable m_up_table;  ///< by luminance times the cosine to +y; empty until hidden
     bool m_black = true, m_constant = false;
 };
 
@@ -256,8 +263,9 @@ public:
     EnvironmentSample sample_without_sun(float u1, float u2) const;
     float pdf_without_sun(const Vec3f& direction) const;
     /// Whether a surface facing straight up has a sampling of its own (a sky's dome:
-    /// Sky::sample_without_sun_facing_up); the two below then use it.
-    bool samples_facing_up() const { return sky() != nullptr; }
+    /// Sky::sample_without_sun_facing_up; a map under an opaque ground:
+    /// Map::sample_facing_up); the two below then use it.
+    bool samples_facing_up() const;
     EnvironmentSample sample_without_sun_facing_up(float u1, float u2) const;
     float pdf_without_sun_facing_up(const Vec3f& direction) const;
 
