@@ -435,21 +435,18 @@ Vec3f Map::radiance(const Vec3f& d) const
     return texel(i, j);
 }
 
-EnvironmentSample Map::sample(float u1, float u2) const
-{
-    float density = 0;
-    int i = 0, j = 0;
-    Vec3f d = m_table.sample(u1, u2, density, i, j);
-    if (!(density > 0))
-        return {};
-    return {d, texel(i, j), density};
-}
+EnvironmentSample Map::sample(float u1, float u2) const { return sample_by(m_table, u1, u2); }
 
 EnvironmentSample Map::sample_facing_up(float u1, float u2) const
 {
+    return sample_by(m_up_table, u1, u2);
+}
+
+EnvironmentSample Map::sample_by(const LatLongTable& table, float u1, float u2) const
+{
     float density = 0;
     int i = 0, j = 0;
-    Vec3f d = m_up_table.sample(u1, u2, density, i, j);
+    Vec3f d = table.sample(u1, u2, density, i, j);
     if (!(density > 0))
         return {};
     return {d, texel(i, j), density};

@@ -200,6 +200,8 @@ public:
 
 private:
     Vec3f texel(int i, int j) const;
+    /// A texel drawn by `table`, with its direction and density.
+    EnvironmentSample sample_by(const LatLongTable& table, float u1, float u2) const;
     void tabulate(bool hidden);
 
     int m_width, m_height;
