@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <limits>
 #include <map>
@@ -536,6 +537,8 @@ int run_animation(const Options& options, const SequenceOutputs& out)
         } restart{derivation_start};
         if (const int signal = SignalNote::signal())
             throw Interrupted(signal);  // a video's run: no further frame is derived
+        if (status == 0 && settings.cancel && settings.cancel->load())
+            throw Interrupted(SIGINT);  // Ctrl-C between renders, or with only files to write
         if (status != 0)
             return;
         if (filter.to_render(number))
@@ -582,11 +585,17 @@ int run_animation(const Options& options, const SequenceOutputs& out)
             out.say("wrote " + file.string());
         }
         if (geometry_files) {
-            // The frame's own geometry, as the turtle draws it for the picture; vector
-            // drawings are framed as a still of it would be.
-            const geom::Scene frame = interpret_turtle_string(
-                model, homo ? *homo : turtle_string(model, string, options), options);
-            auto wrote = [&](const fs::path& file) { out.say("wrote " + file.string()); };
+            // The frame's own geometry, as a still derived to its step writes it: organs
+            // named by the derived string's modules (glTF's nodes), vector drawings
+            // framed as the still's.
+            StringOrigins provenance;
+            const geom::Scene frame =
+                interpret_with_provenance(model, homo ? *homo : string, options, provenance);
+            auto wrote = [&](const fs::path& file) {
+                out.say("wrote " + file.string());
+                if (out.geometry_written)
+                    out.geometry_written(file);
+            };
             if (options.rayshade) {
                 fs::path file = frame_file(*options.rayshade, f.number);
                 geom::write_rayshade(frame, file, rayshade_options(options, file, &model));

@@ -42,6 +42,9 @@ struct SequenceOutputs {
     /// Each frame's image with its number, after its files are written: a caller that
     /// keeps the frames (the Python module's sequences). Null: files only.
     std::function<void(const render::Image&, int number)> frame_images{};
+    /// Each file of an -a frame's geometry (-o meshes and drawings, -ray, -ps, -iv) once it
+    /// is written whole: a caller that lists them (the Python module's exports). Null: none.
+    std::function<void(const std::filesystem::path&)> geometry_written{};
 };
 
 /// Whether the command renders a sequence (-a or --turntable) instead of a still.

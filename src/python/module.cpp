@@ -90,6 +90,9 @@ std::vector<std::string> option_words(const py::dict& options)
         if (key == "o" || key == "output" || key == "outputs")
             throw Error("keyword '" + key +
                         "': the module returns images; write them with Image.write(path)");
+        if (key == "video")  // a sequence's video is a file and an ffmpeg run: the command's
+            throw Error("keyword 'video': the module returns a Sequence; write its frames with "
+                        "Sequence.write(pattern)");
         if (key == "mpi" || key == "tile" || key == "assemble")
             throw Error("keyword '" + key + "': a distributed render is the command's "
                         "(docs/distributed.md)");
@@ -692,17 +695,71 @@ void write_export(const geom::Scene& scene, const app::Options& options,
         app::write_geometry_output(scene, options, file);
 }
 
+/// The command's sequence code stopped early (a render cancelled with no Python exception
+/// to raise) is an error rather than a short sequence.
+void require_last_frame(int status)
+{
+    if (status != 0)
+        throw Error("the sequence stopped before its last frame (exit status " +
+                    std::to_string(status) + ")");
+}
+
+/// -a with a geometry output: each frame's file written by the command's sequence code
+/// (`pattern`'s number field given the frame's step, checked as the command checks it),
+/// nothing rendered. Returns the names written, frame after frame.
+py::list export_frames(const std::filesystem::path& pattern, app::Options options,
+                       const py::object& progress)
+{
+    app::SequenceOutputs out;
+    const std::string extension = pattern.extension().string();
+    if (extension == ".ray")
+        options.rayshade = pattern;
+    else if (extension == ".iv")
+        options.inventor = pattern;
+    else
+        out.geometry = {pattern};
+    std::vector<std::filesystem::path> written;
+    int status = 0;
+    run_released(
+        [&](std::atomic<bool>& cancel, Events& events) {
+            out.settings = app::render_settings(options, {});
+            out.settings.cancel = &cancel;  // checked between frames
+            out.write_strings = [](const app::Model&, const lsys::ModuleString&, int) {};
+            out.say = [](const std::string&) {};
+            out.geometry_written = [&](const std::filesystem::path& file) {
+                written.push_back(file);
+                events.push("frame");
+            };
+            events.push("derive");
+            status = app::run_sequence(options, out);
+        },
+        progress, options.quiet);
+    require_last_frame(status);
+    py::list names;
+    for (const std::filesystem::path& file : written)
+        names.append(file.string());
+    return names;
+}
+
 /// The plant's geometry written to `path` as the command writes it: a mesh or drawing by
 /// the extension (`-o`: .obj, .ply, .glb, .gls, .ps, .svg, .pdf), cpfg's rayshade scene
-/// for .ray (`-ray`) and its Inventor scene for .iv (`-iv`).
-void export_geometry(ModelObject& m, const py::object& path, const py::object& string,
-                     const py::object& progress, const py::kwargs& keywords)
+/// for .ray (`-ray`) and its Inventor scene for .iv (`-iv`). With animate=True, as `-a`:
+/// a file per frame, whose names are returned.
+py::object export_geometry(ModelObject& m, const py::object& path, const py::object& string,
+                           const py::object& progress, const py::kwargs& keywords)
 {
     const std::filesystem::path file = word(path);
     check_export_name(file);
     const app::Options options = m.options_with(keyword_dict(keywords));
-    if (app::is_sequence(options))
-        throw Error(file.string() + ": export writes a still's geometry; not with -a or --turntable");
+    if (options.shot.turntable > 0)
+        throw Error(file.string() + ": a turntable turns one geometry: export the still "
+                                    "(without turntable=)");
+    if (options.shot.animate) {
+        if (!string.is_none())
+            throw Error("animate=True derives each frame's string; export a given string as "
+                        "a still");
+        return export_frames(file, options, progress);
+    }
     std::optional<lsys::ModuleString> given = given_string(m, string);
     run_released(
         [&](std::atomic<bool>&, Events& events) {
@@ -710,6 +767,7 @@ void export_geometry(ModelObject& m, const py::object& path, const py::object& s
             write_export(scene, options, file, m.model.get());
         },
         progress, options.quiet);
+    return py::none();
 }
 
 /// A scene call's file and options: the load's keywords with the call's over them, and
@@ -735,7 +793,7 @@ py::object render_scene(SceneObject& o, bool layers, const py::object& progress,
     const SceneCall call = scene_call(o, keyword_dict(keywords));
     const app::Options& options = call.options;
     if (app::is_sequence(options))
-        throw Error("a sequence is not one image; the command renders a scene's turntable");
+        throw Error("a sequence is not one image: use Scene.turntable()");
     render::RenderSettings settings = app::render_settings(options, {});
     settings.aovs = layers;
     const render::WriteOptions write = app::write_options(options);
@@ -824,17 +882,23 @@ struct SequenceObject {
     int fps = 24;
 };
 
+/// A turntable's keywords: the call's with --turntable and --turntable-elevation.
+py::dict turntable_keywords(const py::kwargs& keywords, int frames, std::optional<double> elevation)
+{
+    py::dict more = keyword_dict(keywords);
+    more["turntable"] = frames;
+    if (elevation)
+        more["turntable_elevation"] = *elevation;
+    return more;
+}
+
 /// A turntable as the command's --turntable renders it: derived and interpreted once,
 /// `frames` views orbiting the vertical axis through the plant, one BVH for all.
 SequenceObject turntable_model(ModelObject& m, int frames, std::optional<double> elevation,
                                const py::object& string, bool layers, const py::object& progress,
                                const py::kwargs& keywords)
 {
-    py::dict more = keyword_dict(keywords);
-    more["turntable"] = frames;
-    if (elevation)
-        more["turntable_elevation"] = *elevation;
-    const app::Options options = m.options_with(more);
+    const app::Options options = m.options_with(turntable_keywords(keywords, frames, elevation));
     std::optional<lsys::ModuleString> given = given_string(m, string);
     render::RenderSettings settings = app::render_settings(options, {});
     settings.aovs = layers;
@@ -866,16 +930,12 @@ SequenceObject turntable_model(ModelObject& m, int frames, std::optional<double>
     return sequence;
 }
 
-/// cpfg's animation mode (-a, with the load's animation file or cpfg's default frames)
-/// as the command renders it, every frame kept in a Sequence in the order of its number:
-/// the same frames, cameras and in-betweens, through the command's own sequence code.
-SequenceObject animate_model(ModelObject& m, bool layers, const py::object& progress, const py::kwargs& keywords)
+/// Runs the command's own sequence code (app::run_sequence) with each frame's image kept
+/// instead of written, and returns the frames in the order of their numbers. With
+/// `scene_file`, the turntable turns that scene file's plants, assembled once.
+SequenceObject kept_sequence(const app::Options& options, bool layers, const py::object& progress,
+                             const app::SceneFile* scene_file = nullptr)
 {
-    py::dict more = keyword_dict(keywords);
-    more["animate"] = true;
-    const app::Options options = m.options_with(more);
-    if (options.shot.turntable > 0)
-        throw Error("animate() renders -a frames; use Model.turntable() for a turntable");
     const render::WriteOptions write = app::write_options(options);
     std::vector<std::pair<int, render::Image>> images;
     int status = 0;
@@ -891,18 +951,49 @@ SequenceObject animate_model(ModelObject& m, bool layers, const py::object& prog
                 images.emplace_back(number, image);
                 events.push("frame");
             };
-            events.push("render");
+            if (scene_file)
+                out.make_scene = [&] {
+                    events.push("assemble");
+                    geom::Scene scene = app::assemble_scene(*scene_file, options);
+                    events.push("render");  // the orbit's frames follow
+                    return scene;
+                };
+            else
+                events.push("render");
             status = app::run_sequence(options, out);
         },
         progress, options.quiet, write);
-    if (status != 0)
-        throw Error("the animation stopped before its last frame (exit status " + std::to_string(status) + ")");
+    require_last_frame(status);
     std::stable_sort(images.begin(), images.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     SequenceObject sequence;
     sequence.fps = options.shot.fps;
     for (auto& [number, image] : images)
         sequence.frames.append(image_object(std::move(image), write));
     return sequence;
+}
+
+/// cpfg's animation mode (-a, with the load's animation file or cpfg's default frames)
+/// as the command renders it, every frame kept in a Sequence in the order of its number:
+/// the same frames, cameras and in-betweens, through the command's own sequence code.
+SequenceObject animate_model(ModelObject& m, bool layers, const py::object& progress, const py::kwargs& keywords)
+{
+    py::dict more = keyword_dict(keywords);
+    more["animate"] = true;
+    const app::Options options = m.options_with(more);
+    if (options.shot.turntable > 0)
+        throw Error("animate() renders -a frames; use Model.turntable() for a turntable");
+    return kept_sequence(options, layers, progress);
+}
+
+/// A scene file's turntable as `cambium field.json --turntable N` renders it: the plants
+/// assembled once, `frames` views orbiting them, through the command's turntable code.
+SequenceObject turntable_scene(SceneObject& o, int frames, std::optional<double> elevation,
+                               bool layers, const py::object& progress, const py::kwargs& keywords)
+{
+    const SceneCall call = scene_call(o, turntable_keywords(keywords, frames, elevation));
+    if (call.options.light_report)
+        check_still_light_report(call.options);
+    return kept_sequence(call.options, layers, progress, &call.file);
 }
 
 /// The frames as an HTML animation (PNG frames shown in turn by a small script), for
@@ -1226,7 +1317,9 @@ PYBIND11_MODULE(cambium, m)
              py::arg("progress") = py::none(),
              "Writes the plant's geometry as the command does: a mesh or drawing by the "
              "extension (.obj, .ply, .glb, .gls, .ps, .svg, .pdf, as -o), cpfg's rayshade "
-             "scene (.ray, as -ray) or Inventor scene (.iv, as -iv); keywords as render()'s")
+             "scene (.ray, as -ray) or Inventor scene (.iv, as -iv); keywords as render()'s. "
+             "With animate=True, a file per frame as -a writes them (a number field in `path`, "
+             "e.g. plant%03d.glb): returns their names")
         .def_property_readonly("view",
                                [](const ModelObject& self) { return view_settings(*self.model->view); })
         .def_property_readonly(
@@ -1245,6 +1338,10 @@ PYBIND11_MODULE(cambium, m)
              "Writes the scene's plants as the command does for a scene file: a mesh or "
              "drawing by the extension (.obj, .ply, .glb, .gls, .ps, .svg, .pdf), .ray or .iv; "
              "keywords as render()'s")
+        .def("turntable", &turntable_scene, py::arg("frames"), py::arg("elevation") = py::none(),
+             py::arg("layers") = false, py::arg("progress") = py::none(),
+             "Renders `frames` views orbiting the scene's plants (cambium field.json "
+             "--turntable, --turntable-elevation) into a Sequence; keywords as render()'s")
         .def("light_report", &scene_light_report, py::arg("path") = py::none(),
              py::arg("progress") = py::none(),
              "The light each organ of each plant absorbs (--light-report): written to `path` "

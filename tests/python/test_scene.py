@@ -5,6 +5,7 @@ import os
 import shutil
 import subprocess
 
+import numpy as np
 import pytest
 
 import cambium
@@ -52,3 +53,33 @@ def test_a_scenes_exports_and_light_report_are_the_commands(field, command):
     assert len(plants) > 100  # each placement's organs, not one plant's
     with pytest.raises(cambium.Error, match="images come from render"):
         scene.export("field.png")
+
+
+def test_a_scenes_turntable_is_the_commands_frames(field, command):
+    subprocess.run([command, "-q", "field.json", "-w", "48", "36", "--spp", "2", "--turntable",
+                    "3", "--turntable-elevation", "25", "-o", "cmd%02d.png"], check=True)
+    scene = cambium.load_scene("field.json")
+    stages = []
+    seq = scene.turntable(3, elevation=25, width=48, height=36, spp=2,
+                          progress=lambda stage, image: stages.append(stage))
+    assert stages == ["assemble", "render", "frame", "frame", "frame"]
+    assert seq.write("py%02d.png") == [f"py{k:02d}.png" for k in range(1, 4)]
+    for k in range(1, 4):
+        cmd = (field / f"cmd{k:02d}.png").read_bytes()
+        assert (field / f"py{k:02d}.png").read_bytes() == cmd, k
+    assert np.asarray(seq[2]).shape == (36, 48, 4)
+    assert not np.array_equal(np.asarray(seq[0]), np.asarray(seq[1]))  # the field turns
+    assert seq._repr_html_().count("data:image/png;base64,") == 3
+
+
+def test_a_scenes_sequence_errors(field):
+    scene = cambium.load_scene("field.json")
+    with pytest.raises(cambium.Error, match="Scene.turntable"):
+        scene.render(turntable=3)
+    with pytest.raises(cambium.Error, match="light-report measures a still"):
+        scene.turntable(3, light_report="light.json")
+    with pytest.raises(cambium.Error, match="two kinds of sequence"):
+        scene.turntable(3, animate=True)
+    with pytest.raises(cambium.Error, match="keyword 'video'"):
+        scene.turntable(3, video=True)
+    assert not list(field.glob("*.mp4")) and not (field / "light.json").exists()
