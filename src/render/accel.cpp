@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// EmbreeScene: the Scene's primitives in Embree (the only user of <embree3/rtcore.h>).
+// EmbreeScene: the Scene's primitives in Embree (with render/shapes, the only user of
+// <embree3/rtcore.h>): the scenes built, hits resolved, rays traced.
 #include "render/accel.h"
 
 #include <embree3/rtcore.h>

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// EmbreeScene: the Scene's primitives in Embree (the only user of <embree3/rtcore.h>).
+// EmbreeScene: the Scene's primitives in Embree (with render/shapes, the only Embree users).
 #pragma once
 
 #include <cstddef>
