@@ -5,17 +5,52 @@
 
 #include <array>
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include "geom/scene.h"
 #include "geom/vec.h"
 
 namespace cambium::geom {
 
+/// The arrays of a Geometry, one per kind of primitive.
+enum class PrimitiveKind : std::uint8_t { lines, curves, spheres, discs, mesh };
+
+/// Provenance: the module entries of a Geometry's primitives of one kind.
+inline const std::vector<std::uint32_t>& modules_of(const Geometry& g, PrimitiveKind k)
+{
+    switch (k) {
+    case PrimitiveKind::lines: return g.lines.module;
+    case PrimitiveKind::curves: return g.curves.module;
+    case PrimitiveKind::spheres: return g.spheres.module;
+    case PrimitiveKind::discs: return g.discs.module;
+    default: return g.mesh.module;
+    }
+}
+
+inline constexpr std::array<PrimitiveKind, 5> primitive_kinds{
+    PrimitiveKind::lines, PrimitiveKind::curves, PrimitiveKind::spheres, PrimitiveKind::discs,
+    PrimitiveKind::mesh};
+
+/// The primitives `g` draws of one kind.
+inline std::size_t primitive_count(const Geometry& g, PrimitiveKind k)
+{
+    switch (k) {
+    case PrimitiveKind::lines: return g.lines.segment_count();
+    case PrimitiveKind::curves: return g.curves.segment_count();
+    case PrimitiveKind::spheres: return g.spheres.size();
+    case PrimitiveKind::discs: return g.discs.size();
+    default: return g.mesh.size();
+    }
+}
+
 /// The primitives `g` draws, every kind together.
 inline std::size_t primitive_count(const Geometry& g)
 {
-    return g.lines.segment_count() + g.curves.segment_count() + g.spheres.size() + g.discs.size() +
-           g.mesh.size();
+    std::size_t n = 0;
+    for (PrimitiveKind k : primitive_kinds)
+        n += primitive_count(g, k);
+    return n;
 }
 
 /// An instance's placement x' = A x + t: Instance::transform read as its 3x4 column-major

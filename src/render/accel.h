@@ -9,6 +9,7 @@
 #include <span>
 #include <vector>
 
+#include "geom/primitives.h"
 #include "geom/scene.h"
 #include "render/camera.h"
 #include "render/vecf.h"
@@ -112,7 +113,7 @@ struct LightRay {
 };
 
 /// The Geometry array a shape's primitives are in.
-enum class PrimitiveKind : std::uint8_t { lines, curves, spheres, discs, mesh };
+using geom::PrimitiveKind;
 inline PrimitiveKind primitive_kind(Shape s)
 {
     switch (s) {

@@ -163,6 +163,7 @@ AreaLights::Group AreaLights::make_group(const geom::Geometry& g, std::uint16_t 
     Group group;
     for (Shape shape : emitting_shapes) {
         const ShapeKind& row = kind(shape);
+        // (lines: only shaded ones; pixel-width lines are drawn unlit)
         if ((row.similarity_only && !round_shapes) || (shape == Shape::line && !lines))
             continue;
         add_emitters(group, shape, row.emitting_part(g), front_inherited, back_inherited,
