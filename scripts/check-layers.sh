@@ -5,8 +5,8 @@
 #   lsys    + base
 #   geom    + lsys; never Embree, TBB, OpenImageIO or render
 #   env     + geom (open L-systems' environments); never Embree, TBB, OpenImageIO or render
-#   render  + geom/scene.h, geom/scene_limits.h, geom/line_ends.h and geom/vec.h (the Scene contract), Embree, TBB,
-#           FreeType and fontconfig (labels), cairo (vector outputs)
+#   render  + geom/scene.h, geom/primitives.h, geom/scene_limits.h, geom/line_ends.h and geom/vec.h
+#           (the Scene contract), Embree, TBB, FreeType and fontconfig (labels), cairo (vector outputs)
 #   imageio what render may + render + OpenImageIO (libcambium_imageio.so: the only OpenImageIO user)
 #   app     everything
 #   python  + app (the command's pipeline) and pybind11: the Python module
@@ -23,8 +23,8 @@ BEGIN {
     project["lsys"] = "^(base|lsys)/"
     project["geom"] = "^(base|lsys|geom)/"
     project["env"] = "^(base|lsys|geom|env)/"
-    project["render"] = "^(base|render)/|^geom/(scene|scene_limits|line_ends|vec)\\.h$"
-    project["imageio"] = "^(base|render|imageio)/|^geom/(scene|scene_limits|line_ends|vec)\\.h$"
+    project["render"] = "^(base|render)/|^geom/(scene|primitives|scene_limits|line_ends|vec)\\.h$"
+    project["imageio"] = "^(base|render|imageio)/|^geom/(scene|primitives|scene_limits|line_ends|vec)\\.h$"
     project["app"] = "."
     project["python"] = "^(base|lsys|geom|env|render|app)/"
     library["render"] = "^(embree3|tbb|fontconfig)/|^ft2build\\.h$|^cairo(-[a-z]+)?\\.h$"
@@ -35,7 +35,7 @@ BEGIN {
     rule["lsys"] = "the standard library and base only"
     rule["geom"] = "the standard library, base and lsys only"
     rule["env"] = "the standard library, base, lsys and geom only"
-    rule["render"] = "base, geom/scene.h, geom/scene_limits.h, geom/line_ends.h, geom/vec.h, Embree, TBB, FreeType, fontconfig and cairo only"
+    rule["render"] = "base, geom/scene.h, geom/primitives.h, geom/scene_limits.h, geom/line_ends.h, geom/vec.h, Embree, TBB, FreeType, fontconfig and cairo only"
     rule["imageio"] = "base, render, the Scene contract, TBB and OpenImageIO only"
     rule["app"] = "anything"
     rule["python"] = "the project layers and pybind11 only"

@@ -30,6 +30,7 @@
 #include "base/subprocess.h"
 #include "geom/background_scene.h"
 #include "geom/placed_geometry.h"
+#include "geom/primitives.h"
 #include "geom/scene_limits.h"
 #include "render/framing.h"
 #include "render/render.h"
@@ -206,13 +207,6 @@ bool same_texture(const geom::TextureDef& x, const geom::TextureDef& y)
 /// Tables appended to a combined table: (offset, size) each.
 using Tables = std::vector<std::pair<std::size_t, std::size_t>>;
 
-/// The primitives `g` draws (each about 100 B in the BVH and its arrays).
-std::size_t primitive_count(const geom::Geometry& g)
-{
-    return g.lines.segment_count() + g.curves.segment_count() + g.spheres.size() + g.discs.size() +
-           g.mesh.size();
-}
-
 /// A plant variant ready to place: its prototype, its organs' instances in its own
 /// frame, its bounds.
 struct PlacedVariant {
@@ -373,8 +367,7 @@ geom::Bounds3 placed_bounds(const geom::Bounds3& b, const Transform& t)
     for (int i = 0; i < 8; ++i) {
         double x = (i & 1) ? b.hi.x : b.lo.x, y = (i & 2) ? b.hi.y : b.lo.y,
                z = (i & 4) ? b.hi.z : b.lo.z;
-        out.extend(geom::Vec3{t[0] * x + t[3] * y + t[6] * z + t[9], t[1] * x + t[4] * y + t[7] * z + t[10],
-                              t[2] * x + t[5] * y + t[8] * z + t[11]});
+        out.extend(geom::Affine3x4(t).apply(geom::Vec3{x, y, z}));
     }
     return out;
 }

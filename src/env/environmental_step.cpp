@@ -9,6 +9,7 @@
 #include "env/builtins.h"
 #include "base/limits.h"
 #include "geom/gls_polygons.h"
+#include "geom/primitives.h"
 #include "geom/query.h"
 
 namespace cambium::env {
@@ -43,24 +44,13 @@ SentVector sent_scalar(const std::optional<TurtleFormat>& format, double v)
     return s;
 }
 
-/// A point of a placed plant in the world.
-geom::Vec3 placed_point(const geom::Vec3& v, const std::array<float, 12>& m)
-{
-    return {m[0] * v.x + m[3] * v.y + m[6] * v.z + m[9], m[1] * v.x + m[4] * v.y + m[7] * v.z + m[10],
-            m[2] * v.x + m[5] * v.y + m[8] * v.z + m[11]};
-}
-
 /// The turtle in the world of a placed plant: position moved, frame turned (unit length).
 void place(geom::TurtleAtModule& t, const std::array<float, 12>& m)
 {
-    auto linear = [&](const geom::Vec3& v) {
-        return geom::Vec3{m[0] * v.x + m[3] * v.y + m[6] * v.z, m[1] * v.x + m[4] * v.y + m[7] * v.z,
-                          m[2] * v.x + m[5] * v.y + m[8] * v.z};
-    };
-    const geom::Vec3 p = linear(t.position);
-    t.position = {p.x + m[9], p.y + m[10], p.z + m[11]};
+    const geom::Affine3x4 placement(m);
+    t.position = placement.apply(t.position);
     for (geom::Vec3* v : {&t.heading, &t.left, &t.up})
-        *v = geom::normalize(linear(*v));
+        *v = geom::normalize(placement.linear(*v));
 }
 
 }  // namespace
@@ -200,7 +190,7 @@ std::vector<Query> EnvironmentalStep::queries_of(const lsys::TurtleString& pass,
             for (geom::GlsPolygon& p : polygons[range_of[c - communicating.begin()]]) {
                 if (m_connection.placement)
                     for (geom::Vec3& v : p)
-                        v = placed_point(v, *m_connection.placement);
+                        v = geom::Affine3x4(*m_connection.placement).apply(v);
                 q.geometry->push_back(geom::gls_polygon_statement(p));
                 geometry_bytes += q.geometry->back().size() + 1;
             }

@@ -5,6 +5,7 @@
 
 #include "geom/background_scene.h"
 #include "geom/placed_geometry.h"
+#include "geom/primitives.h"
 
 namespace cambium::geom {
 
@@ -14,8 +15,7 @@ namespace {
 bool small_mesh(const Prototype& p, const FlattenLimits& limits)
 {
     const Geometry& g = p.geometry;
-    return g.lines.segment_count() == 0 && g.curves.segment_count() == 0 && g.spheres.size() == 0 &&
-           g.discs.size() == 0 && g.mesh.size() > 0 &&
+    return g.mesh.size() > 0 && primitive_count(g) == g.mesh.size() &&
            g.mesh.size() <= limits.max_prototype_triangles;
 }
 

@@ -14,6 +14,7 @@
 #include "base/diagnostics.h"
 #include "base/limits.h"
 #include "geom/mesh_export.h"
+#include "geom/primitives.h"
 #include "geom/tessellate.h"
 
 namespace cambium::geom {
@@ -41,12 +42,6 @@ struct Segments {
     float width = 1;
 };
 
-Vec3 placed(const std::array<float, 12>& m, const Vec3& p)
-{
-    return {m[0] * p.x + m[3] * p.y + m[6] * p.z + m[9], m[1] * p.x + m[4] * p.y + m[7] * p.z + m[10],
-            m[2] * p.x + m[5] * p.y + m[8] * p.z + m[11]};
-}
-
 void add_segments(const LinearCurves& lines, const Instance* in, Segments& out)
 {
     for (std::size_t i = 0; i < lines.segment_count(); ++i) {
@@ -55,8 +50,8 @@ void add_segments(const LinearCurves& lines, const Instance* in, Segments& out)
         Vec3 pa{a[0], a[1], a[2]}, pb{b[0], b[1], b[2]};
         std::uint16_t m = i < lines.material.size() ? lines.material[i] : 0;
         if (in) {
-            pa = placed(in->transform, pa);
-            pb = placed(in->transform, pb);
+            pa = Affine3x4(in->transform).apply(pa);
+            pb = Affine3x4(in->transform).apply(pb);
             if (m == inherit_material)
                 m = in->material;
         }

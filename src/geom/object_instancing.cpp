@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "base/diagnostics.h"
+#include "geom/primitives.h"
 
 namespace cambium::geom {
 namespace {
@@ -35,12 +36,6 @@ bool is_float_format(const std::string& format)
     if (i < format.size() && format[i] == 'l')
         ++i;
     return i < format.size() && std::string_view("eEfFgG").find(format[i]) != std::string_view::npos;
-}
-
-Float3 place_point(const std::array<float, 12>& m, const Float3& p)
-{
-    return {m[0] * p[0] + m[3] * p[1] + m[6] * p[2] + m[9], m[1] * p[0] + m[4] * p[1] + m[7] * p[2] + m[10],
-            m[2] * p[0] + m[5] * p[1] + m[8] * p[2] + m[11]};
 }
 
 /// A normal under the placement: by the inverse transpose of its 3x3 part (the
@@ -96,7 +91,7 @@ void append_placed_mesh(TriangleMesh& into, const TriangleMesh& from, const Inst
         into.module.insert(into.module.end(), from.size(), instance.module);
     auto base = static_cast<std::uint32_t>(into.positions.size());
     for (std::size_t i = 0; i < from.positions.size(); ++i) {
-        into.positions.push_back(place_point(instance.transform, from.positions[i]));
+        into.positions.push_back(Affine3x4(instance.transform).apply(from.positions[i]));
         into.normals.push_back(i < from.normals.size() ? place_normal(instance.transform, from.normals[i])
                                                        : Float3{0, 0, 0});
         into.uvs.push_back(i < from.uvs.size() ? from.uvs[i] : Float2{0, 0});

@@ -4,29 +4,12 @@
 
 #include <cmath>
 
+#include "geom/primitives.h"
+
 namespace cambium::geom {
 namespace {
 
 using Transform = std::array<float, 12>;
-
-Float3 apply_point(const Transform& m, float x, float y, float z)
-{
-    return {m[0] * x + m[3] * y + m[6] * z + m[9], m[1] * x + m[4] * y + m[7] * z + m[10],
-            m[2] * x + m[5] * y + m[8] * z + m[11]};
-}
-
-Float3 apply_vector(const Transform& m, float x, float y, float z)
-{
-    return {m[0] * x + m[3] * y + m[6] * z, m[1] * x + m[4] * y + m[7] * z,
-            m[2] * x + m[5] * y + m[8] * z};
-}
-
-double determinant(const Transform& m)
-{
-    return double(m[0]) * (double(m[4]) * m[8] - double(m[7]) * m[5]) -
-           double(m[3]) * (double(m[1]) * m[8] - double(m[7]) * m[2]) +
-           double(m[6]) * (double(m[1]) * m[5] - double(m[4]) * m[2]);
-}
 
 /// Normals go by the inverse transpose: the cofactor matrix (the determinant's
 /// factor does not matter after normalising; its sign does).
@@ -45,7 +28,7 @@ Float3 apply_normal(const Transform& m, const Float3& n, double det)
 
 void place_key(Float4& k, const Transform& m, float radius_scale)
 {
-    Float3 p = apply_point(m, k[0], k[1], k[2]);
+    Float3 p = Affine3x4(m).apply(Float3{k[0], k[1], k[2]});
     k = {p[0], p[1], p[2], k[3] * radius_scale};
 }
 
@@ -73,7 +56,7 @@ void inherit_texture(std::vector<std::int16_t>& textures, std::size_t count, std
 void place_geometry(Geometry& g, const Instance& instance)
 {
     const Transform& m = instance.transform;
-    double det = determinant(m);
+    double det = Affine3x4(m).determinant();
     auto radius_scale = static_cast<float>(std::cbrt(std::abs(det)));
 
     for (Float4& k : g.lines.keys)
@@ -84,7 +67,7 @@ void place_geometry(Geometry& g, const Instance& instance)
     for (Float4& p : g.curves.points)
         place_key(p, m, radius_scale);
     for (Float4& t : g.curves.tangents) {
-        Float3 v = apply_vector(m, t[0], t[1], t[2]);
+        Float3 v = Affine3x4(m).linear(Float3{t[0], t[1], t[2]});
         t = {v[0], v[1], v[2], t[3] * radius_scale};
     }
     inherit(g.curves.material, instance.material);
@@ -105,7 +88,7 @@ void place_geometry(Geometry& g, const Instance& instance)
 
     TriangleMesh& mesh = g.mesh;
     for (Float3& p : mesh.positions)
-        p = apply_point(m, p[0], p[1], p[2]);
+        p = Affine3x4(m).apply(p);
     for (Float3& n : mesh.normals)
         if (n[0] != 0 || n[1] != 0 || n[2] != 0)
             n = apply_normal(m, n, det);

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "base/diagnostics.h"
+#include "geom/primitives.h"
 
 namespace cambium::geom {
 namespace {
@@ -205,9 +206,7 @@ bool placeable(const Instance& instance, double reach)
     double norm = 0;
     for (int row = 0; row < 3; ++row)
         norm = std::max(norm, std::abs(double(m[row])) + std::abs(double(m[3 + row])) + std::abs(double(m[6 + row])));
-    double det = double(m[0]) * (double(m[4]) * m[8] - double(m[7]) * m[5]) -
-                 double(m[3]) * (double(m[1]) * m[8] - double(m[7]) * m[2]) +
-                 double(m[6]) * (double(m[1]) * m[5] - double(m[4]) * m[2]);
+    double det = Affine3x4(m).determinant();
     if (!(std::abs(det) > 0) || norm > max_instance_scale)
         return false;
     // The inverse's rows are the cofactor columns over the determinant.

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
-// EmbreeScene: the Scene's primitives in Embree (the only user of <embree3/rtcore.h>).
+// EmbreeScene: the Scene's primitives in Embree (with render/shapes, the only user of
+// <embree3/rtcore.h>): the scenes built, hits resolved, rays traced.
 #include "render/accel.h"
 
 #include <embree3/rtcore.h>
@@ -33,6 +34,7 @@
 #include "render/pixel_lines.h"
 #include "render/ray_counter.h"
 #include "render/ray_tilt.h"
+#include "render/shapes.h"
 #include "render/texture.h"
 #include "render/tube_angle.h"
 
@@ -75,23 +77,11 @@ struct ErrorSink {
     }
 };
 
-using Key = std::array<float, 4>;
-
-Vec3f vec(const geom::Float3& a) { return {a[0], a[1], a[2]}; }
-Vec3f vec(const geom::Float4& a) { return {a[0], a[1], a[2]}; }
-
 /// v normalised (zero stays zero) by one division, not three: the hit's normals.
 Vec3f unit(const Vec3f& v)
 {
     float l = length(v);
     return l > 0 ? v * (1 / l) : v;
-}
-
-/// The largest magnitude among p's coordinates. std::max, not std::fmax: for numbers they
-/// agree, and fmax's NaN rule keeps the compiler from inlining it (a libm call per use).
-float largest_coordinate(const Vec3f& p)
-{
-    return std::max({std::fabs(p.x), std::fabs(p.y), std::fabs(p.z)});
 }
 
 /// An intersection context that carries the primitive to ignore (Embree 3 passes the
@@ -195,600 +185,7 @@ std::size_t heap_in_use()
 #endif
 }
 
-/// The Hermite basis at u: weights of p0, t0, p1, t1.
-std::array<float, 4> hermite(float u)
-{
-    float u2 = u * u, u3 = u2 * u;
-    return {2 * u3 - 3 * u2 + 1, u3 - 2 * u2 + u, -2 * u3 + 3 * u2, u3 - u2};
-}
-
-/// The derivatives of the Hermite basis at u.
-std::array<float, 4> hermite_derivative(float u)
-{
-    float u2 = u * u;
-    return {6 * u2 - 6 * u, 3 * u2 - 4 * u + 1, -6 * u2 + 6 * u, 3 * u2 - 2 * u};
-}
-
-template <class T>
-T at_or(const std::vector<T>& v, std::size_t i, T fallback)
-{
-    return i < v.size() ? v[i] : fallback;
-}
-
-struct HitResolver;
-
-/// A primitive's own material entries for both sides (`back` = `front` where the part has
-/// no back materials), before inherit_material is resolved.
-struct MaterialEntries {
-    std::uint16_t front = 0, back = 0;
-};
-
-/// What a hit on a triangle of a large mesh reads of it, in one cache line (56 of its 64
-/// bytes): the true normal turned to the front and the extent, as triangle_surface()
-/// makes them from the vertices, the three vertex normals and the material entries. Read
-/// through the triangle's vertex indices instead, each hit waited for two cache misses,
-/// one after the other (the indices, then the vertices), beside those of the entries.
-struct alignas(64) TriangleRecord {
-    Vec3f face;
-    float extent = 0;
-    std::array<Vec3f, 3> normals;
-    MaterialEntries materials;
-};
-static_assert(sizeof(TriangleRecord) == 64);
-
-/// One Embree geometry's source primitives and where their attributes live.
-struct GeometrySource {
-    Shape shape = Shape::line;
-    const geom::Geometry* geometry = nullptr;
-    const Key* line_keys = nullptr;  ///< lines, caps, joints: keys with world-unit radii
-    bool unlit = false;
-    const HitResolver* owner = nullptr;
-    const LineEnds* ends = nullptr;  ///< caps and joints: the segments they belong to
-    /// Per-primitive attributes, indexed by attribute_index(): front and back (flat
-    /// shapes only) materials, textures (none: never textured).
-    const std::vector<std::uint16_t>* material = nullptr;
-    const std::vector<std::uint16_t>* back_material = nullptr;
-    const std::vector<std::int16_t>* texture = nullptr;
-    /// Some primitive names a texture in `texture` (else only an instance's can apply).
-    bool own_textures = false;
-    /// Caps and joints: the line segment each belongs to (their attributes are its).
-    const std::vector<std::uint32_t>* segment = nullptr;
-    /// The filters its Embree geometry runs on each candidate hit (none: no filter at all):
-    /// the primitive a ray leaves, the pixels a pixel-width line covers, alpha cut-outs.
-    bool skips_self = false, pixel_line = false, cut_out = false;
-    /// Every primitive's material entries are `uniform` (found at build time), so a hit
-    /// reads none: Lilac's 247 k petal triangles have one material, whose two entries
-    /// per triangle were two more cache misses a hit (beside the vertices').
-    std::optional<MaterialEntries> uniform{};
-    /// Triangles of a large mesh of the scene's own: one record each (wants_records(),
-    /// make_records()), else null.
-    const TriangleRecord* records = nullptr;
-
-    std::uint32_t attribute_index(std::uint32_t prim) const
-    {
-        return segment ? (*segment)[prim] : prim;
-    }
-};
-
-/// What a primitive says about its hit in object space.
-struct LocalSurface {
-    Vec3f geometric;     ///< true normal (front side for discs and triangles)
-    /// Triangles: the vertex normals interpolated (front side), or zero: the geometric
-    /// one. Other shapes have none (zero), and surface_hit() reads it for triangles only.
-    Vec3f shading;
-    float radius = 0;
-    bool two_sided = false;
-    /// Flat shapes: their largest coordinate (object space), a measure of the float error
-    /// of a hit on them.
-    float extent = 0;
-};
-
-using TextureCoords = std::array<float, 2>;
-using TextureTangents = std::array<Vec3f, 2>;
-struct TextureFrame {
-    TextureCoords st;
-    TextureTangents tangents;
-};
-
-/// Everything accel does that depends on the kind of primitive: one entry per Shape in
-/// `shape_kinds`, so a new kind of primitive is added in one place (and a case in
-/// local_surface(), which every hit calls).
-struct ShapeKind {
-    /// Embree's geometry of the part's primitives (throws cambium::Error on a bad index).
-    RTCGeometry (*build)(RTCDevice device, const GeometrySource& part);
-    /// Texture coordinates (s, t) of a hit.
-    TextureCoords (*texture_coords)(const GeometrySource& part, std::uint32_t prim, float u,
-                                    float v, const Vec3f& ng);
-    /// A textured hit's (s, t) and its tangents: texture_coords, and dP/ds and dP/dt in
-    /// object space (their derivatives; zero where a coordinate does not change). One call,
-    /// so that what both need (a curve's axis) is found once.
-    TextureFrame (*texture_frame)(const GeometrySource& part, std::uint32_t prim, float u,
-                                  float v, const Vec3f& ng, float radius);
-    /// Spawned rays start this far off the surface: per unit of radius, per unit of the
-    /// hit's largest coordinate, and absolute (see EmbreeScene::intersect).
-    float offset_per_radius, offset_per_scale, offset_absolute;
-    /// Whether a ray leaving the shape must skip it: Embree's round curves and spheres
-    /// have no self-intersection protection (FACTS.md: half the rays leaving a curve would
-    /// hit it again), so their geometries filter the primitive a ray leaves. Flat shapes
-    /// rely on their offset alone and run no filter for it.
-    bool self_hits;
-};
-
-// ---- Shared by the shapes ------------------------------------------------------------
-
-void check_segments(const std::vector<std::uint32_t>& segments, std::size_t keys,
-                    const char* what)
-{
-    for (std::uint32_t first : segments)
-        if (first + 1 >= keys)
-            throw Error(std::string("scene: ") + what + " segment starts at key " +
-                        std::to_string(first) + " of " + std::to_string(keys));
-}
-
-template <class T>
-void check_size(const std::vector<T>& v, std::size_t n, const char* what)
-{
-    if (v.size() != n)
-        throw Error(std::string("scene: ") + std::to_string(v.size()) + " " + what + " for " +
-                    std::to_string(n));
-}
-
-/// Copies `data` into a new Embree-owned buffer (Embree pads it for its SSE loads, which
-/// shared float3 and uint3 buffers would need by hand).
-template <class T>
-void copy_buffer(RTCGeometry g, RTCBufferType type, RTCFormat format, const std::vector<T>& data)
-{
-    void* dst = rtcSetNewGeometryBuffer(g, type, 0, format, sizeof(T), data.size());
-    if (dst)
-        std::memcpy(dst, data.data(), sizeof(T) * data.size());
-}
-
-void share_keys(RTCGeometry g, RTCBufferType type, const Key* keys, std::size_t n)
-{
-    rtcSetSharedGeometryBuffer(g, type, 0, RTC_FORMAT_FLOAT4, keys, 0, sizeof(Key), n);
-}
-
-void share_segments(RTCGeometry g, const std::vector<std::uint32_t>& segments)
-{
-    rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, segments.data(), 0,
-                               sizeof(std::uint32_t), segments.size());
-}
-
-void set_flags(RTCGeometry g, const std::vector<std::uint8_t>& flags, std::size_t segments)
-{
-    // Neighbour flags close the joints of a polyline without caps or bulges.
-    if (flags.size() == segments)
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_FLAGS, 0, RTC_FORMAT_UCHAR, flags.data(), 0,
-                                   sizeof(std::uint8_t), flags.size());
-    else if (!flags.empty())
-        warn("scene: " + std::to_string(flags.size()) + " curve flags for " +
-             std::to_string(segments) + " segments; flags ignored");
-}
-
-/// Around a tube, s runs once round the circumference; along it, t as its keys say.
-/// (The cross product's direction does not depend on ng's length: one root, one division.)
-TextureTangents tube_tangents(const Vec3f& axis, const Vec3f& ng, float radius, float dv)
-{
-    const Vec3f around = cross(axis, ng);
-    const float length = std::sqrt(dot(around, around));
-    return {length > 0 ? around * (2 * pi * radius / length) : around,
-            dv != 0 ? axis * (1 / dv) : Vec3f()};
-}
-
-TextureTangents no_tangents(const GeometrySource&, std::uint32_t, float, const Vec3f&, float)
-{
-    return {Vec3f(), Vec3f()};
-}
-
-TextureCoords no_coords(const GeometrySource&, std::uint32_t, float, float, const Vec3f&)
-{
-    return {0, 0};
-}
-
-/// A shape's texture frame from its separate coordinates and tangents (shapes whose two
-/// share no work).
-template <auto coords, auto tangents>
-TextureFrame frame_of(const GeometrySource& part, std::uint32_t prim, float u, float v,
-                      const Vec3f& ng, float radius)
-{
-    return {coords(part, prim, u, v, ng), tangents(part, prim, u, ng, radius)};
-}
-
-// ---- Lines (F, G): cone curves, or round ones for pixel-width lines ------------------
-
-RTCGeometry build_lines(RTCDevice device, const GeometrySource& part)
-{
-    const geom::LinearCurves& l = part.geometry->lines;
-    check_segments(l.segments, l.keys.size(), "line");
-    // cpfg's pixel lines are GL lines: Embree's round (swept-sphere) curves suit them;
-    // shaded cylinders are exact frustums closed by caps and joints (LineEnds).
-    RTCGeometry g = rtcNewGeometry(device, part.unlit ? RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE
-                                                      : RTC_GEOMETRY_TYPE_CONE_LINEAR_CURVE);
-    share_keys(g, RTC_BUFFER_TYPE_VERTEX, part.line_keys, l.keys.size());
-    share_segments(g, l.segments);
-    if (part.unlit)
-        set_flags(g, l.flags, l.segments.size());
-    return g;
-}
-
-[[gnu::always_inline]] inline LocalSurface line_surface(const GeometrySource& part,
-                                                        std::uint32_t prim, float u, float,
-                                                        const Vec3f& ng)
-{
-    const geom::LinearCurves& l = part.geometry->lines;
-    const Key& k0 = part.line_keys[l.segments[prim]];
-    const Key& k1 = part.line_keys[l.segments[prim] + 1];
-    return {ng, Vec3f(), k0[3] + (k1[3] - k0[3]) * u, false};
-}
-
-/// Texture t at key k of the lines (0 without per-key t).
-float line_t(const geom::LinearCurves& l, std::uint32_t k)
-{
-    return l.v.size() == l.keys.size() ? l.v[k] : 0.0f;
-}
-
-TextureCoords line_coords(const GeometrySource& part, std::uint32_t prim, float u, float,
-                          const Vec3f& ng)
-{
-    const geom::LinearCurves& l = part.geometry->lines;
-    std::uint32_t k = l.segments[prim];
-    float t = line_t(l, k) + (line_t(l, k + 1) - line_t(l, k)) * u;
-    return {angle_around(vec(part.line_keys[k + 1]) - vec(part.line_keys[k]), ng), t};
-}
-
-/// line_coords and the tube's tangents, from one axis.
-TextureFrame line_frame(const GeometrySource& part, std::uint32_t prim, float u, float,
-                        const Vec3f& ng, float radius)
-{
-    const geom::LinearCurves& l = part.geometry->lines;
-    std::uint32_t k = l.segments[prim];
-    const float t0 = line_t(l, k), dt = line_t(l, k + 1) - t0;
-    const Vec3f axis = vec(part.line_keys[k + 1]) - vec(part.line_keys[k]);
-    return {{angle_around(axis, ng), t0 + dt * u}, tube_tangents(axis, ng, radius, dt)};
-}
-
-// ---- Caps and joints: the flat free ends and round bends of shaded lines ------------
-
-/// The largest coordinate of a disc (centre and radius).
-float disc_extent(const Key& c) { return largest_coordinate(vec(c)) + c[3]; }
-
-RTCGeometry build_caps(RTCDevice device, const GeometrySource& part)
-{
-    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
-    share_keys(g, RTC_BUFFER_TYPE_VERTEX, part.ends->caps.data(), part.ends->caps.size());
-    const std::vector<geom::Float3>& normals = part.ends->cap_normals;
-    if (geom::padded_for_embree(normals))  // line_ends() leaves the room
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_NORMAL, 0, RTC_FORMAT_FLOAT3, normals.data(), 0,
-                                   sizeof(geom::Float3), normals.size());
-    else
-        copy_buffer(g, RTC_BUFFER_TYPE_NORMAL, RTC_FORMAT_FLOAT3, normals);
-    return g;
-}
-
-[[gnu::always_inline]] inline LocalSurface cap_surface(const GeometrySource& part,
-                                                       std::uint32_t prim, float, float,
-                                                       const Vec3f&)
-{
-    // the solid cylinder's end: its normal points out, like the tube's
-    const Key& cap = part.ends->caps[prim];
-    return {vec(part.ends->cap_normals[prim]), Vec3f(), cap[3], false, disc_extent(cap)};
-}
-
-/// The rim's t; s is the centre of the unrolled tube (one texel across the end).
-TextureCoords cap_coords(const GeometrySource& part, std::uint32_t prim, float, float,
-                         const Vec3f&)
-{
-    const geom::LinearCurves& l = part.geometry->lines;
-    return {0.5f, line_t(l, l.segments[part.ends->cap_segment[prim]] +
-                               part.ends->cap_at_end[prim])};
-}
-
-RTCGeometry build_joints(RTCDevice device, const GeometrySource& part)
-{
-    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
-    share_keys(g, RTC_BUFFER_TYPE_VERTEX, part.ends->joints.data(), part.ends->joints.size());
-    return g;
-}
-
-[[gnu::always_inline]] inline LocalSurface joint_surface(const GeometrySource& part,
-                                                         std::uint32_t prim, float, float,
-                                                         const Vec3f& ng)
-{
-    return {ng, Vec3f(), part.ends->joints[prim][3], false};
-}
-
-TextureCoords joint_coords(const GeometrySource& part, std::uint32_t prim, float, float,
-                           const Vec3f&)
-{
-    const geom::LinearCurves& l = part.geometry->lines;
-    return {0.5f, line_t(l, l.segments[part.ends->joint_segment[prim]] + 1)};
-}
-
-// ---- Curves: generalized cylinders as round Hermite segments ------------------------
-
-RTCGeometry build_curves(RTCDevice device, const GeometrySource& part)
-{
-    const geom::HermiteCurves& c = part.geometry->curves;
-    check_segments(c.segments, c.points.size(), "curve");
-    check_size(c.tangents, c.points.size(), "curve tangents");
-    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ROUND_HERMITE_CURVE);
-    share_keys(g, RTC_BUFFER_TYPE_VERTEX, c.points.data(), c.points.size());
-    share_keys(g, RTC_BUFFER_TYPE_TANGENT, c.tangents.data(), c.tangents.size());
-    share_segments(g, c.segments);
-    set_flags(g, c.flags, c.segments.size());
-    return g;
-}
-
-/// The direction of a Hermite segment's axis (its derivative) at u.
-Vec3f hermite_axis(const geom::HermiteCurves& c, std::uint32_t k, float u)
-{
-    auto d = hermite_derivative(u);
-    return vec(c.points[k]) * d[0] + vec(c.tangents[k]) * d[1] + vec(c.points[k + 1]) * d[2] +
-           vec(c.tangents[k + 1]) * d[3];
-}
-
-[[gnu::always_inline]] inline LocalSurface curve_surface(const GeometrySource& part,
-                                                         std::uint32_t prim, float u, float,
-                                                         const Vec3f& ng)
-{
-    const geom::HermiteCurves& c = part.geometry->curves;
-    std::uint32_t k = c.segments[prim];
-    auto h = hermite(u);
-    float radius = c.points[k][3] * h[0] + c.tangents[k][3] * h[1] + c.points[k + 1][3] * h[2] +
-                   c.tangents[k + 1][3] * h[3];
-    return {ng, Vec3f(), radius, false};
-}
-
-float curve_dv(const geom::HermiteCurves& c, std::uint32_t k)
-{
-    return c.v.size() == c.points.size() ? c.v[k + 1] - c.v[k] : 0.0f;
-}
-
-TextureCoords curve_coords(const GeometrySource& part, std::uint32_t prim, float u, float,
-                           const Vec3f& ng)
-{
-    const geom::HermiteCurves& c = part.geometry->curves;
-    std::uint32_t k = c.segments[prim];
-    float t = c.v.size() == c.points.size() ? c.v[k] + curve_dv(c, k) * u : 0.0f;
-    return {angle_around(hermite_axis(c, k, u), ng), t};
-}
-
-/// curve_coords and the tube's tangents, from one evaluation of the axis.
-TextureFrame curve_frame(const GeometrySource& part, std::uint32_t prim, float u, float,
-                         const Vec3f& ng, float radius)
-{
-    const geom::HermiteCurves& c = part.geometry->curves;
-    std::uint32_t k = c.segments[prim];
-    const bool keyed = c.v.size() == c.points.size();
-    const float dv = keyed ? c.v[k + 1] - c.v[k] : 0.0f;
-    const Vec3f axis = hermite_axis(c, k, u);
-    return {{angle_around(axis, ng), keyed ? c.v[k] + dv * u : 0.0f},
-            tube_tangents(axis, ng, radius, dv)};
-}
-
-// ---- Spheres (@O) -------------------------------------------------------------------
-
-RTCGeometry build_spheres(RTCDevice device, const GeometrySource& part)
-{
-    const geom::Spheres& sp = part.geometry->spheres;
-    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
-    share_keys(g, RTC_BUFFER_TYPE_VERTEX, sp.centres.data(), sp.centres.size());
-    return g;
-}
-
-[[gnu::always_inline]] inline LocalSurface sphere_surface(const GeometrySource& part,
-                                                          std::uint32_t prim, float, float,
-                                                          const Vec3f& ng)
-{
-    return {ng, Vec3f(), part.geometry->spheres.centres[prim][3], false};
-}
-
-/// s = longitude / 2 pi about z, t = latitude / pi + 1/2.
-TextureCoords sphere_coords(const GeometrySource&, std::uint32_t, float, float, const Vec3f& ng)
-{
-    Vec3f n = normalize(ng);
-    return {std::atan2(n.y, n.x) / (2 * pi) + 0.5f,
-            std::asin(std::fmax(-1.0f, std::fmin(1.0f, n.z))) / pi + 0.5f};
-}
-
-TextureTangents sphere_tangents(const GeometrySource&, std::uint32_t, float, const Vec3f& ng,
-                                float radius)
-{
-    Vec3f n = normalize(ng);
-    float rxy = std::sqrt(n.x * n.x + n.y * n.y);
-    if (rxy <= 0)
-        return {Vec3f(), Vec3f()};
-    Vec3f east(-n.y / rxy, n.x / rxy, 0), north(-n.z * n.x / rxy, -n.z * n.y / rxy, rxy);
-    return {east * (2 * pi * radius * rxy), north * (pi * radius)};
-}
-
-// ---- Discs (@o, @c) -----------------------------------------------------------------
-
-RTCGeometry build_discs(RTCDevice device, const GeometrySource& part)
-{
-    const geom::Discs& d = part.geometry->discs;
-    check_size(d.normals, d.centres.size(), "disc normals");
-    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ORIENTED_DISC_POINT);
-    share_keys(g, RTC_BUFFER_TYPE_VERTEX, d.centres.data(), d.centres.size());
-    copy_buffer(g, RTC_BUFFER_TYPE_NORMAL, RTC_FORMAT_FLOAT3, d.normals);
-    return g;
-}
-
-[[gnu::always_inline]] inline LocalSurface disc_surface(const GeometrySource& part,
-                                                        std::uint32_t prim, float, float,
-                                                        const Vec3f&)
-{
-    return {vec(part.geometry->discs.normals[prim]), Vec3f(), 0, true,
-            disc_extent(part.geometry->discs.centres[prim])};
-}
-
-// ---- Triangles (polygons, surfaces, meshes) -----------------------------------------
-
-RTCGeometry build_triangles(RTCDevice device, const GeometrySource& part)
-{
-    const geom::TriangleMesh& m = part.geometry->mesh;
-    check_size(m.normals, m.positions.size(), "mesh normals");
-    for (const auto& tri : m.triangles)
-        for (std::uint32_t i : tri)
-            if (i >= m.positions.size())
-                throw Error("scene: triangle vertex " + std::to_string(i) + " of " +
-                            std::to_string(m.positions.size()));
-    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    // Read in place where the Scene left room for Embree's 16-byte loads past the last
-    // element (geom::fit_mesh_buffers), else copied.
-    if (geom::padded_for_embree(m.positions))
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                   m.positions.data(), 0, sizeof(geom::Float3), m.positions.size());
-    else
-        copy_buffer(g, RTC_BUFFER_TYPE_VERTEX, RTC_FORMAT_FLOAT3, m.positions);
-    if (geom::padded_for_embree(m.triangles))
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m.triangles.data(),
-                                   0, sizeof(m.triangles[0]), m.triangles.size());
-    else
-        copy_buffer(g, RTC_BUFFER_TYPE_INDEX, RTC_FORMAT_UINT3, m.triangles);
-    return g;
-}
-
-[[gnu::always_inline]] inline LocalSurface triangle_surface(const GeometrySource& part,
-                                                            std::uint32_t prim, float u, float v,
-                                                            const Vec3f&)
-{
-    if (part.records) {
-        const TriangleRecord& r = part.records[prim];
-        return {r.face, r.normals[0] * (1 - u - v) + r.normals[1] * u + r.normals[2] * v, 0,
-                true, r.extent};
-    }
-    const geom::TriangleMesh& m = part.geometry->mesh;
-    const auto& tri = m.triangles[prim];
-    Vec3f p0 = vec(m.positions[tri[0]]), p1 = vec(m.positions[tri[1]]),
-          p2 = vec(m.positions[tri[2]]);
-    Vec3f face = cross(p1 - p0, p2 - p0);
-    Vec3f n0 = vec(m.normals[tri[0]]), n1 = vec(m.normals[tri[1]]), n2 = vec(m.normals[tri[2]]);
-    // The front is where the vertex normals point; a flat face's winding if they vanish.
-    if (dot(face, n0 + n1 + n2) < 0)
-        face = -face;
-    float extent =
-        std::max({largest_coordinate(p0), largest_coordinate(p1), largest_coordinate(p2)});
-    return {face, n0 * (1 - u - v) + n1 * u + n2 * v, 0, true, extent};
-}
-
-TextureCoords triangle_coords(const GeometrySource& part, std::uint32_t prim, float u, float v,
-                              const Vec3f&)
-{
-    const geom::TriangleMesh& m = part.geometry->mesh;
-    const auto& tri = m.triangles[prim];
-    const auto& uv = m.uvs;
-    if (uv.size() != m.positions.size())
-        return {0, 0};
-    float w = 1 - u - v;
-    return {uv[tri[0]][0] * w + uv[tri[1]][0] * u + uv[tri[2]][0] * v,
-            uv[tri[0]][1] * w + uv[tri[1]][1] * u + uv[tri[2]][1] * v};
-}
-
-TextureTangents triangle_tangents(const GeometrySource& part, std::uint32_t prim, float,
-                                  const Vec3f&, float)
-{
-    const geom::TriangleMesh& m = part.geometry->mesh;
-    const auto& tri = m.triangles[prim];
-    if (m.uvs.size() != m.positions.size())
-        return {Vec3f(), Vec3f()};
-    Vec3f e1 = vec(m.positions[tri[1]]) - vec(m.positions[tri[0]]);
-    Vec3f e2 = vec(m.positions[tri[2]]) - vec(m.positions[tri[0]]);
-    const geom::Float2 &uv0 = m.uvs[tri[0]], &uv1 = m.uvs[tri[1]], &uv2 = m.uvs[tri[2]];
-    float s1 = uv1[0] - uv0[0], t1 = uv1[1] - uv0[1];
-    float s2 = uv2[0] - uv0[0], t2 = uv2[1] - uv0[1];
-    float det = s1 * t2 - s2 * t1;
-    if (!(std::fabs(det) > 1e-20f))
-        return {Vec3f(), Vec3f()};
-    float inv = 1 / det;
-    return {(e1 * t2 - e2 * t1) * inv, (e2 * s1 - e1 * s2) * inv};
-}
-
-// ---- The table ----------------------------------------------------------------------
-
-// Spawn offsets, measured (accel_test): with the leaving primitive skipped, round shapes
-// need no offset even at curve joints; a small one guards against float error at large
-// coordinates. Flat shapes skip nothing: their offset is ~80 float ulps of the hit's
-// largest coordinate or the primitive's (see EmbreeScene::intersect), which clears the
-// error of Embree's hit distance at any angle (physics_test: a plane lit at grazing angles).
-constexpr std::array<ShapeKind, 7> shape_kinds{{
-    /* line */ {build_lines, line_coords, line_frame, 1e-3f, 1e-6f, 0, true},
-    /* curve */ {build_curves, curve_coords, curve_frame, 1e-3f, 1e-6f, 0, true},
-    /* sphere */ {build_spheres, sphere_coords, frame_of<sphere_coords, sphere_tangents>, 1e-4f,
-                  1e-6f, 0, true},
-    /* disc */ {build_discs, no_coords, frame_of<no_coords, no_tangents>, 0, 1e-5f, 1e-7f, false},
-    /* triangle */ {build_triangles, triangle_coords, frame_of<triangle_coords, triangle_tangents>,
-                    0, 1e-5f, 1e-7f, false},
-    /* cap */ {build_caps, cap_coords, frame_of<cap_coords, no_tangents>, 1e-3f, 1e-5f, 1e-7f,
-               false},
-    /* joint */ {build_joints, joint_coords, frame_of<joint_coords, no_tangents>, 1e-3f, 1e-6f, 0,
-                 true},
-}};
-
-const ShapeKind& kind(Shape s) { return shape_kinds[static_cast<std::size_t>(s)]; }
-
-/// The hit's surface in object space from Embree's (u, v) and normal ng, by the part's
-/// shape. A switch, not a ShapeKind entry: called for every hit, the shapes' functions
-/// are inlined here, and their result is not returned through memory (reading it back
-/// stalled on store forwarding); inlined, as are the shapes' functions (always_inline:
-/// the compiler kept them calls).
-[[gnu::always_inline]] inline LocalSurface local_surface(const GeometrySource& part,
-                                                         std::uint32_t prim, float u, float v,
-                                                         const Vec3f& ng)
-{
-    switch (part.shape) {
-        case Shape::line: return line_surface(part, prim, u, v, ng);
-        case Shape::curve: return curve_surface(part, prim, u, v, ng);
-        case Shape::sphere: return sphere_surface(part, prim, u, v, ng);
-        case Shape::disc: return disc_surface(part, prim, u, v, ng);
-        case Shape::triangle: return triangle_surface(part, prim, u, v, ng);
-        case Shape::cap: return cap_surface(part, prim, u, v, ng);
-        case Shape::joint: return joint_surface(part, prim, u, v, ng);
-    }
-    return {ng, Vec3f(), 0, false};
-}
-
-/// The sources of a Geometry's primitives of each kind, attributes pointed at.
-GeometrySource lines_source(const geom::Geometry& g, const Key* keys, bool unlit)
-{
-    const geom::LinearCurves& l = g.lines;
-    return {Shape::line, &g, keys, unlit, nullptr, nullptr, &l.material, nullptr, &l.texture};
-}
-
-GeometrySource line_end_source(Shape shape, const geom::Geometry& g, const Key* keys,
-                               const LineEnds& ends)
-{
-    GeometrySource s = lines_source(g, keys, false);
-    s.shape = shape;
-    s.ends = &ends;
-    s.segment = shape == Shape::cap ? &ends.cap_segment : &ends.joint_segment;
-    return s;
-}
-
-GeometrySource curves_source(const geom::Geometry& g)
-{
-    return {Shape::curve, &g, nullptr, false, nullptr, nullptr, &g.curves.material, nullptr,
-            &g.curves.texture};
-}
-
-GeometrySource spheres_source(const geom::Geometry& g)
-{
-    return {Shape::sphere, &g, nullptr, false, nullptr, nullptr, &g.spheres.material, nullptr,
-            &g.spheres.texture};
-}
-
-GeometrySource discs_source(const geom::Geometry& g)
-{
-    // Discs are never textured, not even by their instance.
-    return {Shape::disc, &g, nullptr, false, nullptr, nullptr, &g.discs.material,
-            &g.discs.back_material, nullptr};
-}
-
-GeometrySource triangles_source(const geom::Geometry& g)
-{
-    return {Shape::triangle, &g, nullptr, false, nullptr, nullptr, &g.mesh.material,
-            &g.mesh.back_material, &g.mesh.texture};
-}
+}  // namespace
 
 /// What hits are resolved with: parts by geometry id, instances' placements, textures
 /// (also read by the alpha filter during traversal).
@@ -874,8 +271,6 @@ struct HitResolver {
     }
     int texture_of(const GeometrySource& part, std::uint32_t prim, const InstanceStyle* p) const;
 };
-
-}  // namespace
 
 struct EmbreeScene::Impl : HitResolver {
     ErrorSink errors;
@@ -1042,8 +437,6 @@ bool any_cut_out(const TextureSet* set, const std::vector<T>& textures)
     return false;
 }
 
-}  // namespace
-
 /// A hit's materials: the side hit, then the instance's for inherit_material; a generalized
 /// cylinder's colour blend toward its end material.
 struct HitMaterials {
@@ -1064,24 +457,6 @@ MaterialEntries material_entries(const GeometrySource& part, std::uint32_t prim)
     std::uint32_t index = part.attribute_index(prim);
     std::uint16_t front = at_or(*part.material, index, std::uint16_t{0});
     return {front, part.back_material ? at_or(*part.back_material, index, front) : front};
-}
-
-/// How many primitives the part's Embree geometry holds.
-std::size_t primitive_count(const GeometrySource& part)
-{
-    const geom::Geometry& g = *part.geometry;
-    if (part.segment)  // caps and joints: one per entry
-        return part.segment->size();
-    switch (part.shape) {
-    case Shape::line: return g.lines.segment_count();
-    case Shape::curve: return g.curves.segment_count();
-    case Shape::sphere: return g.spheres.size();
-    case Shape::disc: return g.discs.size();
-    case Shape::triangle: return g.mesh.size();
-    case Shape::cap:
-    case Shape::joint: break;  // (always with a segment)
-    }
-    return 0;
 }
 
 /// The material entries every primitive of the part has, if they are all the same (none:
@@ -1192,6 +567,8 @@ void opacity_filter(const RTCFilterFunctionNArguments* args)
     }
 }
 
+}  // namespace
+
 int HitResolver::texture_of(const GeometrySource& part, std::uint32_t prim,
                             const InstanceStyle* p) const
 {
@@ -1206,6 +583,8 @@ int HitResolver::texture_of(const GeometrySource& part, std::uint32_t prim,
         t = p->texture;
     return t;
 }
+
+namespace {
 
 /// Keeps a hit on a pixel-width line only in the pixels OpenGL draws (pixel_lines.h).
 void pixel_line_filter(const RTCFilterFunctionNArguments* args)
@@ -1256,8 +635,6 @@ void prefetch_records(const RTCFilterFunctionNArguments* args)
             __builtin_prefetch(&part->records[RTCHitN_primID(args->hit, args->N, i)]);
 }
 
-namespace {
-
 /// The bytes of `v` if Embree reads it in place (padded for its loads), else 0.
 template <class T>
 std::size_t padded_bytes(const std::vector<T>& v)
@@ -1290,8 +667,6 @@ std::size_t bytes_shared_with_embree(const GeometrySource& part)
     return 0;
 }
 
-}  // namespace
-
 /// Whether the part's triangles get records: a mesh of the scene's own geometry (a plant,
 /// with its small instances drawn in place) whose indices and vertices outgrow a core's
 /// cache (2 MiB: 64 Ki triangles hold about that much), so that hits on it miss, up to the
@@ -1322,6 +697,8 @@ std::vector<TriangleRecord> make_records(const GeometrySource& part)
     }
     return records;
 }
+
+}  // namespace
 
 void EmbreeScene::Impl::attach(RTCScene s, GeometrySource part,
                                std::vector<const GeometrySource*>& ids, bool alpha)

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// EmbreeScene: the Scene's primitives in Embree (the only user of <embree3/rtcore.h>).
+// EmbreeScene: the Scene's primitives in Embree (with render/shapes, the only Embree users).
 #pragma once
 
 #include <cstddef>
@@ -9,6 +9,7 @@
 #include <span>
 #include <vector>
 
+#include "geom/primitives.h"
 #include "geom/scene.h"
 #include "render/camera.h"
 #include "render/vecf.h"
@@ -112,7 +113,7 @@ struct LightRay {
 };
 
 /// The Geometry array a shape's primitives are in.
-enum class PrimitiveKind : std::uint8_t { lines, curves, spheres, discs, mesh };
+using geom::PrimitiveKind;
 inline PrimitiveKind primitive_kind(Shape s)
 {
     switch (s) {

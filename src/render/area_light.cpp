@@ -29,6 +29,7 @@
 #include <tuple>
 
 #include "base/diagnostics.h"
+#include "render/shapes.h"
 
 namespace cambium::render {
 
@@ -36,18 +37,9 @@ namespace {
 
 constexpr float pi = std::numbers::pi_v<float>;
 
-Vec3f vec(const geom::Float3& a) { return {a[0], a[1], a[2]}; }
-Vec3f vec(const geom::Float4& a) { return {a[0], a[1], a[2]}; }
-
 std::uint16_t resolve(std::uint16_t m, std::uint16_t inherited)
 {
     return m == geom::inherit_material ? inherited : m;
-}
-
-template <class T>
-T at_or(const std::vector<T>& v, std::size_t i, T fallback)
-{
-    return i < v.size() ? v[i] : fallback;
 }
 
 /// Where u falls in a cumulative distribution (entries 0 .. n, last 1): the entry and
@@ -125,112 +117,58 @@ void AreaLights::add(Group& group, const Light& light, std::uint64_t k)
     ++m_stored;
 }
 
+void AreaLights::add_emitters(Group& group, Shape shape, const GeometrySource& part,
+                              std::uint16_t front_inherited, std::uint16_t back_inherited,
+                              const std::vector<SurfaceMaterial>& materials)
+{
+    auto emission = [&](std::uint16_t m, std::uint16_t inherited) {
+        m = resolve(m, inherited);
+        return m < materials.size() ? materials[m].emission : Vec3f();
+    };
+    static_assert(int(Kind::triangle) == int(Emitter::Form::triangle) &&
+                  int(Kind::disc) == int(Emitter::Form::disc) &&
+                  int(Kind::sphere) == int(Emitter::Form::sphere) &&
+                  int(Kind::cylinder) == int(Emitter::Form::cylinder));
+    constexpr std::uint32_t max_prim = 0x1fffffffu;
+    const std::size_t n = primitive_count(part);
+    for (std::uint32_t i = 0; i < n && i <= max_prim; ++i) {
+        // One-sided shapes (spheres, lines) emit from their front only.
+        std::uint16_t fm = at_or(*part.material, i, std::uint16_t{0});
+        Vec3f front = emission(fm, front_inherited);
+        Vec3f back = part.back_material
+                         ? emission(at_or(*part.back_material, i, fm), back_inherited)
+                         : Vec3f();
+        Emitter e;
+        if ((is_black(front) && is_black(back)) || !kind(shape).emitter(part, i, e))
+            continue;
+        Light l;
+        l.kind = static_cast<Kind>(e.form);
+        l.a = e.a;
+        l.b = e.b;
+        l.c = e.c;
+        l.normal = e.normal;
+        l.radius = e.radius;
+        l.area = e.area;
+        l.side = e.side;
+        l.front = front;
+        l.back = back;
+        add(group, l, key(shape, i));
+    }
+}
+
 AreaLights::Group AreaLights::make_group(const geom::Geometry& g, std::uint16_t front_inherited,
                                          std::uint16_t back_inherited, bool round_shapes,
                                          const std::vector<SurfaceMaterial>& materials, bool lines)
 {
     Group group;
-    auto emission = [&](std::uint16_t m, std::uint16_t inherited) {
-        m = resolve(m, inherited);
-        return m < materials.size() ? materials[m].emission : Vec3f();
-    };
-    constexpr std::uint32_t max_prim = 0x1fffffffu;
-
-    const geom::TriangleMesh& mesh = g.mesh;
-    for (std::uint32_t i = 0; i < mesh.size() && i <= max_prim; ++i) {
-        std::uint16_t fm = at_or(mesh.material, i, std::uint16_t{0});
-        Vec3f front = emission(fm, front_inherited);
-        Vec3f back = emission(at_or(mesh.back_material, i, fm), back_inherited);
-        if (is_black(front) && is_black(back))
+    for (Shape shape : emitting_shapes) {
+        const ShapeKind& row = kind(shape);
+        // (lines: only shaded ones; pixel-width lines are drawn unlit)
+        if ((row.similarity_only && !round_shapes) || (shape == Shape::line && !lines))
             continue;
-        const auto& tri = mesh.triangles[i];
-        if (tri[0] >= mesh.positions.size() || tri[1] >= mesh.positions.size() ||
-            tri[2] >= mesh.positions.size())
-            continue;  // the Embree scene rejects such a mesh with a message
-        Vec3f p0 = vec(mesh.positions[tri[0]]), p1 = vec(mesh.positions[tri[1]]),
-              p2 = vec(mesh.positions[tri[2]]);
-        // The front, as accel decides it: where the vertex normals point, else the winding.
-        Vec3f nsum;
-        if (mesh.normals.size() == mesh.positions.size())
-            nsum = vec(mesh.normals[tri[0]]) + vec(mesh.normals[tri[1]]) +
-                   vec(mesh.normals[tri[2]]);
-        float side = dot(cross(p1 - p0, p2 - p0), nsum) < 0 ? -1.0f : 1.0f;
-        Light l;
-        l.kind = Kind::triangle;
-        l.a = p0;
-        l.b = p1;
-        l.c = p2;
-        Vec3f face = cross(l.b - l.a, l.c - l.a);
-        l.area = 0.5f * length(face);
-        if (!(l.area > 0))
-            continue;
-        l.side = side;
-        l.normal = normalize(face) * side;
-        l.front = front;
-        l.back = back;
-        add(group, l, key(Shape::triangle, i));
+        add_emitters(group, shape, row.emitting_part(g), front_inherited, back_inherited,
+                     materials);
     }
-
-    const geom::Discs& discs = g.discs;
-    for (std::uint32_t i = 0; i < discs.size() && i <= max_prim && round_shapes; ++i) {
-        std::uint16_t fm = at_or(discs.material, i, std::uint16_t{0});
-        Vec3f front = emission(fm, front_inherited);
-        Vec3f back = emission(at_or(discs.back_material, i, fm), back_inherited);
-        if ((is_black(front) && is_black(back)) || i >= discs.normals.size())
-            continue;
-        Light l;
-        l.kind = Kind::disc;
-        l.a = vec(discs.centres[i]);
-        l.radius = discs.centres[i][3];
-        l.normal = normalize(vec(discs.normals[i]));
-        l.area = pi * l.radius * l.radius;
-        if (!(l.area > 0) || length(l.normal) == 0)
-            continue;
-        l.front = front;
-        l.back = back;
-        add(group, l, key(Shape::disc, i));
-    }
-
-    const geom::LinearCurves& segs = g.lines;
-    for (std::uint32_t i = 0; lines && round_shapes && i < segs.segments.size() && i <= max_prim;
-         ++i) {
-        Vec3f e = emission(at_or(segs.material, i, std::uint16_t{0}), front_inherited);
-        std::uint32_t k = segs.segments[i];
-        if (is_black(e) || std::size_t(k) + 1 >= segs.keys.size())
-            continue;
-        float r0 = segs.keys[k][3], r1 = segs.keys[k + 1][3];
-        // Cones (tapered lines) are not sampled; a cylinder is.
-        if (!(r0 > 0) || std::fabs(r0 - r1) > 1e-3f * std::max(r0, r1))
-            continue;
-        Light l;
-        l.kind = Kind::cylinder;
-        l.a = vec(segs.keys[k]);
-        l.b = vec(segs.keys[k + 1]);
-        l.radius = 0.5f * (r0 + r1);
-        l.area = 2 * pi * l.radius * length(l.b - l.a);
-        if (!(l.area > 0))
-            continue;
-        l.normal = normalize(l.b - l.a);  // the axis
-        l.front = e;
-        add(group, l, key(Shape::line, i));
-    }
-
-    const geom::Spheres& spheres = g.spheres;
-    for (std::uint32_t i = 0; i < spheres.size() && i <= max_prim && round_shapes; ++i) {
-        Vec3f e = emission(at_or(spheres.material, i, std::uint16_t{0}), front_inherited);
-        if (is_black(e))
-            continue;
-        Light l;
-        l.kind = Kind::sphere;
-        l.a = vec(spheres.centres[i]);
-        l.radius = spheres.centres[i][3];
-        l.area = 4 * pi * l.radius * l.radius;
-        if (!(l.area > 0))
-            continue;
-        l.front = e;
-        add(group, l, key(Shape::sphere, i));
-    }
-
     std::vector<double> power(group.lights.size());
     for (std::size_t i = 0; i < power.size(); ++i) {
         const Light& l = group.lights[i];

@@ -14,6 +14,8 @@
 
 namespace cambium::render {
 
+struct GeometrySource;
+
 /// A point on an area light seen from a shading point: unit direction and distance to
 /// it, the radiance it sends back along -wi and the solid-angle density it was drawn with
 /// (selection included).
@@ -68,6 +70,7 @@ public:
     float pdf(const Vec3f& p, const SurfaceHit& hit) const;
 
 private:
+    /// As Emitter::Form (render/shapes.h), whose values it takes.
     enum class Kind : std::uint8_t { triangle, disc, sphere, cylinder };
     struct Light {
         Kind kind = Kind::triangle;
@@ -106,6 +109,10 @@ private:
     Group make_group(const geom::Geometry& g, std::uint16_t front_inherited,
                      std::uint16_t back_inherited, bool round_shapes,
                      const std::vector<SurfaceMaterial>& materials, bool lines);
+    /// Adds the emissive primitives of one shape's part (render/shapes.h) to `group`.
+    void add_emitters(Group& group, Shape shape, const GeometrySource& part,
+                      std::uint16_t front_inherited, std::uint16_t back_inherited,
+                      const std::vector<SurfaceMaterial>& materials);
     void add(Group& group, const Light& light, std::uint64_t key);
     void place(std::uint32_t group, std::uint32_t instance, const Affine& transform);
     /// The light in world space (its area, normal and radius follow the transform).

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 
+#include "geom/primitives.h"
+
 namespace cambium::render {
 namespace {
 
@@ -41,11 +43,7 @@ double lowest_point(const geom::Scene& scene)
         if (inst.prototype >= scene.prototypes.size())
             continue;
         const auto& m = inst.transform;
-        auto place = [&](const geom::Vec3& p) {
-            return geom::Vec3{m[0] * p.x + m[3] * p.y + m[6] * p.z + m[9],
-                              m[1] * p.x + m[4] * p.y + m[7] * p.z + m[10],
-                              m[2] * p.x + m[5] * p.y + m[8] * p.z + m[11]};
-        };
+        auto place = [&](const geom::Vec3& p) { return geom::Affine3x4(m).apply(p); };
         // Radii scale with the transform's largest axis (an upper bound: the ground
         // may sit slightly lower than a squashed sphere's bottom, never above it).
         double scale = std::max({std::hypot(m[0], m[1], m[2]), std::hypot(m[3], m[4], m[5]),

@@ -119,17 +119,6 @@ void each_area(const geom::Geometry& g, const Affine& t, bool lines_in_pixels, F
     }
 }
 
-const std::vector<std::uint32_t>& modules_of(const geom::Geometry& g, PrimitiveKind k)
-{
-    switch (k) {
-    case PrimitiveKind::lines: return g.lines.module;
-    case PrimitiveKind::curves: return g.curves.module;
-    case PrimitiveKind::spheres: return g.spheres.module;
-    case PrimitiveKind::discs: return g.discs.module;
-    default: return g.mesh.module;
-    }
-}
-
 constexpr std::uint32_t no_organ = 0xffffffffu;
 
 /// The organs and which primitive belongs to which.
@@ -186,13 +175,12 @@ Organs find_organs(const geom::Scene& scene)
     Organs o;
     const bool pixels = scene.line_radius_in_pixels;
     const geom::Geometry& g = scene.geometry;
-    const std::array<std::size_t, 5> counts{g.lines.segment_count(), g.curves.segment_count(),
-                                            g.spheres.size(), g.discs.size(), g.mesh.size()};
     for (std::size_t k = 0; k < 5; ++k) {
+        const std::size_t n = primitive_count(g, static_cast<PrimitiveKind>(k));
         const auto& m = modules_of(g, static_cast<PrimitiveKind>(k));
-        o.own[k].assign(counts[k], no_organ);
-        if (m.size() == counts[k])
-            for (std::size_t i = 0; i < counts[k]; ++i)
+        o.own[k].assign(n, no_organ);
+        if (m.size() == n)
+            for (std::size_t i = 0; i < n; ++i)
                 o.own[k][i] = o.organ(geom::Instance::no_plant, m[i], scene.geometry.modules);
     }
     each_area(g, Affine{}, pixels, [&](PrimitiveKind k, std::size_t i, double area) {

@@ -12,6 +12,7 @@
 
 #include "base/diagnostics.h"
 #include "geom/line_ends.h"
+#include "geom/primitives.h"
 #include "geom/scene_limits.h"
 #include "render/pixel_lines.h"
 
@@ -54,9 +55,9 @@ geom::LinearCurves place_pixel_lines(const geom::Scene& scene, const Camera& cam
         const auto& m = inst.transform;
         auto first = static_cast<std::uint32_t>(out.keys.size());
         for (const geom::Float4& k : l.keys) {
-            geom::Vec3 p{m[0] * k[0] + m[3] * k[1] + m[6] * k[2] + m[9],
-                         m[1] * k[0] + m[4] * k[1] + m[7] * k[2] + m[10],
-                         m[2] * k[0] + m[5] * k[1] + m[8] * k[2] + m[11]};
+            // placed in float, as Embree places a prototype's keys
+            const geom::Float3 q = geom::Affine3x4(m).apply(geom::Float3{k[0], k[1], k[2]});
+            const geom::Vec3 p{q[0], q[1], q[2]};
             out.keys.push_back({float(p.x), float(p.y), float(p.z),
                                 static_cast<float>(pixel_line_world_radius(k[3], camera, p))});
         }

@@ -105,17 +105,6 @@ PixelRect sampled_rect(const RenderSettings& s, std::size_t passes)
     return {x0, y0, x1 - x0, y1 - y0};
 }
 
-const std::vector<std::uint32_t>& modules_of(const geom::Geometry& g, PrimitiveKind k)
-{
-    switch (k) {
-    case PrimitiveKind::lines: return g.lines.module;
-    case PrimitiveKind::curves: return g.curves.module;
-    case PrimitiveKind::spheres: return g.spheres.module;
-    case PrimitiveKind::discs: return g.discs.module;
-    default: return g.mesh.module;
-    }
-}
-
 /// The organ a camera ray's first hit shows (provenance, docs/architecture.md): the
 /// module that drew it, or placed its instance, in its plant placement (a scene file's;
 /// no_plant for a single plant).

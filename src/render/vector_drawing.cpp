@@ -5,18 +5,12 @@
 #include <cmath>
 #include <span>
 
+#include "geom/primitives.h"
+
 namespace cambium::render {
 namespace {
 
 geom::Vec3 vec(const geom::Float3& p) { return {p[0], p[1], p[2]}; }
-
-/// x' = transform * (x, 1) for an instance's column-major 3x4 matrix.
-geom::Vec3 placed(const std::array<float, 12>& m, const geom::Vec3& p)
-{
-    return {m[0] * p.x + m[3] * p.y + m[6] * p.z + m[9],
-            m[1] * p.x + m[4] * p.y + m[7] * p.z + m[10],
-            m[2] * p.x + m[5] * p.y + m[8] * p.z + m[11]};
-}
 
 const geom::Material& material_of(const geom::Scene& scene, std::uint16_t index)
 {
@@ -87,8 +81,8 @@ void add_lines(const geom::Scene& scene, const geom::LinearCurves& lines,
         geom::Vec3 a{ka[0], ka[1], ka[2]}, b{kb[0], kb[1], kb[2]};
         std::uint16_t material = i < lines.material.size() ? lines.material[i] : 0;
         if (instance) {
-            a = placed(instance->transform, a);
-            b = placed(instance->transform, b);
+            a = geom::Affine3x4(instance->transform).apply(a);
+            b = geom::Affine3x4(instance->transform).apply(b);
             if (material == geom::inherit_material)
                 material = instance->material;
         }
