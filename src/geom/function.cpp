@@ -309,31 +309,21 @@ std::vector<SplineFunction> read_function_set_file(const std::filesystem::path& 
 
 FunctionSet FunctionSet::from_view_file(const ViewFile& view)
 {
-    return from_view_commands(view.deferred, view.path.parent_path());
+    return from_view_commands(view.functions, view.path.parent_path());
 }
 
-FunctionSet FunctionSet::from_view_commands(const std::vector<ViewCommand>& commands,
+FunctionSet FunctionSet::from_view_commands(std::span<const FunctionFile> commands,
                                             const std::filesystem::path& base_dir)
 {
     FunctionSet set;
-    for (const ViewCommand& c : commands) {
-        if (c.name != "function" && c.name != "function set")
-            continue;
-        TextCursor in(c.value, c.loc.file, c.loc.line, c.loc.column);
-        std::filesystem::path file = in.word("a file name");
-        if (file.is_relative())
-            file = base_dir / file;
-        if (c.name == "function set") {
+    for (const FunctionFile& c : commands) {
+        std::filesystem::path file = c.file.is_relative() ? base_dir / c.file : c.file;
+        if (c.is_set) {
             set.m_functions = read_function_set_file(file);  // cpfg starts a new list
             set.m_from_set = true;
-            continue;
+        } else {
+            set.add(read_function_file(file, c.samples));
         }
-        int samples = 0;
-        if (!in.at_end())
-            samples = in.integer("the number of samples");
-        if (!in.at_end())
-            throw in.error("unexpected text after 'function: file [samples]'");
-        set.add(read_function_file(file, samples));
     }
     return set;
 }
@@ -755,33 +745,17 @@ SpaceCurve read_curve_file(const std::filesystem::path& file, int samples)
 
 CurveSet CurveSet::from_view_file(const ViewFile& view)
 {
-    return from_view_commands(view.deferred, view.path.parent_path());
+    return from_view_commands(view.curves, view.path.parent_path());
 }
 
-CurveSet CurveSet::from_view_commands(const std::vector<ViewCommand>& commands,
+CurveSet CurveSet::from_view_commands(std::span<const CurveFile> commands,
                                       const std::filesystem::path& base_dir)
 {
     CurveSet set;
-    for (const ViewCommand& c : commands) {
-        if (c.name != "curve")
-            continue;
+    for (const CurveFile& c : commands) {
         try {
-            TextCursor in(c.value, c.loc.file, c.loc.line, c.loc.column);
-            std::filesystem::path file = in.word("a file name");
-            if (file.is_relative())
-                file = base_dir / file;
-            int samples = SpaceCurve::default_curve_samples;
-            if (!in.at_end()) {
-                FileLoc at = in.loc();
-                samples = in.integer("the number of samples");
-                if (samples < 2 || samples > SpaceCurve::max_curve_samples) {
-                    warn(at, "curve samples must be between 2 and " +
-                                 std::to_string(SpaceCurve::max_curve_samples) + "; " +
-                                 std::to_string(SpaceCurve::default_curve_samples) + " used");
-                    samples = SpaceCurve::default_curve_samples;
-                }
-            }
-            set.add(read_curve_file(file, samples));
+            std::filesystem::path file = c.file.is_relative() ? base_dir / c.file : c.file;
+            set.add(read_curve_file(file, c.samples));
         } catch (const Error& e) {
             warn(c.loc, std::string("curve not read, its coordinates and length are 0: ") + e.what());
             set.add(SpaceCurve());

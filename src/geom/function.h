@@ -5,6 +5,7 @@
 #pragma once
 
 #include <filesystem>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -76,14 +77,14 @@ std::vector<SplineFunction> read_function_set_file(const std::filesystem::path& 
 /// The functions `func(id, x)` sees, id from 1.
 class FunctionSet {
 public:
-    /// From the view file's deferred commands, in order: each `function: file [n]`
+    /// From the view file's `function:` and `function set:` commands, in order: each `function: file [n]`
     /// appends one function; a `function set: file` replaces all functions read so far
     /// with the set's (cpfg resets its list there) and marks them as named. Files are
     /// relative to the view file's folder. An unreadable file is an Error.
     static FunctionSet from_view_file(const ViewFile& view);
 
     /// The same from a list of commands; `base_dir` resolves file names.
-    static FunctionSet from_view_commands(const std::vector<ViewCommand>& commands,
+    static FunctionSet from_view_commands(std::span<const FunctionFile> commands,
                                           const std::filesystem::path& base_dir);
 
     void add(SplineFunction function) { m_functions.push_back(std::move(function)); }
@@ -135,8 +136,8 @@ public:
     /// `samples` is clamped to [2, max_curve_samples].
     SpaceCurve(const std::vector<ControlPoint>& points, Kind kind, int samples = default_curve_samples);
 
-    static constexpr int default_curve_samples = 100;
-    static constexpr int max_curve_samples = 1 << 20;
+    static constexpr int default_curve_samples = CurveFile::default_samples;
+    static constexpr int max_curve_samples = CurveFile::max_samples;
 
     Kind kind() const { return m_kind; }
     /// The control points after multiplicities and the closing or phantom points.
@@ -182,10 +183,10 @@ SpaceCurve read_curve_file(const std::filesystem::path& file,
 /// view file's `curve: file [samples]` commands.
 class CurveSet {
 public:
-    /// From the view file's deferred `curve:` commands. A file that cannot be read is a
+    /// From the view file's `curve:` commands. A file that cannot be read is a
     /// warning; its id stays taken by a curve that is 0 everywhere (as in cpfg).
     static CurveSet from_view_file(const ViewFile& view);
-    static CurveSet from_view_commands(const std::vector<ViewCommand>& commands,
+    static CurveSet from_view_commands(std::span<const CurveFile> commands,
                                        const std::filesystem::path& base_dir);
 
     void add(SpaceCurve curve) { m_curves.push_back(std::move(curve)); }
