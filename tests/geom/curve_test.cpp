@@ -13,6 +13,7 @@
 #include <fstream>
 #include <unistd.h>
 
+#include "geom/curve.h"
 #include "geom/function.h"
 #include "geom/view_file.h"
 #include "lsys/lsystem.h"
