@@ -20,6 +20,7 @@
 #include "geom/background_scene.h"
 #include "geom/colour_index_lighting.h"
 #include "geom/flatten.h"
+#include "geom/curve.h"
 #include "geom/function.h"
 #include "geom/gencyl.h"
 #include "geom/interpreter.h"
@@ -235,7 +236,9 @@ std::shared_ptr<const geom::ViewFile> read_view(const Options& options)
             throw Error(loc, what + " '" + named.string() + "' lies outside the model's folder " +
                                  folder.string() + " (--allow-file-access lifts this)");
     };
-    // Every file the view file names (textures, surfaces, contours, functions, background
+    for (const geom::TextureDef& t : view->textures)
+        refuse_outside(t.file, "texture", FileLoc{options.view.string()});
+    // Every other file the view file names (surfaces, contours, functions, background
     // scenes...) that exists (or is a link), read as the readers read it, must lie inside
     // the model's folder. Names of nothing are left to the readers, which fail on them.
     for (const auto& [named, loc] : geom::named_files(*view)) {

@@ -291,17 +291,29 @@ bool apply_cylinder_command(CylinderCommands& c, const std::string& name, ValueR
     return true;
 }
 
+/// A number, the error naming the command `name` (a coefficient's name says more than
+/// its column).
+double named_number(ValueReader& in, const std::string& name)
+{
+    FileLoc where = in.loc();
+    try {
+        return in.number();
+    } catch (const Error&) {
+        throw Error(where, name + ": expected a number");
+    }
+}
+
 /// cpfg's colormap-mode lighting (manual 5.2.5).
 bool apply_colour_index_command(ColourIndexShading& s, const std::string& name, ValueReader& in)
 {
     if (name == "diffuse reflection")
         // Beyond the 256 colour indices a shift means nothing; bounded, as the ramps it
         // sizes must be.
-        s.diffuse_reflection = static_cast<int>(std::clamp(in.number(), -255.0, 255.0));
+        s.diffuse_reflection = static_cast<int>(std::clamp(named_number(in, name), -255.0, 255.0));
     else if (name == "surface ambient")
-        s.surface_ambient = static_cast<float>(in.number());
+        s.surface_ambient = static_cast<float>(named_number(in, name));
     else if (name == "surface diffuse")
-        s.surface_diffuse = static_cast<float>(in.number());
+        s.surface_diffuse = static_cast<float>(named_number(in, name));
     else
         return false;
     return true;

@@ -463,9 +463,6 @@ std::vector<std::pair<std::filesystem::path, FileLoc>> named_files(const ViewFil
     auto add = [&](const std::filesystem::path& file, const FileLoc& loc) {
         files.emplace_back(file.is_absolute() ? file : folder / file, loc);
     };
-    const FileLoc whole_file{view.path.string()};
-    for (const TextureDef& t : view.textures)
-        add(t.file, whole_file);
     for (const ContourFile& c : view.cylinders.contours)
         add(c.file, c.loc);
     for (const SurfaceCommand& s : view.surfaces)

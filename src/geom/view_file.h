@@ -185,8 +185,9 @@ ViewFile read_view_file(const std::filesystem::path& file);
 /// The same from text (tests); `file_name` is used in messages.
 ViewFile parse_view_file(std::string_view text, const std::string& file_name);
 
-/// The files the view file names (textures, contours, surfaces, functions, curves,
-/// background scenes) as the readers find them: relative ones under the view file's folder.
+/// The files the view file's commands name, textures aside (read_view_file makes those
+/// absolute): contours, surfaces, functions, curves and background scenes, as their
+/// readers find them (relative ones under the view file's folder), with their lines.
 std::vector<std::pair<std::filesystem::path, FileLoc>> named_files(const ViewFile& view);
 
 }  // namespace cambium::geom

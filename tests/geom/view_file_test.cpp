@@ -305,7 +305,7 @@ TEST(ViewFile, DrawingCommandsWithBadValuesAreErrorsAtTheirColumn)
     EXPECT_NE(error_of("contour: 0 leaf.con").find("t.v:1:10: error: a contour id"), std::string::npos);
     EXPECT_NE(error_of("contour: 1").find("t.v:1:"), std::string::npos);
     EXPECT_NE(error_of("curve: c.crv 1").find("t.v:1:14: error: curve samples"), std::string::npos);
-    EXPECT_NE(error_of("diffuse reflection: much").find("t.v:1:21: error: expected a number"),
+    EXPECT_NE(error_of("diffuse reflection: much").find("t.v:1:21: error: diffuse reflection: expected a number"),
               std::string::npos);
     EXPECT_NE(error_of("font:").find("t.v:1:"), std::string::npos);
     EXPECT_EQ(error_of("z buffer: on"), "");  // cpfg's window alone: no effect, no error
@@ -327,5 +327,5 @@ TEST(ViewFile, FileCommandsKeepTheirFilesInOrder)
               (std::vector<std::filesystem::path>{"one.dat", "two.dat", "three.dat"}));
     EXPECT_FALSE(v.interprets_past_cut);
     EXPECT_EQ(v.colour_index_shading.diffuse_reflection, 255);  // beyond the colour indices
-    EXPECT_EQ(named_files(v).size(), 6u);
+    EXPECT_EQ(named_files(v).size(), 6u);  // two functions, a curve, three scenes
 }
