@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // Curve files (curve:), read by length as curveX/Y/Z and curveGAL read them.
 #include "fuzz_input.h"
-#include "geom/function.h"
+#include "geom/curve.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
 {

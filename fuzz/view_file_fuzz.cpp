@@ -27,11 +27,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return fuzz::run(size, [&] {
         geom::ViewFile view = geom::parse_view_file(fuzz::text_of(data, size), "fuzz.v");
         geom::cylinder_settings(view);
-        geom::object_keying(view);
         geom::effective_lights(view);
-        for (const geom::ViewCommand& command : view.deferred)
-            if (command.name == "surface" || command.name == "tsurface" || command.name == "line")
-                geom::parse_surface_command(command);
         lsys::SymbolTable symbols;
         std::istringstream walk(turtle_walk);
         lsys::ModuleString string = lsys::read_string_text(walk, symbols);

@@ -18,7 +18,9 @@
 #include "env/environmental_step.h"
 #include "env/light_spec.h"
 #include "geom/background_scene.h"
+#include "geom/colour_index_lighting.h"
 #include "geom/flatten.h"
+#include "geom/curve.h"
 #include "geom/function.h"
 #include "geom/gencyl.h"
 #include "geom/interpreter.h"
@@ -236,22 +238,15 @@ std::shared_ptr<const geom::ViewFile> read_view(const Options& options)
     };
     for (const geom::TextureDef& t : view->textures)
         refuse_outside(t.file, "texture", FileLoc{options.view.string()});
-    // Surfaces, contours, functions, background scenes...: the commands that name files
-    // are many and their syntaxes differ, so every word of every such command that names
-    // an existing file (or a link), read as the readers read it (relative to the view
-    // file's folder), must lie inside the model's folder. Words that name nothing are
-    // left to the readers, which fail on them.
-    const fs::path view_folder = fs::absolute(view->path).parent_path();
-    for (const geom::ViewCommand& c : view->deferred) {
-        std::istringstream words(c.value);
-        for (std::string word; words >> word;) {
-            const fs::path named = fs::path(word).is_absolute() ? fs::path(word) : view_folder / word;
-            std::error_code ec;
-            const fs::file_status status = fs::status(named, ec);
-            if (fs::is_symlink(fs::symlink_status(named, ec)) ||
-                (fs::exists(status) && !fs::is_directory(status)))
-                refuse_outside(named, "file", c.loc);
-        }
+    // Every other file the view file names (surfaces, contours, functions, background
+    // scenes...) that exists (or is a link), read as the readers read it, must lie inside
+    // the model's folder. Names of nothing are left to the readers, which fail on them.
+    for (const auto& [named, loc] : geom::named_files(*view)) {
+        std::error_code ec;
+        const fs::file_status status = fs::status(named, ec);
+        if (fs::is_symlink(fs::symlink_status(named, ec)) ||
+            (fs::exists(status) && !fs::is_directory(status)))
+            refuse_outside(named, "file", loc);
     }
     return view;
 }
@@ -340,85 +335,6 @@ geom::Scene interpret_with_provenance(const Model& model, const lsys::ModuleStri
 }
 
 namespace {
-/// Whether the view's last `render mode:` / `shade mode:` is cpfg's interpolated fill,
-/// which Cambium shades but cpfg draws without any lighting.
-bool interpolated_fill(const geom::ViewFile& view)
-{
-    bool interpolated = false;
-    for (const geom::ViewCommand& c : view.deferred) {
-        std::istringstream in(c.value);
-        std::string word;
-        in >> word;
-        if (c.name == "render mode" || c.name == "shade mode")
-            interpolated = word == (c.name == "render mode" ? "interpolated" : "2");
-    }
-    return interpolated;
-}
-
-/// Whether cpfg lights this model by moving colour indices (manual 5.2.5): colormap
-/// mode (a -m file or none) in render mode flat or shaded.
-bool lit_by_colour_index(const Model& model)
-{
-    geom::Shading mode = geom::render_mode(*model.view);
-    return model.palette.mode() != geom::Palette::Mode::materials &&
-           (mode == geom::Shading::shaded || mode == geom::Shading::flat) &&
-           !interpolated_fill(*model.view);
-}
-
-/// The number a deferred view command holds (`diffuse reflection: 25`).
-double deferred_number(const geom::ViewCommand& c)
-{
-    std::istringstream in(c.value);
-    double value = 0;
-    if (!(in >> value) || !std::isfinite(value))
-        throw Error(c.loc, c.name + ": expected a number, found '" + c.value + "'");
-    return value;
-}
-
-/// cpfg's colormap-mode lighting: materials 0..255 move their index by the cosine,
-/// their copies 256..511 (predefined surfaces and patches) by the surface rule.
-void light_by_colour_index(geom::Scene& scene, const geom::ViewFile& view,
-                           const geom::Palette& palette, int colour_block)
-{
-    geom::ColourIndexLight light;
-    // cpfg's light direction is the first light's position or direction, normalised.
-    geom::Light first = geom::effective_lights(view).front();
-    geom::Vec3 to_light = first.kind == geom::Light::Kind::directional ? first.direction : first.position;
-    if (dot(to_light, to_light) > 0)
-        light.to_light = normalize(to_light);
-    for (const geom::ViewCommand& c : view.deferred) {
-        if (c.name == "diffuse reflection")
-            // Beyond the 256 colour indices a shift means nothing; bounded, as the
-            // ramps it sizes must be.
-            light.diffuse_reflection =
-                static_cast<int>(std::clamp(deferred_number(c), -255.0, 255.0));
-        else if (c.name == "surface ambient")
-            light.surface_ambient = static_cast<float>(deferred_number(c));
-        else if (c.name == "surface diffuse")
-            light.surface_diffuse = static_cast<float>(deferred_number(c));
-    }
-    scene.colour_index_light = light;
-    // 0..255: the selected colormap, cosine rule; 256..511: the same, surface rule;
-    // 512..767: the next colormap, surface rule, for patch colours past 255 (cpfg's
-    // colour table runs on into it; an unloaded one is grey, a last one repeats).
-    const int next_block = std::min(colour_block + 1, geom::Palette::blocks - 1);
-    std::vector<geom::Material> next =
-        next_block > colour_block ? palette.entries(next_block) : scene.materials;
-    scene.materials.resize(3 * geom::colour_indices);
-    for (std::size_t i = 0; i < geom::colour_indices; ++i) {
-        geom::Material& m = scene.materials[i];
-        m.index_lighting = geom::IndexLighting::cosine;
-        m.colour_index = static_cast<std::uint8_t>(i);
-        scene.materials[i + geom::colour_indices] = m;
-        scene.materials[i + geom::colour_indices].index_lighting = geom::IndexLighting::surface;
-        geom::Material& n = scene.materials[i + 2 * geom::colour_indices];
-        n = next.at(i);
-        n.transparency = 0;
-        n.index_lighting = geom::IndexLighting::surface;
-        n.colour_index = static_cast<std::uint8_t>(i);
-        n.colour_table = 2 * geom::colour_indices;
-    }
-}
 /// The scene's own lines: with no texture on any of them, the per-key texture v and the
 /// per-segment texture index say nothing (scene.h lets both be empty), so they go, and
 /// the other buffers give back their growth slack (a quarter of tree10m's Scene memory,
@@ -508,7 +424,7 @@ geom::WireframeStyle wireframe_style(const Model& model, const geom::Scene& scen
 {
     geom::WireframeStyle style;
     style.edge_width_px = geom::wireframe_edge_width(scene.view.box.value_or(scene.bounds), options.width);
-    style.sides = geom::contour_sides(*model.view);
+    style.sides = model.view->cylinders.sides;
     style.quadric_spheres = model.palette.mode() == geom::Palette::Mode::materials;
     return style;
 }
@@ -518,7 +434,7 @@ geom::InterpretOptions interpret_options(const Model& model, const Options& opti
 {
     geom::InterpretOptions turtle;
     turtle.strings = model.lsystem.program().strings;
-    if (lit_by_colour_index(model)) {
+    if (geom::lit_by_colour_index(*model.view, model.palette)) {
         turtle.surface_material_offset = geom::colour_indices;
         turtle.next_colormap_material_offset = 2 * geom::colour_indices;
     }
@@ -571,11 +487,11 @@ geom::Scene interpret_turtle_string(const Model& model, const lsys::ModuleString
         turtle.births = origins->births;
     }
     geom::Scene scene = geom::interpret(string, model.lsystem.symbols(), *model.view, turtle);
-    const bool index_lit = lit_by_colour_index(model);
-    scene.shading = geom::render_mode(*model.view);
+    const bool index_lit = geom::lit_by_colour_index(*model.view, model.palette);
+    scene.shading = model.view->render_mode.shading;
     set_model_materials(scene, model.palette, *model.view, options);
     if (index_lit)
-        light_by_colour_index(scene, *model.view, model.palette, options.colour_block);
+        geom::light_by_colour_index(scene, *model.view, model.palette, options.colour_block);
 
     geom::BackgroundScene background = geom::load_view_background(
         *model.view, scene.materials[0],
@@ -623,7 +539,7 @@ geom::RayshadeOptions rayshade_options(const Options& options, const std::filesy
     ray.width = options.width;
     ray.height = options.height;
     if (model) {
-        ray.scale = geom::rayshade_scale(*model->view);
+        ray.scale = model->view->rayshade_scale;
         for (const geom::Material& m : model->palette.entries(options.colour_block))
             ray.transparency.push_back(m.transparency);
     }

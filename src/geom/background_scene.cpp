@@ -486,24 +486,14 @@ bool has_directive(std::string_view text)
 }
 }  // namespace
 
-BackgroundScene read_background_scene(std::string_view list, const std::filesystem::path& base_dir,
+BackgroundScene read_background_scene(std::span<const std::filesystem::path> files,
+                                      const std::filesystem::path& base_dir,
                                       const Material& initial_material, const FileLoc& loc,
                                       const std::optional<std::filesystem::path>& confine_to)
 {
     std::vector<BackgroundStatement> statements;
-    std::size_t pos = 0;
-    auto is_separator = [](char c) { return c == ' ' || c == '\t' || c == ',' || c == ';' || c == '\r' || c == '\n'; };
-    while (pos < list.size()) {
-        while (pos < list.size() && is_separator(list[pos]))
-            ++pos;
-        std::size_t start = pos;
-        while (pos < list.size() && !is_separator(list[pos]))
-            ++pos;
-        if (pos == start)
-            break;
-        std::filesystem::path file(std::string(list.substr(start, pos - start)));
-        if (file.is_relative())
-            file = base_dir / file;
+    for (const std::filesystem::path& named : files) {
+        const std::filesystem::path file = named.is_relative() ? base_dir / named : named;
         std::error_code ec;
         if (!std::filesystem::is_regular_file(file, ec))
             throw Error(loc, "cannot read the background scene file " + file.string() +
@@ -529,10 +519,8 @@ BackgroundScene load_view_background(const ViewFile& view, const Material& initi
                                      const std::optional<std::filesystem::path>& confine_to)
 {
     BackgroundScene scene;
-    for (const ViewCommand& c : view.deferred) {
-        if (c.name != "background scene")
-            continue;
-        BackgroundScene more = read_background_scene(c.value, view.path.parent_path(), initial_material, c.loc,
+    for (const BackgroundSceneFiles& c : view.background_scenes) {
+        BackgroundScene more = read_background_scene(c.files, view.path.parent_path(), initial_material, c.loc,
                                                      confine_to);
         auto offset = static_cast<std::uint16_t>(scene.materials.size());
         offset_materials(more.geometry, offset);

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -71,11 +72,11 @@ std::vector<BackgroundStatement> parse_background_text(std::string_view text,
 BackgroundScene build_background_scene(const std::vector<BackgroundStatement>& statements,
                                        const Material& initial_material);
 
-/// `background scene: list`: every file of the list (separated by blanks, ',' or ';',
-/// relative to `base_dir`), in order. A missing file is an Error. Files run through
+/// `background scene: list`: every file of the list (relative to `base_dir`), in order. A missing file is an Error. Files run through
 /// cpp may #include only files inside `confine_to` when it is set (the model's folder,
 /// docs/security.md); the listed files themselves are checked by the view's reader.
-BackgroundScene read_background_scene(std::string_view list, const std::filesystem::path& base_dir,
+BackgroundScene read_background_scene(std::span<const std::filesystem::path> files,
+                                      const std::filesystem::path& base_dir,
                                       const Material& initial_material, const FileLoc& loc,
                                       const std::optional<std::filesystem::path>& confine_to);
 

@@ -17,7 +17,7 @@ namespace {
 
 constexpr double min_segment_length = 0.00001;  // cpfg draws nothing shorter
 constexpr int max_strips = 10000;
-constexpr int max_sides = 100000;
+constexpr int max_sides = CylinderCommands::max_contour_sides;
 constexpr long long max_segment_vertices = 1'000'000;
 
 Float3 f3(const Vec3& v) { return {static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)}; }
@@ -78,27 +78,6 @@ void set_end_material(HermiteCurves& hc, std::uint16_t end)
     while (hc.end_material.size() < i)
         hc.end_material.push_back(hc.material[hc.end_material.size()]);
     hc.end_material.push_back(end);
-}
-
-double parse_number(const std::string& text, double fallback)
-{
-    std::istringstream in(text);
-    double value = fallback;
-    in >> value;
-    return in.fail() ? fallback : value;
-}
-
-/// A view-file count in [lo, hi]: beyond it (or not finite) clamped, with a warning.
-int parse_count(const ViewCommand& c, int fallback, int lo, int hi)
-{
-    double value = parse_number(c.value, fallback);
-    if (!(value >= lo && value <= hi)) {
-        warn(c.loc, "'" + c.name + ":' must be " + std::to_string(lo) + " to " + std::to_string(hi) +
-                        (std::isnan(value) ? std::string("; ") + std::to_string(fallback) + " used"
-                                           : "; clamped"));
-        value = std::isnan(value) ? fallback : std::clamp(value, double(lo), double(hi));
-    }
-    return static_cast<int>(value);
 }
 
 /// A cylinder module's parameter as an int clamped to [lo, hi] (NaN: `fallback`).
@@ -198,16 +177,22 @@ Vec3 rmf_step(const Vec3& x0, const Vec3& t0, const Vec3& up0, const Vec3& x1, c
 
 // ---- settings -------------------------------------------------------------------------
 
-int contour_sides(const ViewFile& view)
+/// Reads a `contour:` file into `contours` under its id (a gallery's items under id,
+/// id + 1, ..., a Cambium extension). cpfg looks contours up in file order: the first
+/// with an id wins.
+void load_contours(const ContourFile& c, const std::filesystem::path& folder, ContourTable& contours)
 {
-    int sides = 8;
-    for (const ViewCommand& c : view.deferred) {
-        if (c.name == "contour sides")
-            sides = parse_count(c, 8, 3, max_sides);
-        else if (c.name == "polygonization level")  // cpfg: 2^(n+1) polygons around (manual 5.2.4)
-            sides = 1 << (parse_count(c, 2, 1, 16) + 1);
+    try {
+        std::filesystem::path path = c.file.is_absolute() ? c.file : folder / c.file;
+        std::vector<Contour> read = read_contours(path);
+        for (std::size_t k = 0; k < read.size(); ++k) {
+            int item_id = c.id + static_cast<int>(k);
+            if (!contours.emplace(item_id, std::move(read[k])).second)
+                warn(c.loc, "contour id " + std::to_string(item_id) + " is defined twice; the first is used");
+        }
+    } catch (const Error& e) {
+        warn(c.loc, std::string("contour ") + std::to_string(c.id) + " not loaded: " + e.what());
     }
-    return sides;
 }
 
 CylinderSettings cylinder_settings(const ViewFile& view)
@@ -215,51 +200,12 @@ CylinderSettings cylinder_settings(const ViewFile& view)
     CylinderSettings s;
     s.draw_surfaces = view.line_style == LineStyle::cylinder;
     s.texture_aspect_ratios = view.texture_aspect_ratios;
-    s.mesh_circles = render_mode(view) == Shading::wireframe;
-    std::filesystem::path folder = view.path.parent_path();
-    s.sides = contour_sides(view);
-    for (const ViewCommand& c : view.deferred) {
-        if (c.name == "render mode") {
-            std::istringstream in(c.value);
-            std::string word;
-            in >> word;
-            s.interpolate_colours = word == "interpolated";
-        } else if (c.name == "twist of cylinders") {
-            std::istringstream in(c.value);
-            std::string word;
-            in >> word;
-            std::transform(word.begin(), word.end(), word.begin(), [](unsigned char ch) { return std::tolower(ch); });
-            s.keep_twist = word == "on";
-        } else if (c.name == "contour") {
-            std::istringstream in(c.value);
-            int id = 0;
-            std::string file;
-            in >> id >> file;
-            if (in.fail() || file.empty()) {
-                warn(c.loc, "'contour:' needs an id and a file name; ignored");
-                continue;
-            }
-            if (id == 0) {
-                warn(c.loc, "contour id 0 is the built-in circle; 'contour: 0' ignored");
-                continue;
-            }
-            try {
-                std::filesystem::path path = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : folder / file;
-                // A gallery's items take the ids id, id + 1, ... (a Cambium extension).
-                std::vector<Contour> read = read_contours(path);
-                for (std::size_t k = 0; k < read.size(); ++k) {
-                    int item_id = id + static_cast<int>(k);
-                    if (item_id == 0)
-                        continue;  // the circle keeps id 0
-                    // cpfg looks contours up in file order: the first with an id wins.
-                    if (!s.contours.emplace(item_id, std::move(read[k])).second)
-                        warn(c.loc, "contour id " + std::to_string(item_id) + " is defined twice; the first is used");
-                }
-            } catch (const Error& e) {
-                warn(c.loc, std::string("contour ") + std::to_string(id) + " not loaded: " + e.what());
-            }
-        }
-    }
+    s.mesh_circles = view.render_mode.shading == Shading::wireframe;
+    s.interpolate_colours = view.render_mode.interpolated;
+    s.keep_twist = view.cylinders.keep_twist;
+    s.sides = view.cylinders.sides;
+    for (const ContourFile& c : view.cylinders.contours)
+        load_contours(c, view.path.parent_path(), s.contours);
     return s;
 }
 

@@ -104,12 +104,7 @@ struct CylinderSettings {
     std::vector<double> texture_aspect_ratios;  ///< per texture, `R:` (v = length / (pi width R))
 };
 
-/// Polygons around cylinders and spheres: `contour sides:` or `polygonization level:`
-/// (the last one given), 8 without either.
-int contour_sides(const ViewFile& view);
-
-/// Reads `contour:`, `contour sides:`, `polygonization level:` and `twist of cylinders:`
-/// from the view file's deferred commands and loads the contour files (relative to the
+/// The view file's cylinder settings, with its contour files loaded (relative to the
 /// view file). A contour file that cannot be read is a warning, as in cpfg.
 CylinderSettings cylinder_settings(const ViewFile& view);
 

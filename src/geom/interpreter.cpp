@@ -53,25 +53,6 @@ std::vector<TurtleOp> symbol_ops(const lsys::SymbolTable& symbols)
 /// check sums a few dozen capacities, and the Scene grows by a few hundred bytes a module.
 constexpr std::size_t memory_check_interval = 4096;
 
-/// `interpretation past %:` (manual 5.2.3): whether the turtle goes on after a cut in
-/// the string (on, cpfg's default) or skips the rest of the cut branch (off).
-bool interprets_past_cut(const ViewFile& view)
-{
-    bool past = true;
-    for (const ViewCommand& c : view.deferred) {
-        if (c.name != "interpretation past %")
-            continue;
-        std::istringstream in(c.value);
-        std::string flag;
-        in >> flag;
-        if (flag == "on" || flag == "off")
-            past = flag == "on";
-        else
-            warn(c.loc, "interpretation past %: expected 'on' or 'off'; 'on' is kept");
-    }
-    return past;
-}
-
 class Interpreter {
     /// A polygon vertex: the turtle's position and the frame its texture axes use.
     struct PolygonCorner {
@@ -89,8 +70,8 @@ public:
                       m_scene.bounds)  // the root's: its contour files are read once
     {
         m_turtle.cylinder.sides = m_cylinders.settings().sides;
-        m_past_cut = interprets_past_cut(view);
-        m_polygon_outlines = render_mode(view) == Shading::wireframe;
+        m_past_cut = view.interprets_past_cut;
+        m_polygon_outlines = view.render_mode.shading == Shading::wireframe;
         m_turtle.line_width = view.initial_line_width;
         m_turtle.color = view.initial_color;
         m_turtle.back_color = view.initial_back_color;
@@ -108,7 +89,7 @@ public:
         m_scene.line_radius_in_pixels = view.line_style == LineStyle::pixel;
         m_scene.view = view.view;
         m_scene.lights = effective_lights(view);
-        m_scene.label_font = label_font(view);
+        m_scene.label_font = view.font;
         m_scene.bounds.extend(Vec3{0, 0, 0});  // cpfg's box always holds the origin
         m_provenance = m_root == this && options.provenance && !options.bounds_only;
         if (m_root == this) {

@@ -4,8 +4,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <iomanip>
-#include <sstream>
 #include <string_view>
 #include <vector>
 
@@ -74,76 +72,6 @@ std::string format_label(const std::string& format, std::span<const float> value
         i = end;
     }
     return out;
-}
-
-namespace {
-
-/// A positive whole number of pixels no font is bigger than, or nothing.
-std::optional<int> font_size(const std::string& text, int divisor)
-{
-    if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos || text.size() > 6)
-        return std::nullopt;
-    int size = std::stoi(text) / divisor;
-    if (size < 1 || size > 512)
-        return std::nullopt;
-    return size;
-}
-
-LabelFont x_font(const std::string& name)
-{
-    LabelFont font;
-    std::vector<std::string> fields;  // "", foundry, family, weight, slant, setwidth, style, px, pt
-    std::stringstream in(name);
-    for (std::string field; std::getline(in, field, '-');)
-        fields.push_back(field);
-    auto field = [&](std::size_t i) { return i < fields.size() && fields[i] != "*" ? fields[i] : ""; };
-    if (!field(2).empty())
-        font.family = field(2);
-    if (!field(3).empty())
-        font.bold = field(3) == "bold" || field(3) == "demibold";
-    if (!field(4).empty())
-        font.italic = field(4) == "i" || field(4) == "o";
-    if (std::optional<int> px = font_size(field(7), 1))
-        font.pixel_size = *px;
-    else if (std::optional<int> px = font_size(field(8), 10))
-        font.pixel_size = *px;  // decipoints at X's 75 dpi are about pixels / 10
-    return font;
-}
-
-LabelFont windows_font(const std::string& value)
-{
-    LabelFont font;
-    std::istringstream in(value);
-    std::string name, size, flags;
-    in >> std::ws;
-    if (in.peek() == '"')
-        in >> std::quoted(name);
-    else
-        in >> name;
-    in >> size >> flags;
-    if (!name.empty())
-        font.family = name;
-    if (std::optional<int> px = font_size(size, 1))
-        font.pixel_size = *px;
-    font.bold = flags.find_first_of("bB") != std::string::npos;
-    font.italic = flags.find_first_of("iI") != std::string::npos;
-    return font;
-}
-
-}  // namespace
-
-LabelFont label_font(const ViewFile& view)
-{
-    LabelFont font;
-    for (const ViewCommand& c : view.deferred) {
-        std::size_t first = c.value.find_first_not_of(" \t");
-        std::string value = first == std::string::npos ? "" : c.value.substr(first);
-        if (c.name == "font" && !value.empty())
-            font = x_font(value.substr(0, value.find_first_of(" \t\r")));
-        else if (c.name == "winfont" && !value.empty())
-            font = windows_font(value);
-    }
-    return font;
 }
 
 }  // namespace cambium::geom

@@ -8,7 +8,6 @@
 #include <string>
 
 #include "geom/scene.h"
-#include "geom/view_file.h"
 
 namespace cambium::geom {
 
@@ -21,11 +20,5 @@ std::optional<std::string> label_text(std::span<const float> params, std::span<c
 /// anything that is not one conversion of a number (%s, %n, a conversion wider than 12
 /// characters) is kept as text.
 std::string format_label(const std::string& format, std::span<const float> values);
-
-/// The label font of the view file: its last `font:` (X font name
-/// -foundry-family-weight-slant-setwidth-style-pixels-points-...: family, `bold`, slant
-/// `i`/`o`, pixels, else points / 10) or `winfont:` (name, size in pixels, flags `b` `i`).
-/// Fields that are `*` or missing keep cpfg's default, courier bold 12 pixels.
-LabelFont label_font(const ViewFile& view);
 
 }  // namespace cambium::geom

@@ -14,30 +14,6 @@
 namespace cambium::geom {
 namespace {
 
-/// Whether `format` is text around exactly one printf conversion of a double: flags,
-/// width and precision of at most two digits each, conversion e E f F g G (an `l` may
-/// precede it, as in cpfg's "%lg"). Anything else must not reach snprintf.
-bool is_float_format(const std::string& format)
-{
-    std::size_t percent = format.find('%');
-    if (percent == std::string::npos || format.find('%', percent + 1) != std::string::npos)
-        return false;
-    std::size_t i = format.find_first_not_of("-+ #0", percent + 1);
-    auto digits = [&](std::size_t& at) {
-        std::size_t start = at;
-        while (at < format.size() && at - start < 3 && format[at] >= '0' && format[at] <= '9')
-            ++at;
-        return at - start <= 2;
-    };
-    if (i == std::string::npos || !digits(i))
-        return false;
-    if (i < format.size() && format[i] == '.' && !digits(++i))
-        return false;
-    if (i < format.size() && format[i] == 'l')
-        ++i;
-    return i < format.size() && std::string_view("eEfFgG").find(format[i]) != std::string_view::npos;
-}
-
 /// A normal under the placement: by the inverse transpose of its 3x3 part (the
 /// cofactor matrix over the determinant, of which only the sign matters), normalised.
 Float3 place_normal(const std::array<float, 12>& m, const Float3& n)
@@ -53,29 +29,6 @@ Float3 place_normal(const std::array<float, 12>& m, const Float3& n)
 }
 
 }  // namespace
-
-ObjectKeying object_keying(const ViewFile& view)
-{
-    ObjectKeying keying;
-    for (const ViewCommand& c : view.deferred) {
-        if (c.name != "rayshade objects")
-            continue;
-        // cpfg's rsReadViewCommand: tokens split at blanks and colons
-        std::string text = c.value;
-        std::replace(text.begin(), text.end(), ':', ' ');
-        std::istringstream in(text);
-        std::string format, word, flag;
-        if (!(in >> format))
-            continue;
-        if (is_float_format(format))
-            keying.format = format;
-        else
-            warn(c.loc, "rayshade objects: '" + format + "' is not a printf format of one number; using %g");
-        if (in >> word >> flag && word == "turtle" && flag.starts_with("considered"))
-            keying.turtle_considered = true;
-    }
-    return keying;
-}
 
 std::array<float, 12> object_transform(const Turtle& t)
 {
@@ -161,7 +114,7 @@ bool GeometryCheckpoint::restore(Geometry& g) const
 }
 
 ObjectInstancer::ObjectInstancer(const ViewFile& view, Expand expand)
-    : m_keying(object_keying(view)), m_expand(std::move(expand))
+    : m_keying(view.rayshade_objects), m_expand(std::move(expand))
 {
 }
 

@@ -19,15 +19,6 @@
 
 namespace cambium::geom {
 
-/// The view file's `rayshade objects: FORMAT [turtle considered]` (cpfg's
-/// rsReadViewCommand). A format that is not one printf conversion of a float (with
-/// flags, width, precision, text around it) is replaced by %g with a warning.
-struct ObjectKeying {
-    std::string format = "%g";
-    bool turtle_considered = false;
-};
-ObjectKeying object_keying(const ViewFile& view);
-
 /// The placement of an object built in the turtle's starting frame (H = +y, L = -x,
 /// U = -z at the origin): its x axis goes to -L, y to H, z to -U, the origin to the
 /// turtle. No scale: the object was built with the first occurrence's turtle scale

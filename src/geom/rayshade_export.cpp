@@ -350,21 +350,6 @@ std::string light_lines(const Scene& scene)
 
 }  // namespace
 
-double rayshade_scale(const ViewFile& view)
-{
-    double scale = 1;
-    for (const ViewCommand& c : view.deferred) {
-        if (c.name != "rayshade scale")
-            continue;
-        std::istringstream in(c.value);
-        double s = 0;
-        if (!(in >> s) || !(s > 0) || !std::isfinite(s))
-            throw Error(c.loc, "rayshade scale: expected a positive number, not '" + c.value + "'");
-        scale = s;
-    }
-    return scale;
-}
-
 void write_rayshade(std::ostream& stream, const Scene& scene, const RayshadeOptions& options)
 {
     SurfaceNames surfaces(scene, options);

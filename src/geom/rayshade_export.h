@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "geom/scene.h"
-#include "geom/view_file.h"
 
 namespace cambium::geom {
 
@@ -32,10 +31,6 @@ struct RayshadeOptions {
     /// missing from them).
     double shortest_segment = 0.003;
 };
-
-/// The view file's `rayshade scale: s` (1 when absent); a value that is not a positive
-/// number is an Error naming the view file's line.
-double rayshade_scale(const ViewFile& view);
 
 /// The scene as rayshade 4.0 text: cpfg's layout, #ifndef NOSURFACES / NOHEADERS and
 /// #ifdef BBOX blocks included. Line segments become cylinders (cones where the radius

@@ -151,66 +151,7 @@ std::string without_comments(std::string_view text)
     return out;
 }
 
-/// The value text of a view command starts right after the colon; its column is
-/// unknown here, so messages name the command's own column.
-TextCursor command_cursor(const ViewCommand& command)
-{
-    return TextCursor(command.value, command.loc.file, command.loc.line, command.loc.column);
-}
-
-std::optional<std::int16_t> texture_from_view(int tex, const FileLoc& loc)
-{
-    if (tex < 0 || tex > 32767)
-        throw Error(loc, "surface texture index out of range: " + std::to_string(tex));
-    if (tex == 0)
-        return no_texture;
-    return static_cast<std::int16_t>(tex - 1);
-}
-
 }  // namespace
-
-SurfaceCommand parse_surface_command(const ViewCommand& command)
-{
-    SurfaceCommand sc;
-    sc.loc = command.loc;
-    if (command.name == "surface" || command.name == "line")
-        sc.kind = SurfaceCommand::Kind::bicubic;
-    else if (command.name == "tsurface")
-        sc.kind = SurfaceCommand::Kind::triangles;
-    else
-        throw Error(command.loc, "not a surface command: '" + command.name + "'");
-    TextCursor in = command_cursor(command);
-    std::string id = in.word("the surface's letter");
-    if (id.size() != 1)
-        throw Error(command.loc, command.name + ": the identifier must be one character, not '" +
-                                     id + "'");
-    sc.letter = id[0];
-    sc.file = in.word("the surface's file name");
-    sc.scale = in.number("the surface's scale");
-    std::vector<int> rest;
-    while (!in.at_end()) {
-        if (rest.size() == 3)
-            throw in.error(command.name + ": too many values");
-        rest.push_back(in.integer("precision or texture"));
-    }
-    if (sc.kind == SurfaceCommand::Kind::triangles) {
-        if (!rest.empty())
-            warn(command.loc, "tsurface: values after the scale ignored");
-        return sc;
-    }
-    if (rest.size() >= 2) {
-        sc.s_steps = rest[0];
-        sc.t_steps = rest[1];
-    }
-    if (command.name == "line" && rest.size() == 1) {
-        warn(command.loc, "line: a single number after the size is not read by cpfg (it reads "
-                          "'s t [texture]'); ignored");
-        return sc;
-    }
-    if (rest.size() == 1 || rest.size() == 3)
-        sc.texture = texture_from_view(rest.back(), command.loc);
-    return sc;
-}
 
 // ---------------------------------------------------------------------------------------
 // The `.s` reader
@@ -533,18 +474,15 @@ std::vector<SurfaceDef> load_view_surfaces(const ViewFile& view)
     std::vector<SurfaceDef> defs;
     std::set<char> letters;
     const std::filesystem::path base_dir = view.path.parent_path();
-    for (const ViewCommand& command : view.deferred) {
-        if (command.name != "surface" && command.name != "tsurface" && command.name != "line")
-            continue;
-        SurfaceCommand sc = parse_surface_command(command);
+    for (const SurfaceCommand& sc : view.surfaces) {
         if (letters.count(sc.letter)) {
-            warn(command.loc, std::string("surface '") + sc.letter + "' defined twice; ignored");
+            warn(sc.loc, std::string("surface '") + sc.letter + "' defined twice; ignored");
             continue;
         }
         std::filesystem::path file = sc.file.is_absolute() ? sc.file : base_dir / sc.file;
         std::error_code ec;
         if (!std::filesystem::is_regular_file(file, ec)) {
-            warn(command.loc, "cannot open surface file " + file.string() + "; surface '" +
+            warn(sc.loc, "cannot open surface file " + file.string() + "; surface '" +
                                   std::string(1, sc.letter) + "' ignored");
             continue;
         }

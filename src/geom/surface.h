@@ -19,33 +19,6 @@
 
 namespace cambium::geom {
 
-/// A view-file `surface: id file scale [s t] [tex]` or `tsurface: id file scale` command.
-struct SurfaceCommand {
-    enum class Kind { bicubic, triangles };
-    Kind kind = Kind::bicubic;
-    char letter = 0;
-    std::filesystem::path file;  ///< as written (relative to the view file's folder)
-    double scale = 1;            ///< the view file's size for the surface
-    int s_steps = 0;             ///< 0: from the file's PRECISION line, else cpfg's default 5
-    int t_steps = 0;
-    /// The fixed texture: nullopt = the turtle's (`@Tx`), no_texture = none (tex 0),
-    /// else an index into Scene::textures (the file's `tex` minus 1).
-    std::optional<std::int16_t> texture;
-    FileLoc loc;
-};
-
-/// Parses a deferred view command named "surface", "tsurface" or "line" (Error
-/// otherwise or when malformed).
-///
-/// `line: id file size [s t [tex]]` defines a bicubic surface exactly as `surface:` does
-/// (cpfg reads it with the same read_surface; `~id` draws it). cpfg also records the id
-/// as its "line type", meant for drawing F segments as that surface, but that drawing is
-/// disabled in cpfg (its segment code is commented out), so segments are not affected
-/// here either. Unlike `surface:`, a single number after the size is not a texture:
-/// cpfg reads precisions as a pair, then the texture; a lone number is ignored (with a
-/// warning here).
-SurfaceCommand parse_surface_command(const ViewCommand& command);
-
 /// A patch's own colour indices (manual 5.4.3 `TOP COLOR:`, `BOTTOM COLOR:`): 0 means
 /// the turtle's. cpfg's colormap-mode lighting uses them instead of the turtle's index,
 /// relative to the selected colormap (so 256..511 lie in the next one); lighting by

@@ -2,6 +2,7 @@
 // Reading cpfg's small text formats: bounded file reads, comment removal, value tokens.
 #include "geom/text_input.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -143,6 +144,38 @@ std::string ValueReader::word(const char* what)
     if (out.empty())
         throw error(std::string("expected ") + what);
     return out;
+}
+
+bool ValueReader::on_off()
+{
+    FileLoc where = loc();
+    std::string found = word("on or off");
+    if (found == "on")
+        return true;
+    if (found == "off")
+        return false;
+    throw Error(where, "expected 'on' or 'off', found '" + found + "'");
+}
+
+std::string ValueReader::name(const char* what)
+{
+    if (at_end())
+        throw error(std::string("expected ") + what);
+    std::size_t start = m_pos;
+    while (m_pos < m_line.size() && !std::isspace(static_cast<unsigned char>(m_line[m_pos])) &&
+           m_line[m_pos] != ',')
+        ++m_pos;
+    return std::string(m_line.substr(start, m_pos - start));
+}
+
+std::string ValueReader::rest()
+{
+    while (m_pos < m_line.size() && std::isspace(static_cast<unsigned char>(m_line[m_pos])))
+        ++m_pos;
+    std::string_view text = m_line.substr(std::min(m_pos, m_line.size()));
+    m_pos = m_line.size();
+    std::size_t last = text.find_last_not_of(" \t\r");
+    return std::string(last == std::string_view::npos ? std::string_view() : text.substr(0, last + 1));
 }
 
 char ValueReader::subcommand(const char* what)

@@ -40,6 +40,12 @@ public:
     int integer();
     /// A word of letters, digits, '.', '_', '-', lower-cased; `what` names it in errors.
     std::string word(const char* what);
+    /// `on` or `off`.
+    bool on_off();
+    /// A run of characters other than blanks and ',', case kept (a file or font name).
+    std::string name(const char* what);
+    /// The rest of the line, consumed, without leading or trailing blanks.
+    std::string rest();
     /// A one-letter subcommand such as "O:" or "D" (the colon is optional); upper-cased.
     char subcommand(const char* what);
     /// Expects `label` followed by an optional ':' (as in "x: 0,1").

@@ -13,30 +13,10 @@
 
 #include "geom/scene_limits.h"
 #include "geom/text_input.h"
+#include "geom/view_drawing.h"
 
 namespace cambium::geom {
 namespace {
-
-/// Commands of manual 5.2 (and a few cpfg accepts that the manual omits) that are
-/// parsed and kept for later stages, or that only concern cpfg's OpenGL window.
-constexpr std::array deferred_commands = {
-    "render mode", "shade mode", "z buffer", "cue range", "font", "winfont",
-    "interpretation past %", "interpretation step", "rayshade objects", "rayshade scale",
-    "antialiasing", "min zoom", "max zoom", "polygonization level", "contour",
-    "contour sides", "surface", "line", "tsurface", "twist of cylinders",
-    "background scene", "ambient light", "diffuse reflection", "surface ambient",
-    "surface diffuse", "background color", "function",
-    "function set", "concave polygons", "shadow map", "curve", "corner"};
-
-bool parse_flag(ValueReader& in)
-{
-    std::string word = in.word("on or off");
-    if (word == "on")
-        return true;
-    if (word == "off")
-        return false;
-    throw in.error("expected 'on' or 'off', found '" + word + "'");
-}
 
 Vec3 parse_vec3(ValueReader& in)
 {
@@ -293,8 +273,9 @@ TranslucencySetting parse_translucency(ValueReader& in)
     return t;
 }
 
-/// Applies one `name: value` command to the view file.
-void apply_command(ViewFile& v, const std::string& name, ValueReader& in)
+/// Applies one `name: value` command of the turtle, the view or the lights to the view
+/// file; false when `name` is none of them.
+bool apply_command(ViewFile& v, const std::string& name, ValueReader& in)
 {
     if (name == "angle factor") {
         double factor = in.number();
@@ -321,7 +302,7 @@ void apply_command(ViewFile& v, const std::string& name, ValueReader& in)
     } else if (name == "line style") {
         v.line_style = parse_line_style(in);
     } else if (name == "tapered lines" || name == "tappered lines") {
-        v.tapered_lines = parse_flag(in);
+        v.tapered_lines = in.on_off();
     } else if (name == "viewpoint") {
         v.view.viewpoint = parse_position(in);
     } else if (name == "view reference point") {
@@ -363,10 +344,9 @@ void apply_command(ViewFile& v, const std::string& name, ValueReader& in)
     } else if (name == "translucency") {
         v.translucency.push_back(parse_translucency(in));
     } else {
-        return;  // handled by the caller
+        return false;
     }
-    if (!in.at_end())
-        warn(in.loc(), "extra text after '" + name + ":' ignored");
+    return true;
 }
 
 /// Commands whose value starts with one number. cpfg reads them with sscanf and keeps
@@ -416,6 +396,7 @@ void parse_command(ViewFile& v, std::string_view body, std::size_t colon, const 
     ValueReader in(body, colon + 1, line_loc);
     if (name == "texture") {
         parse_texture(v, body, colon + 1, line_loc);
+        return;  // reads the whole line itself
     } else if (is_applied(name)) {
         int column = 0;
         if (keeps_default_without_number(name) && starts_without_number(body, colon + 1, column)) {
@@ -424,12 +405,14 @@ void parse_command(ViewFile& v, std::string_view body, std::size_t colon, const 
             return;
         }
         apply_command(v, name, in);
-    } else if (std::find(deferred_commands.begin(), deferred_commands.end(), name) !=
-               deferred_commands.end()) {
-        v.deferred.push_back({name, std::string(body.substr(colon + 1)), loc});
+    } else if (is_drawing_command(name)) {
+        apply_drawing_command(v, name, in);
     } else {
         warn(loc, "unknown view-file command '" + name + ":' ignored");
+        return;
     }
+    if (!in.at_end())
+        warn(in.loc(), "extra text after '" + name + ":' ignored");
 }
 
 }  // namespace
@@ -473,29 +456,25 @@ ViewFile read_view_file(const std::filesystem::path& file)
     return v;
 }
 
-/// `fast` is filled (manual 5.2: filled with wireframe spheres); `interpolated` and
-/// `shadows` are shaded (the former's colour blending is the generalized cylinders'
-/// concern). The older `shade mode:` numbers as cpfg converts them: 1 simple fill
-/// (filled), 4 and 5 B-spline polygons and 7 wireframe (wireframe), the rest shaded
-/// (2 interpolated fill, 3 Gouraud, 6 two-sided).
-Shading render_mode(const ViewFile& view)
+std::vector<std::pair<std::filesystem::path, FileLoc>> named_files(const ViewFile& view)
 {
-    Shading mode = Shading::shaded;
-    for (const ViewCommand& c : view.deferred) {
-        std::istringstream in(c.value);
-        std::string word;
-        in >> word;
-        if (c.name == "render mode")
-            mode = word == "flat"                        ? Shading::flat
-                   : word == "filled" || word == "fast" ? Shading::filled
-                   : word == "wireframe"                ? Shading::wireframe
-                                                        : Shading::shaded;
-        else if (c.name == "shade mode")
-            mode = word == "1"                                 ? Shading::filled
-                   : word == "4" || word == "5" || word == "7" ? Shading::wireframe
-                                                               : Shading::shaded;
-    }
-    return mode;
+    std::vector<std::pair<std::filesystem::path, FileLoc>> files;
+    const std::filesystem::path folder = view.path.parent_path();
+    auto add = [&](const std::filesystem::path& file, const FileLoc& loc) {
+        files.emplace_back(file.is_absolute() ? file : folder / file, loc);
+    };
+    for (const ContourFile& c : view.cylinders.contours)
+        add(c.file, c.loc);
+    for (const SurfaceCommand& s : view.surfaces)
+        add(s.file, s.loc);
+    for (const FunctionFile& f : view.functions)
+        add(f.file, f.loc);
+    for (const CurveFile& c : view.curves)
+        add(c.file, c.loc);
+    for (const BackgroundSceneFiles& b : view.background_scenes)
+        for (const std::filesystem::path& file : b.files)
+            add(file, b.loc);
+    return files;
 }
 
 }  // namespace cambium::geom

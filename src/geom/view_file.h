@@ -2,9 +2,12 @@
 // The view file (.v, CPFG manual 5.2): every setting with cpfg's default.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "base/diagnostics.h"
@@ -16,12 +19,87 @@ namespace cambium::geom {
 /// How F and G are drawn (`line style:`, or the suffix of `initial line width:`).
 enum class LineStyle { pixel, polygon, cylinder };
 
-/// A view-file command that Cambium reads but does not use yet, kept with its
-/// location so later stages can find it.
-struct ViewCommand {
-    std::string name;   ///< lower-case, without the colon: "contour", "tropism"...
-    std::string value;  ///< the text after the colon, comments removed
+/// `render mode:` or `shade mode:` (the last one given), as a path tracer draws it.
+struct RenderMode {
+    Shading shading = Shading::shaded;
+    /// cpfg's interpolated fill (`render mode: interpolated`, `shade mode: 2`): shaded
+    /// here, with colours blended along generalized cylinders and no lighting by
+    /// colour index (cpfg draws it unlit).
+    bool interpolated = false;
+};
+
+/// `contour: id file`: a contour (or, a Cambium extension, a gallery whose items take
+/// the ids id, id + 1, ...) read when the generalized cylinders are set up.
+struct ContourFile {
+    int id = 0;                  ///< 1.. (0 is the built-in circle)
+    std::filesystem::path file;  ///< as written (relative to the view file's folder)
     FileLoc loc;
+};
+
+/// The generalized cylinders' commands (manual 5.2.4).
+struct CylinderCommands {
+    /// `contour sides:` (3..max_contour_sides), or `polygonization level: n` as cpfg's
+    /// 2^(n+1) polygons around; the last one given.
+    int sides = 8;
+    static constexpr int max_contour_sides = 100000;
+    static constexpr int max_polygonization_level = 16;
+    bool keep_twist = false;  ///< `twist of cylinders: on`
+    std::vector<ContourFile> contours;
+};
+
+/// A view-file `surface: id file scale [s t] [tex]`, `line:` (the same) or
+/// `tsurface: id file scale` command.
+struct SurfaceCommand {
+    enum class Kind { bicubic, triangles };
+    Kind kind = Kind::bicubic;
+    char letter = 0;
+    std::filesystem::path file;  ///< as written (relative to the view file's folder)
+    double scale = 1;            ///< the view file's size for the surface
+    int s_steps = 0;             ///< 0: from the file's PRECISION line, else cpfg's default 5
+    int t_steps = 0;
+    /// The fixed texture: nullopt = the turtle's (`@Tx`), no_texture = none (tex 0),
+    /// else an index into Scene::textures (the file's `tex` minus 1).
+    std::optional<std::int16_t> texture;
+    FileLoc loc;
+};
+
+/// `function: file [samples]` or `function set: file`, in the view file's order (a set
+/// replaces the functions read before it, as cpfg's list restarts there).
+struct FunctionFile {
+    std::filesystem::path file;  ///< as written (relative to the view file's folder)
+    int samples = 0;             ///< 0: the function's own
+    bool is_set = false;         ///< `function set:`
+    FileLoc loc;
+};
+
+/// `curve: file [samples]`.
+struct CurveFile {
+    static constexpr int default_samples = 100;
+    static constexpr int max_samples = 1 << 20;
+    std::filesystem::path file;  ///< as written (relative to the view file's folder)
+    int samples = default_samples;  ///< 2..max_samples
+    FileLoc loc;
+};
+
+/// `background scene: list`: its files (separated by blanks, ',' or ';').
+struct BackgroundSceneFiles {
+    std::vector<std::filesystem::path> files;  ///< as written (relative to the view file's folder)
+    FileLoc loc;
+};
+
+/// cpfg's colormap-mode lighting (manual 5.2.5): how far a colour index moves with the
+/// cosine to the light, and the surface rule's weights.
+struct ColourIndexShading {
+    int diffuse_reflection = 10;    ///< `diffuse reflection:`, -255..255
+    float surface_ambient = 0.15f;  ///< `surface ambient:`
+    float surface_diffuse = 0.75f;  ///< `surface diffuse:`
+};
+
+/// `rayshade objects: format [turtle considered]`: how `-o` objects are keyed by their
+/// parameters (cpfg's rsReadViewCommand).
+struct ObjectKeying {
+    std::string format = "%g";  ///< a printf conversion of one float
+    bool turtle_considered = false;
 };
 
 /// Cambium extension `translucency: FIRST [LAST] AMOUNT`: colour indices FIRST..LAST
@@ -77,8 +155,25 @@ struct ViewFile {
     std::vector<Light> lights;     ///< `light:` commands, in order
     std::optional<Vec3> light_direction;  ///< colormap mode `light direction:`
 
-    /// Recognised commands whose meaning is implemented later (surfaces, tropisms...).
-    std::vector<ViewCommand> deferred;
+    // Drawing (5.2.3, 5.2.4)
+    RenderMode render_mode;
+    /// `interpretation past %:` (5.2.3): whether the turtle goes on after a cut in the
+    /// string (cpfg's default) or skips the rest of the cut branch.
+    bool interprets_past_cut = true;
+    CylinderCommands cylinders;
+    /// `surface:`, `line:` and `tsurface:` in order.
+    std::vector<SurfaceCommand> surfaces;
+    std::vector<FunctionFile> functions;
+    std::vector<CurveFile> curves;
+    std::vector<BackgroundSceneFiles> background_scenes;
+    /// The label font: the last `font:` (X font name -foundry-family-weight-slant-
+    /// setwidth-style-pixels-points-...: family, `bold`, slant `i`/`o`, pixels, else
+    /// points / 10) or `winfont:` (name, size in pixels, flags `b` `i`). Fields that
+    /// are `*` or missing keep cpfg's default, courier bold 12 pixels.
+    LabelFont font;
+    ColourIndexShading colour_index_shading;
+    double rayshade_scale = 1;  ///< `rayshade scale:`, > 0
+    ObjectKeying rayshade_objects;
 };
 
 /// Reads a view file. Unknown commands are a warning naming file and line (as in
@@ -90,8 +185,9 @@ ViewFile read_view_file(const std::filesystem::path& file);
 /// The same from text (tests); `file_name` is used in messages.
 ViewFile parse_view_file(std::string_view text, const std::string& file_name);
 
-/// The view file's `render mode:` or `shade mode:` (the last one given), as a path
-/// tracer draws it (geom::Shading).
-Shading render_mode(const ViewFile& view);
+/// The files the view file's commands name, textures aside (read_view_file makes those
+/// absolute): contours, surfaces, functions, curves and background scenes, as their
+/// readers find them (relative ones under the view file's folder), with their lines.
+std::vector<std::pair<std::filesystem::path, FileLoc>> named_files(const ViewFile& view);
 
 }  // namespace cambium::geom

@@ -460,17 +460,18 @@ py::dict view_settings(const geom::ViewFile& v)
         d["box"] = py::none();
     d["front_distance"] = v.view.front_distance ? py::cast(*v.view.front_distance) : py::none();
     d["back_distance"] = v.view.back_distance ? py::cast(*v.view.back_distance) : py::none();
-    const geom::Shading mode = geom::render_mode(v);
+    const geom::Shading mode = v.render_mode.shading;
     d["render_mode"] = mode == geom::Shading::shaded   ? "shaded"
                        : mode == geom::Shading::flat   ? "flat"
                        : mode == geom::Shading::filled ? "filled"
                                                        : "wireframe";
     d["lights"] = v.lights.size();
     d["textures"] = v.textures.size();
-    py::list others;
-    for (const geom::ViewCommand& c : v.deferred)
-        others.append(py::make_tuple(c.name, c.value));
-    d["other_commands"] = others;
+    d["contours"] = v.cylinders.contours.size();
+    d["surfaces"] = v.surfaces.size();
+    d["functions"] = v.functions.size();
+    d["curves"] = v.curves.size();
+    d["background_scenes"] = v.background_scenes.size();
     return d;
 }
 

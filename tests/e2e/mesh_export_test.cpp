@@ -131,7 +131,7 @@ TEST(MeshExport, ObjPlyAndGlsHoldTheTessellatedPlant)
 
     // GLS: the background scene's reader builds the same triangles with the same colours
     const geom::BackgroundScene gls = geom::read_background_scene(
-        "plant.gls", plant.folder, geom::Material{}, FileLoc{}, plant.folder);
+        std::vector<std::filesystem::path>{"plant.gls"}, plant.folder, geom::Material{}, FileLoc{}, plant.folder);
     ASSERT_EQ(gls.geometry.mesh.size(), mesh.size());
     for (std::size_t t = 0; t < mesh.size(); ++t)
         for (int k = 0; k < 3; ++k)

@@ -198,7 +198,7 @@ TEST(BackgroundSceneConformance, CorpusBackgroundsRead)
     if (!std::filesystem::exists(plant / "background.dat"))
         GTEST_SKIP() << "corpus not found";
     // background.dat uses `#define TR1 0.5` for the material's alphas: cpp must run.
-    BackgroundScene s = read_background_scene("background.dat", plant, Material{}, FileLoc{"plant.v", 14, 1}, std::nullopt);
+    BackgroundScene s = read_background_scene(std::vector<std::filesystem::path>{"background.dat"}, plant, Material{}, FileLoc{"plant.v", 14, 1}, std::nullopt);
     ASSERT_FALSE(s.materials.empty());
     EXPECT_FLOAT_EQ(s.materials[0].transparency, 0.5f);
     EXPECT_EQ(s.materials[0].diffuse, (Rgb{0.5f, 0.2f, 0.2f}));
@@ -219,7 +219,7 @@ TEST(BackgroundSceneConformance, CorpusBackgroundsRead)
     EXPECT_GE(s.geometry.lines.segment_count(), 2u);
 
     std::filesystem::path knot = root / "10-manuals/20-EnviroPgms/CPFG-CelticKnot/background.dat";
-    BackgroundScene k = read_background_scene(knot.string(), "/", Material{}, FileLoc{"viewfile.v", 1, 1}, std::nullopt);
+    BackgroundScene k = read_background_scene(std::span(&knot, 1), "/", Material{}, FileLoc{"viewfile.v", 1, 1}, std::nullopt);
     EXPECT_GT(k.geometry.lines.segment_count(), 0u);
 }
 
@@ -264,10 +264,10 @@ void in_folder(const std::filesystem::path& folder, Body body)
     std::filesystem::current_path(saved);
 }
 
-std::string error_of(const std::string& list, const std::filesystem::path& base)
+std::string error_of(const std::filesystem::path& file, const std::filesystem::path& base)
 {
     try {
-        read_background_scene(list, base, Material{}, FileLoc{"plant.v", 14, 1}, std::nullopt);
+        read_background_scene(std::span(&file, 1), base, Material{}, FileLoc{"plant.v", 14, 1}, std::nullopt);
     } catch (const Error& e) {
         return e.what();
     }
@@ -286,7 +286,7 @@ TEST(BackgroundScene, RelativeFileInTheCurrentFolderIsPreprocessed)
     std::filesystem::create_directories(dir);
     std::ofstream(dir / "bg.dat") << "#define R 0.25\nsphere R\n";
     in_folder(dir, [] {
-        BackgroundScene s = read_background_scene("bg.dat", "", Material{}, FileLoc{"plant.v", 1, 1}, std::nullopt);
+        BackgroundScene s = read_background_scene(std::vector<std::filesystem::path>{"bg.dat"}, "", Material{}, FileLoc{"plant.v", 1, 1}, std::nullopt);
         ASSERT_EQ(s.geometry.spheres.size(), 1u);
         EXPECT_EQ(s.geometry.spheres.centres[0], (Float4{0, 0, 0, 0.25f}));
     });
@@ -296,7 +296,7 @@ TEST(BackgroundScene, RelativeFileInTheCurrentFolderIsPreprocessed)
     if (!std::filesystem::exists(plant / "background.dat"))
         return;
     in_folder(plant, [] {
-        BackgroundScene s = read_background_scene("background.dat", "", Material{}, FileLoc{"plant.v", 14, 1}, std::nullopt);
+        BackgroundScene s = read_background_scene(std::vector<std::filesystem::path>{"background.dat"}, "", Material{}, FileLoc{"plant.v", 14, 1}, std::nullopt);
         // `sphere 0.5`, and `sphere 1.0` under `scale 2 1 1`: an ellipsoid, as cpfg draws it
         EXPECT_EQ(s.geometry.spheres.size(), 1u);
         EXPECT_GE(s.geometry.mesh.size(), 960u);

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <unistd.h>
 
+#include "geom/curve.h"
 #include "geom/function.h"
 #include "geom/view_file.h"
 #include "lsys/lsystem.h"
@@ -215,12 +216,11 @@ TEST(CurveSet, ViewCommandsGiveIdsFromOneAndSamples)
     std::filesystem::path dir = temp_dir("curve_test");
     std::ofstream(dir / "line.crv") << curve_text("bspline", "0 0 0 1\n1 0 0 1\n2 0 0 1\n3 0 0 1\n4 0 0 1\n", 5);
     std::ofstream(dir / "up.crv") << curve_text("bspline", "0 0 0 1\n0 1 0 1\n0 2 0 1\n0 3 0 1\n", 4);
-    std::vector<ViewCommand> commands = {
-        {"curve", " line.crv", FileLoc{"v.v", 1, 1}},
-        {"curve", " missing.crv", FileLoc{"v.v", 2, 1}},  // a warning; id 2 stays taken
-        {"curve", " up.crv 3", FileLoc{"v.v", 3, 1}},
-    };
-    CurveSet set = CurveSet::from_view_commands(commands, dir);
+    ViewFile view = parse_view_file("curve: line.crv\n"
+                                    "curve: missing.crv\n"  // a warning; id 2 stays taken
+                                    "curve: up.crv 3\n",
+                                    "v.v");
+    CurveSet set = CurveSet::from_view_commands(view.curves, dir);
     ASSERT_EQ(set.size(), 3u);
     EXPECT_NEAR(set.evaluate('x', 1, 0.5), 2, 1e-5);
     EXPECT_NEAR(set.evaluate('l', 1, 0), 2, 1e-5);
@@ -238,8 +238,8 @@ TEST(CurveSet, SamplesSetTheLengthTable)
     // polyline is longer), as cpfg's curveGAL does.
     std::filesystem::path dir = temp_dir("curve_test");
     std::ofstream(dir / "arc.crv") << curve_text("bspline", "0 0 0 3\n0 1 0 1\n1 1 0 3\n", 3);
-    CurveSet coarse = CurveSet::from_view_commands({{"curve", " arc.crv 3", FileLoc{}}}, dir);
-    CurveSet fine = CurveSet::from_view_commands({{"curve", " arc.crv 1000", FileLoc{}}}, dir);
+    CurveSet coarse = CurveSet::from_view_commands(parse_view_file("curve: arc.crv 3\n", "v.v").curves, dir);
+    CurveSet fine = CurveSet::from_view_commands(parse_view_file("curve: arc.crv 1000\n", "v.v").curves, dir);
     // Three samples: the chords from (0,0) to the middle point and on to (1,1).
     const SpaceCurve& c = fine.curve(1);
     Vec3 middle = c.at_parameter(0.5);

@@ -126,8 +126,8 @@ TEST(FunctionSet, ViewCommandsOrderIdsAndDefines)
         << "funcgalleryver 1 1\nitems: 2\n"
            "fver 1 1\nname: Width\nsamples: 0\nflip: off\npoints: 4\n0 5\n0.3 5\n0.6 5\n1 5\n"
            "fver 1 1\nname: turn\nsamples: 10\nflip: off\npoints: 4\n0 7\n0.3 7\n0.6 7\n1 7\n";
-    FileLoc loc{"v.v", 1, 1};
-    FunctionSet fs = FunctionSet::from_view_commands({{"function", " lin.func 20", loc}}, dir);
+    auto commands = [](const std::string& text) { return parse_view_file(text, "v.v").functions; };
+    FunctionSet fs = FunctionSet::from_view_commands(commands("function: lin.func 20\n"), dir);
     ASSERT_EQ(fs.size(), 1u);
     EXPECT_EQ(fs.function(1).samples(), 20);
     EXPECT_NEAR(fs.evaluate(1, 0.5), 2, 3e-3);
@@ -136,13 +136,13 @@ TEST(FunctionSet, ViewCommandsOrderIdsAndDefines)
     EXPECT_EQ(fs.evaluate(2, 0.5), 0);  // no such function
     set_warnings_enabled(true);
 
-    FunctionSet set = FunctionSet::from_view_commands(
-        {{"function", " lin.func", loc}, {"function set", " set.fset", loc}}, dir);
+    FunctionSet set =
+        FunctionSet::from_view_commands(commands("function: lin.func\nfunction set: set.fset\n"), dir);
     ASSERT_EQ(set.size(), 2u);  // the set replaces what came before
     EXPECT_NEAR(set.evaluate(1, 0.3), 5, 1e-9);
     EXPECT_NEAR(set.evaluate(2, 0.9), 7, 1e-9);
     EXPECT_EQ(set.define_names(), (std::vector<std::string>{"WIDTH=1", "TURN=2"}));
-    EXPECT_THROW(FunctionSet::from_view_commands({{"function", " missing.func", loc}}, dir), Error);
+    EXPECT_THROW(FunctionSet::from_view_commands(commands("function: missing.func\n"), dir), Error);
     std::filesystem::remove_all(dir);
 }
 

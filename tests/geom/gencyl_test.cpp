@@ -616,18 +616,20 @@ TEST(GencylHostileNumbers, ParametersNoIntHoldsAreIgnoredOrClampedWithAMessage)
     EXPECT_EQ(scene.geometry.curves.segment_count(), 1u);
 }
 
-TEST(GencylHostileNumbers, ViewFileCountsBeyondTheirRangeAreClamped)
+TEST(GencylHostileNumbers, ViewFileCountsBeyondTheirRangeAreErrors)
 {
-    testing::internal::CaptureStderr();
-    std::filesystem::path dir = temp_dir("gc_test");
-    ViewFile view = parse_view_file("contour sides: 1e30\npolygonization level: -1e30\n", (dir / "t.v").string());
-    CylinderSettings s = cylinder_settings(view);
-    std::string err = testing::internal::GetCapturedStderr();
-    EXPECT_EQ(s.sides, 4);  // the level's 2^(1 + 1) came last
-    EXPECT_NE(err.find("t.v:1:1: warning: 'contour sides:' must be 3 to 100000; clamped"), std::string::npos)
-        << err;
-    EXPECT_NE(err.find("t.v:2:1: warning: 'polygonization level:' must be 1 to 16; clamped"), std::string::npos)
-        << err;
+    try {
+        parse_view_file("contour sides: 1e30\npolygonization level: -1e30\n", "t.v");
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        std::string err = e.what();
+        EXPECT_NE(err.find("t.v:1:16: error: contour sides must be a whole number from 3 to 100000"),
+                  std::string::npos)
+            << err;
+        EXPECT_NE(err.find("t.v:2:23: error: polygonization level must be a whole number from 1 to 16"),
+                  std::string::npos)
+            << err;
+    }
 }
 
 TEST(GencylHostileNumbers, OversizedMeshSegmentsGetFewerStrips)

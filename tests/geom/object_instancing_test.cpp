@@ -235,17 +235,16 @@ endlsystem
 
 TEST(ObjectInstancing, RayshadeObjectsCommandIsReadAsCpfgDoes)
 {
-    ObjectKeying k = object_keying(parse_view_file("rayshade objects: %.3f turtle considered\n", "t.v"));
+    ObjectKeying k = parse_view_file("rayshade objects: %.3f turtle considered\n", "t.v").rayshade_objects;
     EXPECT_EQ(k.format, "%.3f");
     EXPECT_TRUE(k.turtle_considered);
-    k = object_keying(parse_view_file("rayshade objects: %lg turtle\n", "t.v"));
+    k = parse_view_file("rayshade objects: %lg turtle\n", "t.v").rayshade_objects;
     EXPECT_EQ(k.format, "%lg");
     EXPECT_FALSE(k.turtle_considered);
-    // not a conversion of one number: never handed to printf
-    EXPECT_EQ(object_keying(parse_view_file("rayshade objects: %s\n", "t.v")).format, "%g");
-    EXPECT_EQ(object_keying(parse_view_file("rayshade objects: %g%n\n", "t.v")).format, "%g");
-    EXPECT_EQ(object_keying(parse_view_file("rayshade objects: %123f\n", "t.v")).format, "%g");
-    EXPECT_EQ(object_keying(parse_view_file("", "t.v")).format, "%g");
+    EXPECT_EQ(parse_view_file("", "t.v").rayshade_objects.format, "%g");
+    // not a conversion of one number: an error, never handed to printf
+    for (const char* format : {"%s", "%g%n", "%123f"})
+        EXPECT_THROW(parse_view_file(std::string("rayshade objects: ") + format + "\n", "t.v"), Error) << format;
 }
 
 TEST(ObjectInstancing, ObjectsBreakTheLineChainCleanly)

@@ -145,10 +145,11 @@ TEST(RayshadeExport, PerspectiveViewAndLightsAsCpfgWritesThem)
 
 TEST(RayshadeExport, RayshadeScaleIsReadAndBadValuesAreErrors)
 {
-    EXPECT_EQ(rayshade_scale(parse_view_file("rayshade scale: 2.5\n", "t.v")), 2.5);
-    EXPECT_EQ(rayshade_scale(parse_view_file("", "t.v")), 1.0);
+    EXPECT_EQ(parse_view_file("rayshade scale: 2.5\n", "t.v").rayshade_scale, 2.5);
+    EXPECT_EQ(parse_view_file("", "t.v").rayshade_scale, 1.0);
     set_warnings_enabled(false);
-    EXPECT_THROW(rayshade_scale(parse_view_file("rayshade scale: big\n", "t.v")), Error);
+    EXPECT_THROW(parse_view_file("rayshade scale: big\n", "t.v"), Error);
+    EXPECT_THROW(parse_view_file("rayshade scale: 0\n", "t.v"), Error);
     set_warnings_enabled(true);
     RayshadeOptions options;
     options.object_name = "p.ray";

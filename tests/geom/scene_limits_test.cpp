@@ -224,7 +224,7 @@ TEST(HostileParameters, FunctionsAndCurvesOfNotANumber)
     std::filesystem::path dir = std::filesystem::temp_directory_path() / "cambium_limits_test";
     std::filesystem::create_directories(dir);
     std::ofstream(dir / "flat.func") << "fver 1 1\nname: flat\nsamples: 0\nflip: off\npoints: 4\n0 5\n0.3 5\n0.6 5\n1 5\n";
-    FunctionSet functions = FunctionSet::from_view_commands({{"function", " flat.func", FileLoc{"v.v", 1, 1}}}, dir);
+    FunctionSet functions = FunctionSet::from_view_commands(parse_view_file("function: flat.func\n", "v.v").functions, dir);
     testing::internal::CaptureStderr();
     EXPECT_NEAR(functions.evaluate(1, std::nan("")), 5, 1e-9);
     std::string err = testing::internal::GetCapturedStderr();

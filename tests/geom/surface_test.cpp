@@ -175,42 +175,47 @@ TEST(Surface, MismatchedNeighboursWarnAndKeepOwnNormals)
     expect_near(v3(mesh.normals[2]), {0, 0, 1}, 1e-6);  // A's vertex s = 0, t = 1 on the seam
 }
 
+/// The one surface a view-file line defines.
+SurfaceCommand view_surface(const std::string& line)
+{
+    return parse_view_file(line + "\n", "p.v").surfaces.at(0);
+}
+
 TEST(Surface, CommandParsing)
 {
-    ViewCommand vc{"surface", " l leaf.s 1.5 8 4", FileLoc{"p.v", 3, 1}};
-    SurfaceCommand c = parse_surface_command(vc);
+    SurfaceCommand c = view_surface("surface: l leaf.s 1.5 8 4");
     EXPECT_EQ(c.letter, 'l');
     EXPECT_EQ(c.file, "leaf.s");
     EXPECT_DOUBLE_EQ(c.scale, 1.5);
     EXPECT_EQ(c.s_steps, 8);
     EXPECT_EQ(c.t_steps, 4);
     EXPECT_FALSE(c.texture.has_value());
-    c = parse_surface_command({"surface", " l leaf.s 1 3", FileLoc{"p.v", 3, 1}});
+    c = view_surface("surface: l leaf.s 1 3");
     ASSERT_TRUE(c.texture.has_value());
     EXPECT_EQ(*c.texture, 2);  // tex 3 is Scene::textures[2]
-    c = parse_surface_command({"surface", " l leaf.s 1 2 2 0", FileLoc{"p.v", 3, 1}});
+    c = view_surface("surface: l leaf.s 1 2 2 0");
     EXPECT_EQ(*c.texture, no_texture);
-    c = parse_surface_command({"tsurface", " t tri.ray 2", FileLoc{"p.v", 3, 1}});
+    c = view_surface("tsurface: t tri.ray 2");
     EXPECT_EQ(c.kind, SurfaceCommand::Kind::triangles);
-    EXPECT_THROW(parse_surface_command({"surface", " lx leaf.s 1", FileLoc{"p.v", 3, 1}}), Error);
-    EXPECT_THROW(parse_surface_command({"surface", " l leaf.s", FileLoc{"p.v", 3, 1}}), Error);
+    EXPECT_THROW(view_surface("surface: lx leaf.s 1"), Error);
+    EXPECT_THROW(view_surface("surface: l leaf.s"), Error);
 }
 
 TEST(Surface, LineCommandDefinesASurface)
 {
     // `line: id file size [s t [tex]]` is read as `surface:` (cpfg's read_surface) but a
     // lone number after the size is not a texture there.
-    SurfaceCommand c = parse_surface_command({"line", " L line.s .01", FileLoc{"p.v", 3, 1}});
+    SurfaceCommand c = view_surface("line: L line.s .01");
     EXPECT_EQ(c.kind, SurfaceCommand::Kind::bicubic);
     EXPECT_EQ(c.letter, 'L');
     EXPECT_EQ(c.file, "line.s");
     EXPECT_DOUBLE_EQ(c.scale, 0.01);
     set_warnings_enabled(false);
-    c = parse_surface_command({"line", " L line.s 1 3", FileLoc{"p.v", 3, 1}});
+    c = view_surface("line: L line.s 1 3");
     set_warnings_enabled(true);
     EXPECT_FALSE(c.texture.has_value());
     EXPECT_EQ(c.s_steps, 0);
-    c = parse_surface_command({"line", " L line.s 1 2 4 3", FileLoc{"p.v", 3, 1}});
+    c = view_surface("line: L line.s 1 2 4 3");
     EXPECT_EQ(c.s_steps, 2);
     EXPECT_EQ(c.t_steps, 4);
     ASSERT_TRUE(c.texture.has_value());

@@ -121,12 +121,15 @@ TEST(ViewFile, UnknownCommandIsNotAnError)
     EXPECT_DOUBLE_EQ(v.angle_increment_deg, 90);
 }
 
-TEST(ViewFile, DeferredCommandsAreKept)
+TEST(ViewFile, ContourCommandsKeepIdFileAndPlace)
 {
-    ViewFile v = parse_view_file("contour: 1 stripe.con\n", "a.v");
-    ASSERT_EQ(v.deferred.size(), 1u);
-    EXPECT_EQ(v.deferred[0].name, "contour");
-    EXPECT_EQ(v.deferred[0].loc.line, 1);
+    ViewFile v = parse_view_file("contour sides: 12\ncontour: 2 Stripe.con\n", "a.v");
+    EXPECT_EQ(v.cylinders.sides, 12);
+    ASSERT_EQ(v.cylinders.contours.size(), 1u);
+    EXPECT_EQ(v.cylinders.contours[0].id, 2);
+    EXPECT_EQ(v.cylinders.contours[0].file, "Stripe.con");  // case kept
+    EXPECT_EQ(v.cylinders.contours[0].loc.line, 2);
+    EXPECT_EQ(parse_view_file("polygonization level: 3\n", "a.v").cylinders.sides, 16);
 }
 
 TEST(ViewFile, TropismsAndTorquesInOrder)
@@ -246,20 +249,83 @@ TEST(ViewFileRanges, CameraAndLightValuesBeyondTheLimitAreErrorsAtTheirColumn)
 
 TEST(LabelFont, XFontNamesAndWinfontGiveFamilySizeAndStyle)
 {
-    LabelFont d = label_font(parse_view_file("", "t.v"));
+    LabelFont d = parse_view_file("", "t.v").font;
     EXPECT_EQ(d.family, "courier");  // cpfg's default: -*-courier-bold-r-*-12-*
     EXPECT_EQ(d.pixel_size, 12);
     EXPECT_TRUE(d.bold);
-    LabelFont x = label_font(parse_view_file("font: -adobe-helvetica-medium-o-normal-*-24-*-*-*-*-*-*-*\n", "t.v"));
+    LabelFont x = parse_view_file("font: -adobe-helvetica-medium-o-normal-*-24-*-*-*-*-*-*-*\n", "t.v").font;
     EXPECT_EQ(x.family, "helvetica");
     EXPECT_EQ(x.pixel_size, 24);
     EXPECT_FALSE(x.bold);
     EXPECT_TRUE(x.italic);
-    LabelFont points = label_font(parse_view_file("font: -*-times-bold-r-*-*-*-140-*-*-*-*-*-*\n", "t.v"));
+    LabelFont points = parse_view_file("font: -*-times-bold-r-*-*-*-140-*-*-*-*-*-*\n", "t.v").font;
     EXPECT_EQ(points.pixel_size, 14);  // decipoints
-    LabelFont w = label_font(parse_view_file("winfont: \"Times New Roman\" 18 Ib\n", "t.v"));
+    LabelFont w = parse_view_file("winfont: \"Times New Roman\" 18 Ib\n", "t.v").font;
     EXPECT_EQ(w.family, "Times New Roman");
     EXPECT_EQ(w.pixel_size, 18);
     EXPECT_TRUE(w.bold);
     EXPECT_TRUE(w.italic);
+}
+
+namespace {
+
+/// The message of the error a one-line view file gives ("" when it reads).
+std::string error_of(const std::string& line)
+{
+    try {
+        parse_view_file(line + "\n", "t.v");
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "";
+}
+
+}  // namespace
+
+TEST(ViewFile, RenderAndShadeModesAreTyped)
+{
+    auto mode = [](const char* text) { return parse_view_file(text, "t.v").render_mode; };
+    EXPECT_EQ(mode("").shading, Shading::shaded);
+    EXPECT_EQ(mode("render mode: fast\n").shading, Shading::filled);
+    EXPECT_EQ(mode("render mode: flat\n").shading, Shading::flat);
+    EXPECT_EQ(mode("render mode: shadows\n").shading, Shading::shaded);
+    EXPECT_TRUE(mode("render mode: interpolated\n").interpolated);
+    EXPECT_EQ(mode("shade mode: 7\n").shading, Shading::wireframe);
+    EXPECT_TRUE(mode("render mode: wireframe\nshade mode: 2\n").interpolated);  // the last wins
+    EXPECT_EQ(mode("shade mode: 2\nrender mode: wireframe\n").shading, Shading::wireframe);
+}
+
+TEST(ViewFile, DrawingCommandsWithBadValuesAreErrorsAtTheirColumn)
+{
+    EXPECT_NE(error_of("render mode: glossy").find("t.v:1:14: error: expected 'fast'"), std::string::npos);
+    EXPECT_NE(error_of("shade mode: 9").find("t.v:1:13: error: shade mode must be"), std::string::npos);
+    EXPECT_NE(error_of("interpretation past %: maybe").find("t.v:1:24: error: expected 'on' or 'off'"),
+              std::string::npos);
+    EXPECT_NE(error_of("twist of cylinders: yes").find("t.v:1:21:"), std::string::npos);
+    EXPECT_NE(error_of("contour: 0 leaf.con").find("t.v:1:10: error: a contour id"), std::string::npos);
+    EXPECT_NE(error_of("contour: 1").find("t.v:1:"), std::string::npos);
+    EXPECT_NE(error_of("curve: c.crv 1").find("t.v:1:14: error: curve samples"), std::string::npos);
+    EXPECT_NE(error_of("diffuse reflection: much").find("t.v:1:21: error: diffuse reflection: expected a number"),
+              std::string::npos);
+    EXPECT_NE(error_of("font:").find("t.v:1:"), std::string::npos);
+    EXPECT_EQ(error_of("z buffer: on"), "");  // cpfg's window alone: no effect, no error
+}
+
+TEST(ViewFile, FileCommandsKeepTheirFilesInOrder)
+{
+    ViewFile v = parse_view_file("function: a.func 20\nfunction set: b.fset\ncurve: c.crv 3\n"
+                                 "background scene: one.dat, two.dat;three.dat\n"
+                                 "interpretation past %: off\ndiffuse reflection: 300\n",
+                                 "t.v");
+    ASSERT_EQ(v.functions.size(), 2u);
+    EXPECT_EQ(v.functions[0].samples, 20);
+    EXPECT_TRUE(v.functions[1].is_set);
+    ASSERT_EQ(v.curves.size(), 1u);
+    EXPECT_EQ(v.curves[0].samples, 3);
+    ASSERT_EQ(v.background_scenes.size(), 1u);
+    EXPECT_EQ(v.background_scenes[0].files,
+              (std::vector<std::filesystem::path>{"one.dat", "two.dat", "three.dat"}));
+    EXPECT_FALSE(v.interprets_past_cut);
+    EXPECT_EQ(v.colour_index_shading.diffuse_reflection, 255);  // beyond the colour indices
+    EXPECT_EQ(named_files(v).size(), 6u);  // two functions, a curve, three scenes
 }
