@@ -289,13 +289,7 @@ void write_light_report(const geom::Scene& scene, const Options& options,
 int run_scene(Options options, const std::function<void(const std::string&)>& say,
               Clock::time_point command_start, Mpi* mpi)
 {
-    if (options.shot.animate)
-        throw Error("-a animates one L-system; a scene file has no animation (try --turntable)");
-    if (options.string_text || options.string_binary)
-        throw Error("-str and -strb write one L-system's string; not with a scene file");
-    if (!options.colour_files.empty())
-        throw Error("-m and -M name one model's colours; each plant of a scene names its own "
-                    "in its command");
+    refuse_single_model_options(options);
     SceneFile file = read_scene_file(*options.scene, options);
     apply_scene_settings(file, options);
     if (options.steps)  // --steps derives every plant that many steps

@@ -665,6 +665,17 @@ std::string nested_message(const std::exception& e)
     return text.starts_with("error: ") ? text.substr(7) : text;
 }
 
+void refuse_single_model_options(const Options& options)
+{
+    if (options.shot.animate)
+        throw Error("-a animates one L-system; a scene file has no animation (try --turntable)");
+    if (options.string_text || options.string_binary)
+        throw Error("-str and -strb write one L-system's string; not with a scene file");
+    if (!options.colour_files.empty())
+        throw Error("-m and -M name one model's colours; each plant of a scene names its own "
+                    "in its command");
+}
+
 SceneFile read_scene_file(const fs::path& file, const Options& options, const SceneLimits& limits)
 {
     const std::string name = file.string();

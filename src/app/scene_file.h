@@ -127,6 +127,10 @@ struct SceneFile {
 SceneFile read_scene_file(const std::filesystem::path& file, const Options& options,
                           const SceneLimits& limits = {});
 
+/// Refuses the options that belong to one L-system, not to a scene file of many plants
+/// (-a, -str and -strb, -m and -M), with the command's messages. Throws cambium::Error.
+void refuse_single_model_options(const Options& options);
+
 /// The placements of a scatter: deterministic for its seed; up to `count` points at
 /// least `min_spacing` apart (rejection sampling; fewer when the area is full, with a
 /// warning), each turned about +y by a random angle when rotate_y and scaled uniformly

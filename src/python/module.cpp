@@ -573,6 +573,7 @@ SceneObject load_scene(const py::object& file, const py::object& progress,
     o.options = o.options_with(py::dict());
     if (!o.options.scene)
         throw Error(o.files[0] + ": a scene file is a .json file (docs/scenes.md)");
+    app::refuse_single_model_options(o.options);
     run_released(
         [&](std::atomic<bool>&, Events& events) {
             events.push("load");

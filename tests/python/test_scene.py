@@ -83,3 +83,17 @@ def test_a_scenes_sequence_errors(field):
     with pytest.raises(cambium.Error, match="keyword 'video'"):
         scene.turntable(3, video=True)
     assert not list(field.glob("*.mp4")) and not (field / "light.json").exists()
+
+
+def test_one_models_options_are_refused_with_a_scene_as_by_the_command(field, command):
+    for keywords, flags in [({"colormap": "plant.map"}, ["-m", "plant.map"]),
+                            ({"materials": "plant.mat"}, ["-M", "plant.mat"]),
+                            ({"animate": True}, ["-a"])]:
+        run = subprocess.run([command, "-q", *flags, "field.json", "-o", "cmd.png"],
+                             capture_output=True, text=True)
+        assert run.returncode != 0
+        message = run.stderr.strip().removeprefix("cambium: error: ")
+        with pytest.raises(cambium.Error) as caught:
+            cambium.load_scene("field.json", **keywords)
+        assert message and str(caught.value).endswith(message)
+    assert not (field / "cmd.png").exists()
